@@ -1,0 +1,235 @@
+//! Primitives placed in a frame: everything the narrow phase needs, with rotations applied.
+
+use crate::bounds::Bounds;
+use crate::cores::Core;
+use crate::math::{Pose, Rot, Vec2};
+use crate::shape::{MAX_POLYGON_VERTICES, Primitive, Shape};
+
+/// A circle in a frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlacedCircle {
+    /// Centre.
+    pub center: Vec2,
+    /// Radius.
+    pub radius: f64,
+}
+
+/// An axis-aligned box in a frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlacedAabb {
+    /// Centre.
+    pub center: Vec2,
+    /// Half width and half height.
+    pub half: Vec2,
+}
+
+/// An oriented box in a frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlacedObb {
+    /// Centre.
+    pub center: Vec2,
+    /// The box's rotation (body angle plus its own).
+    pub rot: Rot,
+    /// Half width and half height along the box's own axes.
+    pub half: Vec2,
+}
+
+/// A capsule in a frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlacedCapsule {
+    /// First end of the core segment.
+    pub a: Vec2,
+    /// Second end of the core segment.
+    pub b: Vec2,
+    /// Radius.
+    pub radius: f64,
+}
+
+/// A convex polygon in a frame, with its outward unit edge normals.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlacedPolygon {
+    /// Vertices, counter-clockwise; only the first `count` are used.
+    pub vertices: [Vec2; MAX_POLYGON_VERTICES],
+    /// `normals[i]` is the outward unit normal of the edge `vertices[i]`–`vertices[i + 1]`.
+    pub normals: [Vec2; MAX_POLYGON_VERTICES],
+    /// How many vertices.
+    pub count: usize,
+}
+
+/// A primitive placed in a frame (world coordinates, or coordinates relative to an origin).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[expect(
+    clippy::large_enum_variant,
+    reason = "placed primitives live briefly on the stack; boxing a polygon would allocate in the narrow phase"
+)]
+pub enum PlacedPrimitive {
+    /// A placed circle.
+    Circle(PlacedCircle),
+    /// A placed axis-aligned box.
+    Aabb(PlacedAabb),
+    /// A placed oriented box.
+    Obb(PlacedObb),
+    /// A placed capsule.
+    Capsule(PlacedCapsule),
+    /// A placed polygon.
+    Polygon(PlacedPolygon),
+}
+
+/// Places `primitive` at `pose`, in a frame whose origin is the world point `origin`.
+///
+/// Passing the position of one body of a pair as `origin` keeps every coordinate small, so a
+/// pair far from the world origin is computed as accurately as the same pair near it.
+#[must_use]
+pub fn place(primitive: &Primitive, pose: &Pose, origin: Vec2) -> PlacedPrimitive {
+    place_with(
+        primitive,
+        pose.position - origin,
+        Rot::from_angle(pose.angle),
+        pose.angle,
+    )
+}
+
+/// [`place`] with the body rotation already computed.
+#[must_use]
+pub(crate) fn place_with(
+    primitive: &Primitive,
+    position: Vec2,
+    rot: Rot,
+    angle: f64,
+) -> PlacedPrimitive {
+    match primitive {
+        Primitive::Circle(c) => PlacedPrimitive::Circle(PlacedCircle {
+            center: position + rot.apply(c.center),
+            radius: c.radius,
+        }),
+        Primitive::Aabb(b) => PlacedPrimitive::Aabb(PlacedAabb {
+            center: position + rot.apply(b.center),
+            half: b.half_extents,
+        }),
+        Primitive::Obb(b) => PlacedPrimitive::Obb(PlacedObb {
+            center: position + rot.apply(b.center),
+            rot: if b.angle == 0.0 {
+                rot
+            } else {
+                Rot::from_angle(angle + b.angle)
+            },
+            half: b.half_extents,
+        }),
+        Primitive::Capsule(c) => PlacedPrimitive::Capsule(PlacedCapsule {
+            a: position + rot.apply(c.a),
+            b: position + rot.apply(c.b),
+            radius: c.radius,
+        }),
+        Primitive::Polygon(p) => {
+            let local = p.vertices();
+            let mut vertices = [Vec2::ZERO; MAX_POLYGON_VERTICES];
+            for (out, v) in vertices.iter_mut().zip(local) {
+                *out = position + rot.apply(*v);
+            }
+            // Normals are the local ones, rotated: rotating a unit vector keeps it unit and is
+            // more accurate than normalising a difference of large coordinates.
+            let mut normals = [Vec2::ZERO; MAX_POLYGON_VERTICES];
+            let n = local.len();
+            for (out, u) in normals.iter_mut().zip(p.normals()) {
+                *out = rot.apply(*u);
+            }
+            PlacedPrimitive::Polygon(PlacedPolygon {
+                vertices,
+                normals,
+                count: n,
+            })
+        }
+    }
+}
+
+impl PlacedPrimitive {
+    /// The bounding box in this frame.
+    #[must_use]
+    pub fn bounds(&self) -> Bounds {
+        match self {
+            PlacedPrimitive::Circle(c) => Bounds::around(c.center, Vec2::splat(c.radius)),
+            PlacedPrimitive::Aabb(b) => Bounds::around(b.center, b.half),
+            PlacedPrimitive::Obb(b) => {
+                let ux = Vec2::new(b.rot.c, b.rot.s);
+                let uy = Vec2::new(-b.rot.s, b.rot.c);
+                let h = ux.abs() * b.half.x + uy.abs() * b.half.y;
+                Bounds::around(b.center, h)
+            }
+            PlacedPrimitive::Capsule(c) => {
+                let r = Vec2::splat(c.radius);
+                Bounds {
+                    min: c.a.min(c.b) - r,
+                    max: c.a.max(c.b) + r,
+                }
+            }
+            PlacedPrimitive::Polygon(p) => Bounds::of_points(&p.vertices[..p.count]),
+        }
+    }
+
+    /// The shape as a convex core swept by a radius, for the general algorithm
+    /// ([`crate::pairs::collide_cores`]).
+    #[must_use]
+    pub fn core(&self) -> Core {
+        match self {
+            PlacedPrimitive::Circle(c) => c.core(),
+            PlacedPrimitive::Aabb(b) => b.core(),
+            PlacedPrimitive::Obb(b) => b.core(),
+            PlacedPrimitive::Capsule(c) => c.core(),
+            PlacedPrimitive::Polygon(p) => p.core(),
+        }
+    }
+}
+
+impl PlacedCircle {
+    pub(crate) fn core(&self) -> Core {
+        Core::point(self.center, self.radius)
+    }
+}
+
+impl PlacedAabb {
+    pub(crate) fn core(&self) -> Core {
+        Core::quad(self.center, Vec2::X, Vec2::Y, self.half)
+    }
+}
+
+impl PlacedObb {
+    pub(crate) fn core(&self) -> Core {
+        let ux = Vec2::new(self.rot.c, self.rot.s);
+        let uy = Vec2::new(-self.rot.s, self.rot.c);
+        Core::quad(self.center, ux, uy, self.half)
+    }
+}
+
+impl PlacedCapsule {
+    pub(crate) fn core(&self) -> Core {
+        Core::segment(self.a, self.b, self.radius)
+    }
+}
+
+impl PlacedPolygon {
+    pub(crate) fn core(&self) -> Core {
+        Core {
+            points: self.vertices,
+            normals: self.normals,
+            count: self.count,
+            radius: 0.0,
+        }
+    }
+}
+
+impl Shape {
+    /// The world bounding box of this shape at `pose`.
+    #[must_use]
+    pub fn bounds(&self, pose: &Pose) -> Bounds {
+        let rot = self.rotation(pose.angle);
+        let mut prims = self.primitives().iter();
+        let first = prims
+            .next()
+            .map(|p| place_with(p, pose.position, rot, pose.angle));
+        let mut b = first.map_or(Bounds::around(pose.position, Vec2::ZERO), |p| p.bounds());
+        for p in prims {
+            b = b.union(place_with(p, pose.position, rot, pose.angle).bounds());
+        }
+        b
+    }
+}

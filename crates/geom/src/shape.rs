@@ -1,0 +1,407 @@
+//! The shapes a body can carry, in local coordinates, validated on construction.
+
+use crate::math::{Vec2, cross};
+
+/// The most vertices a polygon may have (Box2D's limit too). Fixed so that a polygon is `Copy`
+/// and the narrow phase never allocates.
+pub const MAX_POLYGON_VERTICES: usize = 8;
+
+/// Why a shape description was rejected. `field` is the path of the offending value, relative
+/// to the shape (for example `vertices[2]` or `parts[1].radius`).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{field}: {problem}")]
+pub struct ShapeError {
+    /// Path of the offending field inside the shape description.
+    pub field: String,
+    /// What is wrong and what was expected.
+    pub problem: String,
+}
+
+impl ShapeError {
+    pub(crate) fn new(field: impl Into<String>, problem: impl Into<String>) -> ShapeError {
+        ShapeError {
+            field: field.into(),
+            problem: problem.into(),
+        }
+    }
+
+    /// The same error with `prefix.` in front of its field path.
+    #[must_use]
+    pub fn within(mut self, prefix: &str) -> ShapeError {
+        self.field = if self.field.is_empty() {
+            prefix.to_owned()
+        } else {
+            format!("{prefix}.{}", self.field)
+        };
+        self
+    }
+}
+
+fn finite(field: &str, v: f64) -> Result<f64, ShapeError> {
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(ShapeError::new(
+            field,
+            format!("must be a finite number, got {v}"),
+        ))
+    }
+}
+
+fn finite_vec(field: &str, v: Vec2) -> Result<Vec2, ShapeError> {
+    finite(&format!("{field}[0]"), v.x)?;
+    finite(&format!("{field}[1]"), v.y)?;
+    Ok(v)
+}
+
+fn positive(field: &str, v: f64) -> Result<f64, ShapeError> {
+    finite(field, v)?;
+    if v > 0.0 {
+        Ok(v)
+    } else {
+        Err(ShapeError::new(
+            field,
+            format!("must be greater than 0, got {v}"),
+        ))
+    }
+}
+
+/// A disc of `radius` around `center`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Circle {
+    /// Local offset of the centre from the body origin.
+    pub center: Vec2,
+    /// Radius, `> 0`.
+    pub radius: f64,
+}
+
+/// An axis-aligned box: it ignores the body's rotation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Aabb {
+    /// Local offset of the centre (turned by the body's angle; the box itself is not).
+    pub center: Vec2,
+    /// Half width and half height, both `> 0`.
+    pub half_extents: Vec2,
+}
+
+/// An oriented box: turned by the body's angle plus its own.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Obb {
+    /// Local offset of the centre from the body origin.
+    pub center: Vec2,
+    /// Half width and half height, both `> 0`.
+    pub half_extents: Vec2,
+    /// The box's own angle relative to the body, radians counter-clockwise.
+    pub angle: f64,
+}
+
+/// A segment `a`–`b` swept by `radius`. A zero-length segment is a circle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Capsule {
+    /// First end of the core segment, local coordinates.
+    pub a: Vec2,
+    /// Second end of the core segment, local coordinates.
+    pub b: Vec2,
+    /// Radius, `> 0`.
+    pub radius: f64,
+}
+
+/// A convex, counter-clockwise polygon of 3 to [`MAX_POLYGON_VERTICES`] vertices.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Polygon {
+    vertices: [Vec2; MAX_POLYGON_VERTICES],
+    /// Outward unit normal of each edge `i`–`i + 1`, computed once here rather than per query.
+    normals: [Vec2; MAX_POLYGON_VERTICES],
+    count: usize,
+}
+
+impl Polygon {
+    /// Validates `vertices` (local coordinates, already including any centre offset): 3 to
+    /// [`MAX_POLYGON_VERTICES`] finite points, counter-clockwise, strictly convex, no repeated
+    /// vertex.
+    pub fn new(vertices: &[Vec2]) -> Result<Polygon, ShapeError> {
+        let n = vertices.len();
+        if !(3..=MAX_POLYGON_VERTICES).contains(&n) {
+            return Err(ShapeError::new(
+                "vertices",
+                format!("a polygon needs 3 to {MAX_POLYGON_VERTICES} vertices, got {n}"),
+            ));
+        }
+        for (i, v) in vertices.iter().enumerate() {
+            finite_vec(&format!("vertices[{i}]"), *v)?;
+        }
+        let mut twice_area = 0.0;
+        for i in 0..n {
+            twice_area += cross(vertices[i], vertices[(i + 1) % n]);
+        }
+        if twice_area <= 0.0 {
+            return Err(ShapeError::new(
+                "vertices",
+                format!(
+                    "polygon is clockwise or flat (signed area {}); list the vertices counter-clockwise",
+                    twice_area / 2.0
+                ),
+            ));
+        }
+        for i in 0..n {
+            let p = vertices[i];
+            let q = vertices[(i + 1) % n];
+            let r = vertices[(i + 2) % n];
+            if p == q {
+                return Err(ShapeError::new(
+                    format!("vertices[{}]", (i + 1) % n),
+                    "repeats the previous vertex",
+                ));
+            }
+            if cross(q - p, r - q) <= 0.0 {
+                return Err(ShapeError::new(
+                    format!("vertices[{}]", (i + 1) % n),
+                    "polygon is not convex here (the boundary turns clockwise or goes straight); \
+                     a polygon must be convex and counter-clockwise",
+                ));
+            }
+        }
+        let mut out = [Vec2::ZERO; MAX_POLYGON_VERTICES];
+        out[..n].copy_from_slice(vertices);
+        let mut normals = [Vec2::ZERO; MAX_POLYGON_VERTICES];
+        for i in 0..n {
+            let e = vertices[(i + 1) % n] - vertices[i];
+            normals[i] = Vec2::new(e.y, -e.x).normalize();
+        }
+        Ok(Polygon {
+            vertices: out,
+            normals,
+            count: n,
+        })
+    }
+
+    /// The outward unit edge normals, local coordinates: `normals()[i]` belongs to the edge
+    /// from vertex `i` to vertex `i + 1`.
+    #[must_use]
+    pub fn normals(&self) -> &[Vec2] {
+        &self.normals[..self.count]
+    }
+
+    /// The vertices, counter-clockwise, in local coordinates.
+    #[must_use]
+    pub fn vertices(&self) -> &[Vec2] {
+        &self.vertices[..self.count]
+    }
+}
+
+/// One convex piece: every shape kind except a compound.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[expect(
+    clippy::large_enum_variant,
+    reason = "polygons are stored inline (272 bytes) so a primitive is Copy and the narrow phase never chases a pointer"
+)]
+pub enum Primitive {
+    /// A disc.
+    Circle(Circle),
+    /// An axis-aligned box.
+    Aabb(Aabb),
+    /// An oriented box.
+    Obb(Obb),
+    /// A swept segment.
+    Capsule(Capsule),
+    /// A convex polygon.
+    Polygon(Polygon),
+}
+
+/// Several primitives carried by one body, each with its own local offset: the "list of
+/// geometries" that lets one body follow a concave outline.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Compound {
+    parts: Vec<Primitive>,
+}
+
+impl Compound {
+    /// A compound of at least one part.
+    pub fn new(parts: Vec<Primitive>) -> Result<Compound, ShapeError> {
+        if parts.is_empty() {
+            return Err(ShapeError::new(
+                "parts",
+                "a compound needs at least one part",
+            ));
+        }
+        Ok(Compound { parts })
+    }
+
+    /// The parts, in the order given.
+    #[must_use]
+    pub fn parts(&self) -> &[Primitive] {
+        &self.parts
+    }
+}
+
+/// A collision shape in local coordinates.
+#[derive(Clone, Debug, PartialEq)]
+#[expect(
+    clippy::large_enum_variant,
+    reason = "a body's shape is usually one primitive, kept inline; compounds hold a Vec"
+)]
+pub enum Shape {
+    /// One convex primitive.
+    Primitive(Primitive),
+    /// A list of primitives.
+    Compound(Compound),
+}
+
+/// The kind of a primitive, used to name pairings (`circle-obb`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum ShapeKind {
+    /// [`Circle`].
+    Circle,
+    /// [`Aabb`].
+    Aabb,
+    /// [`Obb`].
+    Obb,
+    /// [`Capsule`].
+    Capsule,
+    /// [`Polygon`].
+    Polygon,
+}
+
+impl ShapeKind {
+    /// The name used in scenario and case files.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            ShapeKind::Circle => "circle",
+            ShapeKind::Aabb => "aabb",
+            ShapeKind::Obb => "obb",
+            ShapeKind::Capsule => "capsule",
+            ShapeKind::Polygon => "polygon",
+        }
+    }
+}
+
+impl Primitive {
+    /// Which kind of primitive this is.
+    #[must_use]
+    pub fn kind(&self) -> ShapeKind {
+        match self {
+            Primitive::Circle(_) => ShapeKind::Circle,
+            Primitive::Aabb(_) => ShapeKind::Aabb,
+            Primitive::Obb(_) => ShapeKind::Obb,
+            Primitive::Capsule(_) => ShapeKind::Capsule,
+            Primitive::Polygon(_) => ShapeKind::Polygon,
+        }
+    }
+
+    /// A validated circle.
+    pub fn circle(center: Vec2, radius: f64) -> Result<Primitive, ShapeError> {
+        Ok(Primitive::Circle(Circle {
+            center: finite_vec("center", center)?,
+            radius: positive("radius", radius)?,
+        }))
+    }
+
+    /// A validated axis-aligned box.
+    pub fn aabb(center: Vec2, half_extents: Vec2) -> Result<Primitive, ShapeError> {
+        Ok(Primitive::Aabb(Aabb {
+            center: finite_vec("center", center)?,
+            half_extents: Vec2::new(
+                positive("half_extents[0]", half_extents.x)?,
+                positive("half_extents[1]", half_extents.y)?,
+            ),
+        }))
+    }
+
+    /// A validated oriented box.
+    pub fn obb(center: Vec2, half_extents: Vec2, angle: f64) -> Result<Primitive, ShapeError> {
+        Ok(Primitive::Obb(Obb {
+            center: finite_vec("center", center)?,
+            half_extents: Vec2::new(
+                positive("half_extents[0]", half_extents.x)?,
+                positive("half_extents[1]", half_extents.y)?,
+            ),
+            angle: finite("angle", angle)?,
+        }))
+    }
+
+    /// A validated capsule; `a` and `b` already include any centre offset.
+    pub fn capsule(a: Vec2, b: Vec2, radius: f64) -> Result<Primitive, ShapeError> {
+        Ok(Primitive::Capsule(Capsule {
+            a: finite_vec("a", a)?,
+            b: finite_vec("b", b)?,
+            radius: positive("radius", radius)?,
+        }))
+    }
+
+    /// A validated polygon; see [`Polygon::new`].
+    pub fn polygon(vertices: &[Vec2]) -> Result<Primitive, ShapeError> {
+        Ok(Primitive::Polygon(Polygon::new(vertices)?))
+    }
+
+    /// Whether turning the body changes this primitive: false only for a circle or an AABB
+    /// centred on the body origin, which lets the narrow phase skip the trigonometry.
+    #[must_use]
+    pub fn turns_with_body(&self) -> bool {
+        match self {
+            Primitive::Circle(c) => c.center != Vec2::ZERO,
+            Primitive::Aabb(b) => b.center != Vec2::ZERO,
+            _ => true,
+        }
+    }
+
+    /// Half the diagonal of the local bounding box: the "size" the shared cases use to scale
+    /// tolerances.
+    #[must_use]
+    pub fn size(&self) -> f64 {
+        let b = crate::place(self, &crate::Pose::default(), Vec2::ZERO);
+        b.bounds().half_extents().length()
+    }
+}
+
+impl Shape {
+    /// A circle of `radius` at the body origin.
+    pub fn circle(radius: f64) -> Result<Shape, ShapeError> {
+        Primitive::circle(Vec2::ZERO, radius).map(Shape::Primitive)
+    }
+
+    /// An axis-aligned box centred on the body origin.
+    pub fn aabb(half_extents: Vec2) -> Result<Shape, ShapeError> {
+        Primitive::aabb(Vec2::ZERO, half_extents).map(Shape::Primitive)
+    }
+
+    /// An oriented box centred on the body origin.
+    pub fn obb(half_extents: Vec2) -> Result<Shape, ShapeError> {
+        Primitive::obb(Vec2::ZERO, half_extents, 0.0).map(Shape::Primitive)
+    }
+
+    /// A capsule around the segment `a`–`b`.
+    pub fn capsule(a: Vec2, b: Vec2, radius: f64) -> Result<Shape, ShapeError> {
+        Primitive::capsule(a, b, radius).map(Shape::Primitive)
+    }
+
+    /// A convex counter-clockwise polygon.
+    pub fn polygon(vertices: &[Vec2]) -> Result<Shape, ShapeError> {
+        Primitive::polygon(vertices).map(Shape::Primitive)
+    }
+
+    /// A compound of primitives.
+    pub fn compound(parts: Vec<Primitive>) -> Result<Shape, ShapeError> {
+        Compound::new(parts).map(Shape::Compound)
+    }
+
+    /// The rotation a body at `angle` applies to this shape, skipping the trigonometry when
+    /// no part turns with the body.
+    #[must_use]
+    pub fn rotation(&self, angle: f64) -> crate::Rot {
+        if self.primitives().iter().any(Primitive::turns_with_body) {
+            crate::Rot::from_angle(angle)
+        } else {
+            crate::Rot::IDENTITY
+        }
+    }
+
+    /// The primitives of this shape: one for a primitive, all parts for a compound.
+    #[must_use]
+    pub fn primitives(&self) -> &[Primitive] {
+        match self {
+            Shape::Primitive(p) => std::slice::from_ref(p),
+            Shape::Compound(c) => c.parts(),
+        }
+    }
+}

@@ -1,0 +1,292 @@
+//! Invariants of the narrow phase over random shapes and poses (proptest), and degenerate
+//! inputs that must still give a finite unit normal.
+
+use proptest::prelude::*;
+use ricochet_geom::pairs::collide_cores;
+use ricochet_geom::{
+    Bounds, Contact, Pose, Primitive, Shape, Vec2, contact, contact_placed, overlaps, place,
+};
+
+const TAU: f64 = std::f64::consts::TAU;
+
+fn v(x: f64, y: f64) -> Vec2 {
+    Vec2::new(x, y)
+}
+
+fn primitive() -> impl Strategy<Value = Primitive> {
+    let size = 0.05f64..3.0;
+    let offset = (-1.0f64..1.0, -1.0f64..1.0);
+    prop_oneof![
+        (size.clone(), offset.clone())
+            .prop_map(|(r, (x, y))| Primitive::circle(v(x, y), r).unwrap()),
+        (size.clone(), size.clone(), offset.clone()).prop_map(|(w, h, (x, y))| Primitive::aabb(
+            v(x, y),
+            v(w, h)
+        )
+        .unwrap()),
+        (size.clone(), size.clone(), offset.clone(), -3.2f64..3.2)
+            .prop_map(|(w, h, (x, y), a)| Primitive::obb(v(x, y), v(w, h), a).unwrap()),
+        (offset.clone(), offset.clone(), size.clone()).prop_map(|((ax, ay), (bx, by), r)| {
+            Primitive::capsule(v(ax, ay), v(bx, by), r).unwrap()
+        }),
+        (
+            proptest::collection::vec(0.0f64..1.0, 3..=8),
+            size.clone(),
+            size,
+            offset
+        )
+            .prop_filter_map("a convex polygon", |(mut ts, sx, sy, (x, y))| {
+                // Points on an ellipse in angular order are convex and counter-clockwise.
+                ts.sort_by(f64::total_cmp);
+                let pts: Vec<Vec2> = ts
+                    .iter()
+                    .map(|t| v(x + sx * libm::cos(t * TAU), y + sy * libm::sin(t * TAU)))
+                    .collect();
+                Primitive::polygon(&pts).ok()
+            }),
+    ]
+}
+
+fn shape() -> impl Strategy<Value = Shape> {
+    prop_oneof![
+        4 => primitive().prop_map(Shape::Primitive),
+        1 => proptest::collection::vec(primitive(), 1..4)
+            .prop_map(|parts| Shape::compound(parts).unwrap()),
+    ]
+}
+
+fn pose() -> impl Strategy<Value = Pose> {
+    (-4.0f64..4.0, -4.0f64..4.0, -3.2f64..3.2).prop_map(|(x, y, a)| Pose::new(v(x, y), a))
+}
+
+fn has_aabb(s: &Shape) -> bool {
+    s.primitives()
+        .iter()
+        .any(|p| matches!(p, Primitive::Aabb(_)))
+}
+
+/// Rounding allowance: the inputs are O(1..10), so a few hundred ulps of 10.
+const EPS: f64 = 1e-11;
+
+/// Whether pushing `b` by `depth` along `n` separates the pair (up to rounding): what makes
+/// `n` a valid minimum translation direction when several faces tie.
+fn separates(a: &Shape, pa: &Pose, b: &Shape, pb: &Pose, n: Vec2, depth: f64) -> bool {
+    let moved = Pose::new(pb.position + n * depth, pb.angle);
+    contact(a, pa, b, &moved).depth <= 1e-9
+}
+
+fn assert_unit(c: &Contact) {
+    assert!(
+        c.depth.is_finite() && c.normal.is_finite() && c.point.is_finite(),
+        "{c:?}"
+    );
+    assert!((c.normal.length() - 1.0).abs() < 1e-12, "{c:?}");
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig {
+        cases: 2000,
+        max_global_rejects: 1_000_000,
+        failure_persistence: None,
+        ..ProptestConfig::default()
+    })]
+
+    #[test]
+    fn swapping_a_and_b_flips_the_normal_and_keeps_the_depth(
+        a in shape(), pa in pose(), b in shape(), pb in pose()
+    ) {
+        let ab = contact(&a, &pa, &b, &pb);
+        let ba = contact(&b, &pb, &a, &pa);
+        assert_unit(&ab);
+        assert_unit(&ba);
+        prop_assert!((ab.depth - ba.depth).abs() <= EPS, "{ab:?} vs {ba:?}");
+        let flipped = ab.normal.dot(-ba.normal) > 1.0 - 1e-12;
+        // Where two faces tie, either is a right answer: check it really separates.
+        prop_assert!(
+            flipped || ab.depth <= 0.0 || separates(&a, &pa, &b, &pb, -ba.normal, ab.depth + 1e-9),
+            "{ab:?} vs {ba:?}"
+        );
+    }
+
+    #[test]
+    fn translating_both_shapes_changes_nothing(
+        a in shape(), pa in pose(), b in shape(), pb in pose(),
+        dx in -1e3f64..1e3, dy in -1e3f64..1e3,
+    ) {
+        let d = v(dx, dy);
+        let before = contact(&a, &pa, &b, &pb);
+        let after = contact(
+            &a, &Pose::new(pa.position + d, pa.angle),
+            &b, &Pose::new(pb.position + d, pb.angle),
+        );
+        // Positions are rounded to the new magnitude (1e3: ulp 1.1e-13) before the pair is
+        // computed relative to a, so the comparison allows for that, no more.
+        prop_assert!((before.depth - after.depth).abs() <= 1e-9, "{before:?} vs {after:?}");
+        prop_assert!(
+            before.normal.dot(after.normal) > 1.0 - 1e-9
+                || before.depth <= 0.0
+                || separates(&a, &pa, &b, &pb, after.normal, before.depth + 1e-8),
+            "{before:?} vs {after:?}"
+        );
+        prop_assert!((after.point - d - before.point).length() <= 1e-9);
+    }
+
+    #[test]
+    fn rotating_both_shapes_rotates_the_normal(
+        a in shape(), pa in pose(), b in shape(), pb in pose(), turn in -3.2f64..3.2,
+    ) {
+        prop_assume!(!has_aabb(&a) && !has_aabb(&b));
+        let rot = ricochet_geom::Rot::from_angle(turn);
+        let ra = Pose::new(rot.apply(pa.position), pa.angle + turn);
+        let rb = Pose::new(rot.apply(pb.position), pb.angle + turn);
+        let before = contact(&a, &pa, &b, &pb);
+        let after = contact(&a, &ra, &b, &rb);
+        prop_assert!((before.depth - after.depth).abs() <= 1e-9, "{before:?} vs {after:?}");
+        let expected = rot.apply(before.normal);
+        prop_assert!(
+            expected.dot(after.normal) > 1.0 - 1e-9
+                || before.depth <= 0.0
+                || separates(&a, &ra, &b, &rb, after.normal, before.depth + 1e-8),
+            "{before:?} vs {after:?}"
+        );
+    }
+
+    #[test]
+    fn every_shape_lies_inside_its_bounds(s in shape(), p in pose(), t in 0.0f64..1.0, side in 0usize..4) {
+        let b: Bounds = s.bounds(&p);
+        // A speck just outside any side of the box never touches the shape.
+        let gap = 1e-9;
+        let probe = match side {
+            0 => v(b.min.x - gap, b.min.y + t * (b.max.y - b.min.y)),
+            1 => v(b.max.x + gap, b.min.y + t * (b.max.y - b.min.y)),
+            2 => v(b.min.x + t * (b.max.x - b.min.x), b.min.y - gap),
+            _ => v(b.min.x + t * (b.max.x - b.min.x), b.max.y + gap),
+        };
+        let speck = Shape::circle(1e-12).unwrap();
+        let c = contact(&s, &p, &speck, &Pose::new(probe, 0.0));
+        prop_assert!(c.depth < 0.0, "{probe} is in the shape: {c:?}, bounds {b:?}");
+        // And the box is tight: the shape comes within rounding of every side.
+        prop_assert!(!side_is_loose(&s, &p, &b, side), "side {side} of {b:?} is loose");
+    }
+
+    #[test]
+    fn overlaps_agrees_with_contact(a in shape(), pa in pose(), b in shape(), pb in pose()) {
+        let c = contact(&a, &pa, &b, &pb);
+        let yes = overlaps(&a, &pa, &b, &pb);
+        // Two different computations may round differently only when touching.
+        prop_assert!(yes == c.overlaps() || c.depth.abs() <= EPS, "overlaps {yes}, {c:?}");
+    }
+
+    #[test]
+    fn each_pair_function_agrees_with_the_general_core_algorithm(
+        a in primitive(), pa in pose(), b in primitive(), pb in pose()
+    ) {
+        let (a, b) = (place(&a, &pa, pa.position), place(&b, &pb, pa.position));
+        let special = contact_placed(&a, &b);
+        let general = collide_cores(&a.core(), &b.core());
+        prop_assert!((special.depth - general.depth).abs() <= EPS, "{special:?} vs {general:?}");
+        prop_assert!(
+            special.normal.dot(general.normal) > 1.0 - 1e-9 || special.depth <= 0.0
+                || (special.depth - general.depth).abs() <= EPS,
+            "{special:?} vs {general:?}"
+        );
+    }
+
+    #[test]
+    fn the_contact_point_lies_between_the_surfaces(a in shape(), pa in pose(), b in shape(), pb in pose()) {
+        let c = contact(&a, &pa, &b, &pb);
+        prop_assume!(c.depth > 0.0);
+        // The point is inside both shapes grown by the depth: a speck there touches both.
+        let speck = Shape::circle(c.depth + 1e-9).unwrap();
+        let at = Pose::new(c.point, 0.0);
+        prop_assert!(overlaps(&a, &pa, &speck, &at), "{c:?}");
+        prop_assert!(overlaps(&b, &pb, &speck, &at), "{c:?}");
+    }
+}
+
+/// Whether the shape stays clear of a whole side of its bounds: never, for a tight box.
+/// Scanning 401 spots along the side, the nearest is within 1/800 of the side's length of
+/// where the shape touches it.
+fn side_is_loose(s: &Shape, p: &Pose, b: &Bounds, side: usize) -> bool {
+    let speck = Shape::circle(1e-12).unwrap();
+    (0..=400).all(|i| {
+        let t = f64::from(i) / 400.0;
+        let probe = match side {
+            0 => v(b.min.x, b.min.y + t * (b.max.y - b.min.y)),
+            1 => v(b.max.x, b.min.y + t * (b.max.y - b.min.y)),
+            2 => v(b.min.x + t * (b.max.x - b.min.x), b.min.y),
+            _ => v(b.min.x + t * (b.max.x - b.min.x), b.max.y),
+        };
+        contact(s, p, &speck, &Pose::new(probe, 0.0)).depth < -1e-3 * (b.max - b.min).length()
+    })
+}
+
+fn check(a: &Shape, pa: Pose, b: &Shape, pb: Pose) -> Contact {
+    let c = contact(a, &pa, b, &pb);
+    assert_unit(&c);
+    c
+}
+
+#[test]
+fn a_zero_length_capsule_is_a_circle() {
+    let capsule = Shape::capsule(v(0.3, 0.3), v(0.3, 0.3), 0.5).unwrap();
+    let circle = Shape::Primitive(Primitive::circle(v(0.3, 0.3), 0.5).unwrap());
+    let other = Shape::polygon(&[v(0.0, 0.0), v(1.0, 0.0), v(0.0, 1.0)]).unwrap();
+    let at = Pose::new(v(0.9, 0.2), 0.4);
+    let c1 = check(&capsule, Pose::at(0.0, 0.0), &other, at);
+    let c2 = check(&circle, Pose::at(0.0, 0.0), &other, at);
+    assert!((c1.depth - c2.depth).abs() < 1e-15, "{c1:?} {c2:?}");
+    assert!((c1.normal - c2.normal).length() < 1e-12, "{c1:?} {c2:?}");
+}
+
+#[test]
+fn a_box_a_micrometre_thick_still_collides_exactly() {
+    let sliver = Shape::obb(v(1.0, 1e-6)).unwrap();
+    let ball = Shape::circle(0.5).unwrap();
+    // Ball centre 0.4 above the sliver's centre line: 0.5 + 1e-6 - 0.4 deep, pushed up.
+    let c = check(&sliver, Pose::at(0.0, 0.0), &ball, Pose::at(0.2, 0.4));
+    assert!((c.depth - (0.1 + 1e-6)).abs() < 1e-15, "{c:?}");
+    assert_eq!(c.normal, Vec2::Y);
+}
+
+#[test]
+fn concentric_circles_get_a_finite_unit_normal() {
+    let a = Shape::circle(1.0).unwrap();
+    let b = Shape::circle(0.25).unwrap();
+    let c = check(&a, Pose::at(3.0, 3.0), &b, Pose::at(3.0, 3.0));
+    assert_eq!(c.depth, 1.25);
+}
+
+#[test]
+fn coincident_boxes_get_a_finite_unit_normal_and_their_half_size() {
+    for (a, b) in [
+        (
+            Shape::aabb(v(2.0, 1.0)).unwrap(),
+            Shape::aabb(v(2.0, 1.0)).unwrap(),
+        ),
+        (
+            Shape::obb(v(2.0, 1.0)).unwrap(),
+            Shape::obb(v(2.0, 1.0)).unwrap(),
+        ),
+        (
+            Shape::aabb(v(2.0, 1.0)).unwrap(),
+            Shape::obb(v(2.0, 1.0)).unwrap(),
+        ),
+    ] {
+        let c = check(&a, Pose::at(1.0, 1.0), &b, Pose::at(1.0, 1.0));
+        // Leaving through the short side: 1 + 1.
+        assert_eq!(c.depth, 2.0, "{c:?}");
+        assert_eq!(c.normal.x, 0.0, "{c:?}");
+    }
+}
+
+#[test]
+fn coincident_capsules_and_polygons_get_finite_unit_normals() {
+    let cap = Shape::capsule(v(-1.0, 0.0), v(1.0, 0.0), 0.5).unwrap();
+    let c = check(&cap, Pose::at(0.0, 0.0), &cap, Pose::at(0.0, 0.0));
+    assert_eq!(c.depth, 1.0, "{c:?}");
+    let tri = Shape::polygon(&[v(0.0, 0.0), v(1.0, 0.0), v(0.0, 1.0)]).unwrap();
+    check(&tri, Pose::at(0.0, 0.0), &tri, Pose::at(0.0, 0.0));
+    let speck = Shape::circle(1e-9).unwrap();
+    check(&speck, Pose::at(0.0, 0.0), &tri, Pose::at(0.0, 0.0));
+}

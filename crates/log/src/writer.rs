@@ -1,0 +1,156 @@
+//! Writing a deterministic, chunked, indexed MCAP log.
+
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+
+use mcap::records::MessageHeader;
+use serde::Serialize;
+
+use crate::LogError;
+use crate::foxglove::{LOG_SCHEMA, LOG_SCHEMA_NAME, SCENE_UPDATE_SCHEMA, SCENE_UPDATE_SCHEMA_NAME};
+
+/// Target uncompressed size of one chunk: 1 MiB, mcap's default. Foxglove
+/// loads a log chunk by chunk, so this bounds what it reads to seek.
+const CHUNK_SIZE: u64 = 1024 * 1024;
+
+/// A channel of a [`LogWriter`], returned when the channel is added.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct ChannelId(u16);
+
+/// Writes an MCAP log of JSON messages that Foxglove can open.
+///
+/// The file is a pure function of the calls made: no wall-clock time, host
+/// name or thread count reaches it. Chunks are zstd-compressed on the calling
+/// thread (multithreaded zstd output differs from single-threaded output), and
+/// the summary lists schemas and channels in id order.
+///
+/// Call [`finish`](Self::finish) to write the summary and index, also after an
+/// interrupted run: a log finished early is complete and indexed, it just
+/// holds fewer messages. A writer dropped without `finish` still tries to
+/// finish the file, but any error is lost.
+pub struct LogWriter {
+    path: PathBuf,
+    mcap: mcap::Writer<BufWriter<File>>,
+    /// Next sequence number of each channel.
+    sequences: BTreeMap<ChannelId, u32>,
+}
+
+impl LogWriter {
+    /// Creates (or truncates) the log file at `path` and writes the MCAP
+    /// header, naming `library` (e.g. `"ricochet 0.1.0"`) as the writer.
+    ///
+    /// The file is created now, so an unwritable path fails before any
+    /// simulation runs.
+    pub fn create(path: &Path, library: &str) -> Result<Self, LogError> {
+        let file = File::create(path).map_err(|source| LogError::Create {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let options = mcap::WriteOptions::new()
+            .library(library)
+            .profile("")
+            .use_chunks(true)
+            .chunk_size(Some(CHUNK_SIZE))
+            .compression(Some(mcap::Compression::Zstd))
+            .compression_level(0)
+            .compression_threads(0);
+        let mcap = options
+            .create(BufWriter::new(file))
+            .map_err(|source| LogError::Write {
+                path: path.to_path_buf(),
+                source,
+            })?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            mcap,
+            sequences: BTreeMap::new(),
+        })
+    }
+
+    /// Adds a channel on `topic` whose messages are JSON (message encoding
+    /// `json`) described by the JSON Schema `schema_json` named
+    /// `schema_name` (schema encoding `jsonschema`).
+    ///
+    /// Adding the same topic and schema again returns the same channel.
+    pub fn add_json_channel(
+        &mut self,
+        topic: &str,
+        schema_name: &str,
+        schema_json: &str,
+    ) -> Result<ChannelId, LogError> {
+        let schema_id = self
+            .mcap
+            .add_schema(schema_name, "jsonschema", schema_json.as_bytes())
+            .map_err(|source| self.write_error(source))?;
+        let channel_id = self
+            .mcap
+            .add_channel(schema_id, topic, "json", &BTreeMap::new())
+            .map_err(|source| self.write_error(source))?;
+        Ok(ChannelId(channel_id))
+    }
+
+    /// Adds a `foxglove.SceneUpdate` channel on `topic`, for
+    /// [`SceneUpdate`](crate::foxglove::SceneUpdate) messages.
+    pub fn add_scene_channel(&mut self, topic: &str) -> Result<ChannelId, LogError> {
+        self.add_json_channel(topic, SCENE_UPDATE_SCHEMA_NAME, SCENE_UPDATE_SCHEMA)
+    }
+
+    /// Adds a `foxglove.Log` channel on `topic`, for
+    /// [`Log`](crate::foxglove::Log) messages.
+    pub fn add_log_channel(&mut self, topic: &str) -> Result<ChannelId, LogError> {
+        self.add_json_channel(topic, LOG_SCHEMA_NAME, LOG_SCHEMA)
+    }
+
+    /// Writes `message` as compact JSON on `channel` at simulation time
+    /// `time_ns` (both the log and publish time). Its sequence number is the
+    /// count of messages written on `channel` before it.
+    ///
+    /// Floating-point fields of `message` must be finite: `serde_json`
+    /// writes NaN and the infinities as `null`.
+    pub fn write<T: Serialize>(
+        &mut self,
+        channel: ChannelId,
+        time_ns: u64,
+        message: &T,
+    ) -> Result<(), LogError> {
+        let data = serde_json::to_vec(message)?;
+        let sequence = self.sequences.get(&channel).copied().unwrap_or(0);
+        let header = MessageHeader {
+            channel_id: channel.0,
+            sequence,
+            log_time: time_ns,
+            publish_time: time_ns,
+        };
+        self.mcap
+            .write_to_known_channel(&header, &data)
+            .map_err(|source| self.write_error(source))?;
+        self.sequences.insert(channel, sequence.wrapping_add(1));
+        Ok(())
+    }
+
+    /// Ends the last chunk, writes the summary (schemas, channels,
+    /// statistics, chunk indexes), the footer and the closing magic, and
+    /// flushes the file.
+    pub fn finish(mut self) -> Result<(), LogError> {
+        self.mcap
+            .finish()
+            .map_err(|source| self.write_error(source))?;
+        let Self { path, mcap, .. } = self;
+        mcap.into_inner()
+            .into_inner()
+            .map_err(|error| LogError::Write {
+                path,
+                source: mcap::McapError::Io(error.into_error()),
+            })?;
+        Ok(())
+    }
+
+    fn write_error(&self, source: mcap::McapError) -> LogError {
+        LogError::Write {
+            path: self.path.clone(),
+            source,
+        }
+    }
+}
