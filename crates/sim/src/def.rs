@@ -1,0 +1,364 @@
+//! Validated definitions: what a scenario file loads into (Box2D's `b2WorldDef` and
+//! `b2BodyDef`), each with a `Default`.
+
+use ricochet_geom::{Shape, Vec2};
+
+/// Index of a layer in [`Layers::names`].
+pub type LayerId = u8;
+
+/// How a body moves.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BodyKind {
+    /// Moved by forces, velocity and collision responses.
+    Dynamic,
+    /// Never moves.
+    Static,
+    /// Moves at its velocity; never pushed by collisions.
+    Kinematic,
+}
+
+impl BodyKind {
+    /// The name used in scenario files and logs.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            BodyKind::Dynamic => "dynamic",
+            BodyKind::Static => "static",
+            BodyKind::Kinematic => "kinematic",
+        }
+    }
+}
+
+/// What drives a body besides physics.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Controller {
+    /// Asteroids ship.
+    Ship {
+        /// Thrust force along the heading.
+        thrust: f64,
+        /// Turn rate at full input, radians/s.
+        turn_rate: f64,
+        /// Template name of the bullet.
+        bullet: String,
+        /// Bullet speed relative to the ship.
+        bullet_speed: f64,
+        /// Distance ahead of the centre where bullets appear.
+        muzzle: f64,
+    },
+    /// Platformer character.
+    Runner {
+        /// Horizontal speed at full input.
+        run_speed: f64,
+        /// Jump speed.
+        jump_speed: f64,
+    },
+    /// Patrols, turning around when bumped along x.
+    Walker {
+        /// Speed; the sign is the current direction.
+        speed: f64,
+    },
+}
+
+/// A child spawned where a body is destroyed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Split {
+    /// Template of the child.
+    pub template: String,
+    /// Offset from the parent's position.
+    pub offset: Vec2,
+    /// Velocity added to the parent's.
+    pub velocity: Vec2,
+}
+
+/// Everything needed to create a body.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BodyDef {
+    /// Name, used by script events and shown in logs.
+    pub name: String,
+    /// Layer.
+    pub layer: LayerId,
+    /// Collision shape.
+    pub shape: Shape,
+    /// Dynamic, static or kinematic.
+    pub kind: BodyKind,
+    /// Mass of a dynamic body (default 1).
+    pub mass: f64,
+    /// Position.
+    pub position: Vec2,
+    /// Angle, radians.
+    pub angle: f64,
+    /// Velocity.
+    pub velocity: Vec2,
+    /// Angular velocity, radians/s.
+    pub angular_velocity: f64,
+    /// Constant force.
+    pub force: Vec2,
+    /// Multiplier of the world gravity (default 1).
+    pub gravity_scale: f64,
+    /// Frames until removal.
+    pub lifetime: Option<u32>,
+    /// Input handling.
+    pub controller: Option<Controller>,
+    /// Children spawned on destruction.
+    pub split: Vec<Split>,
+}
+
+impl Default for BodyDef {
+    fn default() -> Self {
+        BodyDef {
+            name: "body".to_owned(),
+            layer: 0,
+            shape: Shape::circle(0.5).expect("a positive radius is valid"),
+            kind: BodyKind::Dynamic,
+            mass: 1.0,
+            position: Vec2::ZERO,
+            angle: 0.0,
+            velocity: Vec2::ZERO,
+            angular_velocity: 0.0,
+            force: Vec2::ZERO,
+            gravity_scale: 1.0,
+            lifetime: None,
+            controller: None,
+            split: Vec::new(),
+        }
+    }
+}
+
+/// Which body a `destroy` response removes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Doomed {
+    /// The body in the first layer of the pair.
+    First,
+    /// The body in the second layer.
+    Second,
+    /// Both.
+    Both,
+}
+
+/// What happens when two layers' bodies overlap.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Response {
+    /// Never tested.
+    Ignore,
+    /// Logged, and the game gets an event.
+    Report,
+    /// One or both removed (children of a split spawned).
+    Destroy(Doomed),
+    /// Pushed apart: per axis for boxes, along the normal otherwise.
+    Separate,
+}
+
+impl Response {
+    /// The name used in scenario files and logs.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Response::Ignore => "ignore",
+            Response::Report => "report",
+            Response::Destroy(_) => "destroy",
+            Response::Separate => "separate",
+        }
+    }
+}
+
+/// Layer names and the symmetric layer-pair response matrix.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Layers {
+    names: Vec<String>,
+    /// `matrix[a * n + b]`: the response when a body of layer `a` meets one of layer `b`,
+    /// with `Doomed` relative to `(a, b)`.
+    matrix: Vec<Response>,
+}
+
+impl Layers {
+    /// Layers with every pair ignored.
+    #[must_use]
+    pub fn new(names: Vec<String>) -> Layers {
+        let n = names.len();
+        Layers {
+            names,
+            matrix: vec![Response::Ignore; n * n],
+        }
+    }
+
+    /// Sets the response of `(a, b)`, and the mirrored one of `(b, a)`.
+    pub fn set(&mut self, a: LayerId, b: LayerId, response: Response) {
+        let n = self.names.len();
+        let (a, b) = (usize::from(a), usize::from(b));
+        self.matrix[a * n + b] = response;
+        let mirrored = match response {
+            Response::Destroy(Doomed::First) => Response::Destroy(Doomed::Second),
+            Response::Destroy(Doomed::Second) => Response::Destroy(Doomed::First),
+            other => other,
+        };
+        if a != b {
+            self.matrix[b * n + a] = mirrored;
+        }
+    }
+
+    /// The response when a body of layer `a` meets one of layer `b`.
+    #[must_use]
+    #[inline]
+    pub fn response(&self, a: LayerId, b: LayerId) -> Response {
+        self.matrix[usize::from(a) * self.names.len() + usize::from(b)]
+    }
+
+    /// The layer names, in id order.
+    #[must_use]
+    pub fn names(&self) -> &[String] {
+        &self.names
+    }
+
+    /// The id of a layer name.
+    #[must_use]
+    pub fn id(&self, name: &str) -> Option<LayerId> {
+        self.names
+            .iter()
+            .position(|n| n == name)
+            .and_then(|i| LayerId::try_from(i).ok())
+    }
+
+    /// The name of a layer id.
+    #[must_use]
+    pub fn name(&self, id: LayerId) -> &str {
+        &self.names[usize::from(id)]
+    }
+
+    /// Whether any pair of layers has this kind of response.
+    #[must_use]
+    pub fn any(&self, pred: impl Fn(Response) -> bool) -> bool {
+        self.matrix.iter().any(|r| pred(*r))
+    }
+}
+
+/// World bounds.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WorldBounds {
+    /// Lower-left corner.
+    pub min: Vec2,
+    /// Upper-right corner.
+    pub max: Vec2,
+    /// Whether bodies leaving one side come back on the other.
+    pub wrap: bool,
+}
+
+/// World-wide settings.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WorldDef {
+    /// Seconds per step (default 1/60).
+    pub dt: f64,
+    /// Gravity, units/s² (default zero).
+    pub gravity: Vec2,
+    /// Optional bounds.
+    pub bounds: Option<WorldBounds>,
+    /// Layers and their response matrix.
+    pub layers: Layers,
+}
+
+impl Default for WorldDef {
+    fn default() -> Self {
+        WorldDef {
+            dt: 1.0 / 60.0,
+            gravity: Vec2::ZERO,
+            bounds: None,
+            layers: Layers::new(vec!["default".to_owned()]),
+        }
+    }
+}
+
+/// A script event's action, bodies referred to by name.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Action {
+    /// Create a body from a template.
+    Spawn {
+        /// The body to create (template values with the event's overrides).
+        body: Box<BodyDef>,
+        /// Template name, for the event log.
+        template: String,
+    },
+    /// Remove a body.
+    Destroy {
+        /// Body name.
+        body: String,
+    },
+    /// Set a body's velocity.
+    SetVelocity {
+        /// Body name.
+        body: String,
+        /// New velocity.
+        velocity: Vec2,
+    },
+    /// Add impulse / mass to the velocity.
+    ApplyImpulse {
+        /// Body name.
+        body: String,
+        /// Impulse.
+        impulse: Vec2,
+    },
+    /// Set the constant force.
+    SetForce {
+        /// Body name.
+        body: String,
+        /// Force.
+        force: Vec2,
+    },
+    /// Ship engine on or off.
+    Thrust {
+        /// Body name.
+        body: String,
+        /// On.
+        on: bool,
+    },
+    /// Ship turn input.
+    Turn {
+        /// Body name.
+        body: String,
+        /// -1 to 1.
+        input: f64,
+    },
+    /// Ship fires a bullet.
+    Fire {
+        /// Body name.
+        body: String,
+    },
+    /// Runner horizontal input.
+    Move {
+        /// Body name.
+        body: String,
+        /// -1 to 1.
+        input: f64,
+    },
+    /// Runner jumps if grounded.
+    Jump {
+        /// Body name.
+        body: String,
+    },
+}
+
+impl Action {
+    /// The action's name as written in scenario files.
+    #[must_use]
+    pub fn name(&self) -> &'static str {
+        match self {
+            Action::Spawn { .. } => "spawn",
+            Action::Destroy { .. } => "destroy",
+            Action::SetVelocity { .. } => "set_velocity",
+            Action::ApplyImpulse { .. } => "apply_impulse",
+            Action::SetForce { .. } => "set_force",
+            Action::Thrust { .. } => "thrust",
+            Action::Turn { .. } => "turn",
+            Action::Fire { .. } => "fire",
+            Action::Move { .. } => "move",
+            Action::Jump { .. } => "jump",
+        }
+    }
+}
+
+/// A script event.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Event {
+    /// The frame at whose start it happens.
+    pub frame: u64,
+    /// What happens.
+    pub action: Action,
+}

@@ -1,0 +1,124 @@
+//! What one frame produces: contacts, events, destroyed bodies and counters. The recorder
+//! turns these into log messages; the simulation never formats or writes anything.
+
+use std::collections::BTreeMap;
+
+use ricochet_geom::{Pose, Shape, Vec2};
+
+use crate::def::{BodyKind, LayerId, Response};
+use crate::entity::Entity;
+
+/// Which detection pass found a contact.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Phase {
+    /// The per-axis pass after moving along x.
+    X,
+    /// The per-axis pass after moving along y.
+    Y,
+    /// The full pass at the frame's final poses.
+    All,
+}
+
+impl Phase {
+    /// `"x"`, `"y"` or `"all"`.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Phase::X => "x",
+            Phase::Y => "y",
+            Phase::All => "all",
+        }
+    }
+}
+
+/// One detected contact, with the poses it was detected at, so that anyone can recompute it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ContactRecord {
+    /// The body with the lower id.
+    pub a: Entity,
+    /// The body with the higher id.
+    pub b: Entity,
+    /// The pass that found it.
+    pub phase: Phase,
+    /// Exact minimum translation direction from `a` to `b` at the poses below.
+    pub normal: Vec2,
+    /// Exact penetration depth at the poses below.
+    pub depth: f64,
+    /// Contact point.
+    pub point: Vec2,
+    /// `a`'s pose at detection.
+    pub pose_a: Pose,
+    /// `b`'s pose at detection.
+    pub pose_b: Pose,
+    /// The layer pair's response.
+    pub response: Response,
+    /// The push the response applied to the moving body (zero when nothing moved).
+    pub resolved: Vec2,
+}
+
+/// A game event: an input, a spawn, a destruction, a collision.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EventRecord {
+    /// What kind of event (`input`, `spawn`, `destroy`, `expire`, `contact`, `hit_x`, ...).
+    pub kind: &'static str,
+    /// A sentence for people.
+    pub message: String,
+}
+
+/// A body removed this frame, as it was just before removal.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RemovedBody {
+    /// Its id.
+    pub entity: Entity,
+    /// Name.
+    pub name: String,
+    /// Layer.
+    pub layer: LayerId,
+    /// Shape.
+    pub shape: Shape,
+    /// Pose.
+    pub pose: Pose,
+    /// Velocity.
+    pub velocity: Vec2,
+    /// Kind.
+    pub kind: BodyKind,
+}
+
+/// Deterministic per-frame counters (no timings: those differ run to run).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Stats {
+    /// Bodies alive at the end of the frame.
+    pub bodies: usize,
+    /// Pairs whose bounds overlapped and whose layers interact.
+    pub broad_pairs: u64,
+    /// Exact narrow-phase tests run.
+    pub narrow_tests: u64,
+    /// Contacts recorded.
+    pub contacts: u64,
+    /// Pairs whose bounds overlapped but whose layers ignore each other: never tested.
+    pub pairs_ignored_by_layer: u64,
+    /// Stages run.
+    pub stages_run: Vec<&'static str>,
+    /// Stages skipped because the scene had nothing for them.
+    pub stages_skipped: Vec<&'static str>,
+    /// Narrow-phase tests per layer pair, `"a/b"` with `a <= b` by layer id.
+    pub tests_by_layer_pair: BTreeMap<String, u64>,
+    /// Kinetic energy of the dynamic bodies at the end of the frame.
+    pub kinetic_energy: f64,
+}
+
+/// Everything one frame produced.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FrameOutput {
+    /// Frame number (0 is the initial state).
+    pub frame: u64,
+    /// Contacts in detection order: the x pass, the y pass, then the full pass, each sorted
+    /// by `(a, b)`.
+    pub contacts: Vec<ContactRecord>,
+    /// Events in the order they happened.
+    pub events: Vec<EventRecord>,
+    /// Bodies removed this frame.
+    pub removed: Vec<RemovedBody>,
+    /// Counters.
+    pub stats: Stats,
+}

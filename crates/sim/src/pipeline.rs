@@ -1,0 +1,173 @@
+//! The simulation: a world, its scenario, and the fixed stage order.
+//!
+//! Frame 0 is the initial state: its script events run and contacts are detected, but
+//! nothing moves. Every later frame runs every stage in this order, skipping a stage the
+//! scene has nothing for (and counting the skip in [`crate::Stats`]):
+//!
+//! | stage | does |
+//! |---|---|
+//! | `script` | this frame's script events: inputs, spawns, destroys, velocity/force edits |
+//! | `controls` | controllers turn inputs into angular velocity (ship) or x velocity (runner, walker) |
+//! | `forces` | semi-implicit Euler, velocity half: `a = sum(f) / m`, `v += a * dt` |
+//! | `move_x` | `x += vx * dt` for every moving body |
+//! | `resolve_x` | per-axis separation along x (boxes in `separate` layer pairs) |
+//! | `move_y` | `y += vy * dt` |
+//! | `resolve_y` | per-axis separation along y; a push upwards sets `grounded` |
+//! | `turn` | `angle += angular_velocity * dt` |
+//! | `detect` | broad phase, exact narrow phase, `report`/`destroy`/`separate` responses |
+//! | `lifetimes` | count down lifetimes; remove expired bodies |
+//! | `bounds` | wrap around (Asteroids) or remove bodies that left the world |
+
+use std::collections::BTreeMap;
+
+use crate::def::{BodyDef, Event};
+use crate::output::FrameOutput;
+use crate::scenario::Scenario;
+use crate::stages;
+use crate::world::World;
+
+/// How far two solid bodies may still overlap after `separate` has pushed them apart, in
+/// world units: positions are set exactly flush, so what remains is rounding.
+pub const SLOP: f64 = 1e-9;
+
+/// A stage: a plain function over the simulation, with a test of whether it has work.
+pub(crate) struct Stage {
+    pub name: &'static str,
+    pub has_work: fn(&Simulation) -> bool,
+    pub run: fn(&mut Simulation, &mut FrameOutput),
+}
+
+/// The stage order. See the module docs.
+pub(crate) const STAGES: [Stage; 11] = [
+    Stage {
+        name: "script",
+        has_work: stages::script::has_work,
+        run: stages::script::run,
+    },
+    Stage {
+        name: "controls",
+        has_work: stages::motion::has_controls,
+        run: stages::motion::controls,
+    },
+    Stage {
+        name: "forces",
+        has_work: stages::motion::has_forces,
+        run: stages::motion::forces,
+    },
+    Stage {
+        name: "move_x",
+        has_work: stages::motion::has_motion,
+        run: stages::motion::move_x,
+    },
+    Stage {
+        name: "resolve_x",
+        has_work: stages::separate::has_work,
+        run: stages::separate::resolve_x,
+    },
+    Stage {
+        name: "move_y",
+        has_work: stages::motion::has_motion,
+        run: stages::motion::move_y,
+    },
+    Stage {
+        name: "resolve_y",
+        has_work: stages::separate::has_work,
+        run: stages::separate::resolve_y,
+    },
+    Stage {
+        name: "turn",
+        has_work: stages::motion::has_turning,
+        run: stages::motion::turn,
+    },
+    Stage {
+        name: "detect",
+        has_work: stages::detect::has_work,
+        run: stages::detect::run,
+    },
+    Stage {
+        name: "lifetimes",
+        has_work: stages::lifetimes::has_work,
+        run: stages::lifetimes::run,
+    },
+    Stage {
+        name: "bounds",
+        has_work: stages::bounds::has_work,
+        run: stages::bounds::run,
+    },
+];
+
+/// The stages frame 0 runs: the initial state is scripted and checked, never moved.
+const FRAME_ZERO: [&str; 2] = ["script", "detect"];
+
+/// A running simulation.
+pub struct Simulation {
+    /// The scenario it runs.
+    pub scenario: Scenario,
+    /// The bodies.
+    pub world: World,
+    /// The next frame to run.
+    pub(crate) frame: u64,
+    /// Index of the next script event.
+    pub(crate) cursor: usize,
+    /// Templates by name (shared with the scenario; cloned once for spawning).
+    pub(crate) templates: BTreeMap<String, BodyDef>,
+}
+
+impl Simulation {
+    /// A simulation at the start of frame 0, with the scenario's bodies spawned in file order.
+    #[must_use]
+    pub fn new(scenario: &Scenario) -> Simulation {
+        let mut world = World::new();
+        for b in &scenario.bodies {
+            world.spawn(b);
+        }
+        Simulation {
+            templates: scenario.templates.clone(),
+            scenario: scenario.clone(),
+            world,
+            frame: 0,
+            cursor: 0,
+        }
+    }
+
+    /// The frame the next [`step`](Self::step) will run.
+    #[must_use]
+    pub fn frame(&self) -> u64 {
+        self.frame
+    }
+
+    /// Seconds per step.
+    #[must_use]
+    pub fn dt(&self) -> f64 {
+        self.scenario.world.dt
+    }
+
+    /// The script events due at the current frame.
+    pub(crate) fn due_events(&self) -> &[Event] {
+        let rest = &self.scenario.script[self.cursor..];
+        let n = rest.iter().take_while(|e| e.frame == self.frame).count();
+        &rest[..n]
+    }
+
+    /// Runs one frame and reports what happened.
+    pub fn step(&mut self) -> FrameOutput {
+        let mut out = FrameOutput {
+            frame: self.frame,
+            ..FrameOutput::default()
+        };
+        for stage in &STAGES {
+            let allowed = self.frame > 0 || FRAME_ZERO.contains(&stage.name);
+            if allowed && (stage.has_work)(self) {
+                (stage.run)(self, &mut out);
+                out.stats.stages_run.push(stage.name);
+            } else {
+                out.stats.stages_skipped.push(stage.name);
+            }
+        }
+        out.stats.bodies = self.world.len();
+        out.stats.contacts = out.contacts.len() as u64;
+        out.stats.kinetic_energy = self.world.kinetic_energy();
+        self.frame += 1;
+        out
+    }
+}

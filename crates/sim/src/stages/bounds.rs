@@ -1,0 +1,42 @@
+//! The `bounds` stage: wrap around (Asteroids), or remove bodies that left the world.
+
+use crate::def::BodyKind;
+use crate::output::FrameOutput;
+use crate::pipeline::Simulation;
+use crate::stages::remove::remove;
+
+pub(crate) fn has_work(sim: &Simulation) -> bool {
+    sim.scenario.world.bounds.is_some()
+}
+
+pub(crate) fn run(sim: &mut Simulation, out: &mut FrameOutput) {
+    let Some(b) = sim.scenario.world.bounds else {
+        return;
+    };
+    let size = b.max - b.min;
+    let mut gone = Vec::new();
+    let w = &mut sim.world;
+    for i in 0..w.len() {
+        if w.kind[i] == BodyKind::Static {
+            continue;
+        }
+        let p = &mut w.position[i];
+        for axis in 0..2 {
+            if p[axis] < b.min[axis] || p[axis] >= b.max[axis] {
+                if b.wrap {
+                    // rem_euclid is exact (IEEE remainder), so wrapping is deterministic.
+                    p[axis] = b.min[axis] + (p[axis] - b.min[axis]).rem_euclid(size[axis]);
+                    if p[axis] >= b.max[axis] {
+                        // -tiny.rem_euclid(size) can round up to size itself.
+                        p[axis] = b.min[axis];
+                    }
+                } else if !gone.contains(&w.entity[i]) {
+                    gone.push(w.entity[i]);
+                }
+            }
+        }
+    }
+    for e in gone {
+        remove(sim, out, e, "destroy", "left the world", false);
+    }
+}

@@ -1,0 +1,244 @@
+//! The physics against exact answers: semi-implicit Euler's closed form, and per-axis
+//! separation's landing, corner and wall cases.
+
+use ricochet_geom::Vec2;
+use ricochet_sim::{FrameOutput, Phase, SLOP, Simulation, load_scenario};
+
+fn sim(toml: &str) -> Simulation {
+    let s = load_scenario(toml, "test.toml").unwrap_or_else(|e| panic!("{e}"));
+    Simulation::new(&s)
+}
+
+/// Semi-implicit Euler with constant acceleration `a`: `v_n = v0 + n a dt`,
+/// `x_n = x0 + n v0 dt + n(n+1)/2 a dt²` (not the continuous parabola's `n²/2`).
+fn closed_form(x0: Vec2, v0: Vec2, a: Vec2, dt: f64, n: u64) -> Vec2 {
+    let n = n as f64;
+    x0 + v0 * (n * dt) + a * (n * (n + 1.0) / 2.0 * dt * dt)
+}
+
+/// Rounding bound for n steps: each step rounds `v += a dt` and `x += v dt` once per
+/// operation, so the error grows at most by a few ulps of the largest magnitude per step.
+fn bound(x0: Vec2, v0: Vec2, a: Vec2, dt: f64, n: u64) -> f64 {
+    let nf = n as f64;
+    let scale = x0.abs().max_element()
+        + nf * v0.abs().max_element() * dt
+        + nf * nf * a.abs().max_element() * dt * dt;
+    4.0 * nf * f64::EPSILON * scale
+}
+
+#[test]
+fn a_projectile_follows_the_semi_implicit_euler_closed_form() {
+    let mut s = sim(r#"
+        dt = 0.01
+        layers = ["ball"]
+        world.gravity = [0, -9.81]
+        [[bodies]]
+        layer = "ball"
+        shape = { kind = "circle", radius = 0.1 }
+        mass = 3
+        position = [1, 2]
+        velocity = [3, 10]
+    "#);
+    let (x0, v0, a, dt) = (
+        Vec2::new(1.0, 2.0),
+        Vec2::new(3.0, 10.0),
+        Vec2::new(0.0, -9.81),
+        0.01,
+    );
+    s.step(); // frame 0: the initial state
+    for n in 1..=500u64 {
+        s.step();
+        let x = s.world.position[0];
+        let want = closed_form(x0, v0, a, dt, n);
+        let tol = bound(x0, v0, a, dt, n);
+        assert!(
+            (x - want).abs().max_element() <= tol,
+            "frame {n}: {x} vs {want} (bound {tol})"
+        );
+        // And it is not the continuous parabola: that differs by n a dt²/2.
+        let parabola = x0 + v0 * (n as f64 * dt) + a * 0.5 * (n as f64 * dt).powi(2);
+        assert!((x - parabola).y.abs() > 0.4 * n as f64 * 9.81 * dt * dt);
+    }
+}
+
+#[test]
+fn a_thrusting_ship_follows_the_closed_form() {
+    let mut s = sim(r#"
+        dt = 0.02
+        layers = ["ship", "bullet"]
+        [templates.bullet]
+        layer = "bullet"
+        shape = { kind = "circle", radius = 0.1 }
+        [[bodies]]
+        name = "ship"
+        layer = "ship"
+        shape = { kind = "polygon", vertices = [[1, 0], [-1, 0.6], [-1, -0.6]] }
+        mass = 2
+        angle = 0.5
+        velocity = [1, -1]
+        controller = { kind = "ship", thrust = 7, turn_rate = 3, bullet = "bullet", bullet_speed = 20 }
+        [[script]]
+        frame = 0
+        action = "thrust"
+        body = "ship"
+    "#);
+    let heading = Vec2::new(libm::cos(0.5), libm::sin(0.5));
+    let (x0, v0, a, dt) = (Vec2::ZERO, Vec2::new(1.0, -1.0), heading * 3.5, 0.02);
+    s.step();
+    for n in 1..=300u64 {
+        s.step();
+        let x = s.world.position[0];
+        let want = closed_form(x0, v0, a, dt, n);
+        let tol = bound(x0, v0, a, dt, n);
+        assert!(
+            (x - want).abs().max_element() <= tol,
+            "frame {n}: {x} vs {want} (bound {tol})"
+        );
+        assert_eq!(s.world.angle[0], 0.5, "no turn input, no turning");
+    }
+}
+
+const FLOOR: &str = r#"
+    hz = 60
+    layers = ["tile", "box"]
+    world.gravity = [0, -20]
+    [[collide]]
+    a = "box"
+    b = "tile"
+    response = "separate"
+    [[bodies]]
+    name = "floor"
+    layer = "tile"
+    kind = "static"
+    shape = { kind = "aabb", half_extents = [10, 1] }
+    position = [0, -1]
+"#;
+
+/// Overlap of two boxes given as (centre, half extents), on both axes.
+fn box_overlap(c1: Vec2, h1: Vec2, c2: Vec2, h2: Vec2) -> Vec2 {
+    (h1 + h2) - (c2 - c1).abs()
+}
+
+#[test]
+fn a_falling_box_lands_flush_and_grounded() {
+    let mut s = sim(&format!(
+        "{FLOOR}
+        [[bodies]]
+        name = \"box\"
+        layer = \"box\"
+        shape = {{ kind = \"aabb\", half_extents = [0.5, 0.5] }}
+        position = [0.3, 3]
+    "
+    ));
+    let mut landed_at = None;
+    for frame in 0..=240u64 {
+        let out = s.step();
+        let o = box_overlap(
+            Vec2::new(0.0, -1.0),
+            Vec2::new(10.0, 1.0),
+            s.world.position[1],
+            Vec2::splat(0.5),
+        );
+        assert!(
+            o.y <= SLOP,
+            "frame {frame}: box sunk {} into the floor",
+            o.y
+        );
+        if s.world.grounded[1] && landed_at.is_none() {
+            landed_at = Some(frame);
+            assert!(
+                out.contacts.iter().all(|c| c.phase == Phase::Y),
+                "{:?}",
+                out.contacts
+            );
+        }
+    }
+    // Free fall from 2.5 above the floor at 20 units/s² takes 0.5 s: about frame 30.
+    let landed = landed_at.expect("the box lands");
+    assert!((29..=32).contains(&landed), "landed at frame {landed}");
+    assert!(s.world.grounded[1]);
+    assert!(
+        (s.world.position[1].y - 0.5).abs() <= SLOP,
+        "{}",
+        s.world.position[1]
+    );
+    assert_eq!(
+        s.world.position[1].x, 0.3,
+        "a vertical landing never moves x"
+    );
+}
+
+#[test]
+fn a_corner_hit_resolves_along_one_axis_only() {
+    // The box reaches the corner diagonally: after the x move it is still above the block,
+    // after the y move it overlaps by 0.08 vertically and 0.15 horizontally.
+    let mut s = sim(r#"
+        hz = 60
+        layers = ["tile", "box"]
+        [[collide]]
+        a = "box"
+        b = "tile"
+        response = "separate"
+        [[bodies]]
+        layer = "tile"
+        kind = "static"
+        shape = { kind = "aabb", half_extents = [1, 1] }
+        [[bodies]]
+        layer = "box"
+        shape = { kind = "aabb", half_extents = [0.5, 0.5] }
+        position = [-1.45, 1.52]
+        velocity = [6, -6]
+    "#);
+    s.step();
+    let out: FrameOutput = s.step();
+    assert_eq!(out.contacts.len(), 1, "{:?}", out.contacts);
+    let c = &out.contacts[0];
+    assert_eq!(c.phase, Phase::Y);
+    assert_eq!(c.resolved.x, 0.0, "nothing along x");
+    assert!((c.resolved.y - 0.08).abs() < 1e-12, "{:?}", c.resolved);
+    assert_eq!(
+        s.world.velocity[1],
+        Vec2::new(6.0, 0.0),
+        "x velocity kept, y stopped"
+    );
+    assert!(s.world.grounded[1]);
+}
+
+#[test]
+fn a_body_running_into_a_wall_stops_flush() {
+    let mut s = sim(r#"
+        hz = 60
+        layers = ["tile", "box"]
+        [[collide]]
+        a = "box"
+        b = "tile"
+        response = "separate"
+        [[bodies]]
+        name = "wall"
+        layer = "tile"
+        kind = "static"
+        shape = { kind = "aabb", half_extents = [0.5, 5] }
+        position = [5.5, 0]
+        [[bodies]]
+        name = "box"
+        layer = "box"
+        shape = { kind = "aabb", half_extents = [0.5, 0.5] }
+        velocity = [10, 0]
+    "#);
+    let mut hits = 0;
+    for _ in 0..=60 {
+        let out = s.step();
+        hits += out.contacts.len();
+        for c in &out.contacts {
+            assert_eq!(c.phase, Phase::X);
+            assert_eq!(c.resolved.y, 0.0);
+        }
+    }
+    assert_eq!(hits, 1, "one hit, then it rests flush");
+    assert!(
+        (s.world.position[1].x - 4.5).abs() <= SLOP,
+        "{}",
+        s.world.position[1]
+    );
+    assert_eq!(s.world.velocity[1].x, 0.0);
+}

@@ -1,0 +1,225 @@
+//! Recording a run as an MCAP log: five channels per frame, all JSON with a JSON Schema.
+//!
+//! | topic | schema | content |
+//! |---|---|---|
+//! | `/scene` | `foxglove.SceneUpdate` | every body drawn in the XY plane, contact arrows, deletions |
+//! | `/bodies` | `ricochet.Bodies` | every body at the end of the frame, and the removed ones |
+//! | `/contacts` | `ricochet.Contacts` | every contact, with the poses it was detected at |
+//! | `/stats` | `ricochet.Stats` | deterministic counters, for Foxglove's Plot panel |
+//! | `/events` | `foxglove.Log` | inputs, spawns, destructions and collision events |
+//!
+//! `log_time = publish_time = frame * dt_ns`, with `dt_ns` the step rounded to whole
+//! nanoseconds: nothing from the wall clock reaches the file.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use ricochet_geom::{Pose, ShapeDef, Vec2};
+use ricochet_log::foxglove::{Log, LogLevel, Timestamp};
+use ricochet_log::{ChannelId, LogError, LogWriter};
+use ricochet_sim::{BodyKind, FrameOutput, Layers, RemovedBody, Simulation};
+use serde::Serialize;
+
+/// The `library` field of every log's header.
+pub const LIBRARY: &str = concat!("ricochet ", env!("CARGO_PKG_VERSION"));
+
+const BODIES_SCHEMA: &str = include_str!("schemas/Bodies.json");
+const CONTACTS_SCHEMA: &str = include_str!("schemas/Contacts.json");
+const STATS_SCHEMA: &str = include_str!("schemas/Stats.json");
+
+#[derive(Serialize)]
+struct BodyMsg<'a> {
+    id: u32,
+    name: &'a str,
+    layer: &'a str,
+    shape: ShapeDef,
+    position: [f64; 2],
+    angle: f64,
+    velocity: [f64; 2],
+    #[serde(rename = "static")]
+    is_static: bool,
+}
+
+#[derive(Serialize)]
+struct BodiesMsg<'a> {
+    frame: u64,
+    time: f64,
+    bodies: Vec<BodyMsg<'a>>,
+    removed: Vec<BodyMsg<'a>>,
+}
+
+#[derive(Serialize)]
+struct ContactMsg {
+    a: u32,
+    b: u32,
+    phase: &'static str,
+    normal: [f64; 2],
+    depth: f64,
+    point: [f64; 2],
+    pose_a: [f64; 3],
+    pose_b: [f64; 3],
+    response: &'static str,
+    resolved: [f64; 2],
+}
+
+#[derive(Serialize)]
+struct ContactsMsg {
+    frame: u64,
+    contacts: Vec<ContactMsg>,
+}
+
+#[derive(Serialize)]
+struct StatsMsg<'a> {
+    frame: u64,
+    bodies: usize,
+    broad_pairs: u64,
+    narrow_tests: u64,
+    contacts: u64,
+    pairs_ignored_by_layer: u64,
+    stages_run: usize,
+    stages_skipped: usize,
+    skipped: &'a [&'static str],
+    tests_by_layer_pair: &'a BTreeMap<String, u64>,
+    kinetic_energy: f64,
+}
+
+fn xy(v: Vec2) -> [f64; 2] {
+    [v.x, v.y]
+}
+
+fn pose3(p: &Pose) -> [f64; 3] {
+    [p.position.x, p.position.y, p.angle]
+}
+
+fn removed_msg<'a>(r: &'a RemovedBody, layers: &'a Layers) -> BodyMsg<'a> {
+    BodyMsg {
+        id: r.entity.index,
+        name: &r.name,
+        layer: layers.name(r.layer),
+        shape: ShapeDef::from_shape(&r.shape),
+        position: xy(r.pose.position),
+        angle: r.pose.angle,
+        velocity: xy(r.velocity),
+        is_static: r.kind == BodyKind::Static,
+    }
+}
+
+/// Writes a run's frames to an MCAP file.
+pub struct Recorder {
+    writer: LogWriter,
+    dt_ns: u64,
+    scene: ChannelId,
+    bodies: ChannelId,
+    contacts: ChannelId,
+    stats: ChannelId,
+    events: ChannelId,
+}
+
+impl Recorder {
+    /// Creates the file now (so a bad path fails before the simulation starts) and adds the
+    /// five channels.
+    pub fn create(path: &Path, dt: f64) -> Result<Recorder, LogError> {
+        let mut writer = LogWriter::create(path, LIBRARY)?;
+        let scene = writer.add_scene_channel("/scene")?;
+        let bodies = writer.add_json_channel("/bodies", "ricochet.Bodies", BODIES_SCHEMA)?;
+        let contacts =
+            writer.add_json_channel("/contacts", "ricochet.Contacts", CONTACTS_SCHEMA)?;
+        let stats = writer.add_json_channel("/stats", "ricochet.Stats", STATS_SCHEMA)?;
+        let events = writer.add_log_channel("/events")?;
+        Ok(Recorder {
+            writer,
+            // Whole nanoseconds per step; `f64 as u64` saturates and the scenario checks
+            // dt > 0 and finite.
+            dt_ns: (dt * 1e9).round() as u64,
+            scene,
+            bodies,
+            contacts,
+            stats,
+            events,
+        })
+    }
+
+    /// Writes one frame on every channel.
+    pub fn record(&mut self, sim: &Simulation, out: &FrameOutput) -> Result<(), LogError> {
+        let t = out.frame * self.dt_ns;
+        let ts = Timestamp::from_nanos(t);
+        let w = &sim.world;
+        let layers = &sim.scenario.world.layers;
+        self.writer
+            .write(self.scene, t, &crate::scene::scene_update(w, out, ts))?;
+        let bodies = (0..w.len())
+            .map(|i| BodyMsg {
+                id: w.entity[i].index,
+                name: &w.name[i],
+                layer: layers.name(w.layer[i]),
+                shape: ShapeDef::from_shape(&w.shape[i]),
+                position: xy(w.position[i]),
+                angle: w.angle[i],
+                velocity: xy(w.velocity[i]),
+                is_static: w.kind[i] == BodyKind::Static,
+            })
+            .collect();
+        let removed = out.removed.iter().map(|r| removed_msg(r, layers)).collect();
+        let msg = BodiesMsg {
+            frame: out.frame,
+            time: out.frame as f64 * sim.dt(),
+            bodies,
+            removed,
+        };
+        self.writer.write(self.bodies, t, &msg)?;
+        let contacts = out
+            .contacts
+            .iter()
+            .map(|c| ContactMsg {
+                a: c.a.index,
+                b: c.b.index,
+                phase: c.phase.name(),
+                normal: xy(c.normal),
+                depth: c.depth,
+                point: xy(c.point),
+                pose_a: pose3(&c.pose_a),
+                pose_b: pose3(&c.pose_b),
+                response: c.response.name(),
+                resolved: xy(c.resolved),
+            })
+            .collect();
+        self.writer.write(
+            self.contacts,
+            t,
+            &ContactsMsg {
+                frame: out.frame,
+                contacts,
+            },
+        )?;
+        let s = &out.stats;
+        let stats = StatsMsg {
+            frame: out.frame,
+            bodies: s.bodies,
+            broad_pairs: s.broad_pairs,
+            narrow_tests: s.narrow_tests,
+            contacts: s.contacts,
+            pairs_ignored_by_layer: s.pairs_ignored_by_layer,
+            stages_run: s.stages_run.len(),
+            stages_skipped: s.stages_skipped.len(),
+            skipped: &s.stages_skipped,
+            tests_by_layer_pair: &s.tests_by_layer_pair,
+            kinetic_energy: s.kinetic_energy,
+        };
+        self.writer.write(self.stats, t, &stats)?;
+        for e in &out.events {
+            let level = match e.kind {
+                "destroy" | "expire" | "missed" => LogLevel::Warning,
+                "input" | "spawn" => LogLevel::Info,
+                _ => LogLevel::Debug,
+            };
+            let log = Log::new(ts, level, e.kind, e.message.clone());
+            self.writer.write(self.events, t, &log)?;
+        }
+        Ok(())
+    }
+
+    /// Writes the summary and index. Called after an interrupted run too.
+    pub fn finish(self) -> Result<(), LogError> {
+        self.writer.finish()
+    }
+}

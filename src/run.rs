@@ -1,0 +1,142 @@
+//! `ricochet run` and `ricochet check`.
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+use anyhow::Context;
+use ricochet_sim::{Scenario, Simulation, load_scenario};
+
+use crate::record::Recorder;
+
+/// The built-in demo: `scenarios/asteroids.toml`, embedded.
+pub const DEFAULT_SCENARIO: &str = include_str!("../scenarios/asteroids.toml");
+const DEFAULT_NAME: &str = "scenarios/asteroids.toml";
+
+/// Runs of at least this many frames get a progress bar (on a terminal only).
+const PROGRESS_FROM: u64 = 2_000;
+
+/// Reads and checks a scenario, printing the error and returning exit code 2 when bad.
+fn load(path: Option<&Path>) -> Result<Scenario, ExitCode> {
+    let (text, name) = match path {
+        None => (DEFAULT_SCENARIO.to_owned(), DEFAULT_NAME.to_owned()),
+        Some(p) => match std::fs::read_to_string(p) {
+            Ok(t) => (t, p.display().to_string()),
+            Err(e) => {
+                eprintln!("error: {}: {e}", p.display());
+                return Err(ExitCode::from(2));
+            }
+        },
+    };
+    load_scenario(&text, &name).map_err(|e| {
+        eprintln!("error: {e}");
+        ExitCode::from(2)
+    })
+}
+
+/// `ricochet check`: load and validate, print a one-line description.
+pub fn check(path: &Path) -> anyhow::Result<ExitCode> {
+    let s = match load(Some(path)) {
+        Ok(s) => s,
+        Err(code) => return Ok(code),
+    };
+    println!(
+        "{}: ok: \"{}\", {} bodies, {} templates, {} script events, {} layers, dt {} s, {} frames",
+        path.display(),
+        s.name,
+        s.bodies.len(),
+        s.templates.len(),
+        s.script.len(),
+        s.world.layers.names().len(),
+        s.world.dt,
+        s.frames
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `ricochet run`.
+pub fn run(
+    path: Option<&Path>,
+    output: Option<PathBuf>,
+    frames: Option<u64>,
+) -> anyhow::Result<ExitCode> {
+    let scenario = match load(path) {
+        Ok(s) => s,
+        Err(code) => return Ok(code),
+    };
+    let stem = path
+        .unwrap_or(Path::new(DEFAULT_NAME))
+        .file_stem()
+        .map_or_else(|| "run".to_owned(), |s| s.to_string_lossy().into_owned());
+    let output = output.unwrap_or_else(|| PathBuf::from(format!("{stem}.mcap")));
+    let frames = frames.unwrap_or(scenario.frames);
+    // Created before the first step: an unwritable path fails now, not after the run.
+    let mut recorder = match Recorder::create(&output, scenario.world.dt) {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("error: cannot write the log: {e}");
+            return Ok(ExitCode::from(2));
+        }
+    };
+    let interrupted = Arc::new(AtomicBool::new(false));
+    {
+        let flag = Arc::clone(&interrupted);
+        // If a handler can't be installed (one already is), Ctrl-C just ends the process.
+        let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
+    }
+    let progress = (std::io::stderr().is_terminal() && frames >= PROGRESS_FROM).then(|| {
+        let bar = indicatif::ProgressBar::new(frames + 1);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{bar:40} {pos}/{len} frames {per_sec} eta {eta}",
+            )
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        bar
+    });
+    let started = Instant::now();
+    let mut sim = Simulation::new(&scenario);
+    let mut contacts = 0u64;
+    let mut peak_bodies = 0usize;
+    let mut ran = 0u64;
+    for _ in 0..=frames {
+        if interrupted.load(Ordering::SeqCst) {
+            break;
+        }
+        let out = sim.step();
+        contacts += out.contacts.len() as u64;
+        peak_bodies = peak_bodies.max(sim.world.len());
+        recorder
+            .record(&sim, &out)
+            .with_context(|| format!("writing frame {} to {}", out.frame, output.display()))?;
+        ran += 1;
+        if let Some(bar) = &progress {
+            bar.inc(1);
+        }
+    }
+    if let Some(bar) = progress {
+        bar.finish_and_clear();
+    }
+    recorder
+        .finish()
+        .with_context(|| format!("finishing {}", output.display()))?;
+    let wall = started.elapsed().as_secs_f64();
+    let stepped = ran.saturating_sub(1);
+    let note = if interrupted.load(Ordering::SeqCst) {
+        " (interrupted; the log is complete up to here)"
+    } else {
+        ""
+    };
+    eprintln!(
+        "{}: {stepped} frames, {} bodies at the end ({peak_bodies} at most), {contacts} contacts, {:.3} s wall, {:.0} frames/s -> {}{note}",
+        scenario.name,
+        sim.world.len(),
+        wall,
+        ran as f64 / wall.max(1e-9),
+        output.display()
+    );
+    Ok(ExitCode::SUCCESS)
+}
