@@ -18,11 +18,16 @@ use clap::{Parser, Subcommand};
 ///
 /// Write a scenario (a scene plus a script of inputs), run it, replay every frame in Foxglove,
 /// and keep golden logs so any change in your game's physics fails a test.
+///
+/// Start here: `ricochet` (no arguments) runs the built-in Asteroids demo into asteroids.mcap;
+/// open it in Foxglove (File > Open local file) with the layout in foxglove/ricochet-layout.json.
+/// Then try `ricochet run scenarios/platformer.toml` and `ricochet check your-game.toml`.
 #[derive(Parser, Debug)]
-#[command(name = "ricochet", version, about, long_about = None)]
+#[command(name = "ricochet", version, about)]
 struct Cli {
+    /// What to do. Without one, `ricochet` runs the built-in Asteroids demo (`ricochet run`).
     #[command(subcommand)]
-    command: Command,
+    command: Option<Command>,
 }
 
 #[derive(Subcommand, Debug)]
@@ -76,7 +81,12 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    let result = match cli.command {
+    let command = cli.command.unwrap_or(Command::Run {
+        scenario: None,
+        output: None,
+        frames: None,
+    });
+    let result = match command {
         Command::Collide { file } => collide::run(&file),
         Command::Run {
             scenario,

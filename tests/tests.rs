@@ -1,6 +1,8 @@
 //! Ricochet's integration tests: one target, a module per area (ripgrep's layout). Tests that
 //! need the real binary run it through [`util::ricochet`].
 
+mod bad_scenarios;
 mod collide_cli;
 mod collision_cases;
+mod run_cli;
 mod util;

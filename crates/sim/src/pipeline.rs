@@ -7,6 +7,7 @@
 //! | stage | does |
 //! |---|---|
 //! | `script` | this frame's script events: inputs, spawns, destroys, velocity/force edits |
+//! | `unground` | clear `grounded`: it is set again below by whatever holds a body up |
 //! | `controls` | controllers turn inputs into angular velocity (ship) or x velocity (runner, walker) |
 //! | `forces` | semi-implicit Euler, velocity half: `a = sum(f) / m`, `v += a * dt` |
 //! | `move_x` | `x += vx * dt` for every moving body |
@@ -38,11 +39,16 @@ pub(crate) struct Stage {
 }
 
 /// The stage order. See the module docs.
-pub(crate) const STAGES: [Stage; 11] = [
+pub(crate) const STAGES: [Stage; 12] = [
     Stage {
         name: "script",
         has_work: stages::script::has_work,
         run: stages::script::run,
+    },
+    Stage {
+        name: "unground",
+        has_work: stages::motion::has_grounded,
+        run: stages::motion::unground,
     },
     Stage {
         name: "controls",
@@ -96,8 +102,10 @@ pub(crate) const STAGES: [Stage; 11] = [
     },
 ];
 
-/// The stages frame 0 runs: the initial state is scripted and checked, never moved.
-const FRAME_ZERO: [&str; 2] = ["script", "detect"];
+/// The stages frame 0 runs: the initial state is scripted and checked, never moved. Lifetimes
+/// count frame 0, so a body lives `lifetime` frames whether it starts there or is spawned
+/// later.
+const FRAME_ZERO: [&str; 3] = ["script", "detect", "lifetimes"];
 
 /// A running simulation.
 pub struct Simulation {

@@ -55,13 +55,20 @@ struct Ctx<'a> {
 }
 
 impl Ctx<'_> {
+    /// An error at `span`, narrowed to the line of `field`'s own key when that key is
+    /// written inside the span (so `bodies[2].mass` points at `mass = -1`, not at
+    /// `[[bodies]]`).
     fn err(
         &self,
         span: Range<usize>,
         field: impl Into<String>,
         problem: impl Into<String>,
     ) -> ScenarioError {
-        let start = span.start.min(self.text.len());
+        let field = field.into();
+        let start = self
+            .key_in(&span, &field)
+            .unwrap_or(span.start)
+            .min(self.text.len());
         let before = &self.text[..start];
         let line = before.matches('\n').count() + 1;
         let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
@@ -69,9 +76,36 @@ impl Ctx<'_> {
             file: self.file.to_owned(),
             line,
             column,
-            field: field.into(),
+            field,
             problem: problem.into(),
         }
+    }
+
+    /// Where the last key of `field` (`mass` in `bodies[2].mass`, `half_extents` in
+    /// `bodies[0].shape.half_extents[1]`) is written as `key =` in the table at `span`.
+    fn key_in(&self, span: &Range<usize>, field: &str) -> Option<usize> {
+        let last = field.rsplit('.').next()?;
+        let key = last.split('[').next()?;
+        if key.is_empty() {
+            return None;
+        }
+        // A table's span covers only its `[[header]]`: search on to the next header.
+        let end = self.text[span.end.min(self.text.len())..]
+            .find("\n[")
+            .map_or(self.text.len(), |at| span.end + at);
+        let text = self.text.get(span.start..end)?;
+        let mut from = 0;
+        while let Some(at) = text[from..].find(key) {
+            let pos = from + at;
+            let before = text[..pos].chars().next_back();
+            let after = text[pos + key.len()..].trim_start();
+            let starts_word = before.is_none_or(|c| !(c.is_alphanumeric() || c == '_'));
+            if starts_word && after.starts_with('=') {
+                return Some(span.start + pos);
+            }
+            from = pos + key.len();
+        }
+        None
     }
 }
 
@@ -304,6 +338,13 @@ fn layers(ctx: &Ctx<'_>, raw: &ScenarioFile) -> Result<Layers, ScenarioError> {
             ));
         }
         seen.push(key);
+        if a == b && matches!(r.destroy.as_deref(), Some("a" | "b")) {
+            return Err(ctx.err(
+                c.span(),
+                format!("{field}.destroy"),
+                format!("both sides are layer \"{}\": say \"both\"; \"a\" and \"b\" can't tell them apart", r.a),
+            ));
+        }
         let response = match (r.response.as_str(), r.destroy.as_deref()) {
             ("ignore", None) => Response::Ignore,
             ("report", None) => Response::Report,

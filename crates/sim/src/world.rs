@@ -56,7 +56,7 @@ pub struct World {
     pub controller: Vec<Option<Controller>>,
     /// Current inputs.
     pub inputs: Vec<Inputs>,
-    /// Standing on something (set by a y push upwards this frame).
+    /// Standing on something: pushed up by a `separate` response this frame.
     pub grounded: Vec<bool>,
     /// Children spawned on destruction.
     pub split: Vec<Vec<Split>>,
@@ -148,7 +148,7 @@ impl World {
         ricochet_geom::Pose::new(self.position[i], self.angle[i])
     }
 
-    /// Kinetic energy of the dynamic and kinematic bodies, `sum(m v² / 2)` (translation only).
+    /// Kinetic energy of the dynamic bodies, `sum(m v² / 2)` (translation only).
     #[must_use]
     pub fn kinetic_energy(&self) -> f64 {
         (0..self.len())

@@ -6,6 +6,17 @@ use crate::def::{BodyKind, Controller};
 use crate::output::FrameOutput;
 use crate::pipeline::Simulation;
 
+pub(crate) fn has_grounded(sim: &Simulation) -> bool {
+    sim.world.grounded.iter().any(|g| *g)
+}
+
+/// Every body starts the frame's motion airborne; `resolve_y` (a push upwards) or `detect`
+/// (a `separate` normal pointing up) grounds it again. The script ran first, so a `jump`
+/// saw the previous frame's answer.
+pub(crate) fn unground(sim: &mut Simulation, _out: &mut FrameOutput) {
+    sim.world.grounded.fill(false);
+}
+
 pub(crate) fn has_controls(sim: &Simulation) -> bool {
     sim.world.controller.iter().any(Option::is_some)
 }

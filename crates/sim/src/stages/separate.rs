@@ -31,12 +31,6 @@ pub(crate) fn resolve_x(sim: &mut Simulation, out: &mut FrameOutput) {
 }
 
 pub(crate) fn resolve_y(sim: &mut Simulation, out: &mut FrameOutput) {
-    let w = &mut sim.world;
-    for i in 0..w.len() {
-        if w.kind[i] == BodyKind::Dynamic {
-            w.grounded[i] = false;
-        }
-    }
     resolve(sim, out, 1);
 }
 

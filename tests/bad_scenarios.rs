@@ -1,0 +1,147 @@
+//! Bad scenarios: one file per error class in `tests/data/bad-scenarios/`, each rejected by
+//! `ricochet check` with exit code 2 and a `file:line:column: field: problem` message.
+//!
+//! Each case states independently what the message must contain (the line and column of
+//! the offending key, the field path, the words that say what was expected); the insta
+//! snapshot then pins the whole message so any change in wording is reviewed.
+
+use crate::util::ricochet;
+
+fn check(name: &str) -> String {
+    let path = format!("tests/data/bad-scenarios/{name}.toml");
+    let out = ricochet(&["check", &path], b"");
+    assert_eq!(out.status.code(), Some(2), "{name}: bad input exits 2");
+    assert!(out.stdout.is_empty());
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert!(!err.contains("panicked"), "{err}");
+    err
+}
+
+fn case(name: &str, location: &str, must_contain: &[&str]) {
+    let err = check(name);
+    let want = format!("error: tests/data/bad-scenarios/{name}.toml:{location}: ");
+    assert!(
+        err.starts_with(&want),
+        "{name}: expected {want:?}, got {err}"
+    );
+    for s in must_contain {
+        assert!(err.contains(s), "{name}: expected {s:?} in {err}");
+    }
+    insta::assert_snapshot!(name, err);
+}
+
+#[test]
+fn each_error_class_is_named_with_its_location() {
+    case("syntax-error", "3:10", &["expected `]`"]);
+    case("unknown-field", "6:1", &["unknown field `colour`"]);
+    case(
+        "nan-position",
+        "6:1",
+        &["bodies[0].position", "finite", "NaN"],
+    );
+    case(
+        "infinite-velocity",
+        "6:1",
+        &["bodies[0].velocity", "finite", "inf"],
+    );
+    case(
+        "zero-radius",
+        "5:28",
+        &["bodies[0].shape.radius", "greater than 0"],
+    );
+    case(
+        "negative-half-extent",
+        "6:26",
+        &["bodies[0].shape.half_extents[1]", "greater than 0"],
+    );
+    case(
+        "negative-mass",
+        "6:1",
+        &["bodies[0].mass", "greater than 0"],
+    );
+    case(
+        "clockwise-polygon",
+        "5:29",
+        &["bodies[0].shape.vertices", "clockwise"],
+    );
+    case(
+        "non-convex-polygon",
+        "5:29",
+        &["bodies[0].shape.vertices[2]", "not convex"],
+    );
+    case(
+        "unknown-layer",
+        "4:1",
+        &[
+            "bodies[0].layer",
+            "unknown layer \"balll\"",
+            "known: ball, wall",
+        ],
+    );
+    case(
+        "unknown-layer-in-collide",
+        "5:1",
+        &["collide[0].b", "unknown layer \"floor\""],
+    );
+    case(
+        "unknown-response",
+        "6:1",
+        &["collide[0].response", "\"bounce\""],
+    );
+    case(
+        "same-layer-destroy-one",
+        "7:1",
+        &["collide[0].destroy", "\"both\""],
+    );
+    case(
+        "unknown-template",
+        "6:1",
+        &["script[0].template", "unknown template \"rock\""],
+    );
+    case(
+        "event-in-the-past",
+        "9:1",
+        &["script[0].frame", "in the past"],
+    );
+    case(
+        "unknown-body-in-script",
+        "11:1",
+        &["script[0].body", "\"player\""],
+    );
+    case("unknown-action", "3:1", &["unknown variant `teleport`"]);
+    case(
+        "unknown-shape-kind",
+        "5:18",
+        &["unknown variant `triangle`"],
+    );
+    case(
+        "missing-shape",
+        "3:1",
+        &["bodies[0].shape", "needs a shape"],
+    );
+    case("hz-and-dt", "1:6", &["hz", "not both"]);
+    case("non-positive-dt", "1:6", &["dt", "> 0"]);
+}
+
+#[test]
+fn every_bad_scenario_file_has_a_case() {
+    let mut files: Vec<String> = std::fs::read_dir(crate::util::data("bad-scenarios"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".toml"))
+        .collect();
+    files.sort();
+    let source = include_str!("bad_scenarios.rs");
+    for f in files {
+        let name = f.trim_end_matches(".toml");
+        let quoted = format!("\"{name}\",");
+        assert!(source.contains(&quoted), "{f} has no case");
+    }
+}
+
+#[test]
+fn a_missing_scenario_file_is_bad_input() {
+    let out = ricochet(&["check", "no/such/scenario.toml"], b"");
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no/such/scenario.toml"));
+}

@@ -1,0 +1,373 @@
+//! `ricochet run`: the log it writes, for every scenario in `scenarios/`.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use ricochet_geom::pairs::collide_cores;
+use ricochet_geom::{Pose, Shape, ShapeDef, Vec2, place};
+use ricochet_log::{LogMessage, read_log, read_log_file};
+use ricochet_sim::{Response, SLOP, load_scenario};
+use serde_json::Value;
+
+use crate::util::{ricochet, root};
+
+/// Every scenario file shipped in `scenarios/`.
+fn scenarios() -> Vec<PathBuf> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(root().join("scenarios"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    files.sort();
+    assert!(
+        files.len() >= 3,
+        "asteroids, platformer and shapes at least: {files:?}"
+    );
+    files
+}
+
+/// Runs `ricochet run SCENARIO -o OUT` and returns OUT's bytes.
+fn run(scenario: &Path, dir: &Path, out: &str) -> Vec<u8> {
+    let out = dir.join(out);
+    let o = ricochet(
+        &[
+            "run",
+            scenario.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ],
+        b"",
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    std::fs::read(out).unwrap()
+}
+
+fn topic<'a>(log: &'a [LogMessage], name: &'a str) -> impl Iterator<Item = &'a LogMessage> {
+    log.iter().filter(move |m| m.topic == name)
+}
+
+fn validator(schema: &str) -> jsonschema::Validator {
+    let schema: Value = serde_json::from_str(schema).unwrap();
+    jsonschema::validator_for(&schema).unwrap()
+}
+
+#[test]
+fn run_with_no_arguments_writes_the_asteroids_demo_with_five_valid_channels() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_ricochet"))
+        .arg("run")
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let summary = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        summary.contains("frames/s") && summary.contains("asteroids.mcap"),
+        "{summary}"
+    );
+    let log = read_log_file(&dir.path().join("asteroids.mcap")).expect("a valid, complete log");
+    let mut topics: Vec<&str> = log.iter().map(|m| m.topic.as_str()).collect();
+    topics.sort_unstable();
+    topics.dedup();
+    assert_eq!(
+        topics,
+        ["/bodies", "/contacts", "/events", "/scene", "/stats"]
+    );
+    // Every /scene message against the official foxglove.SceneUpdate schema (vendored from
+    // @foxglove/schemas 2.1.0, which marks every field required), and our own channels
+    // against theirs.
+    let checks = [
+        (
+            "/scene",
+            include_str!("../crates/log/schemas/SceneUpdate.json"),
+        ),
+        ("/events", include_str!("../crates/log/schemas/Log.json")),
+        ("/bodies", include_str!("../src/schemas/Bodies.json")),
+        ("/contacts", include_str!("../src/schemas/Contacts.json")),
+        ("/stats", include_str!("../src/schemas/Stats.json")),
+    ];
+    for (name, schema) in checks {
+        let v = validator(schema);
+        let mut n = 0;
+        for m in topic(&log, name) {
+            if let Err(e) = v.validate(&m.data) {
+                panic!("{name} at {} fails its schema: {e}", m.log_time);
+            }
+            n += 1;
+        }
+        assert!(n > 0, "{name} has messages");
+    }
+    // One /scene, /bodies, /contacts and /stats message per frame, at frame * dt.
+    let frames = topic(&log, "/stats").count();
+    for name in ["/scene", "/bodies", "/contacts"] {
+        assert_eq!(topic(&log, name).count(), frames, "{name}");
+    }
+    for (k, m) in topic(&log, "/bodies").enumerate() {
+        assert_eq!(m.data["frame"], k as u64);
+        assert_eq!(
+            m.log_time,
+            k as u64 * 16_666_667,
+            "frame * round(1e9 / 60) ns"
+        );
+        assert_eq!(m.publish_time, m.log_time);
+    }
+}
+
+#[test]
+fn every_scenario_gives_identical_bytes_twice() {
+    let dir = tempfile::tempdir().unwrap();
+    for s in scenarios() {
+        let first = run(&s, dir.path(), "first.mcap");
+        let second = run(&s, dir.path(), "second.mcap");
+        assert!(first == second, "{} is not deterministic", s.display());
+    }
+}
+
+/// Shapes by body id, from a /bodies message's bodies and removed bodies.
+fn shapes(msg: &Value) -> Vec<(u64, Shape)> {
+    let mut out = Vec::new();
+    for key in ["removed", "bodies"] {
+        for b in msg[key].as_array().unwrap() {
+            let def: ShapeDef = serde_json::from_value(b["shape"].clone()).unwrap();
+            out.push((b["id"].as_u64().unwrap(), def.to_shape().unwrap()));
+        }
+    }
+    out
+}
+
+fn pose(v: &Value) -> Pose {
+    Pose::new(
+        Vec2::new(v[0].as_f64().unwrap(), v[1].as_f64().unwrap()),
+        v[2].as_f64().unwrap(),
+    )
+}
+
+/// The contact of two shapes by the general core algorithm, part by part, deepest first:
+/// a different code path from the pair functions the simulation calls.
+fn recompute(a: &Shape, pa: &Pose, b: &Shape, pb: &Pose) -> (f64, Vec2) {
+    let mut best = (f64::NEG_INFINITY, Vec2::ZERO);
+    for x in a.primitives() {
+        for y in b.primitives() {
+            let c = collide_cores(
+                &place(x, pa, pa.position).core(),
+                &place(y, pb, pa.position).core(),
+            );
+            if c.depth > best.0 {
+                best = (c.depth, c.normal);
+            }
+        }
+    }
+    best
+}
+
+#[test]
+fn every_logged_contact_is_the_exact_contact_at_its_logged_poses() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut checked = 0;
+    for s in scenarios() {
+        let log = read_log(&run(&s, dir.path(), "run.mcap")).unwrap();
+        let bodies: Vec<&LogMessage> = topic(&log, "/bodies").collect();
+        for (frame, m) in topic(&log, "/contacts").enumerate() {
+            let known = shapes(&bodies[frame].data);
+            for c in m.data["contacts"].as_array().unwrap() {
+                let (ia, ib) = (c["a"].as_u64().unwrap(), c["b"].as_u64().unwrap());
+                assert!(ia < ib, "pairs are ordered a < b: {c}");
+                let (pa, pb) = (pose(&c["pose_a"]), pose(&c["pose_b"]));
+                let depth = c["depth"].as_f64().unwrap();
+                let normal = Vec2::new(
+                    c["normal"][0].as_f64().unwrap(),
+                    c["normal"][1].as_f64().unwrap(),
+                );
+                // An id reused within the frame has two candidate shapes: one must match.
+                let candidates = |id| known.iter().filter(move |(k, _)| *k == id).map(|(_, s)| s);
+                let ok = candidates(ia).any(|sa| {
+                    candidates(ib).any(|sb| {
+                        let (d, n) = recompute(sa, &pa, sb, &pb);
+                        let size = sa
+                            .bounds(&pa)
+                            .half_extents()
+                            .length()
+                            .min(sb.bounds(&pb).half_extents().length());
+                        let tol = 1e-9 * size.max(1.0);
+                        (d - depth).abs() <= tol && (n.dot(normal) > 1.0 - 1e-9 || d <= tol)
+                    })
+                });
+                assert!(
+                    ok,
+                    "{}: frame {frame}: contact {c} does not match its poses",
+                    s.display()
+                );
+                assert!(depth > 0.0, "{c}");
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked > 50, "the scenarios produce contacts: {checked}");
+}
+
+#[test]
+fn asteroids_never_tests_an_asteroid_against_an_asteroid_and_stats_show_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = read_log(&run(
+        &root().join("scenarios/asteroids.toml"),
+        dir.path(),
+        "a.mcap",
+    ))
+    .unwrap();
+    let mut ignored = 0;
+    let mut tested: BTreeMap<String, u64> = BTreeMap::new();
+    for m in topic(&log, "/stats") {
+        ignored += m.data["pairs_ignored_by_layer"].as_u64().unwrap();
+        for (k, v) in m.data["tests_by_layer_pair"].as_object().unwrap() {
+            *tested.entry(k.clone()).or_default() += v.as_u64().unwrap();
+        }
+    }
+    assert!(!tested.contains_key("asteroid/asteroid"), "{tested:?}");
+    assert!(
+        tested.get("asteroid/bullet").copied().unwrap_or(0) > 0,
+        "{tested:?}"
+    );
+    assert!(
+        ignored > 0,
+        "overlapping asteroid pairs were seen and skipped"
+    );
+    // And no logged contact is between two asteroids.
+    for m in topic(&log, "/contacts") {
+        assert!(
+            m.data["contacts"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .all(|c| c["response"] != "ignore")
+        );
+    }
+}
+
+#[test]
+fn platformer_never_ends_a_frame_with_solids_overlapping_beyond_slop() {
+    let path = root().join("scenarios/platformer.toml");
+    let scenario =
+        load_scenario(&std::fs::read_to_string(&path).unwrap(), "platformer.toml").unwrap();
+    let layers = &scenario.world.layers;
+    let dir = tempfile::tempdir().unwrap();
+    let log = read_log(&run(&path, dir.path(), "p.mcap")).unwrap();
+    let mut pairs = 0;
+    for m in topic(&log, "/bodies") {
+        let bodies = m.data["bodies"].as_array().unwrap();
+        for (i, a) in bodies.iter().enumerate() {
+            for b in &bodies[i + 1..] {
+                let (la, lb) = (
+                    layers.id(a["layer"].as_str().unwrap()).unwrap(),
+                    layers.id(b["layer"].as_str().unwrap()).unwrap(),
+                );
+                if layers.response(la, lb) != Response::Separate
+                    || (a["static"] == true && b["static"] == true)
+                {
+                    continue;
+                }
+                let sa = serde_json::from_value::<ShapeDef>(a["shape"].clone())
+                    .unwrap()
+                    .to_shape()
+                    .unwrap();
+                let sb = serde_json::from_value::<ShapeDef>(b["shape"].clone())
+                    .unwrap()
+                    .to_shape()
+                    .unwrap();
+                let pa = Pose::new(
+                    Vec2::new(
+                        a["position"][0].as_f64().unwrap(),
+                        a["position"][1].as_f64().unwrap(),
+                    ),
+                    a["angle"].as_f64().unwrap(),
+                );
+                let pb = Pose::new(
+                    Vec2::new(
+                        b["position"][0].as_f64().unwrap(),
+                        b["position"][1].as_f64().unwrap(),
+                    ),
+                    b["angle"].as_f64().unwrap(),
+                );
+                let c = ricochet_geom::contact(&sa, &pa, &sb, &pb);
+                assert!(
+                    c.depth <= SLOP,
+                    "frame {}: {} and {} overlap by {}",
+                    m.data["frame"],
+                    a["name"],
+                    b["name"],
+                    c.depth
+                );
+                pairs += 1;
+            }
+        }
+    }
+    assert!(pairs > 0);
+}
+
+#[test]
+fn a_truncated_log_is_reported_as_truncated() {
+    let dir = tempfile::tempdir().unwrap();
+    let bytes = run(&root().join("scenarios/shapes.toml"), dir.path(), "s.mcap");
+    for cut in [bytes.len() / 2, bytes.len() - 1] {
+        let err = read_log(&bytes[..cut]).expect_err("a cut log is refused");
+        assert!(
+            err.to_string().to_lowercase().contains("trunc")
+                || err.to_string().contains("cut short"),
+            "{err}"
+        );
+    }
+}
+
+#[test]
+fn an_unwritable_output_fails_before_the_simulation_starts() {
+    let o = ricochet(&["run", "-o", "no/such/dir/out.mcap"], b"");
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("no/such/dir/out.mcap") && !err.contains("frames/s"),
+        "{err}"
+    );
+}
+
+#[test]
+fn ctrl_c_still_leaves_a_complete_indexed_log() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("long.mcap");
+    let child = std::process::Command::new(env!("CARGO_BIN_EXE_ricochet"))
+        .args([
+            "run",
+            "scenarios/asteroids.toml",
+            "--frames",
+            "100000000",
+            "-o",
+        ])
+        .arg(&out)
+        .current_dir(root())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Wait until frames are being written, then interrupt as a terminal's Ctrl-C would.
+    for _ in 0..200 {
+        if std::fs::metadata(&out).is_ok_and(|m| m.len() > 200_000) {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    let kill = std::process::Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let result = child.wait_with_output().unwrap();
+    assert!(
+        result.status.success(),
+        "{}",
+        String::from_utf8_lossy(&result.stderr)
+    );
+    assert!(String::from_utf8_lossy(&result.stderr).contains("interrupted"));
+    let log = read_log_file(&out).expect("an interrupted run's log is complete and indexed");
+    assert!(topic(&log, "/stats").count() > 10);
+}
