@@ -121,4 +121,7 @@ pub struct FrameOutput {
     pub removed: Vec<RemovedBody>,
     /// Counters.
     pub stats: Stats,
+    /// Every body's pose at the start of the `detect` pass, in id order, when
+    /// [`crate::Simulation::capture_detect_poses`] is on (for the rapier referee).
+    pub detect_poses: Option<Vec<(Entity, Pose)>>,
 }

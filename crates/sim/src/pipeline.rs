@@ -119,6 +119,9 @@ pub struct Simulation {
     pub(crate) cursor: usize,
     /// Templates by name (shared with the scenario; cloned once for spawning).
     pub(crate) templates: BTreeMap<String, BodyDef>,
+    /// Whether each frame reports every body's pose at the start of `detect`
+    /// ([`FrameOutput::detect_poses`]). Off by default: it costs a copy per frame.
+    pub capture_detect_poses: bool,
 }
 
 impl Simulation {
@@ -135,6 +138,7 @@ impl Simulation {
             world,
             frame: 0,
             cursor: 0,
+            capture_detect_poses: false,
         }
     }
 

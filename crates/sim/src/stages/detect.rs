@@ -47,6 +47,9 @@ fn sweep(bounds: &[Bounds]) -> Vec<(usize, usize)> {
 pub(crate) fn run(sim: &mut Simulation, out: &mut FrameOutput) {
     let layers = sim.scenario.world.layers.clone();
     let w = &sim.world;
+    if sim.capture_detect_poses {
+        out.detect_poses = Some((0..w.len()).map(|i| (w.entity[i], w.pose(i))).collect());
+    }
     let bounds: Vec<Bounds> = (0..w.len())
         .map(|i| w.shape[i].bounds(&w.pose(i)))
         .collect();
