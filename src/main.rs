@@ -5,6 +5,7 @@
 //! its own: every answer comes from the library crates.
 
 mod collide;
+mod diff;
 mod record;
 mod run;
 mod scene;
@@ -52,6 +53,29 @@ enum Command {
         #[arg(long, value_name = "N")]
         frames: Option<u64>,
     },
+    /// Compare two logs frame by frame and name the first difference.
+    ///
+    /// Messages are decoded and compared field by field, so compression and chunking don't
+    /// matter. Prints the first divergent frame, topic, body and field with both values, then
+    /// how many messages differ per topic. Exit code: 0 equal (within --tolerance), 1 they
+    /// differ, 2 a file is unreadable or truncated.
+    ///
+    /// Example: ricochet diff recordings/asteroids.mcap asteroids.mcap --topic /bodies
+    Diff {
+        /// The reference log (for example the golden recording).
+        a: PathBuf,
+        /// The log to compare with it.
+        b: PathBuf,
+        /// Numbers within this absolute difference count as equal (default: exact).
+        #[arg(long, default_value_t = 0.0, value_name = "X")]
+        tolerance: f64,
+        /// Compare only this topic (/bodies, /contacts, /stats, /events, /scene).
+        #[arg(long, value_name = "T")]
+        topic: Option<String>,
+        /// Print the report as JSON.
+        #[arg(long)]
+        json: bool,
+    },
     /// Check a scenario file without running it: syntax, units, layers, templates, script.
     ///
     /// Errors are printed as FILE:LINE:COLUMN: FIELD: PROBLEM, with exit code 2.
@@ -94,6 +118,13 @@ fn main() -> ExitCode {
             frames,
         } => run::run(scenario.as_deref(), output, frames),
         Command::Check { scenario } => run::check(&scenario),
+        Command::Diff {
+            a,
+            b,
+            tolerance,
+            topic,
+            json,
+        } => diff::run(&a, &b, tolerance, topic.as_deref(), json),
     };
     match result {
         Ok(code) => code,

@@ -4,5 +4,6 @@
 mod bad_scenarios;
 mod collide_cli;
 mod collision_cases;
+mod golden;
 mod run_cli;
 mod util;

@@ -148,6 +148,35 @@ impl World {
         ricochet_geom::Pose::new(self.position[i], self.angle[i])
     }
 
+    /// A 64-bit FNV-1a hash of every body's raw state bits in id order (entity, position,
+    /// angle, velocity, angular velocity), like Box2D's determinism test: any change of any
+    /// bit anywhere changes it.
+    #[must_use]
+    pub fn digest(&self) -> u64 {
+        const PRIME: u64 = 0x0000_0100_0000_01b3;
+        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+        let mut eat = |bits: u64| {
+            for byte in bits.to_le_bytes() {
+                h ^= u64::from(byte);
+                h = h.wrapping_mul(PRIME);
+            }
+        };
+        for i in 0..self.len() {
+            eat(u64::from(self.entity[i].index) << 32 | u64::from(self.entity[i].generation));
+            for v in [
+                self.position[i].x,
+                self.position[i].y,
+                self.angle[i],
+                self.velocity[i].x,
+                self.velocity[i].y,
+                self.angular_velocity[i],
+            ] {
+                eat(v.to_bits());
+            }
+        }
+        h
+    }
+
     /// Kinetic energy of the dynamic bodies, `sum(m v² / 2)` (translation only).
     #[must_use]
     pub fn kinetic_energy(&self) -> f64 {

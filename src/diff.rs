@@ -1,0 +1,352 @@
+//! `ricochet diff A.mcap B.mcap`: compare two logs message by message, decoded, so chunking
+//! and compression never matter. Reports the first divergent frame, topic, body and field
+//! with both values, then how many messages differ per topic.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::process::ExitCode;
+
+use ricochet_log::{LogMessage, read_log_file};
+use serde::Serialize;
+use serde_json::Value;
+
+/// Topics in the order a report names them when several differ at the same time: the
+/// plain state first, the drawing last.
+const TOPIC_ORDER: [&str; 5] = ["/bodies", "/contacts", "/stats", "/events", "/scene"];
+
+/// The first difference found.
+#[derive(Serialize, Debug)]
+pub struct Divergence {
+    /// Topic.
+    pub topic: String,
+    /// Log time of the message, nanoseconds.
+    pub time_ns: u64,
+    /// The message's `frame` field, when it has one.
+    pub frame: Option<u64>,
+    /// The body the difference is in, when it is inside a list of bodies.
+    pub body: Option<String>,
+    /// Path of the field inside the message (`bodies[id=4].velocity[0]`).
+    pub field: String,
+    /// The value in A (JSON), or a note such as `missing`.
+    pub a: String,
+    /// The value in B.
+    pub b: String,
+}
+
+/// Per-topic counts.
+#[derive(Serialize, Debug, Default)]
+pub struct TopicCount {
+    /// Messages in A.
+    pub messages_a: usize,
+    /// Messages in B.
+    pub messages_b: usize,
+    /// Messages that differ (by position in the topic), plus those only one log has.
+    pub differing: usize,
+}
+
+/// The whole comparison.
+#[derive(Serialize, Debug)]
+pub struct Report {
+    /// Whether the logs are equal (within the tolerance).
+    pub equal: bool,
+    /// The absolute tolerance numbers were compared with.
+    pub tolerance: f64,
+    /// The earliest difference, by log time, then topic order.
+    pub first: Option<Divergence>,
+    /// Counts per topic.
+    pub topics: BTreeMap<String, TopicCount>,
+}
+
+/// Compares two JSON values; returns the first differing path with both values.
+fn compare(
+    a: &Value,
+    b: &Value,
+    tol: f64,
+    path: &mut String,
+    body: &mut Option<String>,
+) -> Option<(String, String, String)> {
+    match (a, b) {
+        (Value::Number(x), Value::Number(y)) => {
+            let (x, y) = (
+                x.as_f64().unwrap_or(f64::NAN),
+                y.as_f64().unwrap_or(f64::NAN),
+            );
+            let same = if tol == 0.0 {
+                x == y
+            } else {
+                (x - y).abs() <= tol
+            };
+            (!same).then(|| (path.clone(), a.to_string(), b.to_string()))
+        }
+        (Value::Object(x), Value::Object(y)) => {
+            for (k, va) in x {
+                let len = path.len();
+                if !path.is_empty() {
+                    path.push('.');
+                }
+                path.push_str(k);
+                let found = match y.get(k) {
+                    None => Some((path.clone(), va.to_string(), "missing".to_owned())),
+                    Some(vb) => compare(va, vb, tol, path, body),
+                };
+                if found.is_some() {
+                    return found;
+                }
+                path.truncate(len);
+            }
+            y.keys().find(|k| !x.contains_key(*k)).map(|k| {
+                (
+                    format!("{path}.{k}"),
+                    "missing".to_owned(),
+                    y[k].to_string(),
+                )
+            })
+        }
+        (Value::Array(x), Value::Array(y)) => compare_arrays(x, y, tol, path, body),
+        _ => (a != b).then(|| (path.clone(), a.to_string(), b.to_string())),
+    }
+}
+
+/// The `id` of a list element that is an object with one (bodies in `/bodies`).
+fn id_of(v: &Value) -> Option<u64> {
+    v.get("id").and_then(Value::as_u64)
+}
+
+fn label(v: &Value) -> String {
+    match (id_of(v), v.get("name").and_then(Value::as_str)) {
+        (Some(id), Some(name)) => format!("{id} ({name})"),
+        (Some(id), None) => id.to_string(),
+        _ => String::new(),
+    }
+}
+
+fn compare_arrays(
+    x: &[Value],
+    y: &[Value],
+    tol: f64,
+    path: &mut String,
+    body: &mut Option<String>,
+) -> Option<(String, String, String)> {
+    // Lists of bodies are matched by id, so one extra body is reported as that body, not as
+    // every later element shifted by one.
+    let by_id = x.iter().chain(y).all(|v| id_of(v).is_some()) && !x.is_empty() && !y.is_empty();
+    if by_id {
+        let ys: BTreeMap<u64, &Value> = y.iter().filter_map(|v| id_of(v).map(|i| (i, v))).collect();
+        for va in x {
+            let id = id_of(va).unwrap_or_default();
+            let len = path.len();
+            path.push_str(&format!("[id={id}]"));
+            let found = match ys.get(&id) {
+                None => Some((path.clone(), va.to_string(), "missing".to_owned())),
+                Some(vb) => compare(va, vb, tol, path, body),
+            };
+            if found.is_some() {
+                *body = Some(label(va));
+                return found;
+            }
+            path.truncate(len);
+        }
+        let xs: Vec<u64> = x.iter().filter_map(id_of).collect();
+        return y
+            .iter()
+            .find(|v| !xs.contains(&id_of(v).unwrap_or_default()))
+            .map(|vb| {
+                *body = Some(label(vb));
+                (
+                    format!("{path}[id={}]", id_of(vb).unwrap_or_default()),
+                    "missing".to_owned(),
+                    vb.to_string(),
+                )
+            });
+    }
+    for (i, (va, vb)) in x.iter().zip(y).enumerate() {
+        let len = path.len();
+        path.push_str(&format!("[{i}]"));
+        if let Some(found) = compare(va, vb, tol, path, body) {
+            if body.is_none() && !label(va).is_empty() {
+                *body = Some(label(va));
+            }
+            return Some(found);
+        }
+        path.truncate(len);
+    }
+    (x.len() != y.len()).then(|| {
+        (
+            format!("{path}.length"),
+            x.len().to_string(),
+            y.len().to_string(),
+        )
+    })
+}
+
+fn first_in_message(topic: &str, a: &LogMessage, b: &LogMessage, tol: f64) -> Option<Divergence> {
+    let mut path = String::new();
+    let mut body = None;
+    let time_differs = a.log_time != b.log_time;
+    let found = if time_differs {
+        Some((
+            "log_time".to_owned(),
+            a.log_time.to_string(),
+            b.log_time.to_string(),
+        ))
+    } else {
+        compare(&a.data, &b.data, tol, &mut path, &mut body)
+    };
+    found.map(|(field, va, vb)| Divergence {
+        topic: topic.to_owned(),
+        time_ns: a.log_time.min(b.log_time),
+        frame: a.data.get("frame").and_then(Value::as_u64),
+        body,
+        field,
+        a: va,
+        b: vb,
+    })
+}
+
+fn by_topic(log: &[LogMessage]) -> BTreeMap<&str, Vec<&LogMessage>> {
+    let mut map: BTreeMap<&str, Vec<&LogMessage>> = BTreeMap::new();
+    for m in log {
+        map.entry(m.topic.as_str()).or_default().push(m);
+    }
+    map
+}
+
+fn rank(topic: &str) -> usize {
+    TOPIC_ORDER
+        .iter()
+        .position(|t| *t == topic)
+        .unwrap_or(TOPIC_ORDER.len())
+}
+
+/// Compares two decoded logs.
+pub fn diff_logs(a: &[LogMessage], b: &[LogMessage], tol: f64, only: Option<&str>) -> Report {
+    let (ta, tb) = (by_topic(a), by_topic(b));
+    let mut topics = BTreeMap::new();
+    let mut first: Option<Divergence> = None;
+    let names: std::collections::BTreeSet<&str> = ta.keys().chain(tb.keys()).copied().collect();
+    for topic in names {
+        if only.is_some_and(|t| t != topic) {
+            continue;
+        }
+        let (ma, mb) = (
+            ta.get(topic).cloned().unwrap_or_default(),
+            tb.get(topic).cloned().unwrap_or_default(),
+        );
+        let mut count = TopicCount {
+            messages_a: ma.len(),
+            messages_b: mb.len(),
+            differing: ma.len().abs_diff(mb.len()),
+        };
+        let mut topic_first = None;
+        for (x, y) in ma.iter().zip(&mb) {
+            if let Some(d) = first_in_message(topic, x, y, tol) {
+                count.differing += 1;
+                if topic_first.is_none() {
+                    topic_first = Some(d);
+                }
+            }
+        }
+        if topic_first.is_none() && ma.len() != mb.len() {
+            let n = ma.len().min(mb.len());
+            let extra = ma.get(n).or(mb.get(n));
+            topic_first = extra.map(|m| Divergence {
+                topic: topic.to_owned(),
+                time_ns: m.log_time,
+                frame: m.data.get("frame").and_then(Value::as_u64),
+                body: None,
+                field: "message count".to_owned(),
+                a: ma.len().to_string(),
+                b: mb.len().to_string(),
+            });
+        }
+        if let Some(d) = topic_first {
+            let earlier = first
+                .as_ref()
+                .is_none_or(|f| (d.time_ns, rank(&d.topic)) < (f.time_ns, rank(&f.topic)));
+            if earlier {
+                first = Some(d);
+            }
+        }
+        topics.insert(topic.to_owned(), count);
+    }
+    Report {
+        equal: first.is_none(),
+        tolerance: tol,
+        first,
+        topics,
+    }
+}
+
+/// `ricochet diff`.
+pub fn run(
+    a: &Path,
+    b: &Path,
+    tolerance: f64,
+    topic: Option<&str>,
+    json: bool,
+) -> anyhow::Result<ExitCode> {
+    let read = |p: &Path| {
+        read_log_file(p).map_err(|e| {
+            eprintln!("error: {}: {e}", p.display());
+            ExitCode::from(2)
+        })
+    };
+    let (la, lb) = match (read(a), read(b)) {
+        (Ok(x), Ok(y)) => (x, y),
+        (Err(code), _) | (_, Err(code)) => return Ok(code),
+    };
+    if !(tolerance.is_finite() && tolerance >= 0.0) {
+        eprintln!("error: --tolerance must be a finite number >= 0, got {tolerance}");
+        return Ok(ExitCode::from(2));
+    }
+    let report = diff_logs(&la, &lb, tolerance, topic);
+    if json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        print!("{}", render(&report, a, b));
+    }
+    Ok(if report.equal {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
+}
+
+/// The human-readable report.
+pub fn render(report: &Report, a: &Path, b: &Path) -> String {
+    let mut s = String::new();
+    match &report.first {
+        None => {
+            s += &format!(
+                "{} and {} are equal{}\n",
+                a.display(),
+                b.display(),
+                if report.tolerance > 0.0 {
+                    format!(" within {}", report.tolerance)
+                } else {
+                    String::new()
+                }
+            )
+        }
+        Some(d) => {
+            s += &format!("{} and {} differ\n", a.display(), b.display());
+            let frame = d.frame.map_or_else(
+                || format!("t = {} ns", d.time_ns),
+                |f| format!("frame {f} (t = {:.6} s)", d.time_ns as f64 * 1e-9),
+            );
+            s += &format!("first difference: {frame}, topic {}", d.topic);
+            if let Some(body) = &d.body {
+                s += &format!(", body {body}");
+            }
+            s += &format!("\n  field {}\n  A: {}\n  B: {}\n", d.field, d.a, d.b);
+        }
+    }
+    s += "per topic (differing messages / messages in A, B):\n";
+    for (t, c) in &report.topics {
+        s += &format!(
+            "  {t:<10} {:>6} / {}, {}\n",
+            c.differing, c.messages_a, c.messages_b
+        );
+    }
+    s
+}
