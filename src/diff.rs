@@ -113,9 +113,14 @@ fn id_of(v: &Value) -> Option<u64> {
 }
 
 fn label(v: &Value) -> String {
-    match (id_of(v), v.get("name").and_then(Value::as_str)) {
-        (Some(id), Some(name)) => format!("{id} ({name})"),
-        (Some(id), None) => id.to_string(),
+    let pair = (
+        v.get("a").and_then(Value::as_u64),
+        v.get("b").and_then(Value::as_u64),
+    );
+    match (id_of(v), v.get("name").and_then(Value::as_str), pair) {
+        (Some(id), Some(name), _) => format!("{id} ({name})"),
+        (Some(id), None, _) => id.to_string(),
+        (None, _, (Some(a), Some(b))) => format!("pair {a}/{b}"),
         _ => String::new(),
     }
 }
@@ -335,8 +340,10 @@ pub fn render(report: &Report, a: &Path, b: &Path) -> String {
                 |f| format!("frame {f} (t = {:.6} s)", d.time_ns as f64 * 1e-9),
             );
             s += &format!("first difference: {frame}, topic {}", d.topic);
-            if let Some(body) = &d.body {
-                s += &format!(", body {body}");
+            match &d.body {
+                Some(pair) if pair.starts_with("pair ") => s += &format!(", {pair}"),
+                Some(body) => s += &format!(", body {body}"),
+                None => {}
             }
             s += &format!("\n  field {}\n  A: {}\n  B: {}\n", d.field, d.a, d.b);
         }

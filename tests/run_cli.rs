@@ -201,7 +201,9 @@ fn every_logged_contact_is_the_exact_contact_at_its_logged_poses() {
                     "{}: frame {frame}: contact {c} does not match its poses",
                     s.display()
                 );
-                assert!(depth > 0.0, "{c}");
+                // A swept contact is logged at the moment of first touch: depth about zero.
+                let swept = c["phase"] == "swept";
+                assert!(depth > 0.0 || (swept && depth > -1e-6), "{c}");
                 checked += 1;
             }
         }

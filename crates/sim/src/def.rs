@@ -168,6 +168,11 @@ pub struct Layers {
     /// `matrix[a * n + b]`: the response when a body of layer `a` meets one of layer `b`,
     /// with `Doomed` relative to `(a, b)`.
     matrix: Vec<Response>,
+    /// `sweep[a * n + b]`: whether the pair is tested along the frame's whole motion (time
+    /// of impact) instead of only at the end of it.
+    sweep: Vec<bool>,
+    /// Layers whose bodies move further than their size in a frame (bullets).
+    fast: Vec<bool>,
 }
 
 impl Layers {
@@ -178,7 +183,42 @@ impl Layers {
         Layers {
             names,
             matrix: vec![Response::Ignore; n * n],
+            sweep: vec![false; n * n],
+            fast: vec![false; n],
         }
+    }
+
+    /// Marks a layer as fast: every pair it is in is swept unless its `[[collide]]` entry says
+    /// otherwise (call before [`Layers::set_sweep`]).
+    pub fn set_fast(&mut self, layer: LayerId) {
+        let n = self.names.len();
+        let l = usize::from(layer);
+        self.fast[l] = true;
+        for other in 0..n {
+            self.sweep[l * n + other] = true;
+            self.sweep[other * n + l] = true;
+        }
+    }
+
+    /// Whether a layer is fast.
+    #[must_use]
+    pub fn is_fast(&self, layer: LayerId) -> bool {
+        self.fast[usize::from(layer)]
+    }
+
+    /// Chooses swept (time-of-impact) testing for a pair, both ways round.
+    pub fn set_sweep(&mut self, a: LayerId, b: LayerId, sweep: bool) {
+        let n = self.names.len();
+        let (a, b) = (usize::from(a), usize::from(b));
+        self.sweep[a * n + b] = sweep;
+        self.sweep[b * n + a] = sweep;
+    }
+
+    /// Whether a pair is swept.
+    #[must_use]
+    #[inline]
+    pub fn sweeps(&self, a: LayerId, b: LayerId) -> bool {
+        self.sweep[usize::from(a) * self.names.len() + usize::from(b)]
     }
 
     /// Sets the response of `(a, b)`, and the mirrored one of `(b, a)`.

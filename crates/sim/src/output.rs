@@ -17,6 +17,9 @@ pub enum Phase {
     Y,
     /// The full pass at the frame's final poses.
     All,
+    /// A swept test: the first touch along the frame's motion (time of impact), logged at
+    /// the poses of that moment.
+    Swept,
 }
 
 impl Phase {
@@ -27,6 +30,7 @@ impl Phase {
             Phase::X => "x",
             Phase::Y => "y",
             Phase::All => "all",
+            Phase::Swept => "swept",
         }
     }
 }

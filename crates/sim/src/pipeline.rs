@@ -167,6 +167,10 @@ impl Simulation {
             frame: self.frame,
             ..FrameOutput::default()
         };
+        // Swept tests run from here to wherever the frame's motion ends.
+        self.world
+            .start_position
+            .copy_from_slice(&self.world.position);
         for stage in &STAGES {
             let allowed = self.frame > 0 || FRAME_ZERO.contains(&stage.name);
             if allowed && (stage.has_work)(self) {

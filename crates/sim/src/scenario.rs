@@ -312,6 +312,19 @@ fn layers(ctx: &Ctx<'_>, raw: &ScenarioFile) -> Result<Layers, ScenarioError> {
         names.push(n.get_ref().clone());
     }
     let mut layers = Layers::new(names);
+    for (i, f) in raw.fast_layers.iter().enumerate() {
+        let Some(id) = layers.id(f.get_ref()) else {
+            return Err(unknown(
+                ctx,
+                f.span(),
+                format!("fast_layers[{i}]"),
+                "layer",
+                f.get_ref(),
+                layers.names().iter(),
+            ));
+        };
+        layers.set_fast(id);
+    }
     let mut seen = Vec::new();
     for (i, c) in raw.collide.iter().enumerate() {
         let field = format!("collide[{i}]");
@@ -375,6 +388,9 @@ fn layers(ctx: &Ctx<'_>, raw: &ScenarioFile) -> Result<Layers, ScenarioError> {
             }
         };
         layers.set(a, b, response);
+        if let Some(sweep) = r.sweep {
+            layers.set_sweep(a, b, sweep);
+        }
     }
     Ok(layers)
 }

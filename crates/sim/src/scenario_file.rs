@@ -25,6 +25,10 @@ pub struct ScenarioFile {
     pub world: WorldFile,
     /// Layer names, in order; a body's `layer` must be one of them.
     pub layers: Spanned<Vec<Spanned<String>>>,
+    /// Layers whose bodies move further than their own size in a frame (bullets): their
+    /// pairs are swept (time of impact) unless a `[[collide]]` entry says `sweep = false`.
+    #[serde(default)]
+    pub fast_layers: Vec<Spanned<String>>,
     /// Which layer pairs interact and how. Unlisted pairs are ignored.
     #[serde(default)]
     pub collide: Vec<Spanned<CollideFile>>,
@@ -74,6 +78,9 @@ pub struct CollideFile {
     pub response: String,
     /// For `destroy`: which body goes, `a`, `b` or `both` (default `both`).
     pub destroy: Option<String>,
+    /// Test along the whole frame's motion (time of impact) rather than at its end only
+    /// (default: true when either layer is in `fast_layers`).
+    pub sweep: Option<bool>,
 }
 
 /// A body or a template. Every field is optional in a template; a body takes its template's

@@ -40,6 +40,8 @@ pub struct World {
     pub mass: Vec<f64>,
     /// Position.
     pub position: Vec<Vec2>,
+    /// Position at the start of the current frame (where a swept test starts).
+    pub start_position: Vec<Vec2>,
     /// Angle, radians.
     pub angle: Vec<f64>,
     /// Velocity.
@@ -104,6 +106,7 @@ impl World {
         self.kind.insert(i, def.kind);
         self.mass.insert(i, def.mass);
         self.position.insert(i, def.position);
+        self.start_position.insert(i, def.position);
         self.angle.insert(i, def.angle);
         let moves = def.kind != BodyKind::Static;
         self.velocity
@@ -130,6 +133,7 @@ impl World {
         self.kind.remove(i);
         self.mass.remove(i);
         self.position.remove(i);
+        self.start_position.remove(i);
         self.angle.remove(i);
         self.velocity.remove(i);
         self.angular_velocity.remove(i);

@@ -10,8 +10,14 @@
 //! - `destroy`: the doomed bodies are removed after the pass (children of a split spawned);
 //! - `separate`: the dynamic body is pushed out along the normal by the depth (two dynamic
 //!   bodies half each), and its velocity into the other is removed.
+//!
+//! Swept pairs (a layer in `fast_layers`, or `sweep = true` on the `[[collide]]` entry;
+//! `report` and `destroy` only) are bounded over the whole frame's motion and tested by time
+//! of impact instead: each moving body's hits are taken in time order and it stops at the
+//! first that destroys it, so a bullet never passes through a rock, and hits the first one
+//! on its path. Rotation during the frame is not swept (the end angles are used).
 
-use ricochet_geom::{Bounds, Vec2, contact};
+use ricochet_geom::{Bounds, Contact, Pose, Vec2, contact};
 
 use crate::def::{BodyKind, Doomed, Response};
 use crate::entity::Entity;
@@ -50,11 +56,25 @@ pub(crate) fn run(sim: &mut Simulation, out: &mut FrameOutput) {
     if sim.capture_detect_poses {
         out.detect_poses = Some((0..w.len()).map(|i| (w.entity[i], w.pose(i))).collect());
     }
+    // A body in a swept pair is bounded over its whole motion this frame, so the broad phase
+    // sees a bullet that went right through something.
+    let sweeping: Vec<bool> = (0..layers.names().len())
+        .map(|l| (0..layers.names().len()).any(|m| layers.sweeps(l as u8, m as u8)))
+        .collect();
     let bounds: Vec<Bounds> = (0..w.len())
-        .map(|i| w.shape[i].bounds(&w.pose(i)))
+        .map(|i| {
+            let b = w.shape[i].bounds(&w.pose(i));
+            let moved = w.start_position[i] - w.position[i];
+            if sweeping[usize::from(w.layer[i])] && moved != Vec2::ZERO {
+                b.union(b.translated(moved))
+            } else {
+                b
+            }
+        })
         .collect();
     let pairs = sweep(&bounds);
     let mut doomed: Vec<(Entity, String)> = Vec::new();
+    let mut swept: Vec<(usize, usize)> = Vec::new();
     for (i, j) in pairs {
         let w = &sim.world;
         if w.kind[i] != BodyKind::Dynamic && w.kind[j] != BodyKind::Dynamic {
@@ -69,12 +89,16 @@ pub(crate) fn run(sim: &mut Simulation, out: &mut FrameOutput) {
             continue;
         }
         out.stats.broad_pairs += 1;
-        out.stats.narrow_tests += 1;
         let (la, lb) = (w.layer[i].min(w.layer[j]), w.layer[i].max(w.layer[j]));
         *out.stats
             .tests_by_layer_pair
             .entry(format!("{}/{}", layers.name(la), layers.name(lb)))
             .or_default() += 1;
+        if response != Response::Separate && layers.sweeps(w.layer[i], w.layer[j]) {
+            swept.push((i, j));
+            continue;
+        }
+        out.stats.narrow_tests += 1;
         let (pose_a, pose_b) = (w.pose(i), w.pose(j));
         let c = contact(&w.shape[i], &pose_a, &w.shape[j], &pose_b);
         let threshold = if response == Response::Separate {
@@ -85,55 +109,185 @@ pub(crate) fn run(sim: &mut Simulation, out: &mut FrameOutput) {
         if c.depth <= threshold {
             continue;
         }
-        let mut resolved = Vec2::ZERO;
-        let (ea, eb) = (w.entity[i], w.entity[j]);
-        let (na, nb) = (w.name[i].clone(), w.name[j].clone());
-        match response {
-            Response::Ignore => {}
-            Response::Report => out.events.push(EventRecord {
-                kind: "contact",
-                message: format!("{na} #{ea} touches {nb} #{eb}, depth {}", c.depth),
-            }),
-            Response::Destroy(which) => {
-                let why = format!("hit by {nb} #{eb}");
-                let why_b = format!("hit by {na} #{ea}");
-                if matches!(which, Doomed::First | Doomed::Both) {
-                    doomed.push((ea, why));
-                }
-                if matches!(which, Doomed::Second | Doomed::Both) {
-                    doomed.push((eb, why_b));
-                }
-            }
-            Response::Separate => {
-                resolved = separate_along_normal(sim, i, j, c.normal, c.depth);
-                let w = &sim.world;
-                out.events.push(EventRecord {
-                    kind: "hit",
-                    message: format!(
-                        "{} #{ea} and {} #{eb} pushed apart by {}",
-                        w.name[i], w.name[j], c.depth
-                    ),
-                });
-            }
-        }
-        out.contacts.push(ContactRecord {
-            a: ea,
-            b: eb,
-            phase: Phase::All,
-            normal: c.normal,
-            depth: c.depth,
-            point: c.point,
-            pose_a,
-            pose_b,
+        respond(
+            sim,
+            out,
+            &mut doomed,
+            (i, j),
             response,
-            resolved,
-        });
+            Phase::All,
+            c,
+            (pose_a, pose_b),
+        );
     }
+    run_swept(sim, out, &mut doomed, &swept, &layers);
     doomed.sort();
     doomed.dedup_by_key(|(e, _)| *e);
     for (e, why) in doomed {
         remove(sim, out, e, "destroy", &why, true);
     }
+}
+
+/// Swept pairs: each pair's first touch along the frame's motion, then, per moving body,
+/// its hits in time order, stopping at the first hit that destroys it. So a bullet hits the
+/// first rock on its path and no other, however fast it goes.
+fn run_swept(
+    sim: &mut Simulation,
+    out: &mut FrameOutput,
+    doomed: &mut Vec<(Entity, String)>,
+    swept: &[(usize, usize)],
+    layers: &crate::Layers,
+) {
+    struct Hit {
+        mover: Entity,
+        toi: f64,
+        pair: (usize, usize),
+        contact: Contact,
+        poses: (Pose, Pose),
+    }
+    let mut hits = Vec::new();
+    for &(i, j) in swept {
+        out.stats.narrow_tests += 1;
+        let w = &sim.world;
+        if let Some((toi, contact, poses)) = time_of_impact(w, i, j) {
+            // The mover is the body that went further: a bullet against a drifting rock.
+            let travel = |k: usize| (w.position[k] - w.start_position[k]).length();
+            let mover = if travel(j) > travel(i) {
+                w.entity[j]
+            } else {
+                w.entity[i]
+            };
+            hits.push(Hit {
+                mover,
+                toi,
+                pair: (i, j),
+                contact,
+                poses,
+            });
+        }
+    }
+    // Per mover, earliest first; ties by the pair's ids (dense order is id order).
+    hits.sort_by(|a, b| {
+        a.mover
+            .cmp(&b.mover)
+            .then(a.toi.total_cmp(&b.toi))
+            .then(a.pair.cmp(&b.pair))
+    });
+    let mut spent: Vec<Entity> = Vec::new();
+    for hit in hits {
+        if spent.contains(&hit.mover) {
+            continue;
+        }
+        let w = &sim.world;
+        let response = layers.response(w.layer[hit.pair.0], w.layer[hit.pair.1]);
+        let before = doomed.len();
+        respond(
+            sim,
+            out,
+            doomed,
+            hit.pair,
+            response,
+            Phase::Swept,
+            hit.contact,
+            hit.poses,
+        );
+        if doomed[before..].iter().any(|(e, _)| *e == hit.mover) {
+            spent.push(hit.mover);
+        }
+    }
+}
+
+/// How close a swept test must get, relative to the smaller shape's size.
+const TOI_TOLERANCE: f64 = 1e-9;
+
+/// The first moment in `[0, 1]` of this frame's motion (both bodies moving in straight
+/// lines from their start to their end positions, at their end angles) when bodies `i` and
+/// `j` touch, by conservative advancement: the exact distance divided by the relative
+/// speed is a step that can never jump past the first touch. Returns the time, the contact
+/// there and the two poses.
+fn time_of_impact(w: &crate::World, i: usize, j: usize) -> Option<(f64, Contact, (Pose, Pose))> {
+    let (si, sj) = (w.start_position[i], w.start_position[j]);
+    let (di, dj) = (w.position[i] - si, w.position[j] - sj);
+    let speed = (di - dj).length();
+    let size = |k: usize| w.shape[k].bounds(&w.pose(k)).half_extents().length();
+    let tol = TOI_TOLERANCE * size(i).min(size(j));
+    let at = |t: f64| {
+        let pa = Pose::new(si + di * t, w.angle[i]);
+        let pb = Pose::new(sj + dj * t, w.angle[j]);
+        (contact(&w.shape[i], &pa, &w.shape[j], &pb), (pa, pb))
+    };
+    let mut t = 0.0;
+    for _ in 0..100 {
+        let (c, poses) = at(t);
+        if c.depth > -tol {
+            return Some((t, c, poses));
+        }
+        if speed == 0.0 {
+            return None;
+        }
+        t += -c.depth / speed;
+        if t > 1.0 {
+            return None;
+        }
+    }
+    // A grazing approach converges slowly: fall back to the end of the frame.
+    let (c, poses) = at(1.0);
+    (c.depth > 0.0).then_some((1.0, c, poses))
+}
+
+/// Records a contact and applies its response.
+#[expect(
+    clippy::too_many_arguments,
+    reason = "one call site per pass; a struct would only rename them"
+)]
+fn respond(
+    sim: &mut Simulation,
+    out: &mut FrameOutput,
+    doomed: &mut Vec<(Entity, String)>,
+    (i, j): (usize, usize),
+    response: Response,
+    phase: Phase,
+    c: Contact,
+    (pose_a, pose_b): (Pose, Pose),
+) {
+    let w = &sim.world;
+    let mut resolved = Vec2::ZERO;
+    let (ea, eb) = (w.entity[i], w.entity[j]);
+    let (na, nb) = (w.name[i].clone(), w.name[j].clone());
+    match response {
+        Response::Ignore => {}
+        Response::Report => out.events.push(EventRecord {
+            kind: "contact",
+            message: format!("{na} #{ea} touches {nb} #{eb}, depth {}", c.depth),
+        }),
+        Response::Destroy(which) => {
+            if matches!(which, Doomed::First | Doomed::Both) {
+                doomed.push((ea, format!("hit by {nb} #{eb}")));
+            }
+            if matches!(which, Doomed::Second | Doomed::Both) {
+                doomed.push((eb, format!("hit by {na} #{ea}")));
+            }
+        }
+        Response::Separate => {
+            resolved = separate_along_normal(sim, i, j, c.normal, c.depth);
+            out.events.push(EventRecord {
+                kind: "hit",
+                message: format!("{na} #{ea} and {nb} #{eb} pushed apart by {}", c.depth),
+            });
+        }
+    }
+    out.contacts.push(ContactRecord {
+        a: ea,
+        b: eb,
+        phase,
+        normal: c.normal,
+        depth: c.depth,
+        point: c.point,
+        pose_a,
+        pose_b,
+        response,
+        resolved,
+    });
 }
 
 /// Pushes the dynamic body (or both, half each) apart along `normal` (from `i` to `j`), and

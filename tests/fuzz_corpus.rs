@@ -1,0 +1,90 @@
+//! The fuzz corpus, replayed as an ordinary test. Every input the `cargo fuzz` targets have
+//! kept (`fuzz/corpus/<target>/`) and every crash they found (`fuzz/regressions/<target>/`) is
+//! run through the very checks the targets run: `fuzz/src/checks.rs`, included here, so the
+//! two can't drift apart. Any input at all must give an error or a result, never a panic.
+//! How to fuzz, and what was found: `fuzz/README.md`.
+
+use std::any::Any;
+use std::path::PathBuf;
+use std::time::Instant;
+
+use crate::util::root;
+
+#[path = "../fuzz/src/checks.rs"]
+mod checks;
+
+/// Every file of `fuzz/corpus/<target>/` and `fuzz/regressions/<target>/`, sorted, and how
+/// many of them came from the corpus.
+fn inputs(target: &str) -> (Vec<PathBuf>, usize) {
+    let mut corpus = 0;
+    let mut files = Vec::new();
+    for dir in ["corpus", "regressions"] {
+        let dir = root().join("fuzz").join(dir).join(target);
+        let Ok(entries) = std::fs::read_dir(&dir) else {
+            continue;
+        };
+        let mut found: Vec<PathBuf> = entries
+            .map(|e| e.expect("the corpus directory can be listed").path())
+            .filter(|p| p.is_file())
+            .collect();
+        found.sort();
+        if dir.ends_with(format!("corpus/{target}")) {
+            corpus = found.len();
+        }
+        files.extend(found);
+    }
+    (files, corpus)
+}
+
+fn message(payload: &(dyn Any + Send)) -> &str {
+    payload
+        .downcast_ref::<String>()
+        .map(String::as_str)
+        .or_else(|| payload.downcast_ref::<&str>().copied())
+        .unwrap_or("(a panic without a message)")
+}
+
+/// Runs `check` on every input of `target`, as the fuzz target does (non-UTF-8 inputs are
+/// skipped there too), and fails naming each input that panicked.
+fn replay(target: &str, check: fn(&str)) {
+    let start = Instant::now();
+    let (files, corpus) = inputs(target);
+    assert!(
+        corpus > 0,
+        "fuzz/corpus/{target}/ holds the committed corpus: run it from a checkout"
+    );
+    let mut failures = Vec::new();
+    for path in &files {
+        let bytes = std::fs::read(path).expect("a corpus file can be read");
+        let Ok(text) = std::str::from_utf8(&bytes) else {
+            continue;
+        };
+        if let Err(payload) = std::panic::catch_unwind(|| check(text)) {
+            let name = path.strip_prefix(root()).unwrap_or(path);
+            failures.push(format!("{}: {}", name.display(), message(&*payload)));
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "{} of {} fuzz inputs panicked (replay one with `cargo +nightly fuzz run {target} FILE` \
+         in fuzz/):\n{}",
+        failures.len(),
+        files.len(),
+        failures.join("\n")
+    );
+    eprintln!(
+        "{target}: {} inputs replayed in {:.2?}",
+        files.len(),
+        start.elapsed()
+    );
+}
+
+#[test]
+fn scenario_corpus_gives_errors_or_results() {
+    replay("scenario", checks::scenario);
+}
+
+#[test]
+fn collide_corpus_gives_errors_or_results() {
+    replay("collide", checks::collide);
+}
