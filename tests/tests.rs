@@ -6,4 +6,5 @@ mod collide_cli;
 mod collision_cases;
 mod golden;
 mod run_cli;
+mod stress;
 mod util;

@@ -4,8 +4,9 @@
 //! checked against the other boxes it may not overlap. Where two overlap by more than
 //! [`SLOP`] on both axes, the dynamic one is pushed out along the moved axis by the smaller of
 //! the two overlaps on that axis, its velocity into the obstacle on that axis is zeroed, and a
-//! `hit_x`/`hit_y` event is raised. A push upwards sets `grounded`. Two dynamic boxes share
-//! the push, half each. Only boxes (a single AABB) are resolved per axis; every other shape in
+//! `hit_x`/`hit_y` event is raised. A push upwards sets `grounded`. Dynamic boxes settle
+//! lowest (leftmost) first, and a settled box is solid to the rest, so stacks resolve
+//! bottom-up in one pass. Only boxes (a single AABB) are resolved per axis; every other shape in
 //! a `separate` pair is pushed along the contact normal by the `detect` stage.
 
 use ricochet_geom::{Bounds, Primitive, Shape, Vec2, contact};
@@ -53,18 +54,29 @@ fn resolve(sim: &mut Simulation, out: &mut FrameOutput, axis: usize) {
     let phase = if axis == 0 { Phase::X } else { Phase::Y };
     let layers = sim.scenario.world.layers.clone();
     let n = sim.world.len();
-    for i in 0..n {
-        let w = &sim.world;
-        if w.kind[i] != BodyKind::Dynamic || !is_box(&w.shape[i]) {
-            continue;
-        }
+    // Dynamic boxes settle in order along the axis, lowest (or leftmost) first, and a settled
+    // box is solid to the ones after it: a stack resolves bottom-up in one pass, each box
+    // landing flush on the one below, with no box pushed back into what held it.
+    let mut order: Vec<usize> = (0..n)
+        .filter(|&i| sim.world.kind[i] == BodyKind::Dynamic && is_box(&sim.world.shape[i]))
+        .collect();
+    let w = &sim.world;
+    let low = |i: usize| w.shape[i].bounds(&w.pose(i)).min[axis];
+    order.sort_by(|&p, &q| low(p).total_cmp(&low(q)).then(p.cmp(&q)));
+    let mut settled = vec![false; n];
+    let first = out.contacts.len();
+    for i in order {
+        #[expect(
+            clippy::needless_range_loop,
+            reason = "j indexes a dozen columns, and `settled` changes between rounds of i"
+        )]
         for j in 0..n {
             let w = &sim.world;
             if j == i
                 || !is_box(&w.shape[j])
                 || layers.response(w.layer[i], w.layer[j]) != Response::Separate
-                // A pair of dynamic boxes is resolved once, from the lower id.
-                || (w.kind[j] == BodyKind::Dynamic && j < i)
+                // An unsettled dynamic box meets this one when its own turn comes.
+                || (w.kind[j] == BodyKind::Dynamic && !settled[j])
             {
                 continue;
             }
@@ -76,15 +88,10 @@ fn resolve(sim: &mut Simulation, out: &mut FrameOutput, axis: usize) {
             let (a, b) = if i < j { (i, j) } else { (j, i) };
             let (pose_a, pose_b) = (w.pose(a), w.pose(b));
             let c = contact(&w.shape[a], &pose_a, &w.shape[b], &pose_b);
-            let push = push_out(&bi, &bj, axis);
-            let shared = w.kind[j] == BodyKind::Dynamic;
             let mut moved = Vec2::ZERO;
-            moved[axis] = if shared { 0.5 * push } else { push };
+            moved[axis] = push_out(&bi, &bj, axis);
             let w = &mut sim.world;
             apply_push(w, i, axis, moved[axis]);
-            if shared {
-                apply_push(w, j, axis, -moved[axis]);
-            }
             out.contacts.push(ContactRecord {
                 a: w.entity[a],
                 b: w.entity[b],
@@ -110,7 +117,10 @@ fn resolve(sim: &mut Simulation, out: &mut FrameOutput, axis: usize) {
                 ),
             });
         }
+        settled[i] = true;
     }
+    // The log's convention: a pass's contacts sorted by (a, b).
+    out.contacts[first..].sort_by_key(|c| (c.a, c.b));
 }
 
 /// Moves body `i` by `push` along `axis`, stops its motion into the obstacle, and notes
