@@ -4,11 +4,13 @@
 //! (0 success, 1 the run failed, 2 bad input). **Never:** holds physics or geometry logic of
 //! its own: every answer comes from the library crates.
 
+mod accuracy;
 mod collide;
 mod diff;
 mod record;
 mod run;
 mod scene;
+mod validate;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -52,6 +54,28 @@ enum Command {
         /// Steps to run after frame 0 (the initial state). Default: the scenario's `frames`.
         #[arg(long, value_name = "N")]
         frames: Option<u64>,
+        /// Also referee every frame with rapier2d, into a /validation channel, and print the
+        /// summary table; exit code 1 on any unexplained difference.
+        #[arg(long)]
+        validate: bool,
+    },
+    /// Referee a scenario with rapier2d: same shapes, same poses, same motion.
+    ///
+    /// Every logged contact is recomputed by rapier's geometry (parry) at the poses Ricochet
+    /// detected it with; the set of pairs in the full pass is compared with rapier's broad
+    /// and narrow phase; swept hits are cast along the frame's motion; free flight is
+    /// compared with rapier's integrator. Differences that are legitimate (static pairs
+    /// Ricochet never tests, boxes owned by the per-axis passes, bodies pushed earlier in a
+    /// pass, touching within tolerance, ...) are counted per named rule, see
+    /// docs/validation.md. Exit code 1 on any difference no rule explains.
+    ///
+    /// Example: ricochet validate scenarios/validation.toml
+    Validate {
+        /// The scenario file (TOML).
+        scenario: PathBuf,
+        /// Steps after frame 0. Default: the scenario's `frames`.
+        #[arg(long, value_name = "N")]
+        frames: Option<u64>,
     },
     /// Compare two logs frame by frame and name the first difference.
     ///
@@ -75,6 +99,23 @@ enum Command {
         /// Print the report as JSON.
         #[arg(long)]
         json: bool,
+    },
+    /// Measure run time against error on scenes with exact answers, and draw the chart.
+    ///
+    /// Sweeps the timestep (1/30 s to 1/960 s) and substeps over: a projectile under gravity,
+    /// a body on a spring, a circular orbit (energy drift over 10,000 frames), a ball dropping
+    /// onto a floor (landing frame and rest height) and a bullet crossing a field of asteroids
+    /// (the exact set of first hits, swept or not). Prints a table; writes a CSV and an SVG
+    /// chart of error against wall time per simulated second, log scales.
+    ///
+    /// Example: ricochet accuracy --csv docs/accuracy.csv --svg docs/accuracy.svg
+    Accuracy {
+        /// Write the table as CSV here.
+        #[arg(long, value_name = "FILE")]
+        csv: Option<PathBuf>,
+        /// Write the chart as SVG here.
+        #[arg(long, value_name = "FILE")]
+        svg: Option<PathBuf>,
     },
     /// Check a scenario file without running it: syntax, units, layers, templates, script.
     ///
@@ -109,6 +150,7 @@ fn main() -> ExitCode {
         scenario: None,
         output: None,
         frames: None,
+        validate: false,
     });
     let result = match command {
         Command::Collide { file } => collide::run(&file),
@@ -116,8 +158,11 @@ fn main() -> ExitCode {
             scenario,
             output,
             frames,
-        } => run::run(scenario.as_deref(), output, frames),
+            validate,
+        } => run::run(scenario.as_deref(), output, frames, validate),
+        Command::Validate { scenario, frames } => validate::run(&scenario, frames),
         Command::Check { scenario } => run::check(&scenario),
+        Command::Accuracy { csv, svg } => accuracy::run(csv.as_deref(), svg.as_deref()),
         Command::Diff {
             a,
             b,

@@ -113,6 +113,7 @@ pub struct Recorder {
     contacts: ChannelId,
     stats: ChannelId,
     events: ChannelId,
+    validation: Option<ChannelId>,
 }
 
 impl Recorder {
@@ -136,7 +137,28 @@ impl Recorder {
             contacts,
             stats,
             events,
+            validation: None,
         })
+    }
+
+    /// Adds the `/validation` channel (`ricochet run --validate`).
+    pub fn add_validation_channel(&mut self) -> Result<(), LogError> {
+        let id = self.writer.add_json_channel(
+            "/validation",
+            "ricochet.Validation",
+            crate::validate::SCHEMA,
+        )?;
+        self.validation = Some(id);
+        Ok(())
+    }
+
+    /// Writes the referee's verdict on a frame to `/validation`.
+    pub fn record_validation(&mut self, r: &ricochet_oracle::FrameReport) -> Result<(), LogError> {
+        if let Some(ch) = self.validation {
+            let msg = crate::validate::ValidationMsg::from_report(r);
+            self.writer.write(ch, r.frame * self.dt_ns, &msg)?;
+        }
+        Ok(())
     }
 
     /// Writes one frame on every channel.

@@ -20,7 +20,7 @@ const DEFAULT_NAME: &str = "scenarios/asteroids.toml";
 const PROGRESS_FROM: u64 = 2_000;
 
 /// Reads and checks a scenario, printing the error and returning exit code 2 when bad.
-fn load(path: Option<&Path>) -> Result<Scenario, ExitCode> {
+pub(crate) fn load(path: Option<&Path>) -> Result<Scenario, ExitCode> {
     let (text, name) = match path {
         None => (DEFAULT_SCENARIO.to_owned(), DEFAULT_NAME.to_owned()),
         Some(p) => match std::fs::read_to_string(p) {
@@ -62,6 +62,7 @@ pub fn run(
     path: Option<&Path>,
     output: Option<PathBuf>,
     frames: Option<u64>,
+    validate: bool,
 ) -> anyhow::Result<ExitCode> {
     let scenario = match load(path) {
         Ok(s) => s,
@@ -97,8 +98,17 @@ pub fn run(
         );
         bar
     });
+    let mut validation = if validate {
+        recorder
+            .add_validation_channel()
+            .with_context(|| format!("adding /validation to {}", output.display()))?;
+        Some(crate::validate::Validation::new(&scenario))
+    } else {
+        None
+    };
     let started = Instant::now();
     let mut sim = Simulation::new(&scenario);
+    sim.capture_detect_poses = validate;
     let mut contacts = 0u64;
     let mut peak_bodies = 0usize;
     let mut ran = 0u64;
@@ -112,6 +122,12 @@ pub fn run(
         recorder
             .record(&sim, &out)
             .with_context(|| format!("writing frame {} to {}", out.frame, output.display()))?;
+        if let Some(v) = &mut validation {
+            let report = v.frame(&sim, &out);
+            recorder
+                .record_validation(&report)
+                .with_context(|| format!("writing frame {} to {}", out.frame, output.display()))?;
+        }
         ran += 1;
         if let Some(bar) = &progress {
             bar.inc(1);
@@ -138,5 +154,10 @@ pub fn run(
         ran as f64 / wall.max(1e-9),
         output.display()
     );
+    if let Some(v) = validation
+        && !v.finish(&scenario, stepped)
+    {
+        return Ok(ExitCode::from(1));
+    }
     Ok(ExitCode::SUCCESS)
 }

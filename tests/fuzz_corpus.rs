@@ -1,8 +1,9 @@
 //! The fuzz corpus, replayed as an ordinary test. Every input the `cargo fuzz` targets have
-//! kept (`fuzz/corpus/<target>/`) and every crash they found (`fuzz/regressions/<target>/`) is
-//! run through the very checks the targets run: `fuzz/src/checks.rs`, included here, so the
-//! two can't drift apart. Any input at all must give an error or a result, never a panic.
-//! How to fuzz, and what was found: `fuzz/README.md`.
+//! kept (`fuzz/corpus/<target>/`), every hand-picked seed (`fuzz/seeds/<target>/`) and every
+//! crash they found (`fuzz/regressions/<target>/`) is run through the very checks the targets
+//! run: `fuzz/src/checks.rs`, included here, so the two can't drift apart. Any input at all
+//! must give an error or a result, never a panic. How to fuzz, and what was found:
+//! `fuzz/README.md`.
 
 use std::any::Any;
 use std::path::PathBuf;
@@ -13,22 +14,22 @@ use crate::util::root;
 #[path = "../fuzz/src/checks.rs"]
 mod checks;
 
-/// Every file of `fuzz/corpus/<target>/` and `fuzz/regressions/<target>/`, sorted, and how
-/// many of them came from the corpus.
+/// Every file of `fuzz/{corpus,seeds,regressions}/<target>/`, sorted, and how many of them
+/// came from the corpus.
 fn inputs(target: &str) -> (Vec<PathBuf>, usize) {
     let mut corpus = 0;
     let mut files = Vec::new();
-    for dir in ["corpus", "regressions"] {
-        let dir = root().join("fuzz").join(dir).join(target);
+    for kind in ["corpus", "seeds", "regressions"] {
+        let dir = root().join("fuzz").join(kind).join(target);
         let Ok(entries) = std::fs::read_dir(&dir) else {
             continue;
         };
         let mut found: Vec<PathBuf> = entries
-            .map(|e| e.expect("the corpus directory can be listed").path())
+            .map(|e| e.expect("a fuzz input directory can be listed").path())
             .filter(|p| p.is_file())
             .collect();
         found.sort();
-        if dir.ends_with(format!("corpus/{target}")) {
+        if kind == "corpus" {
             corpus = found.len();
         }
         files.extend(found);

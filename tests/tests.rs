@@ -1,6 +1,7 @@
 //! Ricochet's integration tests: one target, a module per area (ripgrep's layout). Tests that
 //! need the real binary run it through [`util::ricochet`].
 
+mod accuracy;
 mod bad_scenarios;
 mod collide_cli;
 mod collision_cases;
@@ -8,3 +9,4 @@ mod golden;
 mod run_cli;
 mod stress;
 mod util;
+mod validate_cli;

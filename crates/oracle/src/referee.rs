@@ -1,0 +1,558 @@
+//! The per-frame referee: every logged contact recomputed by parry, and the `all` pass's set
+//! of pairs compared with rapier's own broad and narrow phase at the same poses (swept pairs
+//! are in `swept.rs`).
+
+use std::collections::{BTreeMap, BTreeSet};
+
+use rapier2d_f64::prelude::{
+    ActiveCollisionTypes, ActiveHooks, ColliderBuilder, Group, InteractionGroups,
+    InteractionTestMode, PairContacts, PairFilterContext, PhysicsHooks, PhysicsWorld, SolverFlags,
+};
+use ricochet_geom::{Pose, Primitive, Shape, Vec2};
+use ricochet_sim::{
+    BodyKind, ContactRecord, Entity, FrameOutput, LayerId, Layers, Phase, Response, SLOP, Scenario,
+    Simulation,
+};
+
+use crate::convert::{overlap_along, pairing, place, reference_contact, size};
+use crate::{OracleError, Tolerances, rules};
+
+/// What one frame's check found.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FrameReport {
+    /// The frame checked.
+    pub frame: u64,
+    /// Contact records of the frame (all phases) recomputed by parry.
+    pub contacts_compared: u64,
+    /// Differences no rule explains: each has a line in `details`.
+    pub mismatches: u64,
+    /// Largest `|depth_ricochet - depth_rapier|` over the compared contacts, world units.
+    pub worst_depth_error: f64,
+    /// Largest angle between the two normals, radians, over the compared contacts whose
+    /// normals were not explained by [`rules::TIED_NORMAL`].
+    pub worst_normal_error: f64,
+    /// How many differences each named rule explained (see [`rules`]).
+    pub explained: BTreeMap<&'static str, u64>,
+    /// Per rule, the deepest parry depth among the differences it explained, at the poses
+    /// Ricochet tested each pair (shows, for example, that `per-axis-boxes` pairs are flush).
+    pub explained_depth: BTreeMap<&'static str, f64>,
+    /// `all`-pass contacts whose pair rapier's narrow phase also finds penetrating at the
+    /// detect poses.
+    pub pairs_confirmed: u64,
+    /// `swept` contacts that are parry's first touch along the frame's motion.
+    pub swept_confirmed: u64,
+    /// Compared contacts per phase (`x`, `y`, `all`, `swept`).
+    pub by_phase: BTreeMap<&'static str, u64>,
+    /// Compared contacts per shape pairing (`circle-obb`, `aabb-compound`, ...).
+    pub by_pairing: BTreeMap<String, u64>,
+    /// One sentence per unexplained difference.
+    pub details: Vec<String>,
+}
+
+impl FrameReport {
+    pub(crate) fn explain(&mut self, rule: &'static str, depth: f64) {
+        *self.explained.entry(rule).or_default() += 1;
+        let deepest = self
+            .explained_depth
+            .entry(rule)
+            .or_insert(f64::NEG_INFINITY);
+        *deepest = deepest.max(depth);
+    }
+
+    pub(crate) fn mismatch(&mut self, detail: String) {
+        self.mismatches += 1;
+        self.details.push(detail);
+    }
+}
+
+/// What the referee needs of a body that took part in the frame.
+pub(crate) struct Body<'a> {
+    pub(crate) name: &'a str,
+    pub(crate) shape: &'a Shape,
+    pub(crate) kind: BodyKind,
+    pub(crate) layer: LayerId,
+}
+
+/// The body `e` as it was this frame: alive at its end, or removed during it.
+pub(crate) fn body<'a>(sim: &'a Simulation, out: &'a FrameOutput, e: Entity) -> Option<Body<'a>> {
+    if let Some(i) = sim.world.index_of(e) {
+        let w = &sim.world;
+        return Some(Body {
+            name: &w.name[i],
+            shape: &w.shape[i],
+            kind: w.kind[i],
+            layer: w.layer[i],
+        });
+    }
+    out.removed.iter().find(|r| r.entity == e).map(|r| Body {
+        name: &r.name,
+        shape: &r.shape,
+        kind: r.kind,
+        layer: r.layer,
+    })
+}
+
+/// The angle between two unit vectors, radians (`atan2` of cross and dot: accurate near 0).
+fn angle_between(a: Vec2, b: Vec2) -> f64 {
+    libm::atan2(a.perp_dot(b).abs(), a.dot(b))
+}
+
+/// Whether the shape is resolved per axis by Ricochet: a single AABB.
+fn is_box(s: &Shape) -> bool {
+    matches!(s, Shape::Primitive(Primitive::Aabb(_)))
+}
+
+/// Parry's depth of the pair at these poses (`-inf` when further apart than `prediction`).
+pub(crate) fn depth(
+    a: &Shape,
+    pa: &Pose,
+    b: &Shape,
+    pb: &Pose,
+    prediction: f64,
+) -> Result<f64, OracleError> {
+    Ok(reference_contact(a, pa, b, pb, prediction)?.map_or(f64::NEG_INFINITY, |r| r.depth))
+}
+
+/// The depth at which a response starts: `SLOP` for `separate`, 0 otherwise.
+fn threshold(response: Response) -> f64 {
+    if response == Response::Separate {
+        SLOP
+    } else {
+        0.0
+    }
+}
+
+/// Filters rapier's pairs by the layer matrix when it has more layers than rapier has
+/// collision groups (32): the layer id is the collider's `user_data` high half.
+struct LayerHooks<'a> {
+    layers: &'a Layers,
+}
+
+impl PhysicsHooks for LayerHooks<'_> {
+    fn filter_contact_pair(&self, ctx: &PairFilterContext) -> Option<SolverFlags> {
+        let layer = |h| {
+            ctx.colliders
+                .get(h)
+                .and_then(|c| LayerId::try_from(c.user_data >> 64).ok())
+        };
+        let (a, b) = (layer(ctx.collider1)?, layer(ctx.collider2)?);
+        (self.layers.response(a, b) != Response::Ignore).then_some(SolverFlags::default())
+    }
+}
+
+/// Compares Ricochet's frames with rapier's answers at the same poses. See the crate docs
+/// for what is compared and [`rules`] for the differences it explains.
+pub struct Referee {
+    pub(crate) layers: Layers,
+    pub(crate) tol: Tolerances,
+    /// Every body's position at the end of the last frame checked, and that frame: where a
+    /// body removed during the next frame started it.
+    pub(crate) previous: Option<(u64, BTreeMap<Entity, Vec2>)>,
+}
+
+impl Referee {
+    /// A referee for frames of `scenario` (it keeps the layer matrix), judging with `tol`.
+    #[must_use]
+    pub fn new(scenario: &Scenario, tol: Tolerances) -> Referee {
+        Referee {
+            layers: scenario.world.layers.clone(),
+            tol,
+            previous: None,
+        }
+    }
+
+    /// The tolerances this referee judges with.
+    #[must_use]
+    pub fn tolerances(&self) -> Tolerances {
+        self.tol
+    }
+
+    /// Compare one frame: `sim` is the simulation after `step()` returned `out`
+    /// (`out.detect_poses` is `Some` because the caller set `sim.capture_detect_poses`).
+    ///
+    /// 1. Every contact record of every phase is recomputed by parry at the record's own
+    ///    poses; depth and normal must agree within the tolerances.
+    /// 2. The `all` pass's pairs are compared with the pairs rapier's broad and narrow phase
+    ///    find penetrating at the detect poses; each difference must be explained by a
+    ///    named rule ([`rules`]).
+    /// 3. Every pair Ricochet tests by time of impact is cast by parry along the frame's
+    ///    motion: each `swept` record must be parry's first touch, and each touch parry finds
+    ///    must be logged, or explained by a rule.
+    ///
+    /// Call it for every frame in order: a body removed during a frame started it where the
+    /// previous frame's check saw it last.
+    pub fn check_frame(&mut self, sim: &Simulation, out: &FrameOutput) -> FrameReport {
+        let mut report = FrameReport {
+            frame: out.frame,
+            ..FrameReport::default()
+        };
+        for c in &out.contacts {
+            self.check_contact(sim, out, c, &mut report);
+        }
+        match &out.detect_poses {
+            Some(poses) => {
+                let end = self.check_all_pass(sim, out, poses, &mut report);
+                self.check_swept(sim, out, poses, &end, &mut report);
+            }
+            None if out.stats.stages_run.contains(&"detect") => report.mismatch(format!(
+                "frame {}: detect ran but no poses were captured; set \
+                 Simulation::capture_detect_poses",
+                out.frame
+            )),
+            None => {}
+        }
+        self.remember(sim, out.frame);
+        report
+    }
+
+    /// Keeps every body's end-of-frame position for the next frame's swept checks.
+    fn remember(&mut self, sim: &Simulation, frame: u64) {
+        let w = &sim.world;
+        let positions = (0..w.len()).map(|i| (w.entity[i], w.position[i])).collect();
+        self.previous = Some((frame, positions));
+    }
+
+    /// Whether a layer pair is tested by time of impact (`swept`) rather than at the
+    /// detect poses: swept in the matrix, and a `report` or `destroy` response.
+    pub(crate) fn swept(&self, a: LayerId, b: LayerId) -> bool {
+        let r = self.layers.response(a, b);
+        r != Response::Ignore && r != Response::Separate && self.layers.sweeps(a, b)
+    }
+
+    /// The absolute depth tolerance of a pair.
+    pub(crate) fn depth_tol(&self, a: &Shape, b: &Shape) -> f64 {
+        self.tol.depth * size(a).min(size(b))
+    }
+
+    /// Part 1: one contact record against parry at the record's poses.
+    fn check_contact(
+        &self,
+        sim: &Simulation,
+        out: &FrameOutput,
+        c: &ContactRecord,
+        report: &mut FrameReport,
+    ) {
+        let frame = out.frame;
+        let (Some(a), Some(b)) = (body(sim, out, c.a), body(sim, out, c.b)) else {
+            report.mismatch(format!(
+                "frame {frame}: contact #{} #{} names a body that is neither alive nor removed",
+                c.a, c.b
+            ));
+            return;
+        };
+        report.contacts_compared += 1;
+        *report.by_phase.entry(c.phase.name()).or_default() += 1;
+        *report
+            .by_pairing
+            .entry(pairing(a.shape, b.shape))
+            .or_default() += 1;
+        let who = format!(
+            "frame {frame} {} #{} {} / {} #{} {}",
+            a.name,
+            c.a,
+            a.shape_name(),
+            b.name,
+            c.b,
+            b.shape_name()
+        );
+        let tol = self.depth_tol(a.shape, b.shape);
+        let prediction = tol + (-c.depth).max(0.0);
+        let r = match reference_contact(a.shape, &c.pose_a, b.shape, &c.pose_b, prediction) {
+            Ok(Some(r)) => r,
+            Ok(None) => {
+                report.mismatch(format!(
+                    "{who} (phase {}): Ricochet depth {:e}, rapier finds the shapes apart",
+                    c.phase.name(),
+                    c.depth
+                ));
+                return;
+            }
+            Err(e) => {
+                report.mismatch(format!("{who}: {e}"));
+                return;
+            }
+        };
+        let depth_err = (c.depth - r.depth).abs();
+        report.worst_depth_error = report.worst_depth_error.max(depth_err);
+        if depth_err > tol {
+            report.mismatch(format!(
+                "{who} (phase {}): depth {:e} vs rapier {:e} (error {depth_err:e} > {tol:e})",
+                c.phase.name(),
+                c.depth,
+                r.depth
+            ));
+            return;
+        }
+        let normal_err = angle_between(c.normal, r.normal);
+        if normal_err <= self.tol.normal {
+            report.worst_normal_error = report.worst_normal_error.max(normal_err);
+            return;
+        }
+        match tied_normal(
+            a.shape, &c.pose_a, b.shape, &c.pose_b, c.normal, r.depth, tol,
+        ) {
+            Ok(true) => report.explain(rules::TIED_NORMAL, r.depth),
+            Ok(false) => report.mismatch(format!(
+                "{who} (phase {}): normal {} vs rapier {} ({normal_err:e} rad > {:e})",
+                c.phase.name(),
+                c.normal,
+                r.normal,
+                self.tol.normal
+            )),
+            Err(e) => report.mismatch(format!("{who}: {e}")),
+        }
+    }
+
+    /// Part 2: the `all` pass's pairs against rapier's pipeline at the detect poses.
+    ///
+    /// Returns every body's pose at the end of the pass (the detect poses moved by the
+    /// pass's `separate` pushes): where swept tests end.
+    fn check_all_pass(
+        &self,
+        sim: &Simulation,
+        out: &FrameOutput,
+        poses: &[(Entity, Pose)],
+        report: &mut FrameReport,
+    ) -> BTreeMap<Entity, Pose> {
+        let frame = out.frame;
+        let detect: BTreeMap<Entity, Pose> = poses.iter().copied().collect();
+        let found = match self.rapier_pairs(sim, out, poses) {
+            Ok(f) => f,
+            Err(e) => {
+                report.mismatch(format!("frame {frame}: {e}"));
+                return detect;
+            }
+        };
+        // Swept pairs are not tested at the detect poses: `check_swept` owns them.
+        let found: BTreeSet<(Entity, Entity)> = found
+            .into_iter()
+            .filter(
+                |(ea, eb)| match (body(sim, out, *ea), body(sim, out, *eb)) {
+                    (Some(a), Some(b)) => !self.swept(a.layer, b.layer),
+                    _ => true,
+                },
+            )
+            .collect();
+        let logged: BTreeMap<(Entity, Entity), &ContactRecord> = out
+            .contacts
+            .iter()
+            .filter(|c| c.phase == Phase::All)
+            .map(|c| ((c.a, c.b), c))
+            .collect();
+        // Poses as the pass saw them: the detect poses, moved by each `separate` push in
+        // pair order (replayed from the records, so the same floating-point additions).
+        let mut current = detect.clone();
+        let keys: BTreeSet<(Entity, Entity)> = found.iter().chain(logged.keys()).copied().collect();
+        for (ea, eb) in keys {
+            let (Some(a), Some(b)) = (body(sim, out, ea), body(sim, out, eb)) else {
+                report.mismatch(format!(
+                    "frame {frame}: pair #{ea} #{eb} names an unknown body"
+                ));
+                continue;
+            };
+            let (Some(&pa), Some(&pb)) = (current.get(&ea), current.get(&eb)) else {
+                report.mismatch(format!(
+                    "frame {frame}: pair #{ea} #{eb} has no detect pose"
+                ));
+                continue;
+            };
+            let who = format!(
+                "frame {frame} {} #{ea} {} / {} #{eb} {}",
+                a.name,
+                a.shape_name(),
+                b.name,
+                b.shape_name()
+            );
+            let response = self.layers.response(a.layer, b.layer);
+            let tol = self.depth_tol(a.shape, b.shape);
+            let thr = threshold(response);
+            let moved = pa != detect[&ea] || pb != detect[&eb];
+            let in_rapier = found.contains(&(ea, eb));
+            let logged_here = logged.get(&(ea, eb)).copied();
+            if let Some(c) = logged_here
+                && (c.pose_a != pa || c.pose_b != pb)
+            {
+                report.mismatch(format!(
+                    "{who}: logged at poses {:?} {:?}, the replayed pass says {pa:?} {pb:?}",
+                    c.pose_a, c.pose_b
+                ));
+            }
+            if in_rapier && logged_here.is_some() {
+                report.pairs_confirmed += 1;
+            } else {
+                // A difference: parry's depth where Ricochet tested the pair decides.
+                let d = match depth(a.shape, &pa, b.shape, &pb, tol) {
+                    Ok(d) => d,
+                    Err(e) => {
+                        report.mismatch(format!("{who}: {e}"));
+                        continue;
+                    }
+                };
+                let rule = if logged_here.is_some() {
+                    // Ricochet logged it, rapier's narrow phase saw no penetration.
+                    if moved {
+                        Some(rules::MOVED_IN_PASS)
+                    } else if d >= -tol && d <= thr + tol {
+                        Some(rules::TOUCHING)
+                    } else {
+                        None
+                    }
+                } else if a.kind != BodyKind::Dynamic && b.kind != BodyKind::Dynamic {
+                    Some(rules::STATIC_STATIC)
+                } else if response == Response::Separate && is_box(a.shape) && is_box(b.shape) {
+                    Some(rules::PER_AXIS_BOXES)
+                } else if moved && d <= thr + tol {
+                    Some(rules::MOVED_IN_PASS)
+                } else if d >= -tol && d <= thr + tol {
+                    Some(rules::TOUCHING)
+                } else {
+                    None
+                };
+                match (rule, logged_here) {
+                    (Some(rule), _) => report.explain(rule, d),
+                    (None, Some(c)) => report.mismatch(format!(
+                        "{who}: Ricochet logged depth {:e}; rapier's narrow phase finds no \
+                         penetration (its query: depth {d:e})",
+                        c.depth
+                    )),
+                    (None, None) => report.mismatch(format!(
+                        "{who}: rapier finds depth {d:e} ({} response, threshold {thr:e}); \
+                         Ricochet logged no contact",
+                        response.name()
+                    )),
+                }
+            }
+            if let Some(c) = logged_here {
+                apply_push(&mut current, c, a.kind, b.kind);
+            }
+        }
+        current
+    }
+
+    /// The pairs rapier's broad and narrow phase find penetrating (`dist < 0`) with every
+    /// body's collider at its detect pose, layers filtering as Ricochet's matrix does.
+    fn rapier_pairs(
+        &self,
+        sim: &Simulation,
+        out: &FrameOutput,
+        poses: &[(Entity, Pose)],
+    ) -> Result<BTreeSet<(Entity, Entity)>, OracleError> {
+        let mut world = PhysicsWorld::new();
+        world.integration_parameters.normalized_prediction_distance = 0.0;
+        let n_layers = self.layers.names().len();
+        let use_groups = n_layers <= 32;
+        for (k, (e, pose)) in poses.iter().enumerate() {
+            let b = body(sim, out, *e).ok_or(OracleError::Conversion("unknown body"))?;
+            let (p, shape) = place(b.shape, pose, Vec2::ZERO)?;
+            let mut builder = ColliderBuilder::new(shape)
+                .position(p)
+                .active_collision_types(ActiveCollisionTypes::all())
+                .user_data((u128::from(b.layer) << 64) | k as u128);
+            if use_groups {
+                let mut filter = 0u32;
+                for other in 0..n_layers {
+                    let other = LayerId::try_from(other).unwrap_or(LayerId::MAX);
+                    if self.layers.response(b.layer, other) != Response::Ignore {
+                        filter |= 1 << other;
+                    }
+                }
+                builder = builder.collision_groups(InteractionGroups::new(
+                    Group::from_bits_retain(1 << b.layer),
+                    Group::from_bits_retain(filter),
+                    InteractionTestMode::And,
+                ));
+            } else {
+                builder = builder.active_hooks(ActiveHooks::FILTER_CONTACT_PAIRS);
+            }
+            world.colliders.insert(builder.build());
+        }
+        let hooks = LayerHooks {
+            layers: &self.layers,
+        };
+        world.detect_collisions(&hooks, &());
+        let mut pairs = BTreeSet::new();
+        for pair in world.narrow_phase.contact_pairs() {
+            let PairContacts::Rigid(rigid) = &pair.contacts else {
+                continue;
+            };
+            let penetrating = rigid
+                .manifolds
+                .iter()
+                .flat_map(|m| m.points.iter())
+                .any(|p| p.dist < 0.0);
+            if !penetrating {
+                continue;
+            }
+            let index = |h| {
+                world
+                    .colliders
+                    .get(h)
+                    .map(|c| (c.user_data & u128::from(u64::MAX)) as usize)
+            };
+            let (Some(i), Some(j)) = (index(pair.collider1), index(pair.collider2)) else {
+                continue;
+            };
+            let (ea, eb) = (poses[i].0, poses[j].0);
+            pairs.insert((ea.min(eb), ea.max(eb)));
+        }
+        Ok(pairs)
+    }
+}
+
+impl Body<'_> {
+    pub(crate) fn shape_name(&self) -> &'static str {
+        crate::convert::shape_name(self.shape)
+    }
+}
+
+/// Applies the push a logged `separate` contact made, exactly as Ricochet's `detect` did:
+/// `resolved` is the push of the body that moved (`b`'s when both did, `a`'s being its
+/// negation).
+fn apply_push(current: &mut BTreeMap<Entity, Pose>, c: &ContactRecord, ka: BodyKind, kb: BodyKind) {
+    if c.response != Response::Separate || c.resolved == Vec2::ZERO {
+        return;
+    }
+    let (da, db) = (ka == BodyKind::Dynamic, kb == BodyKind::Dynamic);
+    let push_a = if da && db { -c.resolved } else { c.resolved };
+    if da && let Some(p) = current.get_mut(&c.a) {
+        p.position += push_a;
+    }
+    if db && let Some(p) = current.get_mut(&c.b) {
+        p.position += c.resolved;
+    }
+}
+
+/// Whether `normal` is a minimum-translation direction too: some part pair is as deep as
+/// rapier's deepest (within `tol`) and overlaps along `normal` by that depth (within `tol`).
+/// Overlapping convex shapes overlap along every direction by at least their depth, and by
+/// exactly their depth along a minimum translation, so this accepts exactly the directions
+/// that tie with rapier's.
+fn tied_normal(
+    a: &Shape,
+    pose_a: &Pose,
+    b: &Shape,
+    pose_b: &Pose,
+    normal: Vec2,
+    depth: f64,
+    tol: f64,
+) -> Result<bool, OracleError> {
+    if depth <= 0.0 {
+        return Ok(false);
+    }
+    for pa in a.primitives() {
+        for pb in b.primitives() {
+            let (sa, sb) = (Shape::Primitive(*pa), Shape::Primitive(*pb));
+            let Some(part) = reference_contact(&sa, pose_a, &sb, pose_b, tol)? else {
+                continue;
+            };
+            if part.depth < depth - tol {
+                continue;
+            }
+            let along = overlap_along(pa, pose_a, pb, pose_b, normal)?;
+            if (along - depth).abs() <= tol {
+                return Ok(true);
+            }
+        }
+    }
+    Ok(false)
+}

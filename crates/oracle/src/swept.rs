@@ -1,0 +1,361 @@
+//! Swept pairs: every pair Ricochet tests by time of impact, cast by parry along the same
+//! straight-line motion, and each logged `swept` contact checked to be the first touch.
+
+use std::collections::BTreeMap;
+
+use ricochet_geom::{Pose, Vec2};
+use ricochet_sim::{
+    BodyKind, ContactRecord, Doomed, Entity, FrameOutput, Phase, Response, Simulation,
+};
+
+use crate::convert::{first_touch, size};
+use crate::referee::{Body, FrameReport, Referee, body, depth};
+use crate::{OracleError, rules};
+
+/// One swept-eligible pair, with parry's answer.
+struct Pair<'a> {
+    a: Body<'a>,
+    b: Body<'a>,
+    /// Start poses: start positions, end angles (rotation is not swept).
+    start: (Pose, Pose),
+    /// Displacements over the frame.
+    motion: (Vec2, Vec2),
+    /// Parry's first touch in `[0, 1]`.
+    toi: Option<f64>,
+    /// The body that travelled further (`a` on a tie), as Ricochet picks it.
+    mover: Entity,
+}
+
+/// The deepest the pair gets along its straight-line motion, by parry: per part pair, a
+/// ternary search on `t` (with rotation fixed, the relative position moves along a line
+/// through a fixed convex Minkowski difference, on which the signed depth is concave).
+fn deepest_along(p: &Pair<'_>) -> Result<f64, OracleError> {
+    let (sa, sb) = p.start;
+    let (da, db) = p.motion;
+    let at = |t: f64| {
+        (
+            Pose::new(sa.position + da * t, sa.angle),
+            Pose::new(sb.position + db * t, sb.angle),
+        )
+    };
+    let mut deepest = f64::NEG_INFINITY;
+    for pa in p.a.shape.primitives() {
+        for pb in p.b.shape.primitives() {
+            // A part alone is placed as in its body: only parts that turn use the angle.
+            let (ka, kb) = (
+                ricochet_geom::Shape::Primitive(*pa),
+                ricochet_geom::Shape::Primitive(*pb),
+            );
+            let f = |t: f64| -> Result<f64, OracleError> {
+                let (qa, qb) = at(t);
+                depth(&ka, &qa, &kb, &qb, f64::MAX)
+            };
+            let (mut lo, mut hi) = (0.0_f64, 1.0_f64);
+            for _ in 0..100 {
+                let (m1, m2) = (lo + (hi - lo) / 3.0, hi - (hi - lo) / 3.0);
+                if f(m1)? < f(m2)? {
+                    lo = m1;
+                } else {
+                    hi = m2;
+                }
+            }
+            deepest = deepest.max(f(0.5 * (lo + hi))?);
+        }
+    }
+    Ok(deepest)
+}
+
+/// Whether a swept record's response removed `e`.
+fn dooms(c: &ContactRecord, e: Entity) -> bool {
+    match c.response {
+        Response::Destroy(Doomed::First) => c.a == e,
+        Response::Destroy(Doomed::Second) => c.b == e,
+        Response::Destroy(Doomed::Both) => c.a == e || c.b == e,
+        _ => false,
+    }
+}
+
+impl Referee {
+    /// Where body `e` started the frame: the simulation's `start_position` if it is alive,
+    /// else its position at the end of the previous checked frame, else (a body spawned and
+    /// removed within this frame) its detect position minus `velocity * dt`.
+    fn start_of(
+        &self,
+        sim: &Simulation,
+        out: &FrameOutput,
+        e: Entity,
+        detect: &Pose,
+    ) -> Option<Vec2> {
+        if let Some(i) = sim.world.index_of(e) {
+            return Some(sim.world.start_position[i]);
+        }
+        if let Some((frame, positions)) = &self.previous
+            && *frame + 1 == out.frame
+            && let Some(p) = positions.get(&e)
+        {
+            return Some(*p);
+        }
+        let removed = out.removed.iter().find(|r| r.entity == e)?;
+        Some(detect.position - removed.velocity * sim.dt())
+    }
+
+    /// Part 3: swept pairs. Every pair Ricochet would test by time of impact is cast by
+    /// parry from the start poses along the frame's motion; Ricochet's `swept` records must
+    /// be those first touches, and each hit parry finds must be logged or explained.
+    pub(crate) fn check_swept(
+        &self,
+        sim: &Simulation,
+        out: &FrameOutput,
+        poses: &[(Entity, Pose)],
+        end: &BTreeMap<Entity, Pose>,
+        report: &mut FrameReport,
+    ) {
+        let frame = out.frame;
+        let logged: BTreeMap<(Entity, Entity), &ContactRecord> = out
+            .contacts
+            .iter()
+            .filter(|c| c.phase == Phase::Swept)
+            .map(|c| ((c.a, c.b), c))
+            .collect();
+        let n = self.layers.names().len();
+        let any_swept = (0..n).any(|a| {
+            (0..n).any(|b| match (u8::try_from(a), u8::try_from(b)) {
+                (Ok(a), Ok(b)) => self.swept(a, b),
+                _ => false,
+            })
+        });
+        if !any_swept {
+            for (a, b) in logged.keys() {
+                report.mismatch(format!(
+                    "frame {frame}: swept contact #{a} #{b}, but no layer pair is swept"
+                ));
+            }
+            return;
+        }
+        let pairs = match self.swept_pairs(sim, out, poses, end) {
+            Ok(p) => p,
+            Err(e) => {
+                report.mismatch(format!("frame {frame}: {e}"));
+                return;
+            }
+        };
+        for key in logged.keys() {
+            if !pairs.contains_key(key) {
+                report.mismatch(format!(
+                    "frame {frame}: swept contact #{} #{} is not a swept pair of this frame",
+                    key.0, key.1
+                ));
+            }
+        }
+        for (&(ea, eb), p) in &pairs {
+            let who = format!(
+                "frame {frame} {} #{ea} {} / {} #{eb} {}",
+                p.a.name,
+                p.a.shape_name(),
+                p.b.name,
+                p.b.shape_name()
+            );
+            let tol = self.depth_tol(p.a.shape, p.b.shape);
+            let small = size(p.a.shape).min(size(p.b.shape));
+            let gap = self.tol.toi_gap * small;
+            // The time-of-impact tolerance as a fraction of the frame's motion.
+            let speed = (p.motion.1 - p.motion.0).length();
+            let slack = if speed > 0.0 {
+                self.tol.toi * small / speed
+            } else {
+                0.0
+            };
+            match (logged.get(&(ea, eb)), p.toi) {
+                (Some(c), Some(t_r)) => {
+                    match self.check_first_touch(p, c, t_r, tol, gap, slack) {
+                        Ok(None) => report.swept_confirmed += 1,
+                        Ok(Some(Ok((rule, d)))) => report.explain(rule, d),
+                        Ok(Some(Err(why))) => report.mismatch(format!("{who}: {why}")),
+                        Err(e) => report.mismatch(format!("{who}: {e}")),
+                    }
+                    // A mover is spent by the first hit that destroys it while it is that
+                    // hit's mover: no later hit it moves into may be logged.
+                    let earlier_doom = logged.iter().any(|(k, other)| {
+                        *k != (ea, eb)
+                            && dooms(other, p.mover)
+                            && pairs.get(k).is_some_and(|q| {
+                                q.mover == p.mover && q.toi.is_some_and(|t| t < t_r - slack)
+                            })
+                    });
+                    if earlier_doom {
+                        report.mismatch(format!(
+                            "{who}: logged at t = {t_r:.9} although #{} was destroyed by an \
+                             earlier swept hit",
+                            p.mover
+                        ));
+                    }
+                }
+                (Some(c), None) => {
+                    // Parry finds no touch: within the stopping gap of one is `touching`.
+                    match first_touch(
+                        p.a.shape, &p.start.0, p.motion.0, p.b.shape, &p.start.1, p.motion.1, gap,
+                    ) {
+                        Ok(Some(_)) => report.explain(rules::TOUCHING, c.depth),
+                        Ok(None) => report.mismatch(format!(
+                            "{who}: Ricochet logged a swept hit (depth {:e}); parry's shape \
+                             cast finds no touch during the frame",
+                            c.depth
+                        )),
+                        Err(e) => report.mismatch(format!("{who}: {e}")),
+                    }
+                }
+                (None, Some(t_r)) => {
+                    // Parry finds a touch Ricochet did not log: the mover must have been
+                    // stopped by an earlier hit that destroyed it (as that hit's mover too),
+                    // or the path only grazes.
+                    let spent = logged.iter().any(|(k, other)| {
+                        dooms(other, p.mover)
+                            && pairs.get(k).is_some_and(|q| {
+                                q.mover == p.mover && q.toi.is_some_and(|t| t <= t_r + slack)
+                            })
+                    });
+                    if spent {
+                        let d = depth(p.a.shape, &end[&ea], p.b.shape, &end[&eb], tol)
+                            .unwrap_or(f64::NEG_INFINITY);
+                        report.explain(rules::FIRST_HIT, d);
+                        continue;
+                    }
+                    match deepest_along(p) {
+                        Ok(d) if d <= tol => report.explain(rules::TOUCHING, d),
+                        Ok(d) => report.mismatch(format!(
+                            "{who}: parry's shape cast touches at t = {t_r:.9} of the frame \
+                             and the path goes {d:e} deep; Ricochet logged no swept contact"
+                        )),
+                        Err(e) => report.mismatch(format!("{who}: {e}")),
+                    }
+                }
+                (None, None) => {}
+            }
+        }
+    }
+
+    /// Checks a logged swept contact against parry's first touch `t_r`: `Ok(None)` when it
+    /// is that touch, `Ok(Some(Ok(rule)))` when a rule explains the difference,
+    /// `Ok(Some(Err(why)))` when nothing does.
+    #[expect(
+        clippy::type_complexity,
+        reason = "three outcomes plus a query error, used once"
+    )]
+    fn check_first_touch(
+        &self,
+        p: &Pair<'_>,
+        c: &ContactRecord,
+        t_r: f64,
+        tol: f64,
+        gap: f64,
+        slack: f64,
+    ) -> Result<Option<Result<(&'static str, f64), String>>, OracleError> {
+        let (sa, sb) = p.start;
+        let (da, db) = p.motion;
+        // Ricochet's poses are start + t * motion at the end angles; recover its t.
+        if c.pose_a.angle != sa.angle || c.pose_b.angle != sb.angle {
+            return Ok(Some(Err(format!(
+                "logged at angles {} and {}, the end angles are {} and {}",
+                c.pose_a.angle, c.pose_b.angle, sa.angle, sb.angle
+            ))));
+        }
+        let rel_motion = db - da;
+        let rel0 = sb.position - sa.position;
+        let rel = c.pose_b.position - c.pose_a.position;
+        let t_s = if rel_motion.length_squared() > 0.0 {
+            (rel - rel0).dot(rel_motion) / rel_motion.length_squared()
+        } else {
+            0.0
+        };
+        let off_path = (c.pose_a.position - (sa.position + da * t_s))
+            .length()
+            .max((c.pose_b.position - (sb.position + db * t_s)).length());
+        if off_path > tol.max(1e-12 * (sa.position.length() + da.length())) {
+            return Ok(Some(Err(format!(
+                "logged {off_path:e} off the straight path from the start poses"
+            ))));
+        }
+        let d = depth(p.a.shape, &c.pose_a, p.b.shape, &c.pose_b, gap + tol)?;
+        if t_s > t_r + slack {
+            // Later than parry's first touch: only the end-of-frame fallback of a grazing
+            // approach may do that.
+            let at_end = (t_s - 1.0).abs() <= slack;
+            return Ok(Some(if at_end && d > 0.0 {
+                Ok((rules::TOI_FALLBACK, d))
+            } else {
+                Err(format!(
+                    "logged at t = {t_s:.9} of the frame, after parry's first touch at \
+                     t = {t_r:.9}"
+                ))
+            }));
+        }
+        if d < -gap {
+            return Ok(Some(Err(format!(
+                "logged {:e} apart (parry), more than the stopping gap {gap:e}",
+                -d
+            ))));
+        }
+        if t_s > slack && d > tol {
+            return Ok(Some(Err(format!(
+                "logged {d:e} deep at t = {t_s:.9}: a first touch after the start is never deep"
+            ))));
+        }
+        Ok(None)
+    }
+
+    /// Every pair Ricochet tests by time of impact this frame, with parry's first touch.
+    fn swept_pairs<'a>(
+        &self,
+        sim: &'a Simulation,
+        out: &'a FrameOutput,
+        poses: &[(Entity, Pose)],
+        end: &BTreeMap<Entity, Pose>,
+    ) -> Result<BTreeMap<(Entity, Entity), Pair<'a>>, OracleError> {
+        let mut pairs = BTreeMap::new();
+        for (k, (ea, detect_a)) in poses.iter().enumerate() {
+            for (eb, detect_b) in &poses[k + 1..] {
+                let (Some(a), Some(b)) = (body(sim, out, *ea), body(sim, out, *eb)) else {
+                    continue;
+                };
+                if (a.kind != BodyKind::Dynamic && b.kind != BodyKind::Dynamic)
+                    || !self.swept(a.layer, b.layer)
+                {
+                    continue;
+                }
+                let (Some(start_a), Some(start_b)) = (
+                    self.start_of(sim, out, *ea, detect_a),
+                    self.start_of(sim, out, *eb, detect_b),
+                ) else {
+                    return Err(OracleError::Conversion("a swept body has no start pose"));
+                };
+                let (end_a, end_b) = (end[ea].position, end[eb].position);
+                let start = (
+                    Pose::new(start_a, detect_a.angle),
+                    Pose::new(start_b, detect_b.angle),
+                );
+                let motion = (end_a - start_a, end_b - start_b);
+                let toi = first_touch(
+                    a.shape, &start.0, motion.0, b.shape, &start.1, motion.1, 0.0,
+                )?;
+                let mover = if motion.1.length() > motion.0.length() {
+                    *eb
+                } else {
+                    *ea
+                };
+                // Detect poses are in id order, so `ea < eb`: the log's `(a, b)`.
+                pairs.insert(
+                    (*ea, *eb),
+                    Pair {
+                        a,
+                        b,
+                        start,
+                        motion,
+                        toi,
+                        mover,
+                    },
+                );
+            }
+        }
+        Ok(pairs)
+    }
+}

@@ -1,0 +1,116 @@
+//! `ricochet validate` and `ricochet run --validate`: rapier2d as the referee.
+//!
+//! Every frame, every logged contact is recomputed by parry at its own poses, the `all`
+//! pass's set of pairs is compared with rapier's at the detect poses, and swept hits are
+//! cast along the frame's motion (see `crates/oracle` and `docs/validation.md`). Free flight
+//! is compared with rapier's integrator at the end. Exit code 1 on any difference that no
+//! documented rule explains.
+
+use std::path::Path;
+use std::process::ExitCode;
+
+use ricochet_oracle::{FrameReport, Referee, Tolerances, compare_motion, summary_table};
+use ricochet_sim::{FrameOutput, Scenario, Simulation};
+use serde::Serialize;
+
+/// Test-only hook: when this environment variable is set, every contact's depth is scaled by
+/// 1.01 before the referee sees it, as a broken narrow phase would report it. The tests use
+/// it to prove that `validate` fails on a wrong narrow phase.
+pub const CORRUPT_CONTACTS_HOOK: &str = "RICOCHET_TEST_CORRUPT_CONTACTS";
+
+/// The `/validation` channel's message.
+#[derive(Serialize)]
+pub struct ValidationMsg<'a> {
+    frame: u64,
+    contacts_compared: u64,
+    mismatches: u64,
+    worst_depth_error: f64,
+    worst_normal_error: f64,
+    pairs_confirmed: u64,
+    swept_confirmed: u64,
+    explained: &'a std::collections::BTreeMap<&'static str, u64>,
+    details: &'a [String],
+}
+
+/// The JSON Schema of `/validation`.
+pub const SCHEMA: &str = include_str!("schemas/Validation.json");
+
+impl<'a> ValidationMsg<'a> {
+    /// The message for one frame's report.
+    pub fn from_report(r: &'a FrameReport) -> ValidationMsg<'a> {
+        ValidationMsg {
+            frame: r.frame,
+            contacts_compared: r.contacts_compared,
+            mismatches: r.mismatches,
+            worst_depth_error: r.worst_depth_error,
+            worst_normal_error: r.worst_normal_error,
+            pairs_confirmed: r.pairs_confirmed,
+            swept_confirmed: r.swept_confirmed,
+            explained: &r.explained,
+            details: &r.details,
+        }
+    }
+}
+
+/// Checks one frame, applying the test hook if it is set.
+pub fn check(referee: &mut Referee, sim: &Simulation, out: &FrameOutput) -> FrameReport {
+    if std::env::var_os(CORRUPT_CONTACTS_HOOK).is_some() {
+        let mut broken = out.clone();
+        for c in &mut broken.contacts {
+            c.depth *= 1.01;
+        }
+        return referee.check_frame(sim, &broken);
+    }
+    referee.check_frame(sim, out)
+}
+
+/// A referee for a run, and the summary it adds up.
+pub struct Validation {
+    referee: Referee,
+    summary: ricochet_oracle::ValidationSummary,
+}
+
+impl Validation {
+    /// A referee for `scenario` with the default tolerances.
+    pub fn new(scenario: &Scenario) -> Validation {
+        Validation {
+            referee: Referee::new(scenario, Tolerances::default()),
+            summary: ricochet_oracle::ValidationSummary::new(&scenario.name),
+        }
+    }
+
+    /// Checks one frame and adds it to the summary.
+    pub fn frame(&mut self, sim: &Simulation, out: &FrameOutput) -> FrameReport {
+        let r = check(&mut self.referee, sim, out);
+        self.summary.add(&r);
+        r
+    }
+
+    /// Adds free flight over `frames`, prints the table, and returns whether it passed.
+    pub fn finish(mut self, scenario: &Scenario, frames: u64) -> bool {
+        self.summary.motion = Some(compare_motion(scenario, frames));
+        print!("{}", summary_table(&self.summary));
+        self.summary.passed()
+    }
+}
+
+/// `ricochet validate SCENARIO`: simulate without writing a log, referee every frame.
+pub fn run(path: &Path, frames: Option<u64>) -> anyhow::Result<ExitCode> {
+    let scenario = match crate::run::load(Some(path)) {
+        Ok(s) => s,
+        Err(code) => return Ok(code),
+    };
+    let frames = frames.unwrap_or(scenario.frames);
+    let mut sim = Simulation::new(&scenario);
+    sim.capture_detect_poses = true;
+    let mut v = Validation::new(&scenario);
+    for _ in 0..=frames {
+        let out = sim.step();
+        v.frame(&sim, &out);
+    }
+    Ok(if v.finish(&scenario, frames) {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
+}

@@ -1,0 +1,87 @@
+//! `ricochet validate` and `ricochet run --validate`: rapier2d as the referee.
+
+use std::process::Command;
+
+use crate::util::{ricochet, root};
+
+fn scenarios() -> Vec<String> {
+    let mut files: Vec<String> = std::fs::read_dir(root().join("scenarios"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .map(|p| p.to_string_lossy().into_owned())
+        .collect();
+    files.sort();
+    files
+}
+
+#[test]
+fn validate_passes_on_every_scenario() {
+    for s in scenarios() {
+        let o = ricochet(&["validate", &s], b"");
+        let table = String::from_utf8_lossy(&o.stdout);
+        assert_eq!(
+            o.status.code(),
+            Some(0),
+            "{s}:\n{table}{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        assert!(
+            table.contains(": PASS") && table.contains("unexplained mismatches     0"),
+            "{table}"
+        );
+    }
+}
+
+#[test]
+fn a_broken_narrow_phase_makes_validate_fail() {
+    let o = Command::new(env!("CARGO_BIN_EXE_ricochet"))
+        .args(["validate", "scenarios/shapes.toml", "--frames", "120"])
+        .current_dir(root())
+        .env("RICOCHET_TEST_CORRUPT_CONTACTS", "1")
+        .output()
+        .unwrap();
+    let table = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(o.status.code(), Some(1), "{table}");
+    assert!(table.contains(": FAIL"), "{table}");
+}
+
+#[test]
+fn run_with_validate_writes_a_validation_channel() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("v.mcap");
+    let o = ricochet(
+        &[
+            "run",
+            "scenarios/validation.toml",
+            "--frames",
+            "60",
+            "--validate",
+            "-o",
+            out.to_str().unwrap(),
+        ],
+        b"",
+    );
+    assert!(
+        o.status.success(),
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let log = ricochet_log::read_log_file(&out).unwrap();
+    let v: Vec<_> = log.iter().filter(|m| m.topic == "/validation").collect();
+    assert_eq!(v.len(), 61);
+    let schema: serde_json::Value =
+        serde_json::from_str(include_str!("../src/schemas/Validation.json")).unwrap();
+    let validator = jsonschema::validator_for(&schema).unwrap();
+    for m in &v {
+        assert!(validator.is_valid(&m.data), "{}", m.data);
+        assert_eq!(m.data["mismatches"], 0);
+    }
+    assert!(
+        v.iter()
+            .map(|m| m.data["contacts_compared"].as_u64().unwrap())
+            .sum::<u64>()
+            > 0
+    );
+}
