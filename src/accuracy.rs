@@ -298,7 +298,7 @@ fn projectile_rows() -> anyhow::Result<Vec<Row>> {
     let g = Vec2::new(0.0, -G);
     let t = PROJECTILE_T;
     let exact = PROJECTILE_X0 + PROJECTILE_V0 * t + g * (0.5 * t * t);
-    sweep("projectile", "euler", |hz, k| {
+    let mut rows = sweep("projectile", "euler", |hz, k| {
         let scenario = load(&projectile_text(hz * k, 0.0), "projectile.toml")?;
         let n = steps_in(t, hz * k);
         let dt = scenario.world.dt;
@@ -313,7 +313,17 @@ fn projectile_rows() -> anyhow::Result<Vec<Row>> {
                 ("vs_recurrence", (p - recurrence).length()),
             ])
         })
-    })
+    })?;
+    // rapier2d on the same scene and dt: its PhysicsPipeline, one substep, no damping.
+    rows.extend(sweep("projectile", "rapier", |hz, k| {
+        let scenario = load(&projectile_text(hz * k, 0.0), "projectile.toml")?;
+        let n = steps_in(t, hz * k);
+        timed(t, || {
+            let p = ricochet_oracle::rapier_free_flight(&scenario, n)[0].1;
+            Ok(vec![("position", (p - exact).length())])
+        })
+    })?);
+    Ok(rows)
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1080,12 +1090,18 @@ fn csv_text(rows: &[Row]) -> String {
 // The chart: a hand-written SVG, error against wall time per simulated second, log-log.
 
 /// The series drawn: (scene, method, kind, legend text).
-const CHART: [(&str, &str, &str, &str); 10] = [
+const CHART: [(&str, &str, &str, &str); 11] = [
     (
         "projectile",
         "euler",
         "position",
         "projectile: position at 2 s (units)",
+    ),
+    (
+        "projectile",
+        "rapier",
+        "position",
+        "projectile, rapier2d: position at 2 s (units)",
     ),
     (
         "spring",
@@ -1138,9 +1154,9 @@ const CHART: [(&str, &str, &str, &str); 10] = [
     ),
 ];
 
-const COLOURS: [&str; 10] = [
+const COLOURS: [&str; 11] = [
     "#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f",
-    "#bcbd22", "#17becf",
+    "#bcbd22", "#17becf", "#000000",
 ];
 
 /// `10^k` as SVG text.

@@ -36,6 +36,7 @@ mod swept;
 pub use convert::{ReferenceContact, reference_contact};
 pub use motion::{
     BodyMotion, MOTION_ANGLE_PER_FRAME, MOTION_POSITION_RELATIVE, MotionReport, compare_motion,
+    rapier_free_flight,
 };
 pub use referee::{FrameReport, Referee};
 pub use summary::{MAX_DETAILS, ValidationSummary, summary_table, validate};

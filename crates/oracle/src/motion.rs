@@ -94,6 +94,55 @@ fn angle_difference(a: f64, b: f64) -> f64 {
     if d > std::f64::consts::PI { d - tau } else { d }
 }
 
+/// Rapier set up to integrate Ricochet's model (see [`compare_motion`]): the scenario's
+/// moving bodies, by index into `s.bodies`, and their handles.
+fn rapier_world(s: &Scenario) -> (PhysicsWorld, Vec<(usize, RigidBodyHandle)>) {
+    let mut world = PhysicsWorld::new();
+    world.gravity = to_vector(s.world.gravity);
+    world.integration_parameters.dt = s.world.dt;
+    world.integration_parameters.num_solver_iterations = 1;
+    world.integration_parameters.normalized_max_linear_velocity = f64::MAX;
+    let mut handles = Vec::new();
+    for (index, b) in s.bodies.iter().enumerate() {
+        let builder = match b.kind {
+            BodyKind::Static => continue,
+            BodyKind::Dynamic => RigidBodyBuilder::dynamic().gravity_scale(b.gravity_scale),
+            BodyKind::Kinematic => RigidBodyBuilder::kinematic_velocity_based(),
+        };
+        let body = builder
+            .translation(to_vector(b.position))
+            .rotation(b.angle)
+            .linvel(to_vector(b.velocity))
+            .angvel(b.angular_velocity)
+            .additional_mass_properties(MassProperties::new(Vector::ZERO, b.mass, b.mass))
+            .can_sleep(false)
+            .ccd_enabled(false)
+            .build();
+        let handle = world.insert_body(body);
+        if b.kind == BodyKind::Dynamic {
+            // Rapier keeps user forces until `reset_forces`: added once, they act every step.
+            world.bodies[handle].add_force(to_vector(b.force), true);
+        }
+        handles.push((index, handle));
+    }
+    (world, handles)
+}
+
+/// Rapier's free flight of the scenario's moving bodies (every collision response off, as in
+/// [`compare_motion`]) after `frames` steps: `(index into scenario.bodies, position)`. Used
+/// by `ricochet accuracy` to put rapier's error beside Ricochet's on the same scene and dt.
+#[must_use]
+pub fn rapier_free_flight(scenario: &Scenario, frames: u64) -> Vec<(usize, Vec2)> {
+    let (mut world, handles) = rapier_world(&free_flight(scenario));
+    for _ in 0..frames {
+        world.step();
+    }
+    handles
+        .into_iter()
+        .map(|(i, h)| (i, from_vector(world.bodies[h].translation())))
+        .collect()
+}
+
 /// Runs the scenario's dynamic and kinematic bodies in free flight (every layer pair
 /// ignored, no script, controllers, lifetimes or world bounds) for `frames` steps in both
 /// Ricochet and rapier, and compares positions and angles after every step.
@@ -117,11 +166,7 @@ pub fn compare_motion(scenario: &Scenario, frames: u64) -> MotionReport {
     let mut sim = Simulation::new(&s);
     sim.step(); // frame 0: the initial state, nothing moves
 
-    let mut world = PhysicsWorld::new();
-    world.gravity = to_vector(s.world.gravity);
-    world.integration_parameters.dt = dt;
-    world.integration_parameters.num_solver_iterations = 1;
-    world.integration_parameters.normalized_max_linear_velocity = f64::MAX;
+    let (mut world, handles) = rapier_world(&s);
 
     struct Tracked {
         index: usize,
@@ -132,30 +177,14 @@ pub fn compare_motion(scenario: &Scenario, frames: u64) -> MotionReport {
         omega: f64,
         report: BodyMotion,
     }
-    let mut tracked = Vec::new();
-    for (index, b) in s.bodies.iter().enumerate() {
-        let builder = match b.kind {
-            BodyKind::Static => continue,
-            BodyKind::Dynamic => RigidBodyBuilder::dynamic().gravity_scale(b.gravity_scale),
-            BodyKind::Kinematic => RigidBodyBuilder::kinematic_velocity_based(),
-        };
-        let body = builder
-            .translation(to_vector(b.position))
-            .rotation(b.angle)
-            .linvel(to_vector(b.velocity))
-            .angvel(b.angular_velocity)
-            .additional_mass_properties(MassProperties::new(Vector::ZERO, b.mass, b.mass))
-            .can_sleep(false)
-            .ccd_enabled(false)
-            .build();
-        let handle = world.insert_body(body);
+    let tracked_bodies = handles.into_iter().map(|(index, handle)| {
+        let b = &s.bodies[index];
         let accel = if b.kind == BodyKind::Dynamic {
-            world.bodies[handle].add_force(to_vector(b.force), true);
             b.force / b.mass + s.world.gravity * b.gravity_scale
         } else {
             Vec2::ZERO
         };
-        tracked.push(Tracked {
+        Tracked {
             index,
             handle,
             x0: b.position,
@@ -171,8 +200,9 @@ pub fn compare_motion(scenario: &Scenario, frames: u64) -> MotionReport {
                 worst_angle_ratio: 0.0,
                 raw_angle_difference: 0.0,
             },
-        });
-    }
+        }
+    });
+    let mut tracked: Vec<Tracked> = tracked_bodies.collect();
 
     for n in 1..=frames {
         sim.step();

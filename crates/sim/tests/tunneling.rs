@@ -140,3 +140,45 @@ fn a_swept_bullet_never_passes_a_thin_wall() {
         hits[0].pose_a
     );
 }
+
+/// A grazing path: the bullet's path passes `miss` between centres of a rock of radius 0.5,
+/// the bullet itself radius 0.5, at 600 units/s (10 units a frame).
+fn graze(miss: f64) -> Vec<ricochet_sim::ContactRecord> {
+    let text = format!(
+        r#"
+        hz = 60
+        layers = ["bullet", "rock"]
+        fast_layers = ["bullet"]
+        [[collide]]
+        a = "bullet"
+        b = "rock"
+        response = "report"
+        [[bodies]]
+        layer = "bullet"
+        shape = {{ kind = "circle", radius = 0.5 }}
+        position = [-5, {miss:?}]
+        velocity = [600, 0]
+        [[bodies]]
+        layer = "rock"
+        shape = {{ kind = "circle", radius = 0.5 }}
+        "#
+    );
+    let mut sim = Simulation::new(&load_scenario(&text, "graze.toml").unwrap());
+    (0..3).flat_map(|_| sim.step().contacts).collect()
+}
+
+#[test]
+fn a_grazing_swept_hit_is_found_at_its_first_touch() {
+    // 0.01 deep at the closest approach: a hit, at x = -sqrt(1 - 0.99^2).
+    let hits = graze(0.99);
+    assert_eq!(hits.len(), 1, "{hits:?}");
+    let want = -(1.0f64 - 0.99 * 0.99).sqrt();
+    assert!(
+        (hits[0].pose_a.position.x - want).abs() < 1e-6,
+        "{:?} vs {want}",
+        hits[0].pose_a
+    );
+    assert!(hits[0].depth.abs() < 1e-6);
+    // 1e-6 clear of touching: no hit.
+    assert!(graze(1.0 + 1e-6).is_empty());
+}

@@ -17,7 +17,7 @@
 //! first that destroys it, so a bullet never passes through a rock, and hits the first one
 //! on its path. Rotation during the frame is not swept (the end angles are used).
 
-use ricochet_geom::{Bounds, Contact, Pose, Vec2, contact};
+use ricochet_geom::{Bounds, Contact, Pose, Shape, Vec2, contact};
 
 use crate::def::{BodyKind, Doomed, Response};
 use crate::entity::Entity;
@@ -73,6 +73,9 @@ pub(crate) fn run(sim: &mut Simulation, out: &mut FrameOutput) {
         })
         .collect();
     let pairs = sweep(&bounds);
+    // Tests per layer pair, counted in a flat table and named once at the end.
+    let n_layers = layers.names().len();
+    let mut per_layer_pair = vec![0u64; n_layers * n_layers];
     let mut doomed: Vec<(Entity, String)> = Vec::new();
     let mut swept: Vec<(usize, usize)> = Vec::new();
     for (i, j) in pairs {
@@ -90,10 +93,7 @@ pub(crate) fn run(sim: &mut Simulation, out: &mut FrameOutput) {
         }
         out.stats.broad_pairs += 1;
         let (la, lb) = (w.layer[i].min(w.layer[j]), w.layer[i].max(w.layer[j]));
-        *out.stats
-            .tests_by_layer_pair
-            .entry(format!("{}/{}", layers.name(la), layers.name(lb)))
-            .or_default() += 1;
+        per_layer_pair[usize::from(la) * n_layers + usize::from(lb)] += 1;
         if response != Response::Separate && layers.sweeps(w.layer[i], w.layer[j]) {
             swept.push((i, j));
             continue;
@@ -119,6 +119,13 @@ pub(crate) fn run(sim: &mut Simulation, out: &mut FrameOutput) {
             c,
             (pose_a, pose_b),
         );
+    }
+    for (k, &count) in per_layer_pair.iter().enumerate() {
+        if count > 0 {
+            let (la, lb) = ((k / n_layers) as u8, (k % n_layers) as u8);
+            let name = format!("{}/{}", layers.name(la), layers.name(lb));
+            out.stats.tests_by_layer_pair.insert(name, count);
+        }
     }
     run_swept(sim, out, &mut doomed, &swept, &layers);
     doomed.sort();
@@ -202,37 +209,94 @@ const TOI_TOLERANCE: f64 = 1e-9;
 
 /// The first moment in `[0, 1]` of this frame's motion (both bodies moving in straight
 /// lines from their start to their end positions, at their end angles) when bodies `i` and
-/// `j` touch, by conservative advancement: the exact distance divided by the relative
-/// speed is a step that can never jump past the first touch. Returns the time, the contact
-/// there and the two poses.
+/// `j` come within `tol` of touching. Returns the time, the contact there and the two poses.
+///
+/// Each pair of convex parts is searched on its own, and the earliest touch wins. With the
+/// angles fixed, the signed distance between two convex parts is a convex function of `t`
+/// (the distance from a point moving on a line to a convex set), which makes the search
+/// exact: conservative advancement first (distance ÷ relative speed can never step past the
+/// first touch, and is quick when heading straight in); if that crawls, as on a grazing
+/// path, a golden-section search finds the closest approach, and bisection the first
+/// moment before it within `tol`.
 fn time_of_impact(w: &crate::World, i: usize, j: usize) -> Option<(f64, Contact, (Pose, Pose))> {
     let (si, sj) = (w.start_position[i], w.start_position[j]);
     let (di, dj) = (w.position[i] - si, w.position[j] - sj);
     let speed = (di - dj).length();
     let size = |k: usize| w.shape[k].bounds(&w.pose(k)).half_extents().length();
     let tol = TOI_TOLERANCE * size(i).min(size(j));
-    let at = |t: f64| {
-        let pa = Pose::new(si + di * t, w.angle[i]);
-        let pb = Pose::new(sj + dj * t, w.angle[j]);
-        (contact(&w.shape[i], &pa, &w.shape[j], &pb), (pa, pb))
+    let poses = |t: f64| {
+        (
+            Pose::new(si + di * t, w.angle[i]),
+            Pose::new(sj + dj * t, w.angle[j]),
+        )
     };
+    let mut first: Option<f64> = None;
+    for pa in w.shape[i].primitives() {
+        for pb in w.shape[j].primitives() {
+            let (sa, sb) = (Shape::Primitive(*pa), Shape::Primitive(*pb));
+            let gap = |t: f64| {
+                let (pa, pb) = poses(t);
+                -contact(&sa, &pa, &sb, &pb).depth
+            };
+            if let Some(t) = first_touch(gap, speed, tol)
+                && first.is_none_or(|f| t < f)
+            {
+                first = Some(t);
+            }
+        }
+    }
+    let t = first?;
+    let (pa, pb) = poses(t);
+    Some((t, contact(&w.shape[i], &pa, &w.shape[j], &pb), (pa, pb)))
+}
+
+/// The first `t` in `[0, 1]` with `gap(t) <= tol`, for a convex `gap`.
+fn first_touch(gap: impl Fn(f64) -> f64, speed: f64, tol: f64) -> Option<f64> {
     let mut t = 0.0;
-    for _ in 0..100 {
-        let (c, poses) = at(t);
-        if c.depth > -tol {
-            return Some((t, c, poses));
+    let mut g = gap(t);
+    for _ in 0..16 {
+        if g <= tol {
+            return Some(t);
         }
         if speed == 0.0 {
             return None;
         }
-        t += -c.depth / speed;
+        t += g / speed;
         if t > 1.0 {
             return None;
         }
+        g = gap(t);
     }
-    // A grazing approach converges slowly: fall back to the end of the frame.
-    let (c, poses) = at(1.0);
-    (c.depth > 0.0).then_some((1.0, c, poses))
+    if g <= tol {
+        return Some(t);
+    }
+    // Closest approach on [t, 1] (a convex function is unimodal).
+    const INV_PHI: f64 = 0.618_033_988_749_894_8;
+    let (mut lo, mut hi) = (t, 1.0);
+    for _ in 0..80 {
+        let m1 = hi - (hi - lo) * INV_PHI;
+        let m2 = lo + (hi - lo) * INV_PHI;
+        if gap(m1) <= gap(m2) {
+            hi = m2;
+        } else {
+            lo = m1;
+        }
+    }
+    let closest = 0.5 * (lo + hi);
+    if gap(closest) > tol {
+        return None;
+    }
+    // The gap falls from above tol at t to at most tol at `closest`: bisect the crossing.
+    let (mut above, mut below) = (t, closest);
+    for _ in 0..80 {
+        let mid = 0.5 * (above + below);
+        if gap(mid) > tol {
+            above = mid;
+        } else {
+            below = mid;
+        }
+    }
+    Some(below)
 }
 
 /// Records a contact and applies its response.
