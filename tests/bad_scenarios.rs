@@ -89,6 +89,21 @@ fn each_error_class_is_named_with_its_location() {
         &["collide[0].response", "\"bounce\""],
     );
     case(
+        "split-cycle",
+        "10:1",
+        &["templates.pebble.split", "pebble -> rock -> pebble"],
+    );
+    case(
+        "position-too-far",
+        "6:1",
+        &["bodies[0].position", "1e16", "largest coordinate"],
+    );
+    case(
+        "size-too-small",
+        "5:28",
+        &["bodies[0].shape.radius", "1e-13", "smallest size"],
+    );
+    case(
         "same-layer-destroy-one",
         "7:1",
         &["collide[0].destroy", "\"both\""],

@@ -5,6 +5,7 @@ mod accuracy;
 mod bad_scenarios;
 mod collide_cli;
 mod collision_cases;
+mod fuzz_corpus;
 mod golden;
 mod run_cli;
 mod stress;

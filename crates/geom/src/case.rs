@@ -86,10 +86,13 @@ fn body(def: &BodyDef, name: &str) -> Result<CaseBody, (String, String)> {
         .map_err(|e| e.within(&format!("{name}.shape")))
         .map_err(|e| (e.field, e.problem))?;
     for (i, v) in def.position.iter().enumerate() {
-        if !v.is_finite() {
+        if !(v.is_finite() && v.abs() <= crate::MAX_COORDINATE) {
             return Err((
                 format!("{name}.position[{i}]"),
-                format!("must be a finite number, got {v}"),
+                format!(
+                    "must be a finite number within ±{:e}, got {v}",
+                    crate::MAX_COORDINATE
+                ),
             ));
         }
     }

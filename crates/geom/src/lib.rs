@@ -61,8 +61,8 @@ pub use placed::{
     PlacedAabb, PlacedCapsule, PlacedCircle, PlacedObb, PlacedPolygon, PlacedPrimitive, place,
 };
 pub use shape::{
-    Aabb, Capsule, Circle, Compound, MAX_POLYGON_VERTICES, Obb, Polygon, Primitive, Shape,
-    ShapeError, ShapeKind,
+    Aabb, Capsule, Circle, Compound, MAX_COORDINATE, MAX_POLYGON_VERTICES, MIN_SIZE, Obb, Polygon,
+    Primitive, Shape, ShapeError, ShapeKind,
 };
 
 /// The pair functions, one per pairing of primitives, for callers (and benchmarks) that want

@@ -37,15 +37,29 @@ impl ShapeError {
     }
 }
 
+/// The largest coordinate or size the geometry accepts, in magnitude. The narrow phase
+/// squares lengths, so results stay exact far beyond it (overflow starts near 1e150), and
+/// `f64` still resolves 0.125 at 1e15: the bound keeps every answer finite.
+pub const MAX_COORDINATE: f64 = 1e15;
+
+/// The smallest size (radius, half extent) the geometry accepts. Squares of lengths stay
+/// normal numbers far below it (underflow starts near 1e-150).
+pub const MIN_SIZE: f64 = 1e-12;
+
 fn finite(field: &str, v: f64) -> Result<f64, ShapeError> {
-    if v.is_finite() {
-        Ok(v)
-    } else {
-        Err(ShapeError::new(
+    if !v.is_finite() {
+        return Err(ShapeError::new(
             field,
             format!("must be a finite number, got {v}"),
-        ))
+        ));
     }
+    if v.abs() > MAX_COORDINATE {
+        return Err(ShapeError::new(
+            field,
+            format!("{v:?} is beyond ±{MAX_COORDINATE:e}, the largest coordinate Ricochet accepts"),
+        ));
+    }
+    Ok(v)
 }
 
 fn finite_vec(field: &str, v: Vec2) -> Result<Vec2, ShapeError> {
@@ -56,14 +70,19 @@ fn finite_vec(field: &str, v: Vec2) -> Result<Vec2, ShapeError> {
 
 fn positive(field: &str, v: f64) -> Result<f64, ShapeError> {
     finite(field, v)?;
-    if v > 0.0 {
-        Ok(v)
-    } else {
-        Err(ShapeError::new(
+    if v <= 0.0 {
+        return Err(ShapeError::new(
             field,
             format!("must be greater than 0, got {v}"),
-        ))
+        ));
     }
+    if v < MIN_SIZE {
+        return Err(ShapeError::new(
+            field,
+            format!("{v:?} is below {MIN_SIZE:e}, the smallest size Ricochet accepts"),
+        ));
+    }
+    Ok(v)
 }
 
 /// A disc of `radius` around `center`.

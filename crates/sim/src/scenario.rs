@@ -113,6 +113,25 @@ fn finite(v: f64) -> bool {
     v.is_finite()
 }
 
+/// A position within the coordinates the geometry accepts (`ricochet_geom::MAX_COORDINATE`).
+fn within_world(
+    fail: impl Fn(&str, String) -> ScenarioError,
+    p: Vec2,
+) -> Result<Vec2, ScenarioError> {
+    if p.abs().max_element() > ricochet_geom::MAX_COORDINATE {
+        return Err(fail(
+            "position",
+            format!(
+                "[{:?}, {:?}] is beyond ±{:e}, the largest coordinate Ricochet accepts",
+                p.x,
+                p.y,
+                ricochet_geom::MAX_COORDINATE
+            ),
+        ));
+    }
+    Ok(p)
+}
+
 fn vec2(v: [f64; 2]) -> Vec2 {
     Vec2::new(v[0], v[1])
 }
@@ -193,6 +212,20 @@ pub fn load_scenario(text: &str, file: &str) -> Result<Scenario, ScenarioError> 
             &format!("templates.{name}"),
         )?;
     }
+    // A split chain must end: a template that splits (through others) into itself would
+    // multiply bodies every time one is destroyed.
+    for (name, t) in &raw.templates {
+        if let Some(path) = split_cycle(&templates, name) {
+            return Err(ctx.err(
+                t.span(),
+                format!("templates.{name}.split"),
+                format!(
+                    "{} splits into itself: a split chain must end",
+                    path.join(" -> ")
+                ),
+            ));
+        }
+    }
     let mut bodies = Vec::with_capacity(raw.bodies.len());
     for (i, b) in raw.bodies.iter().enumerate() {
         let field = format!("bodies[{i}]");
@@ -241,6 +274,37 @@ pub fn load_scenario(text: &str, file: &str) -> Result<Scenario, ScenarioError> 
         bodies,
         script,
     })
+}
+
+/// The chain of templates by which `start` splits back into itself, if it does.
+fn split_cycle(templates: &BTreeMap<String, BodyDef>, start: &str) -> Option<Vec<String>> {
+    fn walk(
+        templates: &BTreeMap<String, BodyDef>,
+        start: &str,
+        at: &str,
+        path: &mut Vec<String>,
+    ) -> bool {
+        let Some(t) = templates.get(at) else {
+            return false;
+        };
+        for child in &t.split {
+            if child.template == start {
+                path.push(child.template.clone());
+                return true;
+            }
+            if path.contains(&child.template) {
+                continue;
+            }
+            path.push(child.template.clone());
+            if walk(templates, start, &child.template, path) {
+                return true;
+            }
+            path.pop();
+        }
+        false
+    }
+    let mut path = vec![start.to_owned()];
+    walk(templates, start, start, &mut path).then_some(path)
 }
 
 fn unknown<'a>(
@@ -574,7 +638,7 @@ fn body_def(
         shape,
         kind,
         mass,
-        position: pair("position", b.position.unwrap_or_default())?,
+        position: within_world(fail, pair("position", b.position.unwrap_or_default())?)?,
         angle: num("angle", b.angle.unwrap_or(0.0))?,
         velocity: pair("velocity", b.velocity.unwrap_or_default())?,
         angular_velocity: num("angular_velocity", b.angular_velocity.unwrap_or(0.0))?,
