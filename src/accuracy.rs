@@ -45,9 +45,10 @@ const MIN_RUNS: u32 = if cfg!(debug_assertions) { 1 } else { 3 };
 const TIMED_SECONDS: f64 = 10.0;
 /// Gravity, units/s² (downwards).
 const G: f64 = 9.81;
-/// The coordinate offsets of the stability study.
+/// The coordinate offsets of the stability study, up to just inside
+/// `ricochet_geom::MAX_COORDINATE` (1e15), beyond which scenarios are rejected.
 const OFFSETS: [f64; 14] = [
-    0.0, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
+    0.0, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 9e14,
 ];
 /// The bullet speeds of the stability study, units/s.
 const SPEEDS: [f64; 9] = [1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10];

@@ -3,6 +3,7 @@
 
 mod accuracy;
 mod bad_scenarios;
+mod bench_cli;
 mod collide_cli;
 mod collision_cases;
 mod fuzz_corpus;

@@ -27,6 +27,7 @@
 //! [`Simulation`]: ricochet_sim::Simulation
 //! [`FrameOutput`]: ricochet_sim::FrameOutput
 
+pub mod bench;
 mod convert;
 mod motion;
 mod referee;

@@ -28,6 +28,7 @@
 //! assert!((sim.world.position[0].x - 1.0).abs() < 1e-12);
 //! ```
 
+pub mod broad_phase;
 mod def;
 mod entity;
 mod output;

@@ -1,0 +1,78 @@
+//! `ricochet bench`: Ricochet's step against rapier's collision-only pipeline. Only the
+//! shape of the output and the contact-set agreement are checked; no time is asserted.
+
+use crate::util::{ricochet, root};
+
+const HEADER: &str = "scene,frames,ricochet_median_ms,ricochet_p95_ms,rapier_median_ms,\
+                      rapier_p95_ms,ratio,contact_agreement,peak_mem_mb";
+
+#[test]
+fn bench_writes_a_row_per_scene_and_the_contact_sets_agree() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("bench.csv");
+    let scenes = ["asteroids-200", "platformer-200-20", "rain-100"];
+    let mut args = vec!["bench"];
+    args.extend(scenes);
+    args.extend(["--frames", "5", "--csv", csv.to_str().unwrap()]);
+    let o = ricochet(&args, b"");
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{stdout}{stderr}");
+    for scene in scenes {
+        assert!(stdout.contains(scene), "{stdout}");
+    }
+
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some(HEADER));
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), scenes.len(), "{text}");
+    for (row, scene) in rows.iter().zip(scenes) {
+        assert_eq!(row.len(), 9, "{text}");
+        assert_eq!(row[0], scene);
+        assert_eq!(row[1], "5");
+        for (k, field) in row.iter().enumerate().skip(2) {
+            if k == 7 {
+                continue;
+            }
+            let v: f64 = field
+                .parse()
+                .unwrap_or_else(|_| panic!("{scene}: column {k} {field:?} is not a number"));
+            assert!(v.is_finite() && v >= 0.0, "{scene}: column {k} = {v}");
+        }
+        let (agreed, compared) = row[7].split_once('/').expect("agreed/compared");
+        let (agreed, compared): (u64, u64) = (agreed.parse().unwrap(), compared.parse().unwrap());
+        assert_eq!(agreed, compared, "{scene}: contact sets differ\n{stderr}");
+        assert!(compared > 0, "{scene}: nothing was compared\n{stderr}");
+    }
+}
+
+#[test]
+fn an_unknown_scene_is_bad_input() {
+    let o = ricochet(&["bench", "snow-100", "--frames", "1"], b"");
+    assert_eq!(o.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(stderr.contains("unknown scene \"snow-100\""), "{stderr}");
+}
+
+/// The command in BENCHMARKS.md names scenes the bench knows (checked without running them:
+/// scene names are checked before the frame count).
+#[test]
+fn the_documented_command_names_known_scenes() {
+    let doc = std::fs::read_to_string(root().join("BENCHMARKS.md")).unwrap();
+    let line = doc
+        .lines()
+        .find(|l| l.starts_with("$ ricochet bench "))
+        .expect("BENCHMARKS.md shows a `ricochet bench` command");
+    let mut args: Vec<&str> = line
+        .trim_start_matches("$ ricochet ")
+        .split_whitespace()
+        .take_while(|a| !a.starts_with("--"))
+        .collect();
+    assert!(args.len() > 1, "{line}");
+    args.extend(["--frames", "0"]);
+    let o = ricochet(&args, b"");
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("--frames must be at least 1"), "{stderr}");
+}
