@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 use ricochet_sim::{Simulation, load_scenario};
 
-use crate::util::{ricochet, root};
+use crate::util::{ricochet, root, scenarios};
 
 const BLESS: &str = "RICOCHET_BLESS=1 cargo test --test integration golden";
 
@@ -71,16 +71,6 @@ fn compare(golden: &Path, fresh: &Path) -> Result<(), String> {
         String::from_utf8_lossy(&o.stdout),
         String::from_utf8_lossy(&o.stderr),
     ))
-}
-
-fn scenarios() -> Vec<PathBuf> {
-    let mut files: Vec<PathBuf> = std::fs::read_dir(root().join("scenarios"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
-        .collect();
-    files.sort();
-    files
 }
 
 #[test]

@@ -1,7 +1,7 @@
 //! `ricochet run`: the log it writes, for every scenario in `scenarios/`.
 
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use ricochet_geom::pairs::collide_cores;
 use ricochet_geom::{Pose, Shape, ShapeDef, Vec2, place};
@@ -9,23 +9,9 @@ use ricochet_log::{LogMessage, read_log, read_log_file};
 use ricochet_sim::{Response, SLOP, load_scenario};
 use serde_json::Value;
 
-use crate::util::{ricochet, root};
+use crate::util::{ricochet, root, scenarios};
 
 /// Every scenario file shipped in `scenarios/`.
-fn scenarios() -> Vec<PathBuf> {
-    let mut files: Vec<PathBuf> = std::fs::read_dir(root().join("scenarios"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
-        .collect();
-    files.sort();
-    assert!(
-        files.len() >= 3,
-        "asteroids, platformer and shapes at least: {files:?}"
-    );
-    files
-}
-
 /// Runs `ricochet run SCENARIO -o OUT` and returns OUT's bytes.
 fn run(scenario: &Path, dir: &Path, out: &str) -> Vec<u8> {
     let out = dir.join(out);

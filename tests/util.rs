@@ -29,3 +29,18 @@ pub fn ricochet(args: &[&str], stdin: &[u8]) -> Output {
     drop(input);
     child.wait_with_output().expect("ricochet runs to the end")
 }
+
+/// Every scenario file shipped at the top of `scenarios/` (not `stress/`), sorted.
+pub fn scenarios() -> Vec<PathBuf> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(root().join("scenarios"))
+        .expect("scenarios/ exists")
+        .map(|e| e.expect("a readable entry").path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    files.sort();
+    assert!(
+        files.len() >= 3,
+        "asteroids, platformer and shapes at least: {files:?}"
+    );
+    files
+}

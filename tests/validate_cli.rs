@@ -2,22 +2,12 @@
 
 use std::process::Command;
 
-use crate::util::{ricochet, root};
-
-fn scenarios() -> Vec<String> {
-    let mut files: Vec<String> = std::fs::read_dir(root().join("scenarios"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
-        .map(|p| p.to_string_lossy().into_owned())
-        .collect();
-    files.sort();
-    files
-}
+use crate::util::{ricochet, root, scenarios};
 
 #[test]
 fn validate_passes_on_every_scenario() {
     for s in scenarios() {
+        let s = s.to_string_lossy();
         let o = ricochet(&["validate", &s], b"");
         let table = String::from_utf8_lossy(&o.stdout);
         assert_eq!(
