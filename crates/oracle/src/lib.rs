@@ -7,7 +7,9 @@
 //! compared with rapier's broad and narrow phase at the detect poses; every swept pair cast
 //! by parry along the frame's motion; each difference explained by a named rule of
 //! [`rules`]); the free-flight comparison [`compare_motion`];
-//! and the [`ValidationSummary`] with its printable [`summary_table`]. See
+//! the [`ValidationSummary`] with its printable [`summary_table`]; and the rapier side of
+//! `ricochet bench` ([`bench`](mod@bench): rapier's collision-only pipeline on the same shapes and
+//! poses, and the rule by which two contact sets agree). See
 //! `docs/validation.md` for the rules, the tolerances and the figures.
 //!
 //! **Never:** feeds anything back into the simulation (it only reads a [`Simulation`] and
