@@ -206,7 +206,8 @@ proptest! {
 
 /// Whether the shape stays clear of a whole side of its bounds: never, for a tight box.
 /// Scanning 401 spots along the side, the nearest is within 1/800 of the side's length of
-/// where the shape touches it.
+/// where the shape touches it. (An earlier bound of 1e-3 of the diagonal failed on a sharp
+/// vertex touching a long side: the bound must follow from the spacing.)
 fn side_is_loose(s: &Shape, p: &Pose, b: &Bounds, side: usize) -> bool {
     let speck = Shape::circle(1e-12).unwrap();
     (0..=400).all(|i| {
@@ -217,7 +218,15 @@ fn side_is_loose(s: &Shape, p: &Pose, b: &Bounds, side: usize) -> bool {
             2 => v(b.min.x + t * (b.max.x - b.min.x), b.min.y),
             _ => v(b.min.x + t * (b.max.x - b.min.x), b.max.y),
         };
-        contact(s, p, &speck, &Pose::new(probe, 0.0)).depth < -1e-3 * (b.max - b.min).length()
+        // The shape touches the side somewhere; every point of the side is within half a
+        // spacing of a spot, so some spot is within half a spacing of the shape.
+        let side_length = if side < 2 {
+            b.max.y - b.min.y
+        } else {
+            b.max.x - b.min.x
+        };
+        let half_spacing = side_length / 800.0;
+        contact(s, p, &speck, &Pose::new(probe, 0.0)).depth < -(half_spacing + 1e-9)
     })
 }
 
