@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 use ricochet_sim::{Simulation, load_scenario};
 
-use crate::util::{ricochet, root, scenarios};
+use crate::util::{record, ricochet, root, scenarios};
 
 const BLESS: &str = "RICOCHET_BLESS=1 cargo test --test integration golden";
 
@@ -36,20 +36,6 @@ fn digest(scenario: &Path) -> String {
         sim.world.len(),
         sim.world.digest()
     )
-}
-
-/// Runs a scenario file into `out` with the real binary.
-fn record(scenario: &Path, out: &Path) {
-    let o = ricochet(
-        &[
-            "run",
-            scenario.to_str().unwrap(),
-            "-o",
-            out.to_str().unwrap(),
-        ],
-        b"",
-    );
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
 
 /// Compares a fresh log with the golden one; the error says what diverged and what to do.

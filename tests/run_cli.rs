@@ -9,22 +9,12 @@ use ricochet_log::{LogMessage, read_log, read_log_file};
 use ricochet_sim::{Response, SLOP, load_scenario};
 use serde_json::Value;
 
-use crate::util::{ricochet, root, scenarios};
+use crate::util::{record, ricochet, root, scenarios};
 
-/// Every scenario file shipped in `scenarios/`.
-/// Runs `ricochet run SCENARIO -o OUT` and returns OUT's bytes.
+/// Runs `ricochet run SCENARIO -o DIR/OUT` and returns OUT's bytes.
 fn run(scenario: &Path, dir: &Path, out: &str) -> Vec<u8> {
     let out = dir.join(out);
-    let o = ricochet(
-        &[
-            "run",
-            scenario.to_str().unwrap(),
-            "-o",
-            out.to_str().unwrap(),
-        ],
-        b"",
-    );
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    record(scenario, &out);
     std::fs::read(out).unwrap()
 }
 

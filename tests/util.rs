@@ -44,3 +44,17 @@ pub fn scenarios() -> Vec<PathBuf> {
     );
     files
 }
+
+/// Runs `ricochet run SCENARIO -o OUT` with the real binary; panics with its stderr if it fails.
+pub fn record(scenario: &std::path::Path, out: &std::path::Path) {
+    let o = ricochet(
+        &[
+            "run",
+            scenario.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ],
+        b"",
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
