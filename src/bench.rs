@@ -201,6 +201,7 @@ fn asteroids(name: &str, n: usize, frames: u64) -> Scenario {
             wrap: true,
         }),
         layers: l,
+        ..WorldDef::default()
     };
     let mut bodies = Vec::with_capacity(n + BULLETS + 1);
     bodies.push(BodyDef {
@@ -321,6 +322,7 @@ fn platformer(name: &str, tiles: usize, actors: usize, frames: u64) -> Scenario 
                 (ACTOR, ACTOR, Response::Report),
             ],
         ),
+        ..WorldDef::default()
     };
     scenario(name, world, bodies, frames)
 }
@@ -395,6 +397,7 @@ fn rain(name: &str, n: usize, frames: u64) -> Scenario {
                 (DROP, DROP, Response::Report),
             ],
         ),
+        ..WorldDef::default()
     };
     scenario(name, world, bodies, frames)
 }

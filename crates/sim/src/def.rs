@@ -1,6 +1,7 @@
 //! Validated definitions: what a scenario file loads into (Box2D's `b2WorldDef` and
 //! `b2BodyDef`), each with a `Default`.
 
+use crate::broad_phase::BroadPhaseKind;
 use ricochet_geom::{Shape, Vec2};
 
 /// Index of a layer in [`Layers::names`].
@@ -293,6 +294,23 @@ pub struct WorldDef {
     pub bounds: Option<WorldBounds>,
     /// Layers and their response matrix.
     pub layers: Layers,
+    /// Which broad phase finds candidate pairs (default: chosen automatically).
+    pub broad_phase: BroadPhaseKind,
+    /// Bodies outside this region are frozen (default: none, everything is simulated).
+    pub active_region: Option<ActiveRegion>,
+    /// Dynamic bodies resting on static geometry for this many frames fall asleep
+    /// (default: `None`, nothing sleeps).
+    pub sleep_after: Option<u32>,
+}
+
+/// A region around a focus body (the player): moving bodies entirely outside it are frozen,
+/// neither moved nor tested, until the region reaches them again.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ActiveRegion {
+    /// The name of the body the region follows (the lowest id with that name).
+    pub focus: String,
+    /// Half the region's width and height, centred on the focus body.
+    pub half_extents: Vec2,
 }
 
 impl Default for WorldDef {
@@ -302,6 +320,9 @@ impl Default for WorldDef {
             gravity: Vec2::ZERO,
             bounds: None,
             layers: Layers::new(vec!["default".to_owned()]),
+            broad_phase: BroadPhaseKind::Auto,
+            active_region: None,
+            sleep_after: None,
         }
     }
 }

@@ -39,8 +39,8 @@ mod stages;
 mod world;
 
 pub use def::{
-    Action, BodyDef, BodyKind, Controller, Doomed, Event, LayerId, Layers, Response, Split,
-    WorldBounds, WorldDef,
+    Action, ActiveRegion, BodyDef, BodyKind, Controller, Doomed, Event, LayerId, Layers, Response,
+    Split, WorldBounds, WorldDef,
 };
 pub use entity::{Entity, EntityAllocator};
 pub use output::{ContactRecord, EventRecord, FrameOutput, Phase, RemovedBody, Stats};
