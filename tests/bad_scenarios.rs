@@ -136,6 +136,48 @@ fn each_error_class_is_named_with_its_location() {
     );
     case("hz-and-dt", "1:6", &["hz", "not both"]);
     case("non-positive-dt", "1:6", &["dt", "> 0"]);
+    case(
+        "unknown-broad-phase",
+        "5:15",
+        &[
+            "world.broad_phase",
+            "auto, brute-force, sort-and-sweep or grid",
+            "\"quadtree\"",
+        ],
+    );
+    case(
+        "sleep-after-zero",
+        "6:15",
+        &["world.sleep_after", "from 1 to 4294967295", "got 0"],
+    );
+    case(
+        "sleep-after-too-large",
+        "5:15",
+        &[
+            "world.sleep_after",
+            "from 1 to 4294967295",
+            "got 4294967296",
+        ],
+    );
+    case(
+        "unknown-focus",
+        "8:9",
+        &[
+            "world.active_region.focus",
+            "no body in [[bodies]] is named \"plyer\"",
+            "known: floor, player",
+        ],
+    );
+    case(
+        "zero-active-region",
+        "6:16",
+        &["world.active_region.half_extents", "> 0", "[40, 0]"],
+    );
+    case(
+        "infinite-active-region",
+        "5:52",
+        &["world.active_region.half_extents", "finite", "[inf, 25]"],
+    );
 }
 
 #[test]

@@ -4,9 +4,10 @@
 use std::collections::BTreeMap;
 use std::ops::Range;
 
+use crate::broad_phase::BroadPhaseKind;
 use crate::def::{
-    Action, BodyDef, BodyKind, Controller, Doomed, Event, LayerId, Layers, Response, Split,
-    WorldBounds, WorldDef,
+    Action, ActiveRegion, BodyDef, BodyKind, Controller, Doomed, Event, LayerId, Layers, Response,
+    Split, WorldBounds, WorldDef,
 };
 use crate::scenario_file::{
     ActionFile, BodyFile, ControllerFile, EventFile, ScenarioFile, SplitFile,
@@ -189,6 +190,53 @@ pub fn load_scenario(text: &str, file: &str) -> Result<Scenario, ScenarioError> 
             wrap: r.wrap,
         });
     }
+    if let Some(k) = &raw.world.broad_phase {
+        world.broad_phase = match k.get_ref().as_str() {
+            "auto" => BroadPhaseKind::Auto,
+            "brute-force" => BroadPhaseKind::BruteForce,
+            "sort-and-sweep" => BroadPhaseKind::SortAndSweep,
+            "grid" => BroadPhaseKind::Grid,
+            other => {
+                return Err(ctx.err(
+                    k.span(),
+                    "world.broad_phase",
+                    format!("expected auto, brute-force, sort-and-sweep or grid, got \"{other}\""),
+                ));
+            }
+        };
+    }
+    if let Some(n) = &raw.world.sleep_after {
+        let v = *n.get_ref();
+        let frames = u32::try_from(v).ok().filter(|f| *f >= 1).ok_or_else(|| {
+            ctx.err(
+                n.span(),
+                "world.sleep_after",
+                format!(
+                    "must be a whole number of frames from 1 to {}, got {v}",
+                    u32::MAX
+                ),
+            )
+        })?;
+        world.sleep_after = Some(frames);
+    }
+    if let Some(r) = &raw.world.active_region {
+        let h = *r.half_extents.get_ref();
+        if !h.iter().all(|x| finite(*x) && *x > 0.0) {
+            return Err(ctx.err(
+                r.half_extents.span(),
+                "world.active_region.half_extents",
+                format!(
+                    "must be finite numbers > 0 on both axes, got [{}, {}]",
+                    h[0], h[1]
+                ),
+            ));
+        }
+        // The focus is checked once the bodies are known, below.
+        world.active_region = Some(ActiveRegion {
+            focus: r.focus.get_ref().clone(),
+            half_extents: vec2(h),
+        });
+    }
     let mut templates = BTreeMap::new();
     for (name, t) in &raw.templates {
         let field = format!("templates.{name}");
@@ -259,6 +307,26 @@ pub fn load_scenario(text: &str, file: &str) -> Result<Scenario, ScenarioError> 
             &field,
             &default_name,
         )?);
+    }
+    if let Some(r) = &raw.world.active_region {
+        let focus = r.focus.get_ref();
+        if !bodies.iter().any(|b| &b.name == focus) {
+            let mut names: Vec<&str> = bodies.iter().map(|b| b.name.as_str()).collect();
+            names.sort_unstable();
+            names.dedup();
+            return Err(ctx.err(
+                r.focus.span(),
+                "world.active_region.focus",
+                format!(
+                    "no body in [[bodies]] is named \"{focus}\"; known: {}",
+                    if names.is_empty() {
+                        "none".to_owned()
+                    } else {
+                        names.join(", ")
+                    }
+                ),
+            ));
+        }
     }
     let script = script(&ctx, &raw, &templates, &bodies)?;
     Ok(Scenario {

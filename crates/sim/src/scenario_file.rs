@@ -51,6 +51,23 @@ pub struct WorldFile {
     pub gravity: Option<Spanned<[f64; 2]>>,
     /// World bounds.
     pub bounds: Option<Spanned<BoundsFile>>,
+    /// `auto` (default), `brute-force`, `sort-and-sweep` or `grid`.
+    pub broad_phase: Option<Spanned<String>>,
+    /// Frames at rest on static geometry before a dynamic body sleeps, >= 1 (default:
+    /// nothing sleeps).
+    pub sleep_after: Option<Spanned<i64>>,
+    /// Moving bodies outside a box around a focus body are frozen (default: none).
+    pub active_region: Option<ActiveRegionFile>,
+}
+
+/// `[world.active_region]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ActiveRegionFile {
+    /// Name of a body in `[[bodies]]`; the region follows the lowest id with that name.
+    pub focus: Spanned<String>,
+    /// Half the region's width and height, units, > 0.
+    pub half_extents: Spanned<[f64; 2]>,
 }
 
 /// `[world.bounds]`.
