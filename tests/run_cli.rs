@@ -196,10 +196,17 @@ fn asteroids_never_tests_an_asteroid_against_an_asteroid_and_stats_show_it() {
         "a.mcap",
     ))
     .unwrap();
-    let mut ignored = 0;
     let mut tested: BTreeMap<String, u64> = BTreeMap::new();
     for m in topic(&log, "/stats") {
-        ignored += m.data["pairs_ignored_by_layer"].as_u64().unwrap();
+        // asteroid/asteroid is a layer combination present in every frame that the broad
+        // phase never looks at (with at least two asteroids and a bullet or the ship).
+        if m.data["broad_phase"] != "" {
+            assert!(
+                m.data["layer_pairs_skipped"].as_u64().unwrap() >= 1,
+                "{}",
+                m.data
+            );
+        }
         for (k, v) in m.data["tests_by_layer_pair"].as_object().unwrap() {
             *tested.entry(k.clone()).or_default() += v.as_u64().unwrap();
         }
@@ -208,10 +215,6 @@ fn asteroids_never_tests_an_asteroid_against_an_asteroid_and_stats_show_it() {
     assert!(
         tested.get("asteroid/bullet").copied().unwrap_or(0) > 0,
         "{tested:?}"
-    );
-    assert!(
-        ignored > 0,
-        "overlapping asteroid pairs were seen and skipped"
     );
     // And no logged contact is between two asteroids.
     for m in topic(&log, "/contacts") {

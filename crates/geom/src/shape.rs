@@ -415,6 +415,12 @@ impl Shape {
         }
     }
 
+    /// Whether this is a single axis-aligned box (what per-axis separation resolves).
+    #[must_use]
+    pub fn is_single_aabb(&self) -> bool {
+        matches!(self, Shape::Primitive(Primitive::Aabb(_)))
+    }
+
     /// The primitives of this shape: one for a primitive, all parts for a compound.
     #[must_use]
     pub fn primitives(&self) -> &[Primitive] {

@@ -84,6 +84,20 @@ pub enum BroadPhaseKind {
     Auto,
 }
 
+impl BroadPhaseKind {
+    /// The name scenario files and `/stats` use: `brute-force`, `sort-and-sweep`, `grid`,
+    /// `auto`.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            BroadPhaseKind::BruteForce => "brute-force",
+            BroadPhaseKind::SortAndSweep => "sort-and-sweep",
+            BroadPhaseKind::Grid => "grid",
+            BroadPhaseKind::Auto => "auto",
+        }
+    }
+}
+
 /// One body, as the broad phase sees it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BodyEntry {
@@ -431,6 +445,19 @@ impl BroadPhase {
             };
             (m, layer)
         }));
+        // The same count `by_layers` keeps: layer combinations present that never interact.
+        for (k, &a) in self.mover_layers.iter().enumerate() {
+            let with_statics = if self.dynamic[usize::from(a)] > 0 {
+                &self.statics.layers[..]
+            } else {
+                &[]
+            };
+            for &b in self.mover_layers[k..].iter().chain(with_statics) {
+                if !interactions.interacts(a, b) {
+                    stats.layer_pairs_skipped += 1;
+                }
+            }
+        }
         for (k, (a, la)) in all.iter().enumerate() {
             for (b, lb) in &all[k + 1..] {
                 if (a.dynamic || b.dynamic) && interactions.interacts(*la, *lb) {
@@ -1177,6 +1204,35 @@ struct HashGrid {
 /// A body covering more cells goes to the grid's `big` list.
 const MAX_CELLS: u64 = 16;
 
+/// A grid over boxes that never move, built once (the per-axis stages' static boxes): which
+/// of them overlap a query box. The same grid as the broad phase's static grids.
+#[derive(Debug, Default)]
+pub(crate) struct FixedGrid(HashGrid);
+
+impl FixedGrid {
+    /// Indexes `boxes`, each with a handle reported by [`FixedGrid::query`].
+    pub(crate) fn new(boxes: impl Iterator<Item = (Bounds, u32)>) -> FixedGrid {
+        let mut g = HashGrid {
+            members: boxes
+                .map(|(bounds, handle)| Member {
+                    bounds,
+                    handle,
+                    dynamic: false,
+                })
+                .collect(),
+            ..HashGrid::default()
+        };
+        g.build(&mut Vec::new(), true);
+        FixedGrid(g)
+    }
+
+    /// Calls `f` once with the handle of every box overlapping `q` (touching counts).
+    /// Returns the box tests made.
+    pub(crate) fn query(&self, q: &Bounds, mut f: impl FnMut(u32)) -> u64 {
+        self.0.query(q, |m| f(m.handle))
+    }
+}
+
 /// Cell coordinates stay within `±2^30` of the origin for finite bounds.
 const CELL_RANGE: f64 = (1u64 << 30) as f64;
 
@@ -1199,7 +1255,7 @@ impl CellRange {
 
 /// `floor(v * inv_cell)`, clamped to `i32`: monotone in `v`.
 #[inline]
-fn cell_coord(v: f64, inv_cell: f64) -> i32 {
+pub(crate) fn cell_coord(v: f64, inv_cell: f64) -> i32 {
     // Clamped, then floored by hand (`f64::floor` is a call on baseline x86-64): the cast
     // truncates toward zero, a negative fraction steps down. NaN becomes 0; only regular
     // bounds get here.

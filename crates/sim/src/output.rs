@@ -93,14 +93,23 @@ pub struct RemovedBody {
 pub struct Stats {
     /// Bodies alive at the end of the frame.
     pub bodies: usize,
-    /// Pairs whose bounds overlapped and whose layers interact.
+    /// The broad phase `detect` ran (what `auto` chose), or `""` when it did not run.
+    pub broad_phase: &'static str,
+    /// Candidate pairs the broad phase found that `detect` kept for the narrow phase (bounds
+    /// overlap, layers interact, not both at rest, not two boxes settled per axis).
     pub broad_pairs: u64,
     /// Exact narrow-phase tests run.
     pub narrow_tests: u64,
     /// Contacts recorded.
     pub contacts: u64,
-    /// Pairs whose bounds overlapped but whose layers ignore each other: never tested.
-    pub pairs_ignored_by_layer: u64,
+    /// Layer combinations present in the scene (moving with moving, a layer with itself,
+    /// moving with static) that the broad phase never looked at because they `ignore` each
+    /// other: no body pair of theirs is ever formed.
+    pub layer_pairs_skipped: u64,
+    /// Moving bodies frozen outside the active region this frame.
+    pub frozen: usize,
+    /// Bodies asleep at the end of the frame.
+    pub asleep: usize,
     /// Stages run.
     pub stages_run: Vec<&'static str>,
     /// Stages skipped because the scene had nothing for them.

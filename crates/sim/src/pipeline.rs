@@ -7,6 +7,7 @@
 //! | stage | does |
 //! |---|---|
 //! | `script` | this frame's script events: inputs, spawns, destroys, velocity/force edits |
+//! | `cull` | freeze the moving bodies outside the active region, thaw those inside it |
 //! | `unground` | clear `grounded`: it is set again below by whatever holds a body up |
 //! | `controls` | controllers turn inputs into angular velocity (ship) or x velocity (runner, walker) |
 //! | `forces` | semi-implicit Euler, velocity half: `a = sum(f) / m`, `v += a * dt` |
@@ -18,6 +19,10 @@
 //! | `detect` | broad phase, exact narrow phase, `report`/`destroy`/`separate` responses |
 //! | `lifetimes` | count down lifetimes; remove expired bodies |
 //! | `bounds` | wrap around (Asteroids) or remove bodies that left the world |
+//! | `sleep` | count the frames each dynamic body rested; put to sleep those that rested long enough |
+//!
+//! The motion stages visit only the *active* bodies ([`World::active`]): moving, not frozen,
+//! not asleep. Static bodies are never visited after they are indexed.
 
 use std::collections::BTreeMap;
 
@@ -25,6 +30,8 @@ use crate::def::{BodyDef, Event};
 use crate::output::FrameOutput;
 use crate::scenario::Scenario;
 use crate::stages;
+use crate::stages::detect::DetectState;
+use crate::stages::separate::SeparateState;
 use crate::world::World;
 
 /// How far two solid bodies may still overlap after `separate` has pushed them apart, in
@@ -39,11 +46,16 @@ pub(crate) struct Stage {
 }
 
 /// The stage order. See the module docs.
-pub(crate) const STAGES: [Stage; 12] = [
+pub(crate) const STAGES: [Stage; 14] = [
     Stage {
         name: "script",
         has_work: stages::script::has_work,
         run: stages::script::run,
+    },
+    Stage {
+        name: "cull",
+        has_work: stages::rest::has_region,
+        run: stages::rest::cull,
     },
     Stage {
         name: "unground",
@@ -100,12 +112,17 @@ pub(crate) const STAGES: [Stage; 12] = [
         has_work: stages::bounds::has_work,
         run: stages::bounds::run,
     },
+    Stage {
+        name: "sleep",
+        has_work: stages::rest::has_sleep,
+        run: stages::rest::sleep,
+    },
 ];
 
 /// The stages frame 0 runs: the initial state is scripted and checked, never moved. Lifetimes
 /// count frame 0, so a body lives `lifetime` frames whether it starts there or is spawned
 /// later.
-const FRAME_ZERO: [&str; 3] = ["script", "detect", "lifetimes"];
+const FRAME_ZERO: [&str; 4] = ["script", "cull", "detect", "lifetimes"];
 
 /// A running simulation.
 pub struct Simulation {
@@ -122,6 +139,12 @@ pub struct Simulation {
     /// Whether each frame reports every body's pose at the start of `detect`
     /// ([`FrameOutput::detect_poses`]). Off by default: it costs a copy per frame.
     pub capture_detect_poses: bool,
+    /// The body the active region follows, once found.
+    pub(crate) focus: Option<crate::Entity>,
+    /// The broad phase and buffers of `detect`.
+    pub(crate) detect: DetectState,
+    /// The obstacle grids of `resolve_x` and `resolve_y`.
+    pub(crate) separate: SeparateState,
 }
 
 impl Simulation {
@@ -132,13 +155,41 @@ impl Simulation {
         for b in &scenario.bodies {
             world.spawn(b);
         }
+        // The bodies live in the world; the simulation's copy of the scenario keeps the rest.
+        let rest = Scenario {
+            name: scenario.name.clone(),
+            world: scenario.world.clone(),
+            frames: scenario.frames,
+            templates: scenario.templates.clone(),
+            bodies: Vec::new(),
+            script: scenario.script.clone(),
+        };
+        Simulation::with_world(rest, world)
+    }
+
+    /// A simulation of `scenario` that takes its bodies instead of copying them: for large
+    /// scenes, where a second copy of every body would double the memory.
+    #[must_use]
+    pub fn from_scenario(mut scenario: Scenario) -> Simulation {
+        let mut world = World::new();
+        for b in std::mem::take(&mut scenario.bodies) {
+            world.spawn(&b);
+        }
+        Simulation::with_world(scenario, world)
+    }
+
+    fn with_world(scenario: Scenario, world: World) -> Simulation {
+        let layers = &scenario.world.layers;
         Simulation {
             templates: scenario.templates.clone(),
-            scenario: scenario.clone(),
+            detect: DetectState::new(layers, scenario.world.broad_phase),
+            separate: SeparateState::new(layers),
+            scenario,
             world,
             frame: 0,
             cursor: 0,
             capture_detect_poses: false,
+            focus: None,
         }
     }
 
@@ -167,10 +218,13 @@ impl Simulation {
             frame: self.frame,
             ..FrameOutput::default()
         };
-        // Swept tests run from here to wherever the frame's motion ends.
-        self.world
-            .start_position
-            .copy_from_slice(&self.world.position);
+        // Swept tests run from here to wherever the frame's motion ends. Static bodies never
+        // move, so only the moving ones need it.
+        let w = &mut self.world;
+        for k in 0..w.movers().len() {
+            let i = w.movers()[k] as usize;
+            w.start_position[i] = w.position[i];
+        }
         for stage in &STAGES {
             let allowed = self.frame > 0 || FRAME_ZERO.contains(&stage.name);
             if allowed && (stage.has_work)(self) {

@@ -5,7 +5,7 @@
 //! rest down (`Vec::remove`): slower than a swap-remove, but the order, and so every log,
 //! never depends on what was removed before.
 
-use ricochet_geom::{Shape, Vec2};
+use ricochet_geom::{Bounds, Pose, Shape, Vec2};
 
 use crate::def::{BodyDef, BodyKind, Controller, LayerId, Split};
 use crate::entity::{Entity, EntityAllocator};
@@ -62,6 +62,55 @@ pub struct World {
     pub grounded: Vec<bool>,
     /// Children spawned on destruction.
     pub split: Vec<Vec<Split>>,
+    /// Frozen outside the active region: not moved, not tested, lifetime paused.
+    pub frozen: Vec<bool>,
+    /// Asleep: at rest on static geometry, not integrated until something touches it.
+    pub asleep: Vec<bool>,
+    /// Consecutive frames a dynamic body has ended exactly where it started, grounded.
+    pub rest_frames: Vec<u32>,
+    /// Each body's bounds relative to its position (see [`World::bounds`]).
+    local_bounds: Vec<LocalBounds>,
+    /// Dense indices of the moving (dynamic and kinematic) bodies, ascending.
+    movers: Vec<u32>,
+    /// Dense indices of the moving bodies that are neither frozen nor asleep, ascending.
+    active: Vec<u32>,
+    /// Bumped whenever a static body is added or removed.
+    static_generation: u64,
+    /// How many bodies have a lifetime.
+    with_lifetime: usize,
+    /// How many bodies are asleep.
+    sleeping: usize,
+    /// How many bodies have a controller.
+    with_controller: usize,
+    /// Per layer, how many bodies are not a single AABB (the per-axis stages own box pairs).
+    non_boxes: Vec<u32>,
+}
+
+/// A body's bounds relative to its position, kept from one frame to the next.
+#[derive(Clone, Copy, Debug)]
+struct LocalBounds {
+    /// The angle they were computed at.
+    angle: f64,
+    /// Good at every angle (a shape that turning does not change, or a body that has turned
+    /// and is bounded by the disc that holds it at every angle).
+    any_angle: bool,
+    bounds: Bounds,
+}
+
+impl LocalBounds {
+    fn new(shape: &Shape, angle: f64) -> LocalBounds {
+        LocalBounds {
+            angle,
+            any_angle: turning_keeps_bounds(shape),
+            bounds: shape.bounds(&Pose::new(Vec2::ZERO, angle)),
+        }
+    }
+}
+
+/// Whether a shape's bounds are the same at every angle: circles and AABBs (which ignore
+/// rotation) centred on the body origin.
+fn turning_keeps_bounds(shape: &Shape) -> bool {
+    !shape.primitives().iter().any(|p| p.turns_with_body())
 }
 
 impl World {
@@ -120,6 +169,35 @@ impl World {
         self.inputs.insert(i, Inputs::default());
         self.grounded.insert(i, false);
         self.split.insert(i, def.split.clone());
+        self.frozen.insert(i, false);
+        self.asleep.insert(i, false);
+        self.rest_frames.insert(i, 0);
+        self.local_bounds
+            .insert(i, LocalBounds::new(&def.shape, def.angle));
+        let i = i as u32;
+        for list in [&mut self.movers, &mut self.active] {
+            let at = list.partition_point(|&k| k < i);
+            for k in &mut list[at..] {
+                *k += 1;
+            }
+            if moves {
+                list.insert(at, i);
+            }
+        }
+        if !moves {
+            self.static_generation += 1;
+            // New static geometry may overlap a sleeper, which would never be tested.
+            self.wake_all();
+        }
+        self.with_lifetime += usize::from(def.lifetime.is_some());
+        self.with_controller += usize::from(def.controller.is_some());
+        if !def.shape.is_single_aabb() {
+            let l = usize::from(def.layer);
+            if self.non_boxes.len() <= l {
+                self.non_boxes.resize(l + 1, 0);
+            }
+            self.non_boxes[l] += 1;
+        }
         e
     }
 
@@ -128,9 +206,10 @@ impl World {
         let e = self.entity.remove(i);
         self.ids.free(e);
         self.name.remove(i);
-        self.layer.remove(i);
-        self.shape.remove(i);
-        self.kind.remove(i);
+        let layer = self.layer.remove(i);
+        if !self.shape.remove(i).is_single_aabb() {
+            self.non_boxes[usize::from(layer)] -= 1;
+        }
         self.mass.remove(i);
         self.position.remove(i);
         self.start_position.remove(i);
@@ -139,11 +218,150 @@ impl World {
         self.angular_velocity.remove(i);
         self.force.remove(i);
         self.gravity_scale.remove(i);
-        self.lifetime.remove(i);
-        self.controller.remove(i);
+        if self.controller.remove(i).is_some() {
+            self.with_controller -= 1;
+        }
         self.inputs.remove(i);
         self.grounded.remove(i);
         self.split.remove(i);
+        self.frozen.remove(i);
+        if self.asleep.remove(i) {
+            self.sleeping -= 1;
+        }
+        self.rest_frames.remove(i);
+        self.local_bounds.remove(i);
+        if self.kind.remove(i) == BodyKind::Static {
+            self.static_generation += 1;
+        }
+        if self.lifetime.remove(i).is_some() {
+            self.with_lifetime -= 1;
+        }
+        let i = i as u32;
+        for list in [&mut self.movers, &mut self.active] {
+            let at = list.partition_point(|&k| k < i);
+            if list.get(at) == Some(&i) {
+                list.remove(at);
+            }
+            for k in &mut list[at..] {
+                *k -= 1;
+            }
+        }
+        // What a sleeper rested on may be gone.
+        self.wake_all();
+    }
+
+    /// Dense indices of the moving (dynamic and kinematic) bodies, ascending.
+    #[must_use]
+    pub fn movers(&self) -> &[u32] {
+        &self.movers
+    }
+
+    /// Dense indices of the moving bodies that are neither frozen nor asleep, ascending:
+    /// the bodies the motion stages integrate.
+    #[must_use]
+    pub fn active(&self) -> &[u32] {
+        &self.active
+    }
+
+    /// Recomputes [`World::active`] after `frozen` or `asleep` changed.
+    pub fn refresh_active(&mut self) {
+        self.active.clear();
+        let (frozen, asleep) = (&self.frozen, &self.asleep);
+        self.active.extend(
+            self.movers
+                .iter()
+                .filter(|&&i| !frozen[i as usize] && !asleep[i as usize]),
+        );
+    }
+
+    /// Wakes body `i` if it sleeps: it is integrated again from the next frame (or the
+    /// next [`World::refresh_active`]).
+    pub fn wake(&mut self, i: usize) {
+        if self.asleep[i] {
+            self.sleeping -= 1;
+        }
+        self.asleep[i] = false;
+        self.rest_frames[i] = 0;
+    }
+
+    /// Puts body `i` to sleep (from the next [`World::refresh_active`] on).
+    pub fn put_to_sleep(&mut self, i: usize) {
+        if !self.asleep[i] {
+            self.sleeping += 1;
+        }
+        self.asleep[i] = true;
+    }
+
+    /// How many bodies are asleep.
+    #[must_use]
+    pub fn sleeping(&self) -> usize {
+        self.sleeping
+    }
+
+    /// Wakes every sleeping body, now: the active list is recomputed.
+    pub fn wake_all(&mut self) {
+        if self.sleeping > 0 {
+            self.sleeping = 0;
+            self.asleep.fill(false);
+            self.rest_frames.fill(0);
+            self.refresh_active();
+        }
+    }
+
+    /// Changes whenever a static body is added or removed (static bodies never move).
+    #[must_use]
+    pub fn static_generation(&self) -> u64 {
+        self.static_generation
+    }
+
+    /// Whether any body has a controller.
+    #[must_use]
+    pub fn any_controller(&self) -> bool {
+        self.with_controller > 0
+    }
+
+    /// Whether every body of `layer` is a single AABB (true for an empty layer).
+    #[must_use]
+    pub fn only_boxes(&self, layer: LayerId) -> bool {
+        self.non_boxes
+            .get(usize::from(layer))
+            .is_none_or(|&n| n == 0)
+    }
+
+    /// Whether any body has a lifetime.
+    #[must_use]
+    pub fn any_lifetime(&self) -> bool {
+        self.with_lifetime > 0
+    }
+
+    /// Bounds of body `i` for the broad phase: they hold the shape, and are exact for a body
+    /// that has not turned since it was created (or whose bounds turning does not change).
+    /// A body that has turned is bounded by the square around the disc that holds its shape
+    /// at every angle, so turning never costs a rotation here.
+    pub fn bounds(&mut self, i: usize) -> Bounds {
+        let lb = &mut self.local_bounds[i];
+        let angle = self.angle[i];
+        if !lb.any_angle && lb.angle.to_bits() != angle.to_bits() {
+            // The farthest corner of the angle-0 box is as far as any point of the shape.
+            let b = self.shape[i].bounds(&Pose::default());
+            let r = b.min.abs().max(b.max.abs()).length();
+            // A rotated point may round one ulp past the exact radius.
+            let r = r + r * 1e-12;
+            lb.bounds = Bounds {
+                min: Vec2::splat(-r),
+                max: Vec2::splat(r),
+            };
+            lb.any_angle = true;
+        }
+        let p = self.position[i];
+        let b = lb.bounds;
+        // Translating rounds differently from placing the shape at `p` (a rounding or two,
+        // each at most half an ulp of these magnitudes): pad by more than that.
+        let pad = (p.abs() + b.min.abs().max(b.max.abs())) * 1e-15;
+        Bounds {
+            min: b.min + p - pad,
+            max: b.max + p + pad,
+        }
     }
 
     /// The pose of body `i`.
@@ -184,7 +402,9 @@ impl World {
     /// Kinetic energy of the dynamic bodies, `sum(m v² / 2)` (translation only).
     #[must_use]
     pub fn kinetic_energy(&self) -> f64 {
-        (0..self.len())
+        self.movers
+            .iter()
+            .map(|&i| i as usize)
             .filter(|&i| self.kind[i] == BodyKind::Dynamic)
             .map(|i| 0.5 * self.mass[i] * self.velocity[i].length_squared())
             .sum()

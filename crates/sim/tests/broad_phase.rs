@@ -397,6 +397,10 @@ fn a_layer_that_ignores_itself_is_never_tested_against_itself() {
     bodies.push(body(4000, (10.0, 10.0), 1.0, 2, BodyKind::Dynamic));
     let expected = reference(&bodies, &interactions);
     let mut out = Vec::new();
+    // Brute force counts the skipped layer combinations too (its tests are all pairs).
+    let s = BroadPhase::new(BroadPhaseKind::BruteForce).pairs(&bodies, &interactions, &mut out);
+    assert_eq!(out, expected);
+    assert_eq!(s.layer_pairs_skipped, 4);
     for kind in [BroadPhaseKind::SortAndSweep, BroadPhaseKind::Grid] {
         let mut bp = BroadPhase::new(kind);
         for _ in 0..3 {

@@ -1,6 +1,5 @@
 //! The `bounds` stage: wrap around (Asteroids), or remove bodies that left the world.
 
-use crate::def::BodyKind;
 use crate::output::FrameOutput;
 use crate::pipeline::Simulation;
 use crate::stages::remove::remove;
@@ -16,10 +15,9 @@ pub(crate) fn run(sim: &mut Simulation, out: &mut FrameOutput) {
     let size = b.max - b.min;
     let mut gone = Vec::new();
     let w = &mut sim.world;
-    for i in 0..w.len() {
-        if w.kind[i] == BodyKind::Static {
-            continue;
-        }
+    // Only active bodies move: static, frozen and sleeping ones stay where they were.
+    for k in 0..w.active().len() {
+        let i = w.active()[k] as usize;
         let p = &mut w.position[i];
         for axis in 0..2 {
             if p[axis] < b.min[axis] || p[axis] >= b.max[axis] {

@@ -1,15 +1,21 @@
 //! The `detect` stage: broad phase, exact narrow phase, and the responses of the layer-pair
 //! matrix at the frame's final poses.
 //!
-//! Broad phase: sort and sweep along x over every body's bounds. A candidate pair is dropped
-//! before the narrow phase when neither body can move (static or kinematic against static or
-//! kinematic), when its layers `ignore` each other (counted in `pairs_ignored_by_layer`), or
-//! when two boxes `separate` (the per-axis stages own those). The rest are tested exactly, in
-//! `(a, b)` id order, and respond:
+//! Broad phase: [`crate::broad_phase`], chosen by the scenario's `broad_phase` (automatic
+//! by default), fed with every body's bounds ([`World::bounds`]). Layers that `ignore` each
+//! other are never paired (a layer that ignores itself is never swept against itself), and
+//! static and kinematic bodies never pair with each other: those pairs are never produced,
+//! so never counted. Static bodies are handed over only when they change
+//! ([`World::static_generation`]). A candidate pair is then dropped before the narrow phase
+//! when a body is frozen outside the active region, when both are at rest (asleep or
+//! static), or when two boxes `separate` (the per-axis stages own those). The rest are
+//! tested exactly, in `(a, b)` id order, and respond:
 //! - `report`: the contact is logged and a `contact` event raised;
 //! - `destroy`: the doomed bodies are removed after the pass (children of a split spawned);
 //! - `separate`: the dynamic body is pushed out along the normal by the depth (two dynamic
 //!   bodies half each), and its velocity into the other is removed.
+//!
+//! A sleeping body that touches an awake one wakes up (from the next frame on).
 //!
 //! Swept pairs (a layer in `fast_layers`, or `sweep = true` on the `[[collide]]` entry;
 //! `report` and `destroy` only) are bounded over the whole frame's motion and tested by time
@@ -17,77 +23,159 @@
 //! first that destroys it, so a bullet never passes through a rock, and hits the first one
 //! on its path. Rotation during the frame is not swept (the end angles are used).
 
-use ricochet_geom::{Bounds, Contact, Pose, Shape, Vec2, contact};
+use ricochet_geom::{Contact, Pose, Shape, Vec2, contact};
 
-use crate::def::{BodyKind, Doomed, Response};
+use crate::broad_phase::{BodyEntry, BroadPhase, BroadPhaseKind, Interactions};
+use crate::def::{BodyKind, Doomed, Layers, Response};
 use crate::entity::Entity;
 use crate::output::{ContactRecord, EventRecord, FrameOutput, Phase};
 use crate::pipeline::{SLOP, Simulation};
 use crate::stages::remove::remove;
 use crate::stages::separate::is_box;
+use crate::world::World;
 
 pub(crate) fn has_work(sim: &Simulation) -> bool {
     sim.world.len() >= 2 && sim.scenario.world.layers.any(|r| r != Response::Ignore)
 }
 
-/// Candidate pairs `(i, j)`, `i < j` (dense index order is id order), whose bounds overlap.
-fn sweep(bounds: &[Bounds]) -> Vec<(usize, usize)> {
-    let mut order: Vec<usize> = (0..bounds.len()).collect();
-    // total_cmp and the index as tie-break: a deterministic order even with equal keys.
-    order.sort_by(|&p, &q| bounds[p].min.x.total_cmp(&bounds[q].min.x).then(p.cmp(&q)));
-    let mut pairs = Vec::new();
-    for (k, &p) in order.iter().enumerate() {
-        for &q in &order[k + 1..] {
-            if bounds[q].min.x > bounds[p].max.x {
-                break;
-            }
-            if bounds[p].overlaps(&bounds[q]) {
-                pairs.push((p.min(q), p.max(q)));
+/// What `detect` keeps from one frame to the next: the broad phase (its sorted lists and
+/// static structures) and reused buffers.
+#[derive(Debug)]
+pub(crate) struct DetectState {
+    broad_phase: BroadPhase,
+    /// Layer pairs `detect` tests: not `ignore`, and not `separate` between two layers of
+    /// boxes only (the per-axis stages own those). Rebuilt when `box_only` changes.
+    interactions: Interactions,
+    /// Per layer, whether all its bodies were boxes when `interactions` was built.
+    box_only: Vec<bool>,
+    layers: Layers,
+    /// Layers with a swept pair.
+    sweeping: Vec<bool>,
+    /// The static generation `statics` was built at.
+    static_generation: Option<u64>,
+    statics: Vec<BodyEntry>,
+    movers: Vec<BodyEntry>,
+    pairs: Vec<(u32, u32)>,
+}
+
+impl DetectState {
+    pub(crate) fn new(layers: &Layers, kind: BroadPhaseKind) -> DetectState {
+        let n = layers.names().len();
+        let box_only = vec![false; n];
+        DetectState {
+            broad_phase: BroadPhase::new(kind),
+            interactions: interactions(layers, &box_only),
+            box_only,
+            layers: layers.clone(),
+            sweeping: (0..n)
+                .map(|l| (0..n).any(|m| layers.sweeps(l as u8, m as u8)))
+                .collect(),
+            static_generation: None,
+            statics: Vec::new(),
+            movers: Vec::new(),
+            pairs: Vec::new(),
+        }
+    }
+}
+
+fn interactions(layers: &Layers, box_only: &[bool]) -> Interactions {
+    Interactions::from_fn(box_only.len(), |a, b| match layers.response(a, b) {
+        Response::Ignore => false,
+        Response::Separate => !(box_only[usize::from(a)] && box_only[usize::from(b)]),
+        _ => true,
+    })
+}
+
+fn key(w: &World, i: usize) -> u64 {
+    let e = w.entity[i];
+    (u64::from(e.index) << 32) | u64::from(e.generation)
+}
+
+/// Fills the broad phase's inputs and finds the candidate pairs (dense indices, sorted).
+fn candidate_pairs(sim: &mut Simulation, out: &mut FrameOutput) -> Vec<(u32, u32)> {
+    let st = &mut sim.detect;
+    let w = &mut sim.world;
+    let changed = (0..st.box_only.len()).any(|l| st.box_only[l] != w.only_boxes(l as u8));
+    if changed {
+        for (l, b) in st.box_only.iter_mut().enumerate() {
+            *b = w.only_boxes(l as u8);
+        }
+        st.interactions = interactions(&st.layers, &st.box_only);
+    }
+    if st.static_generation != Some(w.static_generation()) {
+        st.statics.clear();
+        for i in 0..w.len() {
+            if w.kind[i] == BodyKind::Static {
+                let bounds = w.bounds(i);
+                st.statics.push(BodyEntry {
+                    key: key(w, i),
+                    bounds,
+                    layer: w.layer[i],
+                    kind: BodyKind::Static,
+                });
             }
         }
     }
-    pairs.sort_unstable();
+    st.movers.clear();
+    for k in 0..w.movers().len() {
+        let i = w.movers()[k] as usize;
+        let mut bounds = w.bounds(i);
+        // A body in a swept pair is bounded over its whole motion this frame, so the broad
+        // phase sees a bullet that went right through something.
+        let moved = w.start_position[i] - w.position[i];
+        if st.sweeping[usize::from(w.layer[i])] && moved != Vec2::ZERO {
+            bounds = bounds.union(bounds.translated(moved));
+        }
+        // A frozen body is handed over as kinematic (it keeps its place in the dense order)
+        // and its pairs are dropped below.
+        let kind = if w.frozen[i] {
+            BodyKind::Kinematic
+        } else {
+            w.kind[i]
+        };
+        st.movers.push(BodyEntry {
+            key: key(w, i),
+            bounds,
+            layer: w.layer[i],
+            kind,
+        });
+    }
+    let generation = w.static_generation();
+    let mut pairs = std::mem::take(&mut st.pairs);
+    let bp = st.broad_phase.pairs_split(
+        &st.statics,
+        generation,
+        &st.movers,
+        &st.interactions,
+        &mut pairs,
+    );
+    st.static_generation = Some(generation);
+    out.stats.broad_phase = bp.kind.name();
+    out.stats.layer_pairs_skipped += bp.layer_pairs_skipped;
     pairs
 }
 
 pub(crate) fn run(sim: &mut Simulation, out: &mut FrameOutput) {
     let layers = sim.scenario.world.layers.clone();
-    let w = &sim.world;
     if sim.capture_detect_poses {
+        let w = &sim.world;
         out.detect_poses = Some((0..w.len()).map(|i| (w.entity[i], w.pose(i))).collect());
     }
-    // A body in a swept pair is bounded over its whole motion this frame, so the broad phase
-    // sees a bullet that went right through something.
-    let sweeping: Vec<bool> = (0..layers.names().len())
-        .map(|l| (0..layers.names().len()).any(|m| layers.sweeps(l as u8, m as u8)))
-        .collect();
-    let bounds: Vec<Bounds> = (0..w.len())
-        .map(|i| {
-            let b = w.shape[i].bounds(&w.pose(i));
-            let moved = w.start_position[i] - w.position[i];
-            if sweeping[usize::from(w.layer[i])] && moved != Vec2::ZERO {
-                b.union(b.translated(moved))
-            } else {
-                b
-            }
-        })
-        .collect();
-    let pairs = sweep(&bounds);
+    let pairs = candidate_pairs(sim, out);
     // Tests per layer pair, counted in a flat table and named once at the end.
     let n_layers = layers.names().len();
     let mut per_layer_pair = vec![0u64; n_layers * n_layers];
     let mut doomed: Vec<(Entity, String)> = Vec::new();
     let mut swept: Vec<(usize, usize)> = Vec::new();
-    for (i, j) in pairs {
+    let mut woken: Vec<usize> = Vec::new();
+    for &(i, j) in &pairs {
+        let (i, j) = (i as usize, j as usize);
         let w = &sim.world;
-        if w.kind[i] != BodyKind::Dynamic && w.kind[j] != BodyKind::Dynamic {
+        let resting = |k: usize| w.kind[k] == BodyKind::Static || w.asleep[k];
+        if w.frozen[i] || w.frozen[j] || (resting(i) && resting(j)) {
             continue;
         }
         let response = layers.response(w.layer[i], w.layer[j]);
-        if response == Response::Ignore {
-            out.stats.pairs_ignored_by_layer += 1;
-            continue;
-        }
         if response == Response::Separate && is_box(&w.shape[i]) && is_box(&w.shape[j]) {
             continue;
         }
@@ -109,6 +197,7 @@ pub(crate) fn run(sim: &mut Simulation, out: &mut FrameOutput) {
         if c.depth <= threshold {
             continue;
         }
+        woken.extend([i, j].into_iter().filter(|&k| w.asleep[k]));
         respond(
             sim,
             out,
@@ -120,6 +209,7 @@ pub(crate) fn run(sim: &mut Simulation, out: &mut FrameOutput) {
             (pose_a, pose_b),
         );
     }
+    sim.detect.pairs = pairs;
     for (k, &count) in per_layer_pair.iter().enumerate() {
         if count > 0 {
             let (la, lb) = ((k / n_layers) as u8, (k % n_layers) as u8);
@@ -127,7 +217,10 @@ pub(crate) fn run(sim: &mut Simulation, out: &mut FrameOutput) {
             out.stats.tests_by_layer_pair.insert(name, count);
         }
     }
-    run_swept(sim, out, &mut doomed, &swept, &layers);
+    run_swept(sim, out, &mut doomed, &swept, &layers, &mut woken);
+    for i in woken {
+        sim.world.wake(i);
+    }
     doomed.sort();
     doomed.dedup_by_key(|(e, _)| *e);
     for (e, why) in doomed {
@@ -143,7 +236,8 @@ fn run_swept(
     out: &mut FrameOutput,
     doomed: &mut Vec<(Entity, String)>,
     swept: &[(usize, usize)],
-    layers: &crate::Layers,
+    layers: &Layers,
+    woken: &mut Vec<usize>,
 ) {
     struct Hit {
         mover: Entity,
@@ -187,6 +281,11 @@ fn run_swept(
         }
         let w = &sim.world;
         let response = layers.response(w.layer[hit.pair.0], w.layer[hit.pair.1]);
+        woken.extend(
+            [hit.pair.0, hit.pair.1]
+                .into_iter()
+                .filter(|&k| w.asleep[k]),
+        );
         let before = doomed.len();
         respond(
             sim,

@@ -1,20 +1,25 @@
-//! The `lifetimes` stage: bodies with a lifetime are removed when it runs out.
+//! The `lifetimes` stage: bodies with a lifetime are removed when it runs out. A frozen
+//! body's lifetime is paused with the rest of it.
 
 use crate::output::FrameOutput;
 use crate::pipeline::Simulation;
 use crate::stages::remove::remove;
 
 pub(crate) fn has_work(sim: &Simulation) -> bool {
-    sim.world.lifetime.iter().any(Option::is_some)
+    sim.world.any_lifetime()
 }
 
 pub(crate) fn run(sim: &mut Simulation, out: &mut FrameOutput) {
     let mut expired = Vec::new();
-    for (i, life) in sim.world.lifetime.iter_mut().enumerate() {
+    let w = &mut sim.world;
+    for (i, life) in w.lifetime.iter_mut().enumerate() {
+        if w.frozen[i] {
+            continue;
+        }
         if let Some(l) = life {
             *l = l.saturating_sub(1);
             if *l == 0 {
-                expired.push(sim.world.entity[i]);
+                expired.push(w.entity[i]);
             }
         }
     }

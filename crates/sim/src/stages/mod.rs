@@ -6,5 +6,6 @@ pub(crate) mod detect;
 pub(crate) mod lifetimes;
 pub(crate) mod motion;
 pub(crate) mod remove;
+pub(crate) mod rest;
 pub(crate) mod script;
 pub(crate) mod separate;

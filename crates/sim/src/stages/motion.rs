@@ -7,25 +7,39 @@ use crate::output::FrameOutput;
 use crate::pipeline::Simulation;
 
 pub(crate) fn has_grounded(sim: &Simulation) -> bool {
-    sim.world.grounded.iter().any(|g| *g)
+    let w = &sim.world;
+    w.active().iter().any(|&i| w.grounded[i as usize])
 }
 
 /// Every body starts the frame's motion airborne; `resolve_y` (a push upwards) or `detect`
 /// (a `separate` normal pointing up) grounds it again. The script ran first, so a `jump`
 /// saw the previous frame's answer.
+/// Sleeping and frozen bodies keep theirs: they are exactly where they were.
 pub(crate) fn unground(sim: &mut Simulation, _out: &mut FrameOutput) {
-    sim.world.grounded.fill(false);
+    let w = &mut sim.world;
+    for k in 0..w.active().len() {
+        let i = w.active()[k] as usize;
+        w.grounded[i] = false;
+    }
 }
 
 pub(crate) fn has_controls(sim: &Simulation) -> bool {
-    sim.world.controller.iter().any(Option::is_some)
+    let w = &sim.world;
+    w.any_controller()
+        && w.active()
+            .iter()
+            .any(|&i| w.controller[i as usize].is_some())
 }
 
 /// Inputs become velocities: a ship's turn input sets its angular velocity, a runner's or
 /// walker's sets its x velocity. Thrust is a force, applied in `forces`.
 pub(crate) fn controls(sim: &mut Simulation, _out: &mut FrameOutput) {
     let w = &mut sim.world;
-    for i in 0..w.len() {
+    if !w.any_controller() {
+        return;
+    }
+    for k in 0..w.active().len() {
+        let i = w.active()[k] as usize;
         match &w.controller[i] {
             Some(Controller::Ship { turn_rate, .. }) => {
                 w.angular_velocity[i] = w.inputs[i].turn * turn_rate;
@@ -54,19 +68,30 @@ fn thrust(sim: &Simulation, i: usize) -> Vec2 {
 pub(crate) fn has_forces(sim: &Simulation) -> bool {
     let w = &sim.world;
     let g = sim.scenario.world.gravity;
-    (0..w.len()).any(|i| {
-        w.kind[i] == BodyKind::Dynamic
-            && (w.force[i] != Vec2::ZERO
-                || w.inputs[i].thrust
-                || (g != Vec2::ZERO && w.gravity_scale[i] != 0.0))
-    })
+    let dynamic = |i: usize| w.kind[i] == BodyKind::Dynamic;
+    // Gravity first (its first dynamic body usually answers), then thrust (only controlled
+    // bodies have inputs), then a constant force on an active body.
+    (g != Vec2::ZERO
+        && w.active().iter().any(|&i| {
+            let i = i as usize;
+            dynamic(i) && w.gravity_scale[i] != 0.0
+        }))
+        || (w.any_controller()
+            && w.active()
+                .iter()
+                .any(|&i| w.inputs[i as usize].thrust && dynamic(i as usize)))
+        || w.active().iter().any(|&i| {
+            let i = i as usize;
+            dynamic(i) && w.force[i] != Vec2::ZERO
+        })
 }
 
 /// `a = sum(f) / m` with gravity as the force `m * g * gravity_scale`; `v += a * dt`.
 pub(crate) fn forces(sim: &mut Simulation, _out: &mut FrameOutput) {
     let dt = sim.dt();
     let g = sim.scenario.world.gravity;
-    for i in 0..sim.world.len() {
+    for k in 0..sim.world.active().len() {
+        let i = sim.world.active()[k] as usize;
         if sim.world.kind[i] != BodyKind::Dynamic {
             continue;
         }
@@ -79,16 +104,17 @@ pub(crate) fn forces(sim: &mut Simulation, _out: &mut FrameOutput) {
 
 pub(crate) fn has_motion(sim: &Simulation) -> bool {
     let w = &sim.world;
-    (0..w.len()).any(|i| w.kind[i] != BodyKind::Static && w.velocity[i] != Vec2::ZERO)
+    w.active()
+        .iter()
+        .any(|&i| w.velocity[i as usize] != Vec2::ZERO)
 }
 
 fn move_axis(sim: &mut Simulation, axis: usize) {
     let dt = sim.dt();
     let w = &mut sim.world;
-    for i in 0..w.len() {
-        if w.kind[i] != BodyKind::Static {
-            w.position[i][axis] += w.velocity[i][axis] * dt;
-        }
+    for k in 0..w.active().len() {
+        let i = w.active()[k] as usize;
+        w.position[i][axis] += w.velocity[i][axis] * dt;
     }
 }
 
@@ -104,16 +130,17 @@ pub(crate) fn move_y(sim: &mut Simulation, _out: &mut FrameOutput) {
 
 pub(crate) fn has_turning(sim: &Simulation) -> bool {
     let w = &sim.world;
-    (0..w.len()).any(|i| w.kind[i] != BodyKind::Static && w.angular_velocity[i] != 0.0)
+    w.active()
+        .iter()
+        .any(|&i| w.angular_velocity[i as usize] != 0.0)
 }
 
 /// `angle += angular_velocity * dt`.
 pub(crate) fn turn(sim: &mut Simulation, _out: &mut FrameOutput) {
     let dt = sim.dt();
     let w = &mut sim.world;
-    for i in 0..w.len() {
-        if w.kind[i] != BodyKind::Static {
-            w.angle[i] += w.angular_velocity[i] * dt;
-        }
+    for k in 0..w.active().len() {
+        let i = w.active()[k] as usize;
+        w.angle[i] += w.angular_velocity[i] * dt;
     }
 }

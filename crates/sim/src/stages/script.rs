@@ -17,6 +17,8 @@ pub(crate) fn run(sim: &mut Simulation, out: &mut FrameOutput) {
     for event in &events {
         apply(sim, out, &event.action);
     }
+    // A body an event named was woken: it moves this frame.
+    sim.world.refresh_active();
 }
 
 fn apply(sim: &mut Simulation, out: &mut FrameOutput, action: &Action) {
@@ -48,6 +50,7 @@ fn apply(sim: &mut Simulation, out: &mut FrameOutput, action: &Action) {
         return;
     };
     let entity = sim.world.entity[i];
+    sim.world.wake(i);
     let w = &mut sim.world;
     let what = match action {
         Action::Destroy { .. } => {

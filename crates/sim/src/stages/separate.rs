@@ -9,22 +9,35 @@
 //! bottom-up in one pass. Only boxes (a single AABB) are resolved per axis; every other shape in
 //! a `separate` pair is pushed along the contact normal by the `detect` stage.
 
+//!
+//! Finding the obstacles: static boxes sit in a grid built once (rebuilt only when the static
+//! bodies change); kinematic boxes, and dynamic boxes once settled, go into a small grid
+//! rebuilt every pass. Each dynamic box looks up both and meets its obstacles in id order at
+//! its current position; after a push it looks again from the obstacle after the one it was
+//! pushed out of. That is exactly the order of a loop over every body, at the cost of the
+//! few it is near.
+
 use ricochet_geom::{Bounds, Primitive, Shape, Vec2, contact};
 
-use crate::def::{BodyKind, Controller, Response};
+use crate::broad_phase::{FixedGrid, cell_coord};
+use crate::def::{BodyKind, Controller, Layers, Response};
+use crate::entity::Entity;
 use crate::output::{ContactRecord, EventRecord, FrameOutput, Phase};
 use crate::pipeline::{SLOP, Simulation};
+use crate::world::World;
 
 /// Whether a shape is resolved per axis: a single axis-aligned box.
 pub(crate) fn is_box(shape: &Shape) -> bool {
-    matches!(shape, Shape::Primitive(Primitive::Aabb(_)))
+    shape.is_single_aabb()
 }
 
 pub(crate) fn has_work(sim: &Simulation) -> bool {
     let w = &sim.world;
-    let layers = &sim.scenario.world.layers;
-    layers.any(|r| r == Response::Separate)
-        && (0..w.len()).any(|i| w.kind[i] == BodyKind::Dynamic && is_box(&w.shape[i]))
+    sim.separate.any_layer
+        && w.active().iter().any(|&i| {
+            let i = i as usize;
+            w.kind[i] == BodyKind::Dynamic && is_box(&w.shape[i])
+        })
 }
 
 pub(crate) fn resolve_x(sim: &mut Simulation, out: &mut FrameOutput) {
@@ -33,6 +46,68 @@ pub(crate) fn resolve_x(sim: &mut Simulation, out: &mut FrameOutput) {
 
 pub(crate) fn resolve_y(sim: &mut Simulation, out: &mut FrameOutput) {
     resolve(sim, out, 1);
+}
+
+/// What the per-axis stages keep between passes.
+#[derive(Debug, Default)]
+pub(crate) struct SeparateState {
+    /// Whether any layer pair `separate`s.
+    any_layer: bool,
+    /// Layers with a `separate` pair.
+    separating: Vec<bool>,
+    /// The static generation `statics` was built at.
+    static_generation: Option<u64>,
+    /// Static boxes of separating layers; handles index `static_entities`.
+    statics: FixedGrid,
+    static_entities: Vec<Entity>,
+    movers: MoverGrid,
+    found: Vec<u32>,
+}
+
+impl SeparateState {
+    pub(crate) fn new(layers: &Layers) -> SeparateState {
+        let n = layers.names().len();
+        let separating: Vec<bool> = (0..n)
+            .map(|l| (0..n).any(|m| layers.response(l as u8, m as u8) == Response::Separate))
+            .collect();
+        SeparateState {
+            any_layer: separating.iter().any(|s| *s),
+            separating,
+            ..SeparateState::default()
+        }
+    }
+
+    /// Rebuilds the static grid if the static bodies changed.
+    fn refresh_statics(&mut self, w: &World) {
+        if self.static_generation == Some(w.static_generation()) {
+            return;
+        }
+        self.static_generation = Some(w.static_generation());
+        self.static_entities.clear();
+        let mut boxes = Vec::new();
+        for i in 0..w.len() {
+            if w.kind[i] == BodyKind::Static
+                && is_box(&w.shape[i])
+                && self.separating[usize::from(w.layer[i])]
+            {
+                boxes.push((box_bounds(w, i), self.static_entities.len() as u32));
+                self.static_entities.push(w.entity[i]);
+            }
+        }
+        self.statics = FixedGrid::new(boxes.into_iter());
+    }
+}
+
+/// The exact bounds of box `i`: bit for bit `Shape::bounds`, without its general path for a
+/// box on the body origin (the usual case).
+fn box_bounds(w: &World, i: usize) -> Bounds {
+    match &w.shape[i] {
+        Shape::Primitive(Primitive::Aabb(b)) if b.center == Vec2::ZERO => {
+            // `position + 0` is `position` (up to the sign of a zero, which compares equal).
+            Bounds::around(w.position[i], b.half_extents)
+        }
+        s => s.bounds(&w.pose(i)),
+    }
 }
 
 /// The push along `axis` that moves box `m` out of box `o`: the smaller overlap, signed.
@@ -46,81 +121,267 @@ fn push_out(m: &Bounds, o: &Bounds, axis: usize) -> f64 {
     }
 }
 
+/// Whether `inner` lies within `outer`.
+fn contains(outer: &Bounds, inner: &Bounds) -> bool {
+    outer.min.x <= inner.min.x
+        && outer.min.y <= inner.min.y
+        && inner.max.x <= outer.max.x
+        && inner.max.y <= outer.max.y
+}
+
 fn overlap(a: &Bounds, b: &Bounds, axis: usize) -> f64 {
     a.max[axis].min(b.max[axis]) - a.min[axis].max(b.min[axis])
 }
 
+/// Every body that may be an obstacle for a box with bounds `q`, as dense indices from
+/// `from` on, ascending and without repeats, into `found`.
+fn obstacles(st: &mut SeparateState, w: &World, q: &Bounds, from: u32, found: &mut Vec<u32>) {
+    found.clear();
+    let movers = w.movers();
+    st.statics.query(q, |s| {
+        // A static body's dense index: its rank among the static bodies plus the moving
+        // bodies before it.
+        let e = st.static_entities[s as usize];
+        let before = movers.partition_point(|&m| w.entity[m as usize] < e) as u32;
+        let i = s + before;
+        if i >= from {
+            found.push(i);
+        }
+    });
+    st.movers.query(q, |i| {
+        if i >= from {
+            found.push(i);
+        }
+    });
+    found.sort_unstable();
+    found.dedup();
+}
+
 fn resolve(sim: &mut Simulation, out: &mut FrameOutput, axis: usize) {
     let phase = if axis == 0 { Phase::X } else { Phase::Y };
-    let layers = sim.scenario.world.layers.clone();
-    let n = sim.world.len();
+    let mut st = std::mem::take(&mut sim.separate);
+    st.refresh_statics(&sim.world);
+    let w = &sim.world;
+    let layers = &sim.scenario.world.layers;
     // Dynamic boxes settle in order along the axis, lowest (or leftmost) first, and a settled
     // box is solid to the ones after it: a stack resolves bottom-up in one pass, each box
     // landing flush on the one below, with no box pushed back into what held it.
-    let mut order: Vec<usize> = (0..n)
-        .filter(|&i| sim.world.kind[i] == BodyKind::Dynamic && is_box(&sim.world.shape[i]))
-        .collect();
-    let w = &sim.world;
-    let low = |i: usize| w.shape[i].bounds(&w.pose(i)).min[axis];
-    order.sort_by(|&p, &q| low(p).total_cmp(&low(q)).then(p.cmp(&q)));
-    let mut settled = vec![false; n];
-    let first = out.contacts.len();
-    for i in order {
-        #[expect(
-            clippy::needless_range_loop,
-            reason = "j indexes a dozen columns, and `settled` changes between rounds of i"
-        )]
-        for j in 0..n {
-            let w = &sim.world;
-            if j == i
-                || !is_box(&w.shape[j])
-                || layers.response(w.layer[i], w.layer[j]) != Response::Separate
-                // An unsettled dynamic box meets this one when its own turn comes.
-                || (w.kind[j] == BodyKind::Dynamic && !settled[j])
-            {
-                continue;
-            }
-            let bi = w.shape[i].bounds(&w.pose(i));
-            let bj = w.shape[j].bounds(&w.pose(j));
-            if overlap(&bi, &bj, 0) <= SLOP || overlap(&bi, &bj, 1) <= SLOP {
-                continue;
-            }
-            let (a, b) = if i < j { (i, j) } else { (j, i) };
-            let (pose_a, pose_b) = (w.pose(a), w.pose(b));
-            let c = contact(&w.shape[a], &pose_a, &w.shape[b], &pose_b);
-            let mut moved = Vec2::ZERO;
-            moved[axis] = push_out(&bi, &bj, axis);
-            let w = &mut sim.world;
-            apply_push(w, i, axis, moved[axis]);
-            out.contacts.push(ContactRecord {
-                a: w.entity[a],
-                b: w.entity[b],
-                phase,
-                normal: c.normal,
-                depth: c.depth,
-                point: c.point,
-                pose_a,
-                pose_b,
-                response: Response::Separate,
-                resolved: moved,
-            });
-            out.events.push(EventRecord {
-                kind: if axis == 0 { "hit_x" } else { "hit_y" },
-                message: format!(
-                    "{} #{} pushed {} by {} out of {} #{}",
-                    w.name[i],
-                    w.entity[i],
-                    if axis == 0 { "along x" } else { "along y" },
-                    moved[axis],
-                    w.name[j],
-                    w.entity[j]
-                ),
-            });
+    let mut order: Vec<(f64, u32)> = Vec::new();
+    let mut extents: Vec<f64> = Vec::new();
+    for &i in w.movers() {
+        let k = i as usize;
+        if !is_box(&w.shape[k]) || w.frozen[k] || !st.separating[usize::from(w.layer[k])] {
+            continue;
         }
-        settled[i] = true;
+        let b = box_bounds(w, k);
+        if w.kind[k] == BodyKind::Dynamic && !w.asleep[k] {
+            order.push((b.min[axis], i));
+            extents.push((b.max - b.min).max_element());
+        }
     }
+    order.sort_by(|p, q| p.0.total_cmp(&q.0).then(p.1.cmp(&q.1)));
+    // Kinematic boxes and sleeping ones are solid from the start; dynamic ones once settled.
+    st.movers.reset(&mut extents, order.len());
+    for &i in w.movers() {
+        let k = i as usize;
+        if is_box(&w.shape[k])
+            && !w.frozen[k]
+            && st.separating[usize::from(w.layer[k])]
+            && (w.kind[k] == BodyKind::Kinematic || w.asleep[k])
+        {
+            st.movers.insert(&box_bounds(w, k), i);
+        }
+    }
+    let first = out.contacts.len();
+    let mut found = std::mem::take(&mut st.found);
+    let mut woken = Vec::new();
+    for &(_, i) in &order {
+        let i = i as usize;
+        // One lookup usually does: it covers the box moved by up to its own size along the
+        // axis, more than one push can move it (a push is at most the box's overlap).
+        // After pushes that took it further, it looks again.
+        let mut region: Option<Bounds> = None;
+        let mut next = 0;
+        'look: loop {
+            let bi = box_bounds(&sim.world, i);
+            if !region.is_some_and(|r| contains(&r, &bi)) {
+                let mut r = bi;
+                let reach = bi.max[axis] - bi.min[axis];
+                r.min[axis] -= reach;
+                r.max[axis] += reach;
+                // After a push at `found[next - 1]`, the obstacles after it.
+                let from = if next > 0 { found[next - 1] + 1 } else { 0 };
+                obstacles(&mut st, &sim.world, &r, from, &mut found);
+                region = Some(r);
+                next = 0;
+            }
+            while next < found.len() {
+                let j = found[next] as usize;
+                next += 1;
+                let w = &sim.world;
+                if j == i || layers.response(w.layer[i], w.layer[j]) != Response::Separate {
+                    continue;
+                }
+                let bj = box_bounds(w, j);
+                if overlap(&bi, &bj, 0) <= SLOP || overlap(&bi, &bj, 1) <= SLOP {
+                    continue;
+                }
+                let (a, b) = if i < j { (i, j) } else { (j, i) };
+                let (pose_a, pose_b) = (w.pose(a), w.pose(b));
+                let c = contact(&w.shape[a], &pose_a, &w.shape[b], &pose_b);
+                let mut moved = Vec2::ZERO;
+                moved[axis] = push_out(&bi, &bj, axis);
+                if w.asleep[j] {
+                    woken.push(j);
+                }
+                let w = &mut sim.world;
+                apply_push(w, i, axis, moved[axis]);
+                out.contacts.push(ContactRecord {
+                    a: w.entity[a],
+                    b: w.entity[b],
+                    phase,
+                    normal: c.normal,
+                    depth: c.depth,
+                    point: c.point,
+                    pose_a,
+                    pose_b,
+                    response: Response::Separate,
+                    resolved: moved,
+                });
+                out.events.push(EventRecord {
+                    kind: if axis == 0 { "hit_x" } else { "hit_y" },
+                    message: format!(
+                        "{} #{} pushed {} by {} out of {} #{}",
+                        w.name[i],
+                        w.entity[i],
+                        if axis == 0 { "along x" } else { "along y" },
+                        moved[axis],
+                        w.name[j],
+                        w.entity[j]
+                    ),
+                });
+                // The box moved: go on from the next obstacle, at its new place.
+                continue 'look;
+            }
+            break;
+        }
+        st.movers.insert(&box_bounds(&sim.world, i), i as u32);
+    }
+    for j in woken {
+        sim.world.wake(j);
+    }
+    st.found = found;
+    sim.separate = st;
     // The log's convention: a pass's contacts sorted by (a, b).
     out.contacts[first..].sort_by_key(|c| (c.a, c.b));
+}
+
+/// The moving boxes that are solid to the box being settled: a uniform grid rebuilt every
+/// pass, filled as boxes settle. A lookup may return a box twice, or one that does not
+/// overlap: the caller sorts, dedups and tests.
+#[derive(Debug, Default)]
+struct MoverGrid {
+    inv_cell: f64,
+    /// `buckets.len() - 1`, a power of two minus one.
+    mask: usize,
+    buckets: Vec<Vec<u32>>,
+    /// Buckets filled this pass, to empty next pass.
+    used: Vec<usize>,
+    /// Boxes covering more than [`MAX_CELLS`] cells: met by every lookup.
+    big: Vec<u32>,
+}
+
+/// A box covering more cells than this is kept aside and met by every lookup.
+const MAX_CELLS: i64 = 16;
+
+impl MoverGrid {
+    /// Empties the grid and sizes its cells at twice the median of `extents` (the dynamic
+    /// boxes' larger side), for about `count` boxes.
+    fn reset(&mut self, extents: &mut [f64], count: usize) {
+        for &b in &self.used {
+            self.buckets[b].clear();
+        }
+        self.used.clear();
+        self.big.clear();
+        let cell = if extents.is_empty() {
+            1.0
+        } else {
+            let mid = extents.len() / 2;
+            2.0 * *extents.select_nth_unstable_by(mid, f64::total_cmp).1
+        };
+        self.inv_cell = if cell.is_finite() && cell > 0.0 && (1.0 / cell).is_normal() {
+            1.0 / cell
+        } else {
+            1.0
+        };
+        let size = (2 * count).max(16).next_power_of_two();
+        if self.buckets.len() < size {
+            self.buckets.resize_with(size, Vec::new);
+        }
+        self.mask = self.buckets.len() - 1;
+    }
+
+    /// The cells `b` covers, or `None` when too many (or the bounds are not regular).
+    fn cells(&self, b: &Bounds) -> Option<((i32, i32), (i32, i32))> {
+        if !(b.min.x <= b.max.x && b.min.y <= b.max.y) {
+            return None;
+        }
+        let (x0, x1) = (
+            cell_coord(b.min.x, self.inv_cell),
+            cell_coord(b.max.x, self.inv_cell),
+        );
+        let (y0, y1) = (
+            cell_coord(b.min.y, self.inv_cell),
+            cell_coord(b.max.y, self.inv_cell),
+        );
+        let n = (i64::from(x1) - i64::from(x0) + 1) * (i64::from(y1) - i64::from(y0) + 1);
+        (n <= MAX_CELLS).then_some(((x0, x1), (y0, y1)))
+    }
+
+    fn bucket(&self, cx: i32, cy: i32) -> usize {
+        let packed = u64::from(cx as u32) | (u64::from(cy as u32) << 32);
+        (packed.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 32) as usize & self.mask
+    }
+
+    fn insert(&mut self, b: &Bounds, handle: u32) {
+        let Some(((x0, x1), (y0, y1))) = self.cells(b) else {
+            self.big.push(handle);
+            return;
+        };
+        for cy in y0..=y1 {
+            for cx in x0..=x1 {
+                let k = self.bucket(cx, cy);
+                if self.buckets[k].is_empty() {
+                    self.used.push(k);
+                }
+                self.buckets[k].push(handle);
+            }
+        }
+    }
+
+    fn query(&self, q: &Bounds, mut f: impl FnMut(u32)) {
+        for &h in &self.big {
+            f(h);
+        }
+        match self.cells(q) {
+            Some(((x0, x1), (y0, y1))) => {
+                for cy in y0..=y1 {
+                    for cx in x0..=x1 {
+                        for &h in &self.buckets[self.bucket(cx, cy)] {
+                            f(h);
+                        }
+                    }
+                }
+            }
+            None => {
+                for &b in &self.used {
+                    for &h in &self.buckets[b] {
+                        f(h);
+                    }
+                }
+            }
+        }
+    }
 }
 
 /// Moves body `i` by `push` along `axis`, stops its motion into the obstacle, and notes
