@@ -512,8 +512,7 @@ fn run_scene(name: &str, kind: SceneKind, frames: u64) -> anyhow::Result<Row> {
     reset_peak();
     let setup = Instant::now();
     let scenario = build(name, kind, frames);
-    let mut sim = Simulation::new(&scenario);
-    drop(scenario);
+    let mut sim = Simulation::from_scenario(scenario);
     let bodies = sim.world.len();
     eprintln!("bench: {name}: {bodies} bodies, {frames} frames");
     let out0 = sim.step();

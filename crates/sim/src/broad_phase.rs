@@ -1226,10 +1226,11 @@ impl FixedGrid {
         FixedGrid(g)
     }
 
-    /// Calls `f` once with the handle of every box overlapping `q` (touching counts).
+    /// Calls `f` once with the handle and bounds of every box overlapping `q` (touching
+    /// counts).
     /// Returns the box tests made.
-    pub(crate) fn query(&self, q: &Bounds, mut f: impl FnMut(u32)) -> u64 {
-        self.0.query(q, |m| f(m.handle))
+    pub(crate) fn query(&self, q: &Bounds, mut f: impl FnMut(u32, &Bounds)) -> u64 {
+        self.0.query(q, |m| f(m.handle, &m.bounds))
     }
 }
 

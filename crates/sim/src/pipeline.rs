@@ -152,6 +152,7 @@ impl Simulation {
     #[must_use]
     pub fn new(scenario: &Scenario) -> Simulation {
         let mut world = World::new();
+        world.reserve(scenario.bodies.len());
         for b in &scenario.bodies {
             world.spawn(b);
         }
@@ -172,8 +173,17 @@ impl Simulation {
     #[must_use]
     pub fn from_scenario(mut scenario: Scenario) -> Simulation {
         let mut world = World::new();
-        for b in std::mem::take(&mut scenario.bodies) {
+        let mut bodies = std::mem::take(&mut scenario.bodies);
+        world.reserve(bodies.len());
+        // Spawned in file order from the back of the reversed list, whose memory is given
+        // back every few thousand bodies: the peak is the world plus a little, not the
+        // world plus every definition.
+        bodies.reverse();
+        while let Some(b) = bodies.pop() {
             world.spawn(&b);
+            if bodies.len().is_multiple_of(4096) {
+                bodies.shrink_to_fit();
+            }
         }
         Simulation::with_world(scenario, world)
     }
@@ -221,9 +231,14 @@ impl Simulation {
         // Swept tests run from here to wherever the frame's motion ends. Static bodies never
         // move, so only the moving ones need it.
         let w = &mut self.world;
-        for k in 0..w.movers().len() {
-            let i = w.movers()[k] as usize;
-            w.start_position[i] = w.position[i];
+        if 2 * w.movers().len() >= w.len() {
+            // Mostly moving bodies: one straight copy is cheaper than a gather.
+            w.start_position.copy_from_slice(&w.position);
+        } else {
+            for k in 0..w.movers().len() {
+                let i = w.movers()[k] as usize;
+                w.start_position[i] = w.position[i];
+            }
         }
         for stage in &STAGES {
             let allowed = self.frame > 0 || FRAME_ZERO.contains(&stage.name);

@@ -120,6 +120,33 @@ impl World {
         World::default()
     }
 
+    /// Makes room for `additional` more bodies in every column at once (instead of each
+    /// column doubling on its own).
+    pub fn reserve(&mut self, additional: usize) {
+        self.entity.reserve_exact(additional);
+        self.name.reserve_exact(additional);
+        self.layer.reserve_exact(additional);
+        self.shape.reserve_exact(additional);
+        self.kind.reserve_exact(additional);
+        self.mass.reserve_exact(additional);
+        self.position.reserve_exact(additional);
+        self.start_position.reserve_exact(additional);
+        self.angle.reserve_exact(additional);
+        self.velocity.reserve_exact(additional);
+        self.angular_velocity.reserve_exact(additional);
+        self.force.reserve_exact(additional);
+        self.gravity_scale.reserve_exact(additional);
+        self.lifetime.reserve_exact(additional);
+        self.controller.reserve_exact(additional);
+        self.inputs.reserve_exact(additional);
+        self.grounded.reserve_exact(additional);
+        self.split.reserve_exact(additional);
+        self.frozen.reserve_exact(additional);
+        self.asleep.reserve_exact(additional);
+        self.rest_frames.reserve_exact(additional);
+        self.local_bounds.reserve_exact(additional);
+    }
+
     /// How many bodies.
     #[must_use]
     pub fn len(&self) -> usize {

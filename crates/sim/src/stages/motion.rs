@@ -80,10 +80,9 @@ pub(crate) fn has_forces(sim: &Simulation) -> bool {
             && w.active()
                 .iter()
                 .any(|&i| w.inputs[i as usize].thrust && dynamic(i as usize)))
-        || w.active().iter().any(|&i| {
-            let i = i as usize;
-            dynamic(i) && w.force[i] != Vec2::ZERO
-        })
+        // One contiguous column beats a gather through the active list; a static body's
+        // force only makes the stage run for nothing.
+        || w.force.iter().any(|f| *f != Vec2::ZERO)
 }
 
 /// `a = sum(f) / m` with gravity as the force `m * g * gravity_scale`; `v += a * dt`.

@@ -20,7 +20,7 @@
 use ricochet_geom::{Bounds, Primitive, Shape, Vec2, contact};
 
 use crate::broad_phase::{FixedGrid, cell_coord};
-use crate::def::{BodyKind, Controller, Layers, Response};
+use crate::def::{BodyKind, Controller, LayerId, Layers, Response};
 use crate::entity::Entity;
 use crate::output::{ContactRecord, EventRecord, FrameOutput, Phase};
 use crate::pipeline::{SLOP, Simulation};
@@ -59,9 +59,18 @@ pub(crate) struct SeparateState {
     static_generation: Option<u64>,
     /// Static boxes of separating layers; handles index `static_entities`.
     statics: FixedGrid,
-    static_entities: Vec<Entity>,
+    static_entities: Vec<(Entity, LayerId)>,
     movers: MoverGrid,
-    found: Vec<u32>,
+    found: Vec<Obstacle>,
+}
+
+/// A box that may stop the one being settled: its dense index, bounds and layer (static
+/// boxes come from the grid with these, so a million tiles' columns are never read).
+#[derive(Clone, Copy, Debug)]
+struct Obstacle {
+    index: u32,
+    bounds: Bounds,
+    layer: LayerId,
 }
 
 impl SeparateState {
@@ -91,7 +100,7 @@ impl SeparateState {
                 && self.separating[usize::from(w.layer[i])]
             {
                 boxes.push((box_bounds(w, i), self.static_entities.len() as u32));
-                self.static_entities.push(w.entity[i]);
+                self.static_entities.push((w.entity[i], w.layer[i]));
             }
         }
         self.statics = FixedGrid::new(boxes.into_iter());
@@ -135,26 +144,34 @@ fn overlap(a: &Bounds, b: &Bounds, axis: usize) -> f64 {
 
 /// Every body that may be an obstacle for a box with bounds `q`, as dense indices from
 /// `from` on, ascending and without repeats, into `found`.
-fn obstacles(st: &mut SeparateState, w: &World, q: &Bounds, from: u32, found: &mut Vec<u32>) {
+fn obstacles(st: &mut SeparateState, w: &World, q: &Bounds, from: u32, found: &mut Vec<Obstacle>) {
     found.clear();
     let movers = w.movers();
-    st.statics.query(q, |s| {
+    st.statics.query(q, |s, bounds| {
         // A static body's dense index: its rank among the static bodies plus the moving
         // bodies before it.
-        let e = st.static_entities[s as usize];
+        let (e, layer) = st.static_entities[s as usize];
         let before = movers.partition_point(|&m| w.entity[m as usize] < e) as u32;
-        let i = s + before;
-        if i >= from {
-            found.push(i);
+        let index = s + before;
+        if index >= from {
+            found.push(Obstacle {
+                index,
+                bounds: *bounds,
+                layer,
+            });
         }
     });
     st.movers.query(q, |i| {
         if i >= from {
-            found.push(i);
+            found.push(Obstacle {
+                index: i,
+                bounds: box_bounds(w, i as usize),
+                layer: w.layer[i as usize],
+            });
         }
     });
-    found.sort_unstable();
-    found.dedup();
+    found.sort_unstable_by_key(|o| o.index);
+    found.dedup_by_key(|o| o.index);
 }
 
 fn resolve(sim: &mut Simulation, out: &mut FrameOutput, axis: usize) {
@@ -210,19 +227,23 @@ fn resolve(sim: &mut Simulation, out: &mut FrameOutput, axis: usize) {
                 r.min[axis] -= reach;
                 r.max[axis] += reach;
                 // After a push at `found[next - 1]`, the obstacles after it.
-                let from = if next > 0 { found[next - 1] + 1 } else { 0 };
+                let from = if next > 0 {
+                    found[next - 1].index + 1
+                } else {
+                    0
+                };
                 obstacles(&mut st, &sim.world, &r, from, &mut found);
                 region = Some(r);
                 next = 0;
             }
             while next < found.len() {
-                let j = found[next] as usize;
+                let o = found[next];
+                let (j, bj) = (o.index as usize, o.bounds);
                 next += 1;
                 let w = &sim.world;
-                if j == i || layers.response(w.layer[i], w.layer[j]) != Response::Separate {
+                if j == i || layers.response(w.layer[i], o.layer) != Response::Separate {
                     continue;
                 }
-                let bj = box_bounds(w, j);
                 if overlap(&bi, &bj, 0) <= SLOP || overlap(&bi, &bj, 1) <= SLOP {
                     continue;
                 }
