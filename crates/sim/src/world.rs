@@ -60,6 +60,11 @@ pub struct World {
     pub inputs: Vec<Inputs>,
     /// Standing on something: pushed up by a `separate` response this frame.
     pub grounded: Vec<bool>,
+    /// Standing on a static body: pushed up by one this frame (what sleeping needs).
+    pub on_static: Vec<bool>,
+    /// Ended the last frame where it started it, with zero velocity (a box resting on a
+    /// sleeper does not wake it).
+    pub still: Vec<bool>,
     /// Children spawned on destruction.
     pub split: Vec<Vec<Split>>,
     /// Frozen outside the active region: not moved, not tested, lifetime paused.
@@ -140,6 +145,8 @@ impl World {
         self.controller.reserve_exact(additional);
         self.inputs.reserve_exact(additional);
         self.grounded.reserve_exact(additional);
+        self.on_static.reserve_exact(additional);
+        self.still.reserve_exact(additional);
         self.split.reserve_exact(additional);
         self.frozen.reserve_exact(additional);
         self.asleep.reserve_exact(additional);
@@ -195,6 +202,8 @@ impl World {
         self.controller.insert(i, def.controller.clone());
         self.inputs.insert(i, Inputs::default());
         self.grounded.insert(i, false);
+        self.on_static.insert(i, false);
+        self.still.insert(i, false);
         self.split.insert(i, def.split.clone());
         self.frozen.insert(i, false);
         self.asleep.insert(i, false);
@@ -250,6 +259,8 @@ impl World {
         }
         self.inputs.remove(i);
         self.grounded.remove(i);
+        self.on_static.remove(i);
+        self.still.remove(i);
         self.split.remove(i);
         self.frozen.remove(i);
         if self.asleep.remove(i) {

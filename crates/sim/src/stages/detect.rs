@@ -479,6 +479,7 @@ fn separate_along_normal(
         }
         if normal.y < -0.7 {
             w.grounded[i] = true;
+            w.on_static[i] |= w.kind[j] == BodyKind::Static;
         }
         pushed = p;
     }
@@ -491,6 +492,7 @@ fn separate_along_normal(
         }
         if normal.y > 0.7 {
             w.grounded[j] = true;
+            w.on_static[j] |= w.kind[i] == BodyKind::Static;
         }
         pushed = p;
     }

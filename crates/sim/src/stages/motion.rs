@@ -20,6 +20,7 @@ pub(crate) fn unground(sim: &mut Simulation, _out: &mut FrameOutput) {
     for k in 0..w.active().len() {
         let i = w.active()[k] as usize;
         w.grounded[i] = false;
+        w.on_static[i] = false;
     }
 }
 

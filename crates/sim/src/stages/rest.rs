@@ -9,12 +9,13 @@
 //! the focus body gone, nothing is frozen.
 //!
 //! **Sleeping.** With `sleep_after = N`, a dynamic body that ends `N` frames in a row
-//! grounded, with zero velocity and angular velocity and exactly (bit for bit) where it
+//! held up by a static body (pushed up by one that frame), with zero velocity and angular velocity and exactly (bit for bit) where it
 //! started the frame, falls asleep. A body at rest like that is at a fixed point of the
 //! step, so skipping it changes none of its state: it keeps its position, zero velocity and
 //! `grounded`. It is not integrated and not tested against static bodies or other sleepers;
-//! it wakes when an awake body touches it (a `detect` contact, or a per-axis push against
-//! it), when a script event names it, when a static body is added, or when any body is
+//! it wakes when an awake body touches it (a `detect` contact, or a per-axis push against it
+//! by a body that was not itself still the frame before: a box resting on a sleeper leaves
+//! it asleep), when a script event names it, when a static body is added, or when any body is
 //! removed (what it rested on may be gone).
 
 use ricochet_geom::{Bounds, Vec2};
@@ -59,15 +60,14 @@ pub(crate) fn sleep(sim: &mut Simulation, out: &mut FrameOutput) {
         return;
     };
     let w = &mut sim.world;
-    let mut fell_asleep = false;
     for k in 0..w.active().len() {
         let i = w.active()[k] as usize;
-        let resting = w.kind[i] == BodyKind::Dynamic
-            && w.grounded[i]
-            && w.velocity[i] == Vec2::ZERO
+        let still = w.velocity[i] == Vec2::ZERO
             && w.angular_velocity[i] == 0.0
             && w.position[i].x.to_bits() == w.start_position[i].x.to_bits()
             && w.position[i].y.to_bits() == w.start_position[i].y.to_bits();
+        w.still[i] = still;
+        let resting = still && w.kind[i] == BodyKind::Dynamic && w.on_static[i];
         w.rest_frames[i] = if resting {
             w.rest_frames[i].saturating_add(1)
         } else {
@@ -75,11 +75,10 @@ pub(crate) fn sleep(sim: &mut Simulation, out: &mut FrameOutput) {
         };
         if w.rest_frames[i] >= after {
             w.put_to_sleep(i);
-            fell_asleep = true;
         }
     }
-    if fell_asleep {
-        w.refresh_active();
-    }
+    // Bodies put to sleep above, and bodies woken this frame (by a contact or a push),
+    // leave or rejoin the active list for the next frame.
+    w.refresh_active();
     out.stats.asleep = w.sleeping();
 }

@@ -252,11 +252,16 @@ fn resolve(sim: &mut Simulation, out: &mut FrameOutput, axis: usize) {
                 let c = contact(&w.shape[a], &pose_a, &w.shape[b], &pose_b);
                 let mut moved = Vec2::ZERO;
                 moved[axis] = push_out(&bi, &bj, axis);
-                if w.asleep[j] {
+                // A box that was still already (resting on the sleeper) does not wake it.
+                if w.asleep[j] && !w.still[i] {
                     woken.push(j);
                 }
+                let on_static = w.kind[j] == BodyKind::Static;
                 let w = &mut sim.world;
                 apply_push(w, i, axis, moved[axis]);
+                if axis == 1 && moved[axis] > 0.0 && on_static {
+                    w.on_static[i] = true;
+                }
                 out.contacts.push(ContactRecord {
                     a: w.entity[a],
                     b: w.entity[b],
