@@ -1205,32 +1205,213 @@ struct HashGrid {
 const MAX_CELLS: u64 = 16;
 
 /// A grid over boxes that never move, built once (the per-axis stages' static boxes): which
-/// of them overlap a query box. The same grid as the broad phase's static grids.
+/// of them overlap a query box. Each cell's entries hold the boxes' bounds themselves, so a
+/// lookup in a million tiles reads a few cache lines (the cell's bucket start and its
+/// entries) and never the bodies. The cell is twice the median box extent; a dense table
+/// over the occupied rectangle (row by row) when that is at most four cells per entry, as in
+/// a tile map, else a table indexed by a fixed hash of the cell. A box covering more than
+/// [`MAX_CELLS`] cells (or with irregular bounds) is kept in a list every lookup scans.
 #[derive(Debug, Default)]
-pub(crate) struct FixedGrid(HashGrid);
+pub(crate) struct FixedGrid {
+    inv_cell: f64,
+    dense: bool,
+    origin: (i32, i32),
+    span: (u32, u32),
+    bits: u32,
+    starts: Vec<u32>,
+    entries: Vec<FixedEntry>,
+    big: Vec<(Bounds, u32)>,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct FixedEntry {
+    cell: (i32, i32),
+    handle: u32,
+    bounds: Bounds,
+}
 
 impl FixedGrid {
     /// Indexes `boxes`, each with a handle reported by [`FixedGrid::query`].
     pub(crate) fn new(boxes: impl Iterator<Item = (Bounds, u32)>) -> FixedGrid {
-        let mut g = HashGrid {
-            members: boxes
-                .map(|(bounds, handle)| Member {
-                    bounds,
-                    handle,
-                    dynamic: false,
-                })
-                .collect(),
-            ..HashGrid::default()
+        let boxes: Vec<(Bounds, u32)> = boxes.collect();
+        let mut g = FixedGrid::default();
+        // The cell: as the broad phase's grids choose it (twice the median extent, wide
+        // enough that cell coordinates stay within ±2^30).
+        let mut extents = Vec::with_capacity(boxes.len());
+        let mut max_abs: f64 = 0.0;
+        for (b, _) in &boxes {
+            if b.min.x <= b.max.x && b.min.y <= b.max.y {
+                let e = (b.max.x - b.min.x).max(b.max.y - b.min.y);
+                if e.is_finite() {
+                    extents.push(e);
+                }
+                for v in [b.min.x, b.min.y, b.max.x, b.max.y] {
+                    if v.is_finite() {
+                        max_abs = max_abs.max(v.abs());
+                    }
+                }
+            }
+        }
+        let mut cell = if extents.is_empty() {
+            1.0
+        } else {
+            let mid = extents.len() / 2;
+            2.0 * *extents.select_nth_unstable_by(mid, f64::total_cmp).1
         };
-        g.build(&mut Vec::new(), true);
-        FixedGrid(g)
+        if !(cell.is_finite() && cell > 0.0) {
+            cell = 1.0;
+        }
+        cell = cell.max(max_abs / CELL_RANGE);
+        if !(1.0 / cell).is_normal() {
+            cell = 1.0f64.max(max_abs / CELL_RANGE);
+        }
+        g.inv_cell = 1.0 / cell;
+        let mut placed: Vec<(CellRange, Bounds, u32)> = Vec::with_capacity(boxes.len());
+        for &(b, h) in &boxes {
+            match g.range(&b) {
+                Some(r) if r.count() <= MAX_CELLS => placed.push((r, b, h)),
+                _ => g.big.push((b, h)),
+            }
+        }
+        let (mut lo, mut hi) = ((i32::MAX, i32::MAX), (i32::MIN, i32::MIN));
+        let mut total = 0u64;
+        for (r, _, _) in &placed {
+            lo = (lo.0.min(r.x.0), lo.1.min(r.y.0));
+            hi = (hi.0.max(r.x.1), hi.1.max(r.y.1));
+            total += r.count();
+        }
+        let span = |a: i32, b: i32| (i64::from(b) - i64::from(a) + 1).max(0) as u64;
+        let cells = span(lo.0, hi.0).saturating_mul(span(lo.1, hi.1));
+        g.dense = total > 0 && cells <= 4 * total + 64;
+        let size = if g.dense {
+            g.origin = lo;
+            g.span = (span(lo.0, hi.0) as u32, span(lo.1, hi.1) as u32);
+            cells as usize
+        } else {
+            (total as usize).max(16).next_power_of_two()
+        };
+        g.bits = size.trailing_zeros();
+        g.starts = vec![0; size + 1];
+        for (r, _, _) in &placed {
+            for c in r.cells() {
+                if let Some(k) = g.bucket(c) {
+                    g.starts[k] += 1;
+                }
+            }
+        }
+        let mut sum = 0;
+        for st in &mut g.starts {
+            sum += *st;
+            *st = sum;
+        }
+        let blank = FixedEntry {
+            cell: (0, 0),
+            handle: 0,
+            bounds: Bounds::around(Vec2::ZERO, Vec2::ZERO),
+        };
+        g.entries = vec![blank; total as usize];
+        // Backwards, so each bucket ends up in input order.
+        for &(r, bounds, handle) in placed.iter().rev() {
+            for c in r.cells() {
+                if let Some(k) = g.bucket(c) {
+                    g.starts[k] -= 1;
+                    g.entries[g.starts[k] as usize] = FixedEntry {
+                        cell: c,
+                        handle,
+                        bounds,
+                    };
+                }
+            }
+        }
+        g
+    }
+
+    #[inline]
+    fn coord(&self, v: f64) -> i32 {
+        cell_coord(v, self.inv_cell)
+    }
+
+    #[inline]
+    fn range(&self, b: &Bounds) -> Option<CellRange> {
+        if !(b.min.x <= b.max.x && b.min.y <= b.max.y) {
+            return None;
+        }
+        Some(CellRange {
+            x: (self.coord(b.min.x), self.coord(b.max.x)),
+            y: (self.coord(b.min.y), self.coord(b.max.y)),
+        })
+    }
+
+    #[inline]
+    fn bucket(&self, (cx, cy): (i32, i32)) -> Option<usize> {
+        if self.dense {
+            let x = i64::from(cx) - i64::from(self.origin.0);
+            let y = i64::from(cy) - i64::from(self.origin.1);
+            let (w, h) = (i64::from(self.span.0), i64::from(self.span.1));
+            return (0 <= x && x < w && 0 <= y && y < h).then_some((x + y * w) as usize);
+        }
+        let packed = u64::from(cx as u32) | (u64::from(cy as u32) << 32);
+        Some((packed.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> (64 - self.bits)) as usize)
     }
 
     /// Calls `f` once with the handle and bounds of every box overlapping `q` (touching
-    /// counts).
-    /// Returns the box tests made.
+    /// counts). Returns the box tests made.
     pub(crate) fn query(&self, q: &Bounds, mut f: impl FnMut(u32, &Bounds)) -> u64 {
-        self.0.query(q, |m| f(m.handle, &m.bounds))
+        let mut tested = 0;
+        for (b, h) in &self.big {
+            tested += 1;
+            if b.overlaps(q) {
+                f(*h, b);
+            }
+        }
+        let Some(mut r) = self.range(q) else {
+            return tested;
+        };
+        if self.dense {
+            // Only the occupied rectangle has buckets.
+            let last = |o: i32, n: u32| (i64::from(o) + i64::from(n) - 1) as i32;
+            r.x = (
+                r.x.0.max(self.origin.0),
+                r.x.1.min(last(self.origin.0, self.span.0)),
+            );
+            r.y = (
+                r.y.0.max(self.origin.1),
+                r.y.1.min(last(self.origin.1, self.span.1)),
+            );
+        }
+        if r.count() > self.entries.len() as u64 {
+            // Larger than everything: each box once, from its entries in its own first
+            // cell (the lower-left one it covers).
+            for e in &self.entries {
+                let first = (self.coord(e.bounds.min.x), self.coord(e.bounds.min.y));
+                if e.cell == first {
+                    tested += 1;
+                    if e.bounds.overlaps(q) {
+                        f(e.handle, &e.bounds);
+                    }
+                }
+            }
+            return tested;
+        }
+        for c in r.cells() {
+            let Some(k) = self.bucket(c) else {
+                continue;
+            };
+            for e in &self.entries[self.starts[k] as usize..self.starts[k + 1] as usize] {
+                if e.cell != c {
+                    continue;
+                }
+                tested += 1;
+                // Reported once: in the cell holding the lower-left corner of the overlap.
+                if e.bounds.overlaps(q)
+                    && self.coord(e.bounds.min.x.max(q.min.x)) == c.0
+                    && self.coord(e.bounds.min.y.max(q.min.y)) == c.1
+                {
+                    f(e.handle, &e.bounds);
+                }
+            }
+        }
+        tested
     }
 }
 
@@ -1519,5 +1700,79 @@ impl HashGrid {
             }
         }
         tested
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use proptest::prelude::*;
+
+    use super::*;
+
+    fn boxes() -> impl Strategy<Value = Vec<Bounds>> {
+        // Tiles and odd sizes, around the origin and at 1e6, a few huge.
+        let b = (
+            prop_oneof![Just(0.0), Just(1e6)],
+            -20.0..20.0f64,
+            -20.0..20.0f64,
+            prop_oneof![3 => 0.5..1.5f64, 1 => 1e-3..0.1f64, 1 => 5.0..60.0f64],
+            0.1..2.0f64,
+        )
+            .prop_map(|(o, x, y, w, h)| Bounds {
+                min: Vec2::new(o + x, y),
+                max: Vec2::new(o + x + w, y + h),
+            });
+        proptest::collection::vec(b, 0..200)
+    }
+
+    proptest! {
+        #[test]
+        fn fixed_grid_finds_exactly_the_overlapping_boxes_once(
+            fixed in boxes(),
+            queries in boxes(),
+        ) {
+            let grid = FixedGrid::new(fixed.iter().enumerate().map(|(i, b)| (*b, i as u32)));
+            for q in &queries {
+                let mut found = Vec::new();
+                grid.query(q, |h, b| {
+                    assert_eq!(*b, fixed[h as usize]);
+                    found.push(h);
+                });
+                found.sort_unstable();
+                let expected: Vec<u32> = (0..fixed.len() as u32)
+                    .filter(|&i| fixed[i as usize].overlaps(q))
+                    .collect();
+                prop_assert_eq!(found, expected);
+            }
+        }
+    }
+
+    #[test]
+    fn fixed_grid_handles_empty_nan_and_everything_queries() {
+        let tiles: Vec<(Bounds, u32)> = (0..100)
+            .map(|i| {
+                let p = Vec2::new(f64::from(i % 10), f64::from(i / 10));
+                (Bounds::around(p, Vec2::splat(0.5)), i)
+            })
+            .collect();
+        let grid = FixedGrid::new(tiles.iter().copied());
+        let count = |q: Bounds| {
+            let mut n = 0;
+            grid.query(&q, |_, _| n += 1);
+            n
+        };
+        assert_eq!(
+            count(Bounds::around(Vec2::splat(4.5), Vec2::splat(1e9))),
+            100
+        );
+        assert_eq!(count(Bounds::around(Vec2::splat(f64::NAN), Vec2::ONE)), 0);
+        assert_eq!(
+            count(Bounds::around(Vec2::new(0.0, 0.0), Vec2::splat(0.1))),
+            1
+        );
+        let empty = FixedGrid::new(std::iter::empty());
+        let mut n = 0;
+        empty.query(&Bounds::around(Vec2::ZERO, Vec2::ONE), |_, _| n += 1);
+        assert_eq!(n, 0);
     }
 }
