@@ -54,7 +54,8 @@ pub const DEFAULT_SCENES: [&str; 3] = ["asteroids-10000", "platformer-10000-100"
 
 /// The CSV header, one row per scene below it.
 pub const CSV_HEADER: &str = "scene,frames,ricochet_median_ms,ricochet_p95_ms,rapier_median_ms,\
-                              rapier_p95_ms,ratio,contact_agreement,peak_mem_mb";
+                              rapier_p95_ms,ratio,contact_agreement,peak_mem_mb,\
+                              ricochet_alone_median_ms";
 
 /// Seconds per step of every scene.
 const DT: f64 = 1.0 / 60.0;
@@ -495,6 +496,9 @@ struct Row {
     agreement: Agreement,
     ricochet_mb: Option<f64>,
     peak_mb: Option<f64>,
+    /// Median of `frames` more Ricochet steps with rapier idle: Ricochet with the caches to
+    /// itself (between interleaved steps, rapier's step evicts Ricochet's data).
+    ricochet_alone_median_ms: f64,
 }
 
 impl Row {
@@ -554,6 +558,15 @@ fn run_scene(name: &str, kind: SceneKind, frames: u64) -> anyhow::Result<Row> {
         }
     }
     let peak_mb = status_mb("VmHWM");
+    // The same number of frames again, Ricochet alone (rapier's world stays, untouched).
+    let mut alone_times = Vec::with_capacity(ricochet_times.len());
+    for _ in 0..frames {
+        let t = Instant::now();
+        let out = sim.step();
+        alone_times.push(t.elapsed());
+        drop(out);
+    }
+    let (ricochet_alone_median_ms, _) = percentiles(&alone_times);
     let (ricochet_median_ms, ricochet_p95_ms) = percentiles(&ricochet_times);
     let (rapier_median_ms, rapier_p95_ms) = percentiles(&rapier_times);
     Ok(Row {
@@ -567,6 +580,7 @@ fn run_scene(name: &str, kind: SceneKind, frames: u64) -> anyhow::Result<Row> {
         agreement: Agreement::from(&agreement),
         ricochet_mb,
         peak_mb,
+        ricochet_alone_median_ms,
     })
 }
 
@@ -598,7 +612,7 @@ fn table(rows: &[Row]) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "{:<26} {:>8} {:>6} {:>10} {:>10} {:>10} {:>10} {:>8} {:>19} {:>9} {:>9}",
+        "{:<26} {:>8} {:>6} {:>10} {:>10} {:>10} {:>10} {:>8} {:>19} {:>9} {:>9} {:>10}",
         "scene",
         "bodies",
         "frames",
@@ -609,17 +623,29 @@ fn table(rows: &[Row]) -> String {
         "ratio",
         "contacts agree",
         "ricochet",
-        "peak"
+        "peak",
+        "alone"
     );
     let _ = writeln!(
         s,
-        "{:<26} {:>8} {:>6} {:>10} {:>10} {:>10} {:>10} {:>8} {:>19} {:>9} {:>9}",
-        "", "", "", "ms/frame", "ms", "ms/frame", "ms", "", "agreed/compared", "MB", "MB"
+        "{:<26} {:>8} {:>6} {:>10} {:>10} {:>10} {:>10} {:>8} {:>19} {:>9} {:>9} {:>10}",
+        "",
+        "",
+        "",
+        "ms/frame",
+        "ms",
+        "ms/frame",
+        "ms",
+        "",
+        "agreed/compared",
+        "MB",
+        "MB",
+        "ms/frame"
     );
     for r in rows {
         let _ = writeln!(
             s,
-            "{:<26} {:>8} {:>6} {:>10.3} {:>10.3} {:>10.3} {:>10.3} {:>8} {:>19} {:>9} {:>9}",
+            "{:<26} {:>8} {:>6} {:>10.3} {:>10.3} {:>10.3} {:>10.3} {:>8} {:>19} {:>9} {:>9} {:>10.3}",
             r.scene,
             r.bodies,
             r.frames,
@@ -630,7 +656,8 @@ fn table(rows: &[Row]) -> String {
             sig3(r.ratio()),
             format!("{}/{}", r.agreement.agreed, r.agreement.compared),
             mb(r.ricochet_mb),
-            mb(r.peak_mb)
+            mb(r.peak_mb),
+            r.ricochet_alone_median_ms
         );
     }
     s
@@ -642,7 +669,7 @@ fn csv_text(rows: &[Row]) -> String {
     for r in rows {
         let _ = writeln!(
             s,
-            "{},{},{:.4},{:.4},{:.4},{:.4},{:.6},{}/{},{}",
+            "{},{},{:.4},{:.4},{:.4},{:.4},{:.6},{}/{},{},{:.4}",
             r.scene,
             r.frames,
             r.ricochet_median_ms,
@@ -652,7 +679,8 @@ fn csv_text(rows: &[Row]) -> String {
             r.ratio(),
             r.agreement.agreed,
             r.agreement.compared,
-            r.peak_mb.map_or_else(String::new, |v| format!("{v:.1}"))
+            r.peak_mb.map_or_else(String::new, |v| format!("{v:.1}")),
+            r.ricochet_alone_median_ms
         );
     }
     s
@@ -747,7 +775,8 @@ pub fn run(scenes: &[String], frames: u64, csv: Option<&Path>) -> anyhow::Result
     println!(
         "median and p95 (nearest rank) of each engine's time per frame, frame 0 untimed; ratio = \
          rapier median / ricochet median; memory = VmHWM of the scene's own process (ricochet: \
-         after its setup and frame 0, before rapier's world exists; peak: at the end)"
+         after its setup and frame 0, before rapier's world exists; peak: at the end); alone = \
+         median of as many further Ricochet frames with rapier idle (caches to itself)"
     );
     if let Some(path) = csv {
         std::fs::write(path, csv_text(&rows))

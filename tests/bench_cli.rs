@@ -4,7 +4,8 @@
 use crate::util::{ricochet, root};
 
 const HEADER: &str = "scene,frames,ricochet_median_ms,ricochet_p95_ms,rapier_median_ms,\
-                      rapier_p95_ms,ratio,contact_agreement,peak_mem_mb";
+                      rapier_p95_ms,ratio,contact_agreement,peak_mem_mb,\
+                      ricochet_alone_median_ms";
 
 #[test]
 fn bench_writes_a_row_per_scene_and_the_contact_sets_agree() {
@@ -28,7 +29,7 @@ fn bench_writes_a_row_per_scene_and_the_contact_sets_agree() {
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     assert_eq!(rows.len(), scenes.len(), "{text}");
     for (row, scene) in rows.iter().zip(scenes) {
-        assert_eq!(row.len(), 9, "{text}");
+        assert_eq!(row.len(), 10, "{text}");
         assert_eq!(row[0], scene);
         assert_eq!(row[1], "5");
         for (k, field) in row.iter().enumerate().skip(2) {
