@@ -7,6 +7,7 @@
 
 use ricochet_geom::{Bounds, Pose, Shape, Vec2};
 
+use crate::broad_phase::BodyEntry;
 use crate::def::{BodyDef, BodyKind, Controller, LayerId, Split};
 use crate::entity::{Entity, EntityAllocator};
 
@@ -103,6 +104,31 @@ struct LocalBounds {
 }
 
 impl LocalBounds {
+    /// The bounds of `shape` at `angle` and position `p`.
+    #[inline]
+    fn at(&mut self, shape: &Shape, angle: f64, p: Vec2) -> Bounds {
+        if !self.any_angle && self.angle.to_bits() != angle.to_bits() {
+            // The farthest corner of the angle-0 box is as far as any point of the shape.
+            let b = shape.bounds(&Pose::default());
+            let r = b.min.abs().max(b.max.abs()).length();
+            // A rotated point may round one ulp past the exact radius.
+            let r = r + r * 1e-12;
+            self.bounds = Bounds {
+                min: Vec2::splat(-r),
+                max: Vec2::splat(r),
+            };
+            self.any_angle = true;
+        }
+        let b = self.bounds;
+        // Translating rounds differently from placing the shape at `p` (a rounding or two,
+        // each at most half an ulp of these magnitudes): pad by more than that.
+        let pad = (p.abs() + b.min.abs().max(b.max.abs())) * 1e-15;
+        Bounds {
+            min: b.min + p - pad,
+            max: b.max + p + pad,
+        }
+    }
+
     fn new(shape: &Shape, angle: f64) -> LocalBounds {
         LocalBounds {
             angle,
@@ -377,28 +403,37 @@ impl World {
     /// A body that has turned is bounded by the square around the disc that holds its shape
     /// at every angle, so turning never costs a rotation here.
     pub fn bounds(&mut self, i: usize) -> Bounds {
-        let lb = &mut self.local_bounds[i];
-        let angle = self.angle[i];
-        if !lb.any_angle && lb.angle.to_bits() != angle.to_bits() {
-            // The farthest corner of the angle-0 box is as far as any point of the shape.
-            let b = self.shape[i].bounds(&Pose::default());
-            let r = b.min.abs().max(b.max.abs()).length();
-            // A rotated point may round one ulp past the exact radius.
-            let r = r + r * 1e-12;
-            lb.bounds = Bounds {
-                min: Vec2::splat(-r),
-                max: Vec2::splat(r),
-            };
-            lb.any_angle = true;
-        }
-        let p = self.position[i];
-        let b = lb.bounds;
-        // Translating rounds differently from placing the shape at `p` (a rounding or two,
-        // each at most half an ulp of these magnitudes): pad by more than that.
-        let pad = (p.abs() + b.min.abs().max(b.max.abs())) * 1e-15;
-        Bounds {
-            min: b.min + p - pad,
-            max: b.max + p + pad,
+        self.local_bounds[i].at(&self.shape[i], self.angle[i], self.position[i])
+    }
+
+    /// The broad phase's view of every moving body, in [`World::movers`] order, into `out`:
+    /// [`World::bounds`], widened over the frame's motion for a body of a layer in
+    /// `sweeping` (a bullet that went right through something is still paired with it), and
+    /// a frozen body handed over as kinematic (it keeps its place in the dense order; the
+    /// caller drops its pairs).
+    pub(crate) fn mover_entries(&mut self, sweeping: &[bool], out: &mut Vec<BodyEntry>) {
+        out.clear();
+        out.reserve(self.movers.len());
+        for &i in &self.movers {
+            let i = i as usize;
+            let p = self.position[i];
+            let mut bounds = self.local_bounds[i].at(&self.shape[i], self.angle[i], p);
+            let layer = self.layer[i];
+            let moved = self.start_position[i] - p;
+            if sweeping[usize::from(layer)] && moved != Vec2::ZERO {
+                bounds = bounds.union(bounds.translated(moved));
+            }
+            let e = self.entity[i];
+            out.push(BodyEntry {
+                key: (u64::from(e.index) << 32) | u64::from(e.generation),
+                bounds,
+                layer,
+                kind: if self.frozen[i] {
+                    BodyKind::Kinematic
+                } else {
+                    self.kind[i]
+                },
+            });
         }
     }
 

@@ -116,30 +116,7 @@ fn candidate_pairs(sim: &mut Simulation, out: &mut FrameOutput) -> Vec<(u32, u32
             }
         }
     }
-    st.movers.clear();
-    for k in 0..w.movers().len() {
-        let i = w.movers()[k] as usize;
-        let mut bounds = w.bounds(i);
-        // A body in a swept pair is bounded over its whole motion this frame, so the broad
-        // phase sees a bullet that went right through something.
-        let moved = w.start_position[i] - w.position[i];
-        if st.sweeping[usize::from(w.layer[i])] && moved != Vec2::ZERO {
-            bounds = bounds.union(bounds.translated(moved));
-        }
-        // A frozen body is handed over as kinematic (it keeps its place in the dense order)
-        // and its pairs are dropped below.
-        let kind = if w.frozen[i] {
-            BodyKind::Kinematic
-        } else {
-            w.kind[i]
-        };
-        st.movers.push(BodyEntry {
-            key: key(w, i),
-            bounds,
-            layer: w.layer[i],
-            kind,
-        });
-    }
+    w.mover_entries(&st.sweeping, &mut st.movers);
     let generation = w.static_generation();
     let mut pairs = std::mem::take(&mut st.pairs);
     let bp = st.broad_phase.pairs_split(
