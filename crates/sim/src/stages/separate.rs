@@ -151,7 +151,11 @@ fn obstacles(st: &mut SeparateState, w: &World, q: &Bounds, from: u32, found: &m
         // A static body's dense index: its rank among the static bodies plus the moving
         // bodies before it.
         let (e, layer) = st.static_entities[s as usize];
-        let before = movers.partition_point(|&m| w.entity[m as usize] < e) as u32;
+        // Usually every static body comes first (a level's tiles before its actors).
+        let before = match movers.first() {
+            Some(&m) if w.entity[m as usize] > e => 0,
+            _ => movers.partition_point(|&m| w.entity[m as usize] < e) as u32,
+        };
         let index = s + before;
         if index >= from {
             found.push(Obstacle {
