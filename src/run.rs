@@ -98,6 +98,13 @@ pub fn run(
         );
         bar
     });
+    if validate && (scenario.world.active_region.is_some() || scenario.world.sleep_after.is_some())
+    {
+        eprintln!(
+            "warning: frozen and sleeping bodies are not tested, so /validation may list \
+             their pairs as differences; `ricochet validate` turns both off"
+        );
+    }
     let mut validation = if validate {
         recorder
             .add_validation_channel()

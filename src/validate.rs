@@ -96,10 +96,19 @@ impl Validation {
 
 /// `ricochet validate SCENARIO`: simulate without writing a log, referee every frame.
 pub fn run(path: &Path, frames: Option<u64>) -> anyhow::Result<ExitCode> {
-    let scenario = match crate::run::load(Some(path)) {
+    let mut scenario = match crate::run::load(Some(path)) {
         Ok(s) => s,
         Err(code) => return Ok(code),
     };
+    if scenario.world.active_region.is_some() || scenario.world.sleep_after.is_some() {
+        // Frozen and sleeping bodies are not tested on purpose; rapier tests every pair.
+        eprintln!(
+            "validate: active_region and sleep_after are turned off for the referee, which \
+             compares every pair (they are tested to change nothing they do not freeze)"
+        );
+        scenario.world.active_region = None;
+        scenario.world.sleep_after = None;
+    }
     let frames = frames.unwrap_or(scenario.frames);
     let mut sim = Simulation::new(&scenario);
     sim.capture_detect_poses = true;

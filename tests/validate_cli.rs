@@ -75,3 +75,22 @@ fn run_with_validate_writes_a_validation_channel() {
             > 0
     );
 }
+
+#[test]
+fn validate_turns_culling_and_sleeping_off_and_says_so() {
+    // The referee tests every pair, so `validate` runs the scene with neither feature and
+    // says so (they are tested on their own, in crates/sim/tests/rest.rs).
+    let text = std::fs::read_to_string(root().join("scenarios/platformer.toml")).unwrap();
+    assert!(text.contains("\n[world]\n"));
+    let text = text.replacen("\n[world]\n", "\n[world]\nsleep_after = 5\n", 1);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("sleepy.toml");
+    std::fs::write(&path, text).unwrap();
+    let o = ricochet(&["validate", path.to_str().unwrap()], b"");
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{stderr}");
+    assert!(
+        stderr.contains("active_region and sleep_after are turned off"),
+        "{stderr}"
+    );
+}
