@@ -79,6 +79,9 @@ fn free_flight(scenario: &Scenario) -> Scenario {
     let mut s = scenario.clone();
     s.world.layers = Layers::new(s.world.layers.names().to_vec());
     s.world.bounds = None;
+    // Free flight checks integration: every body integrates, none is frozen or asleep.
+    s.world.active_region = None;
+    s.world.sleep_after = None;
     s.script.clear();
     for b in &mut s.bodies {
         b.controller = None;
@@ -144,8 +147,9 @@ pub fn rapier_free_flight(scenario: &Scenario, frames: u64) -> Vec<(usize, Vec2)
 }
 
 /// Runs the scenario's dynamic and kinematic bodies in free flight (every layer pair
-/// ignored, no script, controllers, lifetimes or world bounds) for `frames` steps in both
-/// Ricochet and rapier, and compares positions and angles after every step.
+/// ignored, no script, controllers, lifetimes, world bounds, culling or sleeping) for
+/// `frames` steps in both Ricochet and rapier, and compares positions and angles after
+/// every step.
 ///
 /// Rapier is set up to integrate the same model: one substep per step
 /// (`num_solver_iterations = 1`) of `dt`, the scenario's gravity, no damping, no CCD, no

@@ -5,8 +5,9 @@
 use ricochet_sim::broad_phase::BroadPhaseKind;
 use ricochet_sim::{Simulation, load_scenario};
 
-const SCENARIOS: [&str; 6] = [
+const SCENARIOS: [&str; 7] = [
     "asteroids.toml",
+    "level.toml",
     "platformer.toml",
     "shapes.toml",
     "validation.toml",
