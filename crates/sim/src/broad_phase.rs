@@ -1181,13 +1181,7 @@ fn hull(a: Bounds, b: Bounds) -> Bounds {
 #[derive(Debug, Default)]
 struct HashGrid {
     frame: u64,
-    inv_cell: f64,
-    /// Hashed: the table has `1 << bits` buckets.
-    bits: u32,
-    /// Dense: one bucket per cell of the `span` cells from `origin`, row by row.
-    dense: bool,
-    origin: (i32, i32),
-    span: (u32, u32),
+    cells: Cells,
     /// Bucket `b` is `entries[starts[b]..starts[b + 1]]`.
     starts: Vec<u32>,
     /// `(cell x, cell y, member)`.
@@ -1197,27 +1191,22 @@ struct HashGrid {
     /// against everything.
     big: Vec<u32>,
     is_big: Vec<bool>,
-    /// Build buffer: each member's cells (none for a big one).
-    ranges: Vec<CellRange>,
+    /// Build buffer: each member in cells, with the cells it covers.
+    ranges: Vec<(CellRange, u32)>,
 }
 
 /// A body covering more cells goes to the grid's `big` list.
 const MAX_CELLS: u64 = 16;
 
 /// A grid over boxes that never move, built once (the per-axis stages' static boxes): which
-/// of them overlap a query box. Each cell's entries hold the boxes' bounds themselves, so a
-/// lookup in a million tiles reads a few cache lines (the cell's bucket start and its
-/// entries) and never the bodies. The cell is twice the median box extent; a dense table
-/// over the occupied rectangle (row by row) when that is at most four cells per entry, as in
-/// a tile map, else a table indexed by a fixed hash of the cell. A box covering more than
-/// [`MAX_CELLS`] cells (or with irregular bounds) is kept in a list every lookup scans.
+/// of them overlap a query box. Laid out as the broad phase's grids ([`Cells`]), but each
+/// cell's entries hold the boxes' bounds themselves, so a lookup in a million tiles reads a
+/// few cache lines (the cell's bucket start and its entries) and never the bodies. A box
+/// covering more than [`MAX_CELLS`] cells (or with irregular bounds) is kept in a list every
+/// lookup scans.
 #[derive(Debug, Default)]
 pub(crate) struct FixedGrid {
-    inv_cell: f64,
-    dense: bool,
-    origin: (i32, i32),
-    span: (u32, u32),
-    bits: u32,
+    cells: Cells,
     starts: Vec<u32>,
     entries: Vec<FixedEntry>,
     big: Vec<(Bounds, u32)>,
@@ -1234,12 +1223,103 @@ impl FixedGrid {
     /// Indexes `boxes`, each with a handle reported by [`FixedGrid::query`].
     pub(crate) fn new(boxes: impl Iterator<Item = (Bounds, u32)>) -> FixedGrid {
         let boxes: Vec<(Bounds, u32)> = boxes.collect();
-        let mut g = FixedGrid::default();
-        // The cell: as the broad phase's grids choose it (twice the median extent, wide
-        // enough that cell coordinates stay within ±2^30).
-        let mut extents = Vec::with_capacity(boxes.len());
+        let mut g = FixedGrid {
+            cells: Cells::sized_for(boxes.iter().map(|(b, _)| b), &mut Vec::new()),
+            ..FixedGrid::default()
+        };
+        let mut placed: Vec<(CellRange, (Bounds, u32))> = Vec::with_capacity(boxes.len());
+        for &(b, h) in &boxes {
+            match g.cells.range(&b) {
+                Some(r) if r.count() <= MAX_CELLS => placed.push((r, (b, h))),
+                _ => g.big.push((b, h)),
+            }
+        }
+        let blank = FixedEntry {
+            cell: (0, 0),
+            handle: 0,
+            bounds: Bounds::around(Vec2::ZERO, Vec2::ZERO),
+        };
+        let entry = |cell, (bounds, handle)| FixedEntry {
+            cell,
+            handle,
+            bounds,
+        };
+        g.cells
+            .fill(&placed, blank, entry, &mut g.starts, &mut g.entries);
+        g
+    }
+
+    /// Calls `f` once with the handle and bounds of every box overlapping `q` (touching
+    /// counts). Returns the box tests made.
+    pub(crate) fn query(&self, q: &Bounds, mut f: impl FnMut(u32, &Bounds)) -> u64 {
+        let mut tested = 0;
+        for (b, h) in &self.big {
+            tested += 1;
+            if b.overlaps(q) {
+                f(*h, b);
+            }
+        }
+        let Some(r) = self.cells.range(q).map(|r| self.cells.clip(r)) else {
+            return tested;
+        };
+        if r.count() > self.entries.len() as u64 {
+            // Larger than everything: each box once, from its entry in its own first cell
+            // (the lower-left one it covers).
+            for e in &self.entries {
+                let first = (
+                    self.cells.coord(e.bounds.min.x),
+                    self.cells.coord(e.bounds.min.y),
+                );
+                if e.cell == first {
+                    tested += 1;
+                    if e.bounds.overlaps(q) {
+                        f(e.handle, &e.bounds);
+                    }
+                }
+            }
+            return tested;
+        }
+        for c in r.cells() {
+            let Some(k) = self.cells.bucket(c) else {
+                continue;
+            };
+            for e in &self.entries[self.starts[k] as usize..self.starts[k + 1] as usize] {
+                if e.cell != c {
+                    continue;
+                }
+                tested += 1;
+                // Reported once: in the cell holding the lower-left corner of the overlap.
+                if e.bounds.overlaps(q) && self.cells.owns(&e.bounds, q, c) {
+                    f(e.handle, &e.bounds);
+                }
+            }
+        }
+        tested
+    }
+}
+
+/// How a grid maps space to buckets: the cell size, and either a dense table over the
+/// occupied rectangle of cells (row by row: neighbours are neighbours in memory, as in a tile
+/// map) or a table indexed by a fixed multiplicative hash of the cell. Shared by
+/// [`HashGrid`] and [`FixedGrid`].
+#[derive(Clone, Copy, Debug, Default)]
+struct Cells {
+    inv_cell: f64,
+    /// Hashed: the table has `1 << bits` buckets.
+    bits: u32,
+    /// Dense: one bucket per cell of the `span` cells from `origin`, row by row.
+    dense: bool,
+    origin: (i32, i32),
+    span: (u32, u32),
+}
+
+impl Cells {
+    /// Cells twice the median extent of `boxes` (`max(width, height)`), widened if needed so
+    /// that cell coordinates stay within `±2^30`. `extents` is a buffer.
+    fn sized_for<'a>(boxes: impl Iterator<Item = &'a Bounds>, extents: &mut Vec<f64>) -> Cells {
+        extents.clear();
         let mut max_abs: f64 = 0.0;
-        for (b, _) in &boxes {
+        for b in boxes {
             if b.min.x <= b.max.x && b.min.y <= b.max.y {
                 let e = (b.max.x - b.min.x).max(b.max.y - b.min.y);
                 if e.is_finite() {
@@ -1256,7 +1336,8 @@ impl FixedGrid {
             1.0
         } else {
             let mid = extents.len() / 2;
-            2.0 * *extents.select_nth_unstable_by(mid, f64::total_cmp).1
+            let (_, median, _) = extents.select_nth_unstable_by(mid, f64::total_cmp);
+            2.0 * *median
         };
         if !(cell.is_finite() && cell > 0.0) {
             cell = 1.0;
@@ -1265,188 +1346,71 @@ impl FixedGrid {
         if !(1.0 / cell).is_normal() {
             cell = 1.0f64.max(max_abs / CELL_RANGE);
         }
-        g.inv_cell = 1.0 / cell;
-        let mut placed: Vec<(CellRange, Bounds, u32)> = Vec::with_capacity(boxes.len());
-        for &(b, h) in &boxes {
-            match g.range(&b) {
-                Some(r) if r.count() <= MAX_CELLS => placed.push((r, b, h)),
-                _ => g.big.push((b, h)),
-            }
+        Cells {
+            inv_cell: 1.0 / cell,
+            ..Cells::default()
         }
+    }
+
+    /// Chooses the table for `items` (each with the cells it covers; an empty range for one
+    /// kept out of the cells) and counting-sorts `entry(cell, item)` into `entries`, bucket
+    /// `b` being `entries[starts[b]..starts[b + 1]]`, each bucket in input order. Dense
+    /// unless the occupied rectangle has more than four cells per entry.
+    fn fill<T: Copy, E: Copy>(
+        &mut self,
+        items: &[(CellRange, T)],
+        blank: E,
+        entry: impl Fn((i32, i32), T) -> E,
+        starts: &mut Vec<u32>,
+        entries: &mut Vec<E>,
+    ) {
         let (mut lo, mut hi) = ((i32::MAX, i32::MAX), (i32::MIN, i32::MIN));
         let mut total = 0u64;
-        for (r, _, _) in &placed {
-            lo = (lo.0.min(r.x.0), lo.1.min(r.y.0));
-            hi = (hi.0.max(r.x.1), hi.1.max(r.y.1));
-            total += r.count();
+        for (r, _) in items {
+            if r.count() > 0 {
+                lo = (lo.0.min(r.x.0), lo.1.min(r.y.0));
+                hi = (hi.0.max(r.x.1), hi.1.max(r.y.1));
+                total += r.count();
+            }
         }
         let span = |a: i32, b: i32| (i64::from(b) - i64::from(a) + 1).max(0) as u64;
         let cells = span(lo.0, hi.0).saturating_mul(span(lo.1, hi.1));
-        g.dense = total > 0 && cells <= 4 * total + 64;
-        let size = if g.dense {
-            g.origin = lo;
-            g.span = (span(lo.0, hi.0) as u32, span(lo.1, hi.1) as u32);
+        self.dense = total > 0 && cells <= 4 * total + 64;
+        let size = if self.dense {
+            self.origin = lo;
+            self.span = (span(lo.0, hi.0) as u32, span(lo.1, hi.1) as u32);
             cells as usize
         } else {
             (total as usize).max(16).next_power_of_two()
         };
-        g.bits = size.trailing_zeros();
-        g.starts = vec![0; size + 1];
-        for (r, _, _) in &placed {
+        self.bits = size.trailing_zeros();
+        starts.clear();
+        starts.resize(size + 1, 0);
+        for (r, _) in items {
             for c in r.cells() {
-                if let Some(k) = g.bucket(c) {
-                    g.starts[k] += 1;
+                if let Some(k) = self.bucket(c) {
+                    starts[k] += 1;
                 }
             }
         }
+        // Each bucket's end, then fill backwards: `starts[b]` ends at the bucket's start.
         let mut sum = 0;
-        for st in &mut g.starts {
+        for st in starts.iter_mut() {
             sum += *st;
             *st = sum;
         }
-        let blank = FixedEntry {
-            cell: (0, 0),
-            handle: 0,
-            bounds: Bounds::around(Vec2::ZERO, Vec2::ZERO),
-        };
-        g.entries = vec![blank; total as usize];
-        // Backwards, so each bucket ends up in input order.
-        for &(r, bounds, handle) in placed.iter().rev() {
+        entries.clear();
+        entries.resize(total as usize, blank);
+        for &(r, item) in items.iter().rev() {
             for c in r.cells() {
-                if let Some(k) = g.bucket(c) {
-                    g.starts[k] -= 1;
-                    g.entries[g.starts[k] as usize] = FixedEntry {
-                        cell: c,
-                        handle,
-                        bounds,
-                    };
+                if let Some(k) = self.bucket(c) {
+                    starts[k] -= 1;
+                    entries[starts[k] as usize] = entry(c, item);
                 }
             }
         }
-        g
     }
 
-    #[inline]
-    fn coord(&self, v: f64) -> i32 {
-        cell_coord(v, self.inv_cell)
-    }
-
-    #[inline]
-    fn range(&self, b: &Bounds) -> Option<CellRange> {
-        if !(b.min.x <= b.max.x && b.min.y <= b.max.y) {
-            return None;
-        }
-        Some(CellRange {
-            x: (self.coord(b.min.x), self.coord(b.max.x)),
-            y: (self.coord(b.min.y), self.coord(b.max.y)),
-        })
-    }
-
-    #[inline]
-    fn bucket(&self, (cx, cy): (i32, i32)) -> Option<usize> {
-        if self.dense {
-            let x = i64::from(cx) - i64::from(self.origin.0);
-            let y = i64::from(cy) - i64::from(self.origin.1);
-            let (w, h) = (i64::from(self.span.0), i64::from(self.span.1));
-            return (0 <= x && x < w && 0 <= y && y < h).then_some((x + y * w) as usize);
-        }
-        let packed = u64::from(cx as u32) | (u64::from(cy as u32) << 32);
-        Some((packed.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> (64 - self.bits)) as usize)
-    }
-
-    /// Calls `f` once with the handle and bounds of every box overlapping `q` (touching
-    /// counts). Returns the box tests made.
-    pub(crate) fn query(&self, q: &Bounds, mut f: impl FnMut(u32, &Bounds)) -> u64 {
-        let mut tested = 0;
-        for (b, h) in &self.big {
-            tested += 1;
-            if b.overlaps(q) {
-                f(*h, b);
-            }
-        }
-        let Some(mut r) = self.range(q) else {
-            return tested;
-        };
-        if self.dense {
-            // Only the occupied rectangle has buckets.
-            let last = |o: i32, n: u32| (i64::from(o) + i64::from(n) - 1) as i32;
-            r.x = (
-                r.x.0.max(self.origin.0),
-                r.x.1.min(last(self.origin.0, self.span.0)),
-            );
-            r.y = (
-                r.y.0.max(self.origin.1),
-                r.y.1.min(last(self.origin.1, self.span.1)),
-            );
-        }
-        if r.count() > self.entries.len() as u64 {
-            // Larger than everything: each box once, from its entries in its own first
-            // cell (the lower-left one it covers).
-            for e in &self.entries {
-                let first = (self.coord(e.bounds.min.x), self.coord(e.bounds.min.y));
-                if e.cell == first {
-                    tested += 1;
-                    if e.bounds.overlaps(q) {
-                        f(e.handle, &e.bounds);
-                    }
-                }
-            }
-            return tested;
-        }
-        for c in r.cells() {
-            let Some(k) = self.bucket(c) else {
-                continue;
-            };
-            for e in &self.entries[self.starts[k] as usize..self.starts[k + 1] as usize] {
-                if e.cell != c {
-                    continue;
-                }
-                tested += 1;
-                // Reported once: in the cell holding the lower-left corner of the overlap.
-                if e.bounds.overlaps(q)
-                    && self.coord(e.bounds.min.x.max(q.min.x)) == c.0
-                    && self.coord(e.bounds.min.y.max(q.min.y)) == c.1
-                {
-                    f(e.handle, &e.bounds);
-                }
-            }
-        }
-        tested
-    }
-}
-
-/// Cell coordinates stay within `±2^30` of the origin for finite bounds.
-const CELL_RANGE: f64 = (1u64 << 30) as f64;
-
-#[derive(Clone, Copy, Debug)]
-struct CellRange {
-    x: (i32, i32),
-    y: (i32, i32),
-}
-
-impl CellRange {
-    fn count(self) -> u64 {
-        let span = |(lo, hi): (i32, i32)| (i64::from(hi) - i64::from(lo) + 1).max(0) as u64;
-        span(self.x).saturating_mul(span(self.y))
-    }
-
-    fn cells(self) -> impl Iterator<Item = (i32, i32)> {
-        (self.y.0..=self.y.1).flat_map(move |cy| (self.x.0..=self.x.1).map(move |cx| (cx, cy)))
-    }
-}
-
-/// `floor(v * inv_cell)`, clamped to `i32`: monotone in `v`.
-#[inline]
-pub(crate) fn cell_coord(v: f64, inv_cell: f64) -> i32 {
-    // Clamped, then floored by hand (`f64::floor` is a call on baseline x86-64): the cast
-    // truncates toward zero, a negative fraction steps down. NaN becomes 0; only regular
-    // bounds get here.
-    let x = (v * inv_cell).clamp(f64::from(i32::MIN), f64::from(i32::MAX));
-    let t = x as i32;
-    t - i32::from(f64::from(t) > x)
-}
-
-impl HashGrid {
     /// The cell coordinate of `v`: monotone in `v`, so overlapping boxes share a cell.
     #[inline]
     fn coord(&self, v: f64) -> i32 {
@@ -1484,16 +1448,6 @@ impl HashGrid {
         Some((packed.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> (64 - self.bits)) as usize)
     }
 
-    fn bucket_entries(&self, b: usize) -> &[(i32, i32, u32)] {
-        &self.entries[self.starts[b] as usize..self.starts[b + 1] as usize]
-    }
-
-    /// The entries of cell `c` (and, hashed, of the cells sharing its bucket).
-    #[inline]
-    fn cell_entries(&self, c: (i32, i32)) -> &[(i32, i32, u32)] {
-        self.bucket(c).map_or(&[], |b| self.bucket_entries(b))
-    }
-
     /// `r` cut to the occupied cells when the table is dense.
     fn clip(&self, r: CellRange) -> CellRange {
         if !self.dense {
@@ -1511,117 +1465,84 @@ impl HashGrid {
             ),
         }
     }
+}
+
+/// Cell coordinates stay within `±2^30` of the origin for finite bounds.
+const CELL_RANGE: f64 = (1u64 << 30) as f64;
+
+#[derive(Clone, Copy, Debug)]
+struct CellRange {
+    x: (i32, i32),
+    y: (i32, i32),
+}
+
+impl CellRange {
+    fn count(self) -> u64 {
+        let span = |(lo, hi): (i32, i32)| (i64::from(hi) - i64::from(lo) + 1).max(0) as u64;
+        span(self.x).saturating_mul(span(self.y))
+    }
+
+    fn cells(self) -> impl Iterator<Item = (i32, i32)> {
+        (self.y.0..=self.y.1).flat_map(move |cy| (self.x.0..=self.x.1).map(move |cx| (cx, cy)))
+    }
+}
+
+/// `floor(v * inv_cell)`, clamped to `i32`: monotone in `v`.
+#[inline]
+pub(crate) fn cell_coord(v: f64, inv_cell: f64) -> i32 {
+    // Clamped, then floored by hand (`f64::floor` is a call on baseline x86-64): the cast
+    // truncates toward zero, a negative fraction steps down. NaN becomes 0; only regular
+    // bounds get here.
+    let x = (v * inv_cell).clamp(f64::from(i32::MIN), f64::from(i32::MAX));
+    let t = x as i32;
+    t - i32::from(f64::from(t) > x)
+}
+
+impl HashGrid {
+    fn bucket_entries(&self, b: usize) -> &[(i32, i32, u32)] {
+        &self.entries[self.starts[b] as usize..self.starts[b + 1] as usize]
+    }
+
+    /// The entries of cell `c` (and, hashed, of the cells sharing its bucket).
+    #[inline]
+    fn cell_entries(&self, c: (i32, i32)) -> &[(i32, i32, u32)] {
+        self.cells.bucket(c).map_or(&[], |b| self.bucket_entries(b))
+    }
 
     /// Chooses the cell from `members` and indexes them.
     /// With `reorder` (static grids, built once), the members are first sorted by the row
     /// and column of their lower-left cell, so a cell's members sit together in memory.
     fn build(&mut self, extents: &mut Vec<f64>, reorder: bool) {
-        extents.clear();
-        let mut max_abs: f64 = 0.0;
-        for m in &self.members {
-            let b = &m.bounds;
-            if b.min.x <= b.max.x && b.min.y <= b.max.y {
-                let e = (b.max.x - b.min.x).max(b.max.y - b.min.y);
-                if e.is_finite() {
-                    extents.push(e);
-                }
-                for v in [b.min.x, b.min.y, b.max.x, b.max.y] {
-                    if v.is_finite() {
-                        max_abs = max_abs.max(v.abs());
-                    }
-                }
-            }
-        }
-        let mut cell = if extents.is_empty() {
-            1.0
-        } else {
-            let mid = extents.len() / 2;
-            let (_, median, _) = extents.select_nth_unstable_by(mid, f64::total_cmp);
-            2.0 * *median
-        };
-        if !(cell.is_finite() && cell > 0.0) {
-            cell = 1.0;
-        }
-        cell = cell.max(max_abs / CELL_RANGE);
-        if !(1.0 / cell).is_normal() {
-            cell = 1.0f64.max(max_abs / CELL_RANGE);
-        }
-        self.inv_cell = 1.0 / cell;
+        self.cells = Cells::sized_for(self.members.iter().map(|m| &m.bounds), extents);
         if reorder {
-            let inv = self.inv_cell;
+            let cells = self.cells;
             self.members.sort_by_cached_key(|m| {
                 let b = &m.bounds;
-                (cell_coord(b.min.y, inv), cell_coord(b.min.x, inv), m.handle)
+                (cells.coord(b.min.y), cells.coord(b.min.x), m.handle)
             });
         }
-
         self.big.clear();
         self.is_big.clear();
         self.is_big.resize(self.members.len(), false);
         let mut ranges = std::mem::take(&mut self.ranges);
         ranges.clear();
-        let mut total = 0u64;
         for (i, m) in self.members.iter().enumerate() {
-            match self.range(&m.bounds) {
-                Some(r) if r.count() <= MAX_CELLS => {
-                    total += r.count();
-                    ranges.push(r);
-                }
+            match self.cells.range(&m.bounds) {
+                Some(r) if r.count() <= MAX_CELLS => ranges.push((r, i as u32)),
                 _ => {
                     self.is_big[i] = true;
                     self.big.push(i as u32);
-                    ranges.push(CellRange {
-                        x: (0, -1),
-                        y: (0, -1),
-                    });
                 }
             }
         }
-        // Dense (one bucket per cell of the occupied rectangle: neighbours are neighbours in
-        // memory, as in a tile map) unless that is much larger than the entries.
-        let (mut lo, mut hi) = ((i32::MAX, i32::MAX), (i32::MIN, i32::MIN));
-        for (i, r) in ranges.iter().enumerate() {
-            if !self.is_big[i] {
-                lo = (lo.0.min(r.x.0), lo.1.min(r.y.0));
-                hi = (hi.0.max(r.x.1), hi.1.max(r.y.1));
-            }
-        }
-        let span = |a: i32, b: i32| (i64::from(b) - i64::from(a) + 1).max(0) as u64;
-        let cells = span(lo.0, hi.0).saturating_mul(span(lo.1, hi.1));
-        self.dense = total > 0 && cells <= 4 * total + 64;
-        let size = if self.dense {
-            self.origin = lo;
-            self.span = (span(lo.0, hi.0) as u32, span(lo.1, hi.1) as u32);
-            cells as usize
-        } else {
-            (total as usize).max(16).next_power_of_two()
-        };
-        self.bits = size.trailing_zeros();
-        self.starts.clear();
-        self.starts.resize(size + 1, 0);
-        for r in &ranges {
-            for c in r.cells() {
-                if let Some(b) = self.bucket(c) {
-                    self.starts[b] += 1;
-                }
-            }
-        }
-        // Each bucket's end, then fill backwards: `starts[b]` ends at the bucket's start.
-        let mut sum = 0;
-        for s in &mut self.starts {
-            sum += *s;
-            *s = sum;
-        }
-        self.entries.clear();
-        self.entries.resize(total as usize, (0, 0, 0));
-        for (i, r) in ranges.iter().enumerate() {
-            for c in r.cells() {
-                if let Some(b) = self.bucket(c) {
-                    self.starts[b] -= 1;
-                    self.entries[self.starts[b] as usize] = (c.0, c.1, i as u32);
-                }
-            }
-        }
+        let entry = |(cx, cy), i| (cx, cy, i);
+        self.cells.fill(
+            &ranges,
+            (0, 0, 0),
+            entry,
+            &mut self.starts,
+            &mut self.entries,
+        );
         self.ranges = ranges;
     }
 
@@ -1629,8 +1550,9 @@ impl HashGrid {
     fn query(&self, q: &Bounds, mut f: impl FnMut(&Member)) -> u64 {
         let mut tested = 0;
         let range = self
+            .cells
             .range(q)
-            .map(|r| self.clip(r))
+            .map(|r| self.cells.clip(r))
             .filter(|r| r.count() <= (self.members.len() as u64).max(MAX_CELLS));
         let Some(range) = range else {
             // Too big (or irregular) to look up cell by cell: test everything.
@@ -1650,7 +1572,7 @@ impl HashGrid {
                     }
                     let m = &self.members[i as usize];
                     tested += 1;
-                    if m.bounds.overlaps(q) && self.owns(q, &m.bounds, c) {
+                    if m.bounds.overlaps(q) && self.cells.owns(q, &m.bounds, c) {
                         f(m);
                     }
                 }
@@ -1679,7 +1601,9 @@ impl HashGrid {
                         continue;
                     }
                     tested += 1;
-                    if p.bounds.overlaps(&q.bounds) && self.owns(&p.bounds, &q.bounds, (cx, cy)) {
+                    if p.bounds.overlaps(&q.bounds)
+                        && self.cells.owns(&p.bounds, &q.bounds, (cx, cy))
+                    {
                         out.push((p.handle, q.handle));
                     }
                 }
