@@ -406,6 +406,12 @@ impl World {
         self.local_bounds[i].at(&self.shape[i], self.angle[i], self.position[i])
     }
 
+    /// Body `i`'s entity as one number, ordered as entities are: the broad phase's key.
+    pub(crate) fn key(&self, i: usize) -> u64 {
+        let e = self.entity[i];
+        (u64::from(e.index) << 32) | u64::from(e.generation)
+    }
+
     /// The broad phase's view of every moving body, in [`World::movers`] order, into `out`:
     /// [`World::bounds`], widened over the frame's motion for a body of a layer in
     /// `sweeping` (a bullet that went right through something is still paired with it), and
@@ -423,9 +429,8 @@ impl World {
             if sweeping[usize::from(layer)] && moved != Vec2::ZERO {
                 bounds = bounds.union(bounds.translated(moved));
             }
-            let e = self.entity[i];
             out.push(BodyEntry {
-                key: (u64::from(e.index) << 32) | u64::from(e.generation),
+                key: self.key(i),
                 bounds,
                 layer,
                 kind: if self.frozen[i] {

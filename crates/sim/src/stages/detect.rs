@@ -32,7 +32,6 @@ use crate::output::{ContactRecord, EventRecord, FrameOutput, Phase};
 use crate::pipeline::{SLOP, Simulation};
 use crate::stages::remove::remove;
 use crate::stages::separate::is_box;
-use crate::world::World;
 
 pub(crate) fn has_work(sim: &Simulation) -> bool {
     sim.world.len() >= 2 && sim.scenario.world.layers.any(|r| r != Response::Ignore)
@@ -86,11 +85,6 @@ fn interactions(layers: &Layers, box_only: &[bool]) -> Interactions {
     })
 }
 
-fn key(w: &World, i: usize) -> u64 {
-    let e = w.entity[i];
-    (u64::from(e.index) << 32) | u64::from(e.generation)
-}
-
 /// Fills the broad phase's inputs and finds the candidate pairs (dense indices, sorted).
 fn candidate_pairs(sim: &mut Simulation, out: &mut FrameOutput) -> Vec<(u32, u32)> {
     let st = &mut sim.detect;
@@ -108,7 +102,7 @@ fn candidate_pairs(sim: &mut Simulation, out: &mut FrameOutput) -> Vec<(u32, u32
             if w.kind[i] == BodyKind::Static {
                 let bounds = w.bounds(i);
                 st.statics.push(BodyEntry {
-                    key: key(w, i),
+                    key: w.key(i),
                     bounds,
                     layer: w.layer[i],
                     kind: BodyKind::Static,
