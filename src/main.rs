@@ -6,8 +6,10 @@
 
 mod accuracy;
 mod bench;
+mod check;
 mod collide;
 mod diff;
+mod load;
 mod record;
 mod run;
 mod scene;
@@ -181,7 +183,7 @@ fn main() -> ExitCode {
             validate,
         } => run::run(scenario.as_deref(), output, frames, validate),
         Command::Validate { scenario, frames } => validate::run(&scenario, frames),
-        Command::Check { scenario } => run::check(&scenario),
+        Command::Check { scenario } => check::check(&scenario),
         Command::Bench {
             scenes,
             frames,

@@ -1,4 +1,4 @@
-//! `ricochet run` and `ricochet check`.
+//! `ricochet run`: a scenario stepped to the end (or to Ctrl-C) and recorded.
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -8,54 +8,13 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use anyhow::Context;
-use ricochet_sim::{Scenario, Simulation, load_scenario};
+use ricochet_sim::Simulation;
 
+use crate::load::{DEFAULT_NAME, load};
 use crate::record::Recorder;
-
-/// The built-in demo: `scenarios/asteroids.toml`, embedded.
-pub const DEFAULT_SCENARIO: &str = include_str!("../scenarios/asteroids.toml");
-const DEFAULT_NAME: &str = "scenarios/asteroids.toml";
 
 /// Runs of at least this many frames get a progress bar (on a terminal only).
 const PROGRESS_FROM: u64 = 2_000;
-
-/// Reads and checks a scenario, printing the error and returning exit code 2 when bad.
-pub(crate) fn load(path: Option<&Path>) -> Result<Scenario, ExitCode> {
-    let (text, name) = match path {
-        None => (DEFAULT_SCENARIO.to_owned(), DEFAULT_NAME.to_owned()),
-        Some(p) => match std::fs::read_to_string(p) {
-            Ok(t) => (t, p.display().to_string()),
-            Err(e) => {
-                eprintln!("error: {}: {e}", p.display());
-                return Err(ExitCode::from(2));
-            }
-        },
-    };
-    load_scenario(&text, &name).map_err(|e| {
-        eprintln!("error: {e}");
-        ExitCode::from(2)
-    })
-}
-
-/// `ricochet check`: load and validate, print a one-line description.
-pub fn check(path: &Path) -> anyhow::Result<ExitCode> {
-    let s = match load(Some(path)) {
-        Ok(s) => s,
-        Err(code) => return Ok(code),
-    };
-    println!(
-        "{}: ok: \"{}\", {} bodies, {} templates, {} script events, {} layers, dt {} s, {} frames",
-        path.display(),
-        s.name,
-        s.bodies.len(),
-        s.templates.len(),
-        s.script.len(),
-        s.world.layers.names().len(),
-        s.world.dt,
-        s.frames
-    );
-    Ok(ExitCode::SUCCESS)
-}
 
 /// `ricochet run`.
 pub fn run(

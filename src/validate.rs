@@ -96,7 +96,7 @@ impl Validation {
 
 /// `ricochet validate SCENARIO`: simulate without writing a log, referee every frame.
 pub fn run(path: &Path, frames: Option<u64>) -> anyhow::Result<ExitCode> {
-    let mut scenario = match crate::run::load(Some(path)) {
+    let mut scenario = match crate::load::load(Some(path)) {
         Ok(s) => s,
         Err(code) => return Ok(code),
     };
