@@ -31,10 +31,11 @@
 pub mod broad_phase;
 mod def;
 mod entity;
+#[cfg(feature = "toml")]
+mod load;
 mod output;
 mod pipeline;
 mod scenario;
-mod scenario_file;
 mod stages;
 mod world;
 
@@ -43,7 +44,9 @@ pub use def::{
     Split, WorldBounds, WorldDef,
 };
 pub use entity::{Entity, EntityAllocator};
+#[cfg(feature = "toml")]
+pub use load::{ScenarioError, load_scenario};
 pub use output::{ContactRecord, EventRecord, FrameOutput, Phase, RemovedBody, Stats};
 pub use pipeline::{SLOP, Simulation};
-pub use scenario::{Scenario, ScenarioError, load_scenario};
+pub use scenario::Scenario;
 pub use world::{Inputs, World};

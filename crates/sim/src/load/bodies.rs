@@ -1,0 +1,234 @@
+//! Templates and bodies: a body's fields over its template's, the references between
+//! templates (bullets, splits), and the checked [`BodyDef`].
+
+use std::collections::BTreeMap;
+use std::ops::Range;
+
+use crate::def::{BodyDef, BodyKind, Controller, Layers, Split};
+use crate::load::context::{Ctx, ScenarioError, finite, unknown, vec2, within_world};
+use crate::load::file::{BodyFile, ControllerFile, SplitFile};
+
+/// The chain of templates by which `start` splits back into itself, if it does.
+pub(crate) fn split_cycle(
+    templates: &BTreeMap<String, BodyDef>,
+    start: &str,
+) -> Option<Vec<String>> {
+    fn walk(
+        templates: &BTreeMap<String, BodyDef>,
+        start: &str,
+        at: &str,
+        path: &mut Vec<String>,
+    ) -> bool {
+        let Some(t) = templates.get(at) else {
+            return false;
+        };
+        for child in &t.split {
+            if child.template == start {
+                path.push(child.template.clone());
+                return true;
+            }
+            if path.contains(&child.template) {
+                continue;
+            }
+            path.push(child.template.clone());
+            if walk(templates, start, &child.template, path) {
+                return true;
+            }
+            path.pop();
+        }
+        false
+    }
+    let mut path = vec![start.to_owned()];
+    walk(templates, start, start, &mut path).then_some(path)
+}
+
+/// A body's fields over its template's.
+pub(crate) fn merge(body: &BodyFile, base: &BodyFile) -> BodyFile {
+    BodyFile {
+        template: body.template.clone(),
+        name: body.name.clone().or_else(|| base.name.clone()),
+        layer: body.layer.clone().or_else(|| base.layer.clone()),
+        shape: body.shape.clone().or_else(|| base.shape.clone()),
+        kind: body.kind.clone().or_else(|| base.kind.clone()),
+        mass: body.mass.or(base.mass),
+        position: body.position.or(base.position),
+        angle: body.angle.or(base.angle),
+        velocity: body.velocity.or(base.velocity),
+        angular_velocity: body.angular_velocity.or(base.angular_velocity),
+        force: body.force.or(base.force),
+        gravity_scale: body.gravity_scale.or(base.gravity_scale),
+        lifetime: body.lifetime.or(base.lifetime),
+        controller: body.controller.clone().or_else(|| base.controller.clone()),
+        split: body.split.clone().or_else(|| base.split.clone()),
+    }
+}
+
+pub(crate) fn references(
+    ctx: &Ctx<'_>,
+    templates: &BTreeMap<String, BodyDef>,
+    b: &BodyFile,
+    span: Range<usize>,
+    field: &str,
+) -> Result<(), ScenarioError> {
+    if let Some(ControllerFile::Ship { bullet, .. }) = &b.controller
+        && !templates.contains_key(bullet)
+    {
+        return Err(unknown(
+            ctx,
+            span,
+            format!("{field}.controller.bullet"),
+            "template",
+            bullet,
+            templates.keys(),
+        ));
+    }
+    for (i, s) in b.split.iter().flatten().enumerate() {
+        if !templates.contains_key(&s.template) {
+            return Err(unknown(
+                ctx,
+                span,
+                format!("{field}.split[{i}].template"),
+                "template",
+                &s.template,
+                templates.keys(),
+            ));
+        }
+    }
+    Ok(())
+}
+
+pub(crate) fn body_def(
+    ctx: &Ctx<'_>,
+    layers: &Layers,
+    b: &BodyFile,
+    span: Range<usize>,
+    field: &str,
+    default_name: &str,
+) -> Result<BodyDef, ScenarioError> {
+    let fail = |f: &str, problem: String| ctx.err(span.clone(), format!("{field}.{f}"), problem);
+    let num = |f: &str, v: f64| {
+        if finite(v) {
+            Ok(v)
+        } else {
+            Err(fail(f, format!("must be a finite number, got {v}")))
+        }
+    };
+    let pair = |f: &str, v: [f64; 2]| {
+        if v.iter().all(|x| finite(*x)) {
+            Ok(vec2(v))
+        } else {
+            Err(fail(
+                f,
+                format!("must be finite numbers, got [{}, {}]", v[0], v[1]),
+            ))
+        }
+    };
+    let Some(layer_name) = &b.layer else {
+        return Err(fail(
+            "layer",
+            "every body needs a layer (here or in its template)".to_owned(),
+        ));
+    };
+    let layer = layers.id(layer_name).ok_or_else(|| {
+        unknown(
+            ctx,
+            span.clone(),
+            format!("{field}.layer"),
+            "layer",
+            layer_name,
+            layers.names().iter(),
+        )
+    })?;
+    let Some(shape) = &b.shape else {
+        return Err(fail(
+            "shape",
+            "every body needs a shape (here or in its template)".to_owned(),
+        ));
+    };
+    let shape = shape
+        .to_shape()
+        .map_err(|e| fail(&format!("shape.{}", e.field), e.problem))?;
+    let kind = match b.kind.as_deref() {
+        None | Some("dynamic") => BodyKind::Dynamic,
+        Some("static") => BodyKind::Static,
+        Some("kinematic") => BodyKind::Kinematic,
+        Some(other) => {
+            return Err(fail(
+                "kind",
+                format!("expected dynamic, static or kinematic, got \"{other}\""),
+            ));
+        }
+    };
+    let mass = num("mass", b.mass.unwrap_or(1.0))?;
+    if mass <= 0.0 {
+        return Err(fail("mass", format!("must be greater than 0, got {mass}")));
+    }
+    let lifetime = match b.lifetime {
+        None => None,
+        Some(l) if l >= 1 && l <= i64::from(u32::MAX) => u32::try_from(l).ok(),
+        Some(l) => {
+            return Err(fail(
+                "lifetime",
+                format!("must be a whole number of frames >= 1, got {l}"),
+            ));
+        }
+    };
+    let controller = match &b.controller {
+        None => None,
+        Some(ControllerFile::Ship {
+            thrust,
+            turn_rate,
+            bullet,
+            bullet_speed,
+            muzzle,
+        }) => Some(Controller::Ship {
+            thrust: num("controller.thrust", *thrust)?,
+            turn_rate: num("controller.turn_rate", *turn_rate)?,
+            bullet: bullet.clone(),
+            bullet_speed: num("controller.bullet_speed", *bullet_speed)?,
+            muzzle: num("controller.muzzle", *muzzle)?,
+        }),
+        Some(ControllerFile::Runner {
+            run_speed,
+            jump_speed,
+        }) => Some(Controller::Runner {
+            run_speed: num("controller.run_speed", *run_speed)?,
+            jump_speed: num("controller.jump_speed", *jump_speed)?,
+        }),
+        Some(ControllerFile::Walker { speed }) => Some(Controller::Walker {
+            speed: num("controller.speed", *speed)?,
+        }),
+    };
+    let mut split = Vec::new();
+    for (
+        i,
+        SplitFile {
+            template,
+            offset,
+            velocity,
+        },
+    ) in b.split.iter().flatten().enumerate()
+    {
+        split.push(Split {
+            template: template.clone(),
+            offset: pair(&format!("split[{i}].offset"), *offset)?,
+            velocity: pair(&format!("split[{i}].velocity"), *velocity)?,
+        });
+    }
+    Ok(BodyDef {
+        name: b.name.clone().unwrap_or_else(|| default_name.to_owned()),
+        layer,
+        shape,
+        kind,
+        mass,
+        position: within_world(fail, pair("position", b.position.unwrap_or_default())?)?,
+        angle: num("angle", b.angle.unwrap_or(0.0))?,
+        velocity: pair("velocity", b.velocity.unwrap_or_default())?,
+        angular_velocity: num("angular_velocity", b.angular_velocity.unwrap_or(0.0))?,
+        force: pair("force", b.force.unwrap_or_default())?,
+        gravity_scale: num("gravity_scale", b.gravity_scale.unwrap_or(1.0))?,
+        lifetime,
+        controller,
+        split,
+    })
+}

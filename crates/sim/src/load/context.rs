@@ -1,0 +1,131 @@
+//! Where a scenario error is: `file:line:column`, the field path, and the problem.
+
+use std::ops::Range;
+
+use ricochet_geom::Vec2;
+
+/// Why a scenario was rejected. Displays as `file:line:column: field: problem`.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{file}:{line}:{column}: {field}{sep}{problem}", sep = if self.field.is_empty() { "" } else { ": " })]
+pub struct ScenarioError {
+    /// The file name as given.
+    pub file: String,
+    /// 1-based line.
+    pub line: usize,
+    /// 1-based column.
+    pub column: usize,
+    /// The field path (`bodies[2].layer`), empty for a syntax error.
+    pub field: String,
+    /// What is wrong and what was expected.
+    pub problem: String,
+}
+
+pub(crate) struct Ctx<'a> {
+    pub(crate) file: &'a str,
+    pub(crate) text: &'a str,
+}
+
+impl Ctx<'_> {
+    /// An error at `span`, narrowed to the line of `field`'s own key when that key is
+    /// written inside the span (so `bodies[2].mass` points at `mass = -1`, not at
+    /// `[[bodies]]`).
+    pub(crate) fn err(
+        &self,
+        span: Range<usize>,
+        field: impl Into<String>,
+        problem: impl Into<String>,
+    ) -> ScenarioError {
+        let field = field.into();
+        let start = self
+            .key_in(&span, &field)
+            .unwrap_or(span.start)
+            .min(self.text.len());
+        let before = &self.text[..start];
+        let line = before.matches('\n').count() + 1;
+        let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+        ScenarioError {
+            file: self.file.to_owned(),
+            line,
+            column,
+            field,
+            problem: problem.into(),
+        }
+    }
+
+    /// Where the last key of `field` (`mass` in `bodies[2].mass`, `half_extents` in
+    /// `bodies[0].shape.half_extents[1]`) is written as `key =` in the table at `span`.
+    fn key_in(&self, span: &Range<usize>, field: &str) -> Option<usize> {
+        let last = field.rsplit('.').next()?;
+        let key = last.split('[').next()?;
+        if key.is_empty() {
+            return None;
+        }
+        // A table's span covers only its `[[header]]`: search on to the next header.
+        let end = self.text[span.end.min(self.text.len())..]
+            .find("\n[")
+            .map_or(self.text.len(), |at| span.end + at);
+        let text = self.text.get(span.start..end)?;
+        let mut from = 0;
+        while let Some(at) = text[from..].find(key) {
+            let pos = from + at;
+            let before = text[..pos].chars().next_back();
+            let after = text[pos + key.len()..].trim_start();
+            let starts_word = before.is_none_or(|c| !(c.is_alphanumeric() || c == '_'));
+            if starts_word && after.starts_with('=') {
+                return Some(span.start + pos);
+            }
+            from = pos + key.len();
+        }
+        None
+    }
+}
+
+pub(crate) fn finite(v: f64) -> bool {
+    v.is_finite()
+}
+
+/// A position within the coordinates the geometry accepts (`ricochet_geom::MAX_COORDINATE`).
+pub(crate) fn within_world(
+    fail: impl Fn(&str, String) -> ScenarioError,
+    p: Vec2,
+) -> Result<Vec2, ScenarioError> {
+    if p.abs().max_element() > ricochet_geom::MAX_COORDINATE {
+        return Err(fail(
+            "position",
+            format!(
+                "[{:?}, {:?}] is beyond ±{:e}, the largest coordinate Ricochet accepts",
+                p.x,
+                p.y,
+                ricochet_geom::MAX_COORDINATE
+            ),
+        ));
+    }
+    Ok(p)
+}
+
+pub(crate) fn vec2(v: [f64; 2]) -> Vec2 {
+    Vec2::new(v[0], v[1])
+}
+
+pub(crate) fn unknown<'a>(
+    ctx: &Ctx<'_>,
+    span: Range<usize>,
+    field: String,
+    what: &str,
+    name: &str,
+    known: impl Iterator<Item = &'a String>,
+) -> ScenarioError {
+    let known: Vec<&str> = known.map(String::as_str).collect();
+    ctx.err(
+        span,
+        field,
+        format!(
+            "unknown {what} \"{name}\"; known: {}",
+            if known.is_empty() {
+                "none".to_owned()
+            } else {
+                known.join(", ")
+            }
+        ),
+    )
+}

@@ -1,0 +1,134 @@
+//! Loading a scenario file: TOML text → [`file::ScenarioFile`] (syntax, serde with
+//! `deny_unknown_fields`) → [`Scenario`] (meaning, defaults). Every error carries
+//! `file:line:column`, the field, and what was expected.
+
+mod bodies;
+mod context;
+pub(crate) mod file;
+mod script;
+mod world;
+
+use std::collections::BTreeMap;
+
+use crate::scenario::Scenario;
+use bodies::{body_def, merge, references, split_cycle};
+pub use context::ScenarioError;
+use context::{Ctx, unknown};
+use file::ScenarioFile;
+use script::script;
+use world::world_settings;
+
+/// Parses and checks a scenario. `file` is only used in error messages.
+pub fn load_scenario(text: &str, file: &str) -> Result<Scenario, ScenarioError> {
+    let ctx = Ctx { file, text };
+    let raw: ScenarioFile = toml::from_str(text).map_err(|e| {
+        let span = e.span().unwrap_or(0..0);
+        ctx.err(span, "", e.message().trim_end().to_owned())
+    })?;
+    let (world, frames) = world_settings(&ctx, &raw)?;
+    let mut templates = BTreeMap::new();
+    for (name, t) in &raw.templates {
+        let field = format!("templates.{name}");
+        if t.get_ref().template.is_some() {
+            return Err(ctx.err(
+                t.span(),
+                format!("{field}.template"),
+                "a template cannot itself use a template",
+            ));
+        }
+        let def = body_def(&ctx, &world.layers, t.get_ref(), t.span(), &field, name)?;
+        templates.insert(name.clone(), def);
+    }
+    // Checks that need every template: bullets and splits must name one.
+    for (name, t) in &raw.templates {
+        references(
+            &ctx,
+            &templates,
+            t.get_ref(),
+            t.span(),
+            &format!("templates.{name}"),
+        )?;
+    }
+    // A split chain must end: a template that splits (through others) into itself would
+    // multiply bodies every time one is destroyed.
+    for (name, t) in &raw.templates {
+        if let Some(path) = split_cycle(&templates, name) {
+            return Err(ctx.err(
+                t.span(),
+                format!("templates.{name}.split"),
+                format!(
+                    "{} splits into itself: a split chain must end",
+                    path.join(" -> ")
+                ),
+            ));
+        }
+    }
+    let mut bodies = Vec::with_capacity(raw.bodies.len());
+    for (i, b) in raw.bodies.iter().enumerate() {
+        let field = format!("bodies[{i}]");
+        let merged = match &b.get_ref().template {
+            None => b.get_ref().clone(),
+            Some(t) => {
+                let Some(base) = raw.templates.get(t) else {
+                    return Err(unknown(
+                        &ctx,
+                        b.span(),
+                        format!("{field}.template"),
+                        "template",
+                        t,
+                        raw.templates.keys(),
+                    ));
+                };
+                merge(b.get_ref(), base.get_ref())
+            }
+        };
+        let default_name = b
+            .get_ref()
+            .template
+            .clone()
+            .unwrap_or_else(|| "body".to_owned());
+        references(&ctx, &templates, &merged, b.span(), &field)?;
+        bodies.push(body_def(
+            &ctx,
+            &world.layers,
+            &merged,
+            b.span(),
+            &field,
+            &default_name,
+        )?);
+    }
+    if let Some(r) = &raw.world.active_region {
+        let focus = r.focus.get_ref();
+        if !bodies.iter().any(|b| &b.name == focus) {
+            let mut names: Vec<&str> = bodies.iter().map(|b| b.name.as_str()).collect();
+            names.sort_unstable();
+            names.dedup();
+            return Err(ctx.err(
+                r.focus.span(),
+                "world.active_region.focus",
+                format!(
+                    "no body in [[bodies]] is named \"{focus}\"; known: {}",
+                    if names.is_empty() {
+                        "none".to_owned()
+                    } else {
+                        names.join(", ")
+                    }
+                ),
+            ));
+        }
+    }
+    let script = script(&ctx, &raw, &templates, &bodies)?;
+    Ok(Scenario {
+        name: raw.name.clone().unwrap_or_else(|| {
+            std::path::Path::new(file).file_stem().map_or_else(
+                || "scenario".to_owned(),
+                |s| s.to_string_lossy().into_owned(),
+            )
+        }),
+        world,
+        frames,
+        templates,
+        bodies,
+        script,
+    })
+}

@@ -1,0 +1,136 @@
+//! The script: timed events, checked against the bodies and templates they name.
+
+use std::collections::BTreeMap;
+
+use crate::def::{Action, BodyDef, Event};
+use crate::load::context::{Ctx, ScenarioError, finite, unknown, vec2};
+use crate::load::file::{ActionFile, EventFile, ScenarioFile};
+
+pub(crate) fn script(
+    ctx: &Ctx<'_>,
+    raw: &ScenarioFile,
+    templates: &BTreeMap<String, BodyDef>,
+    bodies: &[BodyDef],
+) -> Result<Vec<Event>, ScenarioError> {
+    // Names a script may refer to: bodies, templates' names, and names given by spawns.
+    let mut names: Vec<&str> = bodies.iter().map(|b| b.name.as_str()).collect();
+    names.extend(templates.values().map(|t| t.name.as_str()));
+    for e in &raw.script {
+        if let ActionFile::Spawn { name: Some(n), .. } = &e.get_ref().action {
+            names.push(n);
+        }
+    }
+    names.sort_unstable();
+    names.dedup();
+    let mut events = Vec::with_capacity(raw.script.len());
+    for (i, e) in raw.script.iter().enumerate() {
+        let field = format!("script[{i}]");
+        let EventFile { frame, action } = e.get_ref();
+        let fail = |f: &str, problem: String| ctx.err(e.span(), format!("{field}.{f}"), problem);
+        if *frame < 0 {
+            return Err(fail(
+                "frame",
+                format!("{frame} is in the past: frames start at 0"),
+            ));
+        }
+        let body = |name: &String| -> Result<String, ScenarioError> {
+            if names.binary_search(&name.as_str()).is_ok() {
+                Ok(name.clone())
+            } else {
+                Err(fail(
+                    "body",
+                    format!(
+                        "no body, template or spawn is named \"{name}\"; known: {}",
+                        names.join(", ")
+                    ),
+                ))
+            }
+        };
+        let v = |f: &str, v: [f64; 2]| {
+            if v.iter().all(|x| finite(*x)) {
+                Ok(vec2(v))
+            } else {
+                Err(fail(f, "must be finite numbers".to_owned()))
+            }
+        };
+        let input = |x: f64| {
+            if finite(x) && (-1.0..=1.0).contains(&x) {
+                Ok(x)
+            } else {
+                Err(fail("input", format!("must be between -1 and 1, got {x}")))
+            }
+        };
+        let action = match action {
+            ActionFile::Spawn {
+                template,
+                name,
+                position,
+                velocity,
+                angle,
+            } => {
+                let Some(base) = templates.get(template) else {
+                    return Err(unknown(
+                        ctx,
+                        e.span(),
+                        format!("{field}.template"),
+                        "template",
+                        template,
+                        templates.keys(),
+                    ));
+                };
+                let mut def = base.clone();
+                if let Some(n) = name {
+                    def.name = n.clone();
+                }
+                def.position = v("position", *position)?;
+                if let Some(vel) = velocity {
+                    def.velocity = v("velocity", *vel)?;
+                }
+                if let Some(a) = angle {
+                    if !finite(*a) {
+                        return Err(fail("angle", "must be a finite number".to_owned()));
+                    }
+                    def.angle = *a;
+                }
+                Action::Spawn {
+                    body: Box::new(def),
+                    template: template.clone(),
+                }
+            }
+            ActionFile::Destroy { body: b } => Action::Destroy { body: body(b)? },
+            ActionFile::SetVelocity { body: b, velocity } => Action::SetVelocity {
+                body: body(b)?,
+                velocity: v("velocity", *velocity)?,
+            },
+            ActionFile::ApplyImpulse { body: b, impulse } => Action::ApplyImpulse {
+                body: body(b)?,
+                impulse: v("impulse", *impulse)?,
+            },
+            ActionFile::SetForce { body: b, force } => Action::SetForce {
+                body: body(b)?,
+                force: v("force", *force)?,
+            },
+            ActionFile::Thrust { body: b, on } => Action::Thrust {
+                body: body(b)?,
+                on: *on,
+            },
+            ActionFile::Turn { body: b, input: x } => Action::Turn {
+                body: body(b)?,
+                input: input(*x)?,
+            },
+            ActionFile::Fire { body: b } => Action::Fire { body: body(b)? },
+            ActionFile::Move { body: b, input: x } => Action::Move {
+                body: body(b)?,
+                input: input(*x)?,
+            },
+            ActionFile::Jump { body: b } => Action::Jump { body: body(b)? },
+        };
+        events.push(Event {
+            frame: frame.unsigned_abs(),
+            action,
+        });
+    }
+    // Stable: events of one frame keep their file order.
+    events.sort_by_key(|e| e.frame);
+    Ok(events)
+}
