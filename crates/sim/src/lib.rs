@@ -29,6 +29,7 @@
 //! ```
 
 pub mod broad_phase;
+mod control;
 mod def;
 mod entity;
 #[cfg(feature = "toml")]
@@ -39,6 +40,7 @@ mod scenario;
 mod stages;
 mod world;
 
+pub use control::ControlError;
 pub use def::{
     Action, ActiveRegion, BodyDef, BodyKind, Controller, Doomed, Event, LayerId, Layers, Response,
     Split, WorldBounds, WorldDef,

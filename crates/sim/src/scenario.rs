@@ -22,3 +22,18 @@ pub struct Scenario {
     /// Script events sorted by frame (file order within a frame).
     pub script: Vec<Event>,
 }
+
+impl Default for Scenario {
+    /// An empty scene: the default [`WorldDef`] (1/60 s, no gravity, one layer), 600
+    /// frames, no bodies, templates or script.
+    fn default() -> Self {
+        Scenario {
+            name: "scenario".to_owned(),
+            world: WorldDef::default(),
+            frames: 600,
+            templates: BTreeMap::new(),
+            bodies: Vec::new(),
+            script: Vec::new(),
+        }
+    }
+}

@@ -314,6 +314,35 @@ impl World {
         self.wake_all();
     }
 
+    /// Moves body `i` to `position` at `angle` now, keeping the caches right: a static body
+    /// bumps [`World::static_generation`] (the broad phase and the per-axis stages re-index
+    /// the static bodies) and wakes every sleeper (what it rested on may have moved); a
+    /// moving body wakes. The frame's swept tests start from the new position.
+    pub fn teleport(&mut self, i: usize, position: Vec2, angle: f64) {
+        self.position[i] = position;
+        self.start_position[i] = position;
+        if self.kind[i] == BodyKind::Static {
+            self.angle[i] = angle;
+            self.local_bounds[i] = LocalBounds::new(&self.shape[i], angle);
+            self.static_generation += 1;
+            self.wake_all();
+        } else {
+            // A turned body's bounds follow from the cache (it widens to the any-angle disc).
+            self.angle[i] = angle;
+            self.wake(i);
+            self.refresh_active();
+        }
+    }
+
+    /// Sets body `i`'s velocity and wakes it; a static body's velocity stays zero.
+    pub fn set_velocity(&mut self, i: usize, velocity: Vec2) {
+        if self.kind[i] != BodyKind::Static {
+            self.velocity[i] = velocity;
+            self.wake(i);
+            self.refresh_active();
+        }
+    }
+
     /// Dense indices of the moving (dynamic and kinematic) bodies, ascending.
     #[must_use]
     pub fn movers(&self) -> &[u32] {

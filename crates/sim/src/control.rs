@@ -1,0 +1,211 @@
+//! What a game does with a running simulation between two steps, addressing bodies by
+//! [`Entity`]: create it from definitions built in code, spawn and remove bodies, read a
+//! body, and move it. Like Box2D's `b2Body_GetPosition`/`b2Body_SetTransform`: a body that
+//! is gone (or whose slot now holds another body) is an error, never another body's data.
+//!
+//! Writes keep the world's caches right: moving a static body bumps the static generation,
+//! so the broad phase and the per-axis stages rebuild their static structures, and wakes
+//! the sleepers (what they rested on may have moved); moving any body wakes it.
+
+use ricochet_geom::{Pose, Vec2};
+
+use crate::def::{BodyDef, WorldDef};
+use crate::entity::Entity;
+use crate::pipeline::Simulation;
+use crate::scenario::Scenario;
+
+/// Why a definition built in code or a call on a body was refused.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ControlError {
+    /// The entity is not alive (removed, or never spawned in this simulation).
+    #[error("no live body has id {}:{}", .0.index, .0.generation)]
+    NoSuchBody(Entity),
+    /// A world setting is out of range.
+    #[error("world.{field}: {problem}")]
+    World {
+        /// The field (`dt`, `gravity`, `bounds`).
+        field: &'static str,
+        /// What is wrong.
+        problem: &'static str,
+    },
+    /// A value passed for a body is not finite or beyond the coordinates Ricochet accepts.
+    #[error(
+        "{field}: must be finite and within ±{}",
+        ricochet_geom::MAX_COORDINATE
+    )]
+    OutOfRange {
+        /// The field (`position`, `velocity`, `angle`).
+        field: &'static str,
+    },
+}
+
+fn world_error(field: &'static str, problem: &'static str) -> ControlError {
+    ControlError::World { field, problem }
+}
+
+/// Checks what a scenario file's loader checks of the world settings.
+fn check_world(world: &WorldDef) -> Result<(), ControlError> {
+    if !(world.dt.is_finite() && world.dt > 0.0) {
+        return Err(world_error("dt", "must be a finite number of seconds > 0"));
+    }
+    if !(world.gravity.x.is_finite() && world.gravity.y.is_finite()) {
+        return Err(world_error("gravity", "must be finite"));
+    }
+    if let Some(b) = &world.bounds {
+        let ok = b.min.is_finite() && b.max.is_finite() && b.min.x < b.max.x && b.min.y < b.max.y;
+        if !ok {
+            return Err(world_error(
+                "bounds",
+                "min and max must be finite with min < max on both axes",
+            ));
+        }
+    }
+    if let Some(r) = &world.active_region
+        && !(r.half_extents.is_finite() && r.half_extents.min_element() > 0.0)
+    {
+        return Err(world_error(
+            "active_region",
+            "half_extents must be finite and > 0 on both axes",
+        ));
+    }
+    Ok(())
+}
+
+fn within(field: &'static str, v: Vec2) -> Result<Vec2, ControlError> {
+    if v.is_finite() && v.abs().max_element() <= ricochet_geom::MAX_COORDINATE {
+        Ok(v)
+    } else {
+        Err(ControlError::OutOfRange { field })
+    }
+}
+
+impl Simulation {
+    /// An empty simulation of `world`, for a scene built in code: add templates with
+    /// [`Simulation::add_template`] and bodies with [`Simulation::spawn`].
+    ///
+    /// # Errors
+    /// A world setting a scenario file would be refused for (`dt` not finite and > 0,
+    /// non-finite gravity, empty bounds or active region).
+    pub fn from_def(world: WorldDef) -> Result<Simulation, ControlError> {
+        check_world(&world)?;
+        Ok(Simulation::from_scenario(Scenario {
+            world,
+            ..Scenario::default()
+        }))
+    }
+
+    /// Adds (or replaces) a template: what a ship's `bullet` and a body's `split` name.
+    pub fn add_template(&mut self, name: &str, def: BodyDef) {
+        self.templates.insert(name.to_owned(), def.clone());
+        self.scenario.templates.insert(name.to_owned(), def);
+    }
+
+    /// Creates a body now; it takes the lowest free id.
+    pub fn spawn(&mut self, def: &BodyDef) -> Entity {
+        let e = self.world.spawn(def);
+        self.world.refresh_active();
+        e
+    }
+
+    /// Whether `e` is alive.
+    #[must_use]
+    pub fn contains(&self, e: Entity) -> bool {
+        self.world.index_of(e).is_some()
+    }
+
+    /// The live body with this name and the lowest id.
+    #[must_use]
+    pub fn entity_named(&self, name: &str) -> Option<Entity> {
+        self.world.find(name).map(|i| self.world.entity[i])
+    }
+
+    fn index(&self, e: Entity) -> Result<usize, ControlError> {
+        self.world.index_of(e).ok_or(ControlError::NoSuchBody(e))
+    }
+
+    /// A body's position, or `None` when it is not alive.
+    #[must_use]
+    pub fn position(&self, e: Entity) -> Option<Vec2> {
+        self.world.index_of(e).map(|i| self.world.position[i])
+    }
+
+    /// A body's angle in radians, or `None` when it is not alive.
+    #[must_use]
+    pub fn angle(&self, e: Entity) -> Option<f64> {
+        self.world.index_of(e).map(|i| self.world.angle[i])
+    }
+
+    /// A body's pose, or `None` when it is not alive.
+    #[must_use]
+    pub fn pose(&self, e: Entity) -> Option<Pose> {
+        self.world.index_of(e).map(|i| self.world.pose(i))
+    }
+
+    /// A body's velocity, or `None` when it is not alive.
+    #[must_use]
+    pub fn velocity(&self, e: Entity) -> Option<Vec2> {
+        self.world.index_of(e).map(|i| self.world.velocity[i])
+    }
+
+    /// A body's angular velocity in radians/s, or `None` when it is not alive.
+    #[must_use]
+    pub fn angular_velocity(&self, e: Entity) -> Option<f64> {
+        self.world
+            .index_of(e)
+            .map(|i| self.world.angular_velocity[i])
+    }
+
+    /// Whether a body was held up by something it stands on in the last step.
+    #[must_use]
+    pub fn grounded(&self, e: Entity) -> Option<bool> {
+        self.world.index_of(e).map(|i| self.world.grounded[i])
+    }
+
+    /// Moves a body to `position` now (a teleport: swept tests of this frame start there).
+    /// A static body moved this way is re-indexed by the broad phase at the next step.
+    ///
+    /// # Errors
+    /// The body is not alive, or the position is not finite or beyond the world limit.
+    pub fn set_position(&mut self, e: Entity, position: Vec2) -> Result<(), ControlError> {
+        let i = self.index(e)?;
+        let position = within("position", position)?;
+        self.world.teleport(i, position, self.world.angle[i]);
+        Ok(())
+    }
+
+    /// Turns a body to `angle` (radians, counter-clockwise) now.
+    ///
+    /// # Errors
+    /// The body is not alive, or the angle is not finite.
+    pub fn set_angle(&mut self, e: Entity, angle: f64) -> Result<(), ControlError> {
+        let i = self.index(e)?;
+        if !angle.is_finite() {
+            return Err(ControlError::OutOfRange { field: "angle" });
+        }
+        self.world.teleport(i, self.world.position[i], angle);
+        Ok(())
+    }
+
+    /// Sets a moving body's velocity (a static body never moves: its velocity stays zero).
+    ///
+    /// # Errors
+    /// The body is not alive, or the velocity is not finite.
+    pub fn set_velocity(&mut self, e: Entity, velocity: Vec2) -> Result<(), ControlError> {
+        let i = self.index(e)?;
+        if !velocity.is_finite() {
+            return Err(ControlError::OutOfRange { field: "velocity" });
+        }
+        self.world.set_velocity(i, velocity);
+        Ok(())
+    }
+
+    /// Removes a body now, without a split and without an event (the game removed it).
+    ///
+    /// # Errors
+    /// The body is not alive.
+    pub fn despawn(&mut self, e: Entity) -> Result<(), ControlError> {
+        let i = self.index(e)?;
+        self.world.despawn(i);
+        Ok(())
+    }
+}
