@@ -180,6 +180,64 @@ fn each_error_class_is_named_with_its_location() {
     );
 }
 
+/// Inputs found by hostile use (issue 11): each was accepted, hung or misreported before.
+#[test]
+fn hostile_scenarios_are_named_with_their_location() {
+    // Was: every path of the chain walked, 2^40 of them (still running after 10 minutes).
+    // The count is exact: r_k creates 2 (1 + c_{k+1}) with c_39 = 0, so c_0 = 2^40 - 2.
+    case(
+        "split-chain-too-long",
+        "6:1",
+        &["templates.r0.split", "1099511627774 bodies", "65536"],
+    );
+    // Was: every log time 0.
+    case("timestep-rounds-to-zero", "2:6", &["dt", "rounds to 0 ns"]);
+    // Was: log times decreasing.
+    case("run-too-long", "2:6", &["dt", "2^64 ns"]);
+    // Was: log_time wrapping past u64 (2e9 s = 2e18 ns per step; frame 10 is 2e19 > 2^64).
+    case(
+        "frames-too-long",
+        "3:10",
+        &["frames", "frame 10", "2^64 ns"],
+    );
+    case(
+        "event-after-last-frame",
+        "10:1",
+        &["script[0].frame", "1000", "last frame (5)"],
+    );
+    case(
+        "duplicate-body-name",
+        "9:1",
+        &["bodies[1].name", "\"ship\"", "bodies[0]", "unique"],
+    );
+    case(
+        "spawn-too-far",
+        "11:1",
+        &["script[0].position", "beyond ±1e15"],
+    );
+    case(
+        "muzzle-too-far",
+        "11:96",
+        &["bodies[0].controller.muzzle", "beyond ±1e15"],
+    );
+    // Was: reported without a field path.
+    case(
+        "integer-too-large",
+        "10:12",
+        &["bodies[1].lifetime", "99999999999999999999"],
+    );
+    // Was: "must be >= 1" for a number far above 1.
+    case(
+        "lifetime-too-large",
+        "6:1",
+        &[
+            "bodies[0].lifetime",
+            "from 1 to 4294967295",
+            "9223372036854775807",
+        ],
+    );
+}
+
 #[test]
 fn every_bad_scenario_file_has_a_case() {
     let mut files: Vec<String> = std::fs::read_dir(crate::util::data("bad-scenarios"))

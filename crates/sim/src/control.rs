@@ -48,6 +48,12 @@ fn check_world(world: &WorldDef) -> Result<(), ControlError> {
     if !(world.dt.is_finite() && world.dt > 0.0) {
         return Err(world_error("dt", "must be a finite number of seconds > 0"));
     }
+    if world.dt_ns().is_err() {
+        return Err(world_error(
+            "dt",
+            "must be at least 1 ns and fit in a log's 64-bit nanoseconds",
+        ));
+    }
     if !(world.gravity.x.is_finite() && world.gravity.y.is_finite()) {
         return Err(world_error("gravity", "must be finite"));
     }

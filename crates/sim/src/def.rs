@@ -303,6 +303,71 @@ pub struct WorldDef {
     pub sleep_after: Option<u32>,
 }
 
+/// The most steps a run may have after frame 0: a scenario's `frames` and a `--frames`
+/// override alike.
+pub const MAX_FRAMES: u64 = 100_000_000;
+
+/// Why a run's length or timestep cannot be logged: every frame's time must be a distinct
+/// whole number of nanoseconds that fits in a `u64` (`log_time = frame * dt_ns`).
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+pub enum RunLengthError {
+    /// More frames than [`MAX_FRAMES`].
+    #[error("must be 0 to {MAX_FRAMES} frames, got {0}")]
+    TooManyFrames(u64),
+    /// The timestep is below half a nanosecond: every frame would be logged at time 0.
+    #[error("a timestep of {0:e} s rounds to 0 ns; logs count time in whole nanoseconds")]
+    StepRoundsToZero(f64),
+    /// The last frame's time is past `u64::MAX` nanoseconds (about 584 years).
+    #[error(
+        "frame {frames} at {dt:e} s per step is past the last time a log can hold \
+         (2^64 ns, about 584 years)"
+    )]
+    TooLong {
+        /// Frames after frame 0.
+        frames: u64,
+        /// Seconds per step.
+        dt: f64,
+    },
+}
+
+impl WorldDef {
+    /// Whole nanoseconds per step, the unit of every log time, or why the timestep can't
+    /// be logged.
+    ///
+    /// # Errors
+    /// The step rounds to 0 ns, or is longer than a log can hold.
+    pub fn dt_ns(&self) -> Result<u64, RunLengthError> {
+        let ns = (self.dt * 1e9).round();
+        // NaN (never: dt is checked finite) and anything below half a nanosecond.
+        if ns.is_nan() || ns < 1.0 {
+            return Err(RunLengthError::StepRoundsToZero(self.dt));
+        }
+        // 2^64 is exactly representable; anything at or past it does not fit.
+        if ns >= 18_446_744_073_709_551_616.0 {
+            return Err(RunLengthError::TooLong {
+                frames: 1,
+                dt: self.dt,
+            });
+        }
+        Ok(ns as u64)
+    }
+
+    /// The log time of the last frame of a run of `frames` steps after frame 0, checked.
+    ///
+    /// # Errors
+    /// Too many frames, or a timestep or length a log's `u64` nanoseconds cannot hold.
+    pub fn last_time_ns(&self, frames: u64) -> Result<u64, RunLengthError> {
+        if frames > MAX_FRAMES {
+            return Err(RunLengthError::TooManyFrames(frames));
+        }
+        let dt_ns = self.dt_ns()?;
+        frames.checked_mul(dt_ns).ok_or(RunLengthError::TooLong {
+            frames,
+            dt: self.dt,
+        })
+    }
+}
+
 /// A region around a focus body (the player): moving bodies entirely outside it are frozen,
 /// neither moved nor tested, until the region reaches them again.
 #[derive(Clone, Debug, PartialEq)]

@@ -42,8 +42,8 @@ mod world;
 
 pub use control::ControlError;
 pub use def::{
-    Action, ActiveRegion, BodyDef, BodyKind, Controller, Doomed, Event, LayerId, Layers, Response,
-    Split, WorldBounds, WorldDef,
+    Action, ActiveRegion, BodyDef, BodyKind, Controller, Doomed, Event, LayerId, Layers,
+    MAX_FRAMES, Response, RunLengthError, Split, WorldBounds, WorldDef,
 };
 pub use entity::{Entity, EntityAllocator};
 #[cfg(feature = "toml")]

@@ -8,38 +8,66 @@ use crate::def::{BodyDef, BodyKind, Controller, Layers, Split};
 use crate::load::context::{Ctx, ScenarioError, finite, unknown, vec2, within_world};
 use crate::load::file::{BodyFile, ControllerFile, SplitFile};
 
-/// The chain of templates by which `start` splits back into itself, if it does.
-pub(crate) fn split_cycle(
+/// The most bodies that destroying one body can create through its split chain (its
+/// children, their children when destroyed, and so on). Asteroids' big → 2 medium → 4 small
+/// is 6; a chain past this is almost surely a mistake, and it would multiply bodies past
+/// what a frame can hold.
+pub(crate) const MAX_SPLIT_BODIES: u64 = 65_536;
+
+/// What is wrong with the templates' split chains.
+pub(crate) enum SplitProblem {
+    /// `path` (from the template back to itself) is a cycle.
+    Cycle(Vec<String>),
+    /// Destroying one body of the template creates this many bodies, down the chain.
+    TooMany(u64),
+}
+
+/// Checks every template's split chain once (a depth-first search that visits each
+/// template a single time, so a chain of 40 templates splitting in two costs 40 visits, not
+/// 2^40): a template on a cycle (the first one found, starting from the templates in name
+/// order), or the first template in name order whose chain creates more than
+/// [`MAX_SPLIT_BODIES`] bodies, with the problem.
+pub(crate) fn split_problem(
     templates: &BTreeMap<String, BodyDef>,
-    start: &str,
-) -> Option<Vec<String>> {
-    fn walk(
-        templates: &BTreeMap<String, BodyDef>,
-        start: &str,
-        at: &str,
-        path: &mut Vec<String>,
-    ) -> bool {
-        let Some(t) = templates.get(at) else {
-            return false;
-        };
-        for child in &t.split {
-            if child.template == start {
-                path.push(child.template.clone());
-                return true;
-            }
-            if path.contains(&child.template) {
+) -> Option<(String, SplitProblem)> {
+    // Bodies created by destroying one body of each finished template (saturating).
+    let mut created: BTreeMap<&str, u64> = BTreeMap::new();
+    for start in templates.keys() {
+        // Iterative DFS: (template, next child to visit); `path` is the grey stack.
+        let mut path: Vec<(&str, usize)> = vec![(start.as_str(), 0)];
+        while let Some(&mut (at, ref mut next)) = path.last_mut() {
+            if created.contains_key(at) {
+                path.pop();
                 continue;
             }
-            path.push(child.template.clone());
-            if walk(templates, start, &child.template, path) {
-                return true;
+            let children = templates.get(at).map_or(&[][..], |t| &t.split[..]);
+            if let Some(child) = children.get(*next) {
+                *next += 1;
+                let c = child.template.as_str();
+                if let Some(k) = path.iter().position(|(t, _)| *t == c) {
+                    let mut cycle: Vec<String> =
+                        path[k..].iter().map(|(t, _)| (*t).to_owned()).collect();
+                    cycle.push(c.to_owned());
+                    return Some((c.to_owned(), SplitProblem::Cycle(cycle)));
+                }
+                if !created.contains_key(c) {
+                    path.push((c, 0));
+                }
+                continue;
             }
+            let total = children.iter().fold(0u64, |sum, child| {
+                let below = created.get(child.template.as_str()).copied().unwrap_or(0);
+                sum.saturating_add(below.saturating_add(1))
+            });
+            created.insert(at, total);
             path.pop();
         }
-        false
+        let total = created.get(start.as_str()).copied().unwrap_or(0);
+        if total > MAX_SPLIT_BODIES {
+            return Some((start.clone(), SplitProblem::TooMany(total)));
+        }
     }
-    let mut path = vec![start.to_owned()];
-    walk(templates, start, start, &mut path).then_some(path)
+    None
 }
 
 /// A body's fields over its template's.
@@ -169,7 +197,10 @@ pub(crate) fn body_def(
         Some(l) => {
             return Err(fail(
                 "lifetime",
-                format!("must be a whole number of frames >= 1, got {l}"),
+                format!(
+                    "must be a whole number of frames from 1 to {}, got {l}",
+                    u32::MAX
+                ),
             ));
         }
     };
@@ -186,7 +217,19 @@ pub(crate) fn body_def(
             turn_rate: num("controller.turn_rate", *turn_rate)?,
             bullet: bullet.clone(),
             bullet_speed: num("controller.bullet_speed", *bullet_speed)?,
-            muzzle: num("controller.muzzle", *muzzle)?,
+            muzzle: {
+                let m = num("controller.muzzle", *muzzle)?;
+                if m.abs() > ricochet_geom::MAX_COORDINATE {
+                    return Err(fail(
+                        "controller.muzzle",
+                        format!(
+                            "{m:e} is beyond ±{:e}, the largest coordinate Ricochet accepts",
+                            ricochet_geom::MAX_COORDINATE
+                        ),
+                    ));
+                }
+                m
+            },
         }),
         Some(ControllerFile::Runner {
             run_speed,

@@ -52,6 +52,96 @@ impl Ctx<'_> {
         }
     }
 
+    /// The field path of the value at `offset`, from the text alone, for errors the TOML
+    /// parser reports without one (an integer beyond `i64`, a wrong type): the table header
+    /// above it, counted for arrays of tables (`bodies[1]`), then the keys leading to the
+    /// offset on its line, inline tables included (`bodies[0].shape.radius`). Empty when the
+    /// offset is not after a `key =`.
+    pub(crate) fn field_at(&self, offset: usize) -> String {
+        let offset = offset.min(self.text.len());
+        let Some(line_start) = self
+            .text
+            .get(..offset)
+            .map(|t| t.rfind('\n').map_or(0, |n| n + 1))
+        else {
+            return String::new();
+        };
+        let mut keys: Vec<&str> = Vec::new();
+        let mut depth = 0usize;
+        let line = &self.text[line_start..offset];
+        let bytes = line.as_bytes();
+        let mut k = 0;
+        while k < bytes.len() {
+            match bytes[k] {
+                b'"' | b'\'' => {
+                    let quote = bytes[k];
+                    k += 1;
+                    while k < bytes.len() && bytes[k] != quote {
+                        k += if bytes[k] == b'\\' { 2 } else { 1 };
+                    }
+                }
+                b'{' => depth += 1,
+                b'}' => {
+                    depth = depth.saturating_sub(1);
+                    keys.truncate(depth + 1);
+                }
+                c if c.is_ascii_alphanumeric() || c == b'_' || c == b'-' => {
+                    let start = k;
+                    while k < bytes.len()
+                        && (bytes[k].is_ascii_alphanumeric()
+                            || bytes[k] == b'_'
+                            || bytes[k] == b'-')
+                    {
+                        k += 1;
+                    }
+                    let rest = line[k..].trim_start();
+                    if rest.starts_with('=') && !rest.starts_with("==") {
+                        keys.truncate(depth);
+                        keys.push(&line[start..k]);
+                    }
+                    continue;
+                }
+                _ => {}
+            }
+            k += 1;
+        }
+        if keys.is_empty() {
+            return String::new();
+        }
+        let above = &self.text[..line_start];
+        let header = above
+            .lines()
+            .rev()
+            .map(str::trim)
+            .find(|l| l.starts_with('['));
+        let table = match header {
+            Some(h) if h.starts_with("[[") => {
+                let name = h
+                    .trim_start_matches("[[")
+                    .split("]]")
+                    .next()
+                    .unwrap_or("")
+                    .trim();
+                let count = above.lines().filter(|l| l.trim() == h).count();
+                format!("{name}[{}]", count.saturating_sub(1))
+            }
+            Some(h) => h
+                .trim_start_matches('[')
+                .split(']')
+                .next()
+                .unwrap_or("")
+                .trim()
+                .to_owned(),
+            None => String::new(),
+        };
+        let path = keys.join(".");
+        if table.is_empty() {
+            path
+        } else {
+            format!("{table}.{path}")
+        }
+    }
+
     /// Where the last key of `field` (`mass` in `bodies[2].mass`, `half_extents` in
     /// `bodies[0].shape.half_extents[1]`) is written as `key =` in the table at `span`.
     fn key_in(&self, span: &Range<usize>, field: &str) -> Option<usize> {

@@ -11,11 +11,12 @@ mod world;
 use std::collections::BTreeMap;
 
 use crate::scenario::Scenario;
-use bodies::{body_def, merge, references, split_cycle};
+use bodies::{MAX_SPLIT_BODIES, SplitProblem, body_def, merge, references, split_problem};
 pub use context::ScenarioError;
 use context::{Ctx, unknown};
 use file::ScenarioFile;
 use script::script;
+use toml::Spanned;
 use world::world_settings;
 
 /// Parses and checks a scenario. `file` is only used in error messages.
@@ -23,7 +24,8 @@ pub fn load_scenario(text: &str, file: &str) -> Result<Scenario, ScenarioError> 
     let ctx = Ctx { file, text };
     let raw: ScenarioFile = toml::from_str(text).map_err(|e| {
         let span = e.span().unwrap_or(0..0);
-        ctx.err(span, "", e.message().trim_end().to_owned())
+        let field = ctx.field_at(span.start);
+        ctx.err(span, field, e.message().trim_end().to_owned())
     })?;
     let (world, frames) = world_settings(&ctx, &raw)?;
     let mut templates = BTreeMap::new();
@@ -49,23 +51,44 @@ pub fn load_scenario(text: &str, file: &str) -> Result<Scenario, ScenarioError> 
             &format!("templates.{name}"),
         )?;
     }
-    // A split chain must end: a template that splits (through others) into itself would
-    // multiply bodies every time one is destroyed.
-    for (name, t) in &raw.templates {
-        if let Some(path) = split_cycle(&templates, name) {
+    // A split chain must end, and not multiply bodies past what a frame can hold.
+    if let Some((name, problem)) = split_problem(&templates) {
+        let span = raw.templates.get(&name).map_or(0..0, Spanned::span);
+        let problem = match problem {
+            SplitProblem::Cycle(path) => format!(
+                "{} splits into itself: a split chain must end",
+                path.join(" -> ")
+            ),
+            SplitProblem::TooMany(n) => format!(
+                "destroying one {name} creates {} bodies down its split chain; at most \
+                 {MAX_SPLIT_BODIES} are allowed",
+                if n == u64::MAX {
+                    "more than 2^64".to_owned()
+                } else {
+                    n.to_string()
+                }
+            ),
+        };
+        return Err(ctx.err(span, format!("templates.{name}.split"), problem));
+    }
+    let mut bodies = Vec::with_capacity(raw.bodies.len());
+    // Names a body's own table gives: they address script events and the active region, so
+    // two bodies may not share one (bodies named after their template may).
+    let mut named: BTreeMap<&str, usize> = BTreeMap::new();
+    for (i, b) in raw.bodies.iter().enumerate() {
+        let field = format!("bodies[{i}]");
+        if let Some(name) = &b.get_ref().name
+            && let Some(first) = named.insert(name, i)
+        {
             return Err(ctx.err(
-                t.span(),
-                format!("templates.{name}.split"),
+                b.span(),
+                format!("{field}.name"),
                 format!(
-                    "{} splits into itself: a split chain must end",
-                    path.join(" -> ")
+                    "\"{name}\" is already the name of bodies[{first}]; names address \
+                         script events and the active region, so each must be unique"
                 ),
             ));
         }
-    }
-    let mut bodies = Vec::with_capacity(raw.bodies.len());
-    for (i, b) in raw.bodies.iter().enumerate() {
-        let field = format!("bodies[{i}]");
         let merged = match &b.get_ref().template {
             None => b.get_ref().clone(),
             Some(t) => {
@@ -117,7 +140,7 @@ pub fn load_scenario(text: &str, file: &str) -> Result<Scenario, ScenarioError> 
             ));
         }
     }
-    let script = script(&ctx, &raw, &templates, &bodies)?;
+    let script = script(&ctx, &raw, &templates, &bodies, frames)?;
     Ok(Scenario {
         name: raw.name.clone().unwrap_or_else(|| {
             std::path::Path::new(file).file_stem().map_or_else(

@@ -3,7 +3,7 @@
 use std::collections::BTreeMap;
 
 use crate::def::{Action, BodyDef, Event};
-use crate::load::context::{Ctx, ScenarioError, finite, unknown, vec2};
+use crate::load::context::{Ctx, ScenarioError, finite, unknown, vec2, within_world};
 use crate::load::file::{ActionFile, EventFile, ScenarioFile};
 
 pub(crate) fn script(
@@ -11,6 +11,7 @@ pub(crate) fn script(
     raw: &ScenarioFile,
     templates: &BTreeMap<String, BodyDef>,
     bodies: &[BodyDef],
+    frames: u64,
 ) -> Result<Vec<Event>, ScenarioError> {
     // Names a script may refer to: bodies, templates' names, and names given by spawns.
     let mut names: Vec<&str> = bodies.iter().map(|b| b.name.as_str()).collect();
@@ -31,6 +32,15 @@ pub(crate) fn script(
             return Err(fail(
                 "frame",
                 format!("{frame} is in the past: frames start at 0"),
+            ));
+        }
+        if frame.unsigned_abs() > frames {
+            return Err(fail(
+                "frame",
+                format!(
+                    "{frame} is after the last frame ({frames}): the event would never \
+                     happen; raise `frames` or move the event"
+                ),
             ));
         }
         let body = |name: &String| -> Result<String, ScenarioError> {
@@ -82,7 +92,7 @@ pub(crate) fn script(
                 if let Some(n) = name {
                     def.name = n.clone();
                 }
-                def.position = v("position", *position)?;
+                def.position = within_world(fail, v("position", *position)?)?;
                 if let Some(vel) = velocity {
                     def.velocity = v("velocity", *vel)?;
                 }

@@ -2,12 +2,12 @@
 //! layer-pair matrix, gravity, bounds, broad phase, sleeping and the active region.
 
 use crate::broad_phase::BroadPhaseKind;
-use crate::def::{ActiveRegion, Doomed, LayerId, Layers, Response, WorldBounds, WorldDef};
+use crate::def::{
+    ActiveRegion, Doomed, LayerId, Layers, MAX_FRAMES, Response, RunLengthError, WorldBounds,
+    WorldDef,
+};
 use crate::load::context::{Ctx, ScenarioError, finite, unknown, vec2};
 use crate::load::file::ScenarioFile;
-
-/// The most frames a scenario may ask for by default; longer runs are a `--frames` choice.
-pub(crate) const MAX_FRAMES: i64 = 100_000_000;
 
 fn timestep(ctx: &Ctx<'_>, raw: &ScenarioFile) -> Result<f64, ScenarioError> {
     match (&raw.hz, &raw.dt) {
@@ -149,7 +149,7 @@ pub(crate) fn world_settings(
         None => 600,
         Some(f) => {
             let v = *f.get_ref();
-            if !(0..=MAX_FRAMES).contains(&v) {
+            if u64::try_from(v).is_ok_and(|v| v > MAX_FRAMES) || v < 0 {
                 return Err(ctx.err(
                     f.span(),
                     "frames",
@@ -165,6 +165,21 @@ pub(crate) fn world_settings(
         layers,
         ..WorldDef::default()
     };
+    if let Err(e) = world.last_time_ns(frames) {
+        // Point at what the user can change: the timestep when it alone can't be logged,
+        // else the frame count.
+        let step = raw
+            .hz
+            .as_ref()
+            .map(|h| (h.span(), "hz"))
+            .or_else(|| raw.dt.as_ref().map(|d| (d.span(), "dt")));
+        let at = match (e, &raw.frames) {
+            (RunLengthError::TooLong { .. }, Some(f)) => Some((f.span(), "frames")),
+            _ => step,
+        };
+        let (span, field) = at.unwrap_or((0..0, "dt"));
+        return Err(ctx.err(span, field, e.to_string()));
+    }
     if let Some(g) = &raw.world.gravity {
         let v = *g.get_ref();
         if !v.iter().all(|x| finite(*x)) {
