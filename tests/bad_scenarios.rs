@@ -205,10 +205,21 @@ fn hostile_scenarios_are_named_with_their_location() {
         "10:1",
         &["script[0].frame", "1000", "last frame (5)"],
     );
+    // Was: the event went to the lowest id silently. Bodies may share a name (a label);
+    // a name that addresses an event or the active region must name one body.
     case(
         "duplicate-body-name",
-        "9:1",
-        &["bodies[1].name", "\"ship\"", "bodies[0]", "unique"],
+        "18:1",
+        &[
+            "script[0].body",
+            "2 bodies are named \"ship\"",
+            "bodies[0], bodies[1]",
+        ],
+    );
+    case(
+        "duplicate-focus",
+        "5:9",
+        &["world.active_region.focus", "2 bodies are named \"player\""],
     );
     case(
         "spawn-too-far",

@@ -133,13 +133,13 @@ position = [-3.2, 2.5]
 velocity = [1.5, 0]
 
 [[bodies]]
-name = "crate"
+name = "crate_b"
 layer = "box"
 shape = {{ kind = "aabb", half_extents = [0.6, 0.4] }}
 position = [-2.7, 5.1]
 
 [[bodies]]
-name = "crate"
+name = "crate_c"
 layer = "box"
 shape = {{ kind = "aabb", half_extents = [0.45, 0.7] }}
 position = [4.1, 1.3]

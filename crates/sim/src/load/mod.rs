@@ -72,23 +72,8 @@ pub fn load_scenario(text: &str, file: &str) -> Result<Scenario, ScenarioError> 
         return Err(ctx.err(span, format!("templates.{name}.split"), problem));
     }
     let mut bodies = Vec::with_capacity(raw.bodies.len());
-    // Names a body's own table gives: they address script events and the active region, so
-    // two bodies may not share one (bodies named after their template may).
-    let mut named: BTreeMap<&str, usize> = BTreeMap::new();
     for (i, b) in raw.bodies.iter().enumerate() {
         let field = format!("bodies[{i}]");
-        if let Some(name) = &b.get_ref().name
-            && let Some(first) = named.insert(name, i)
-        {
-            return Err(ctx.err(
-                b.span(),
-                format!("{field}.name"),
-                format!(
-                    "\"{name}\" is already the name of bodies[{first}]; names address \
-                         script events and the active region, so each must be unique"
-                ),
-            ));
-        }
         let merged = match &b.get_ref().template {
             None => b.get_ref().clone(),
             Some(t) => {
@@ -122,7 +107,24 @@ pub fn load_scenario(text: &str, file: &str) -> Result<Scenario, ScenarioError> 
     }
     if let Some(r) = &raw.world.active_region {
         let focus = r.focus.get_ref();
-        if !bodies.iter().any(|b| &b.name == focus) {
+        let same: Vec<String> = bodies
+            .iter()
+            .enumerate()
+            .filter(|(_, b)| &b.name == focus)
+            .map(|(i, _)| format!("bodies[{i}]"))
+            .collect();
+        if same.len() > 1 {
+            return Err(ctx.err(
+                r.focus.span(),
+                "world.active_region.focus",
+                format!(
+                    "{} bodies are named \"{focus}\" ({}): name the one to follow apart",
+                    same.len(),
+                    same.join(", ")
+                ),
+            ));
+        }
+        if same.is_empty() {
             let mut names: Vec<&str> = bodies.iter().map(|b| b.name.as_str()).collect();
             names.sort_unstable();
             names.dedup();

@@ -44,6 +44,23 @@ pub(crate) fn script(
             ));
         }
         let body = |name: &String| -> Result<String, ScenarioError> {
+            let same: Vec<String> = bodies
+                .iter()
+                .enumerate()
+                .filter(|(_, b)| &b.name == name)
+                .map(|(i, _)| format!("bodies[{i}]"))
+                .collect();
+            if same.len() > 1 {
+                return Err(fail(
+                    "body",
+                    format!(
+                        "{} bodies are named \"{name}\" ({}): name the one this event is \
+                         for apart from the others",
+                        same.len(),
+                        same.join(", ")
+                    ),
+                ));
+            }
             if names.binary_search(&name.as_str()).is_ok() {
                 Ok(name.clone())
             } else {
