@@ -2,13 +2,13 @@
 
 use ricochet_geom::{Bounds, Vec2};
 
-use super::grid::{CellRange, Cells, MAX_CELLS};
+use super::grid::{CellRange, Cells};
 
 /// A grid over boxes that never move, built once (the per-axis stages' static boxes): which
 /// of them overlap a query box. Laid out as the broad phase's grids ([`Cells`]), but each
 /// cell's entries hold the boxes' bounds themselves, so a lookup in a million tiles reads a
 /// few cache lines (the cell's bucket start and its entries) and never the bodies. A box
-/// covering more than [`MAX_CELLS`] cells (or with irregular bounds) is kept in a list every
+/// covering more than [`MAX_CELLS`](super::grid::MAX_CELLS) cells (or with irregular bounds) is kept in a list every
 /// lookup scans.
 #[derive(Debug, Default)]
 pub(crate) struct FixedGrid {
@@ -43,9 +43,9 @@ impl FixedGrid {
         };
         let mut placed: Vec<(CellRange, (Bounds, u32))> = Vec::with_capacity(boxes.len());
         for &(b, h) in &boxes {
-            match g.cells.range(&b) {
-                Some(r) if r.count() <= MAX_CELLS => placed.push((r, (b, h))),
-                _ => g.big.push((b, h)),
+            match g.cells.placed(&b) {
+                Some(r) => placed.push((r, (b, h))),
+                None => g.big.push((b, h)),
             }
         }
         let blank = FixedEntry {
@@ -116,23 +116,8 @@ impl FixedGrid {
 mod tests {
     use proptest::prelude::*;
 
+    use super::super::grid::test_boxes as boxes;
     use super::*;
-
-    fn boxes() -> impl Strategy<Value = Vec<Bounds>> {
-        // Tiles and odd sizes, around the origin and at 1e6, a few huge.
-        let b = (
-            prop_oneof![Just(0.0), Just(1e6)],
-            -20.0..20.0f64,
-            -20.0..20.0f64,
-            prop_oneof![3 => 0.5..1.5f64, 1 => 1e-3..0.1f64, 1 => 5.0..60.0f64],
-            0.1..2.0f64,
-        )
-            .prop_map(|(o, x, y, w, h)| Bounds {
-                min: Vec2::new(o + x, y),
-                max: Vec2::new(o + x + w, y + h),
-            });
-        proptest::collection::vec(b, 0..200)
-    }
 
     proptest! {
         #[test]

@@ -9,16 +9,19 @@
 //! (bodies at 1e6 with 1e-7 extents), and clamped to `i32` besides, which is monotone and so
 //! still correct. A box covering more than [`MAX_CELLS`] cells, or with inverted or NaN
 //! bounds, is kept aside in a list tested against everything instead.
+//!
+//! Used by the broad phase's [`HashGrid`](super::hash_grid::HashGrid) and by the per-axis
+//! stages' [`FixedGrid`](super::FixedGrid) (both counting-sorted into a table by
+//! [`Cells::fill`]) and [`MoverGrid`](super::MoverGrid) (filled box by box, hashed).
 
 use ricochet_geom::Bounds;
 
-/// A body covering more cells goes to the grid's `big` list.
+/// A box covering more cells is kept aside (in its grid's `big` list), not entered in cells.
 pub(super) const MAX_CELLS: u64 = 16;
 
 /// How a grid maps space to buckets: the cell size, and either a dense table over the
 /// occupied rectangle of cells (row by row: neighbours are neighbours in memory, as in a tile
-/// map) or a table indexed by a fixed multiplicative hash of the cell. Shared by
-/// [`HashGrid`](super::hash_grid::HashGrid) and [`FixedGrid`](super::FixedGrid).
+/// map) or a table indexed by a fixed multiplicative hash of the cell.
 #[derive(Clone, Copy, Debug, Default)]
 pub(super) struct Cells {
     /// One over the cell size.
@@ -55,22 +58,20 @@ impl Cells {
                 }
             }
         }
-        let mut cell = if extents.is_empty() {
-            1.0
-        } else {
-            let mid = extents.len() / 2;
-            let (_, median, _) = extents.select_nth_unstable_by(mid, f64::total_cmp);
-            2.0 * *median
-        };
-        if !(cell.is_finite() && cell > 0.0) {
-            cell = 1.0;
-        }
-        cell = cell.max(max_abs / CELL_RANGE);
-        if !(1.0 / cell).is_normal() {
-            cell = 1.0f64.max(max_abs / CELL_RANGE);
-        }
         Cells {
-            inv_cell: 1.0 / cell,
+            inv_cell: inv_cell_size(extents, max_abs),
+            ..Cells::default()
+        }
+    }
+
+    /// A hashed table of `buckets` buckets (a power of two), for a grid filled box by box:
+    /// cells twice the median of `extents` (the boxes' `max(width, height)`, in any order),
+    /// not widened (the bounds are not known yet; coordinates clamp to `i32`, still correct).
+    pub(super) fn hashed(extents: &mut [f64], buckets: usize) -> Cells {
+        debug_assert!(buckets.is_power_of_two() && buckets > 1, "a hashed table");
+        Cells {
+            inv_cell: inv_cell_size(extents, 0.0),
+            bits: buckets.trailing_zeros(),
             ..Cells::default()
         }
     }
@@ -152,6 +153,13 @@ impl Cells {
         })
     }
 
+    /// The cells `b` is entered in, or `None` when it is kept aside: covering more than
+    /// [`MAX_CELLS`] cells, or with inverted or NaN bounds.
+    #[inline]
+    pub(super) fn placed(&self, b: &Bounds) -> Option<CellRange> {
+        self.range(b).filter(|r| r.count() <= MAX_CELLS)
+    }
+
     /// Whether cell `c` is where the pair `(a, b)` is reported: the one holding the lower
     /// left corner of their intersection, a cell both cover.
     #[inline]
@@ -168,8 +176,15 @@ impl Cells {
             let (w, h) = (i64::from(self.span.0), i64::from(self.span.1));
             return (0 <= x && x < w && 0 <= y && y < h).then_some((x + y * w) as usize);
         }
+        Some(self.hashed_bucket((cx, cy)))
+    }
+
+    /// The bucket of cell `c` in a hashed table: the top `bits` bits of a fixed
+    /// multiplicative (Fibonacci) hash of the cell.
+    #[inline]
+    pub(super) fn hashed_bucket(&self, (cx, cy): (i32, i32)) -> usize {
         let packed = u64::from(cx as u32) | (u64::from(cy as u32) << 32);
-        Some((packed.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> (64 - self.bits)) as usize)
+        (packed.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> (64 - self.bits)) as usize
     }
 
     /// `r` cut to the occupied cells when the table is dense.
@@ -189,6 +204,27 @@ impl Cells {
             ),
         }
     }
+}
+
+/// One over the cell size for boxes of these extents (`max(width, height)` each; reordered):
+/// twice their median, widened if needed so that coordinates up to `max_abs` give cells
+/// within `±2^30`, and 1 when there is nothing sensible to go by.
+fn inv_cell_size(extents: &mut [f64], max_abs: f64) -> f64 {
+    let mut cell = if extents.is_empty() {
+        1.0
+    } else {
+        let mid = extents.len() / 2;
+        let (_, median, _) = extents.select_nth_unstable_by(mid, f64::total_cmp);
+        2.0 * *median
+    };
+    if !(cell.is_finite() && cell > 0.0) {
+        cell = 1.0;
+    }
+    cell = cell.max(max_abs / CELL_RANGE);
+    if !(1.0 / cell).is_normal() {
+        cell = 1.0f64.max(max_abs / CELL_RANGE);
+    }
+    1.0 / cell
 }
 
 /// Cell coordinates stay within `±2^30` of the origin for finite bounds.
@@ -218,11 +254,31 @@ impl CellRange {
 
 /// `floor(v * inv_cell)`, clamped to `i32`: monotone in `v`.
 #[inline]
-pub(crate) fn cell_coord(v: f64, inv_cell: f64) -> i32 {
+fn cell_coord(v: f64, inv_cell: f64) -> i32 {
     // Clamped, then floored by hand (`f64::floor` is a call on baseline x86-64): the cast
     // truncates toward zero, a negative fraction steps down. NaN becomes 0; only regular
     // bounds get here.
     let x = (v * inv_cell).clamp(f64::from(i32::MIN), f64::from(i32::MAX));
     let t = x as i32;
     t - i32::from(f64::from(t) > x)
+}
+
+/// Random boxes for the grids' tests: tiles and odd sizes, around the origin and at 1e6, a
+/// few huge.
+#[cfg(test)]
+pub(super) fn test_boxes() -> impl proptest::strategy::Strategy<Value = Vec<Bounds>> {
+    use proptest::prelude::*;
+    use ricochet_geom::Vec2;
+    let b = (
+        prop_oneof![Just(0.0), Just(1e6)],
+        -20.0..20.0f64,
+        -20.0..20.0f64,
+        prop_oneof![3 => 0.5..1.5f64, 1 => 1e-3..0.1f64, 1 => 5.0..60.0f64],
+        0.1..2.0f64,
+    )
+        .prop_map(|(o, x, y, w, h)| Bounds {
+            min: Vec2::new(o + x, y),
+            max: Vec2::new(o + x + w, y + h),
+        });
+    proptest::collection::vec(b, 0..200)
 }

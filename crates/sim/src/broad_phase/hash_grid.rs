@@ -62,9 +62,9 @@ impl HashGrid {
         let mut ranges = std::mem::take(&mut self.ranges);
         ranges.clear();
         for (i, m) in self.members.iter().enumerate() {
-            match self.cells.range(&m.bounds) {
-                Some(r) if r.count() <= MAX_CELLS => ranges.push((r, i as u32)),
-                _ => {
+            match self.cells.placed(&m.bounds) {
+                Some(r) => ranges.push((r, i as u32)),
+                None => {
                     self.is_big[i] = true;
                     self.big.push(i as u32);
                 }

@@ -61,6 +61,7 @@ mod fixed_grid;
 mod grid;
 mod hash_grid;
 mod interactions;
+mod mover_grid;
 mod sort_and_sweep;
 mod static_set;
 mod static_tree;
@@ -71,9 +72,9 @@ use ricochet_geom::Bounds;
 use crate::def::BodyKind;
 
 pub(crate) use fixed_grid::FixedGrid;
-pub(crate) use grid::cell_coord;
 use hash_grid::HashGrid;
 pub use interactions::Interactions;
+pub(crate) use mover_grid::MoverGrid;
 use sort_and_sweep::{Slot, SweepList, SweepView, sweep_cross, sweep_self};
 use static_set::StaticSet;
 use tally::Tally;
