@@ -19,7 +19,7 @@
 
 use ricochet_geom::{Bounds, Primitive, Shape, Vec2, contact};
 
-use crate::broad_phase::{FixedGrid, cell_coord};
+use crate::broad_phase::{FixedGrid, MoverGrid};
 use crate::def::{BodyKind, Controller, LayerId, Layers, Response};
 use crate::entity::Entity;
 use crate::output::{ContactRecord, EventRecord, FrameOutput, Phase};
@@ -304,114 +304,6 @@ fn resolve(sim: &mut Simulation, out: &mut FrameOutput, axis: usize) {
     sim.separate = st;
     // The log's convention: a pass's contacts sorted by (a, b).
     out.contacts[first..].sort_by_key(|c| (c.a, c.b));
-}
-
-/// The moving boxes that are solid to the box being settled: a uniform grid rebuilt every
-/// pass, filled as boxes settle. A lookup may return a box twice, or one that does not
-/// overlap: the caller sorts, dedups and tests.
-#[derive(Debug, Default)]
-struct MoverGrid {
-    inv_cell: f64,
-    /// `buckets.len() - 1`, a power of two minus one.
-    mask: usize,
-    buckets: Vec<Vec<u32>>,
-    /// Buckets filled this pass, to empty next pass.
-    used: Vec<usize>,
-    /// Boxes covering more than [`MAX_CELLS`] cells: met by every lookup.
-    big: Vec<u32>,
-}
-
-/// A box covering more cells than this is kept aside and met by every lookup.
-const MAX_CELLS: i64 = 16;
-
-impl MoverGrid {
-    /// Empties the grid and sizes its cells at twice the median of `extents` (the dynamic
-    /// boxes' larger side), for about `count` boxes.
-    fn reset(&mut self, extents: &mut [f64], count: usize) {
-        for &b in &self.used {
-            self.buckets[b].clear();
-        }
-        self.used.clear();
-        self.big.clear();
-        let cell = if extents.is_empty() {
-            1.0
-        } else {
-            let mid = extents.len() / 2;
-            2.0 * *extents.select_nth_unstable_by(mid, f64::total_cmp).1
-        };
-        self.inv_cell = if cell.is_finite() && cell > 0.0 && (1.0 / cell).is_normal() {
-            1.0 / cell
-        } else {
-            1.0
-        };
-        let size = (2 * count).max(16).next_power_of_two();
-        if self.buckets.len() < size {
-            self.buckets.resize_with(size, Vec::new);
-        }
-        self.mask = self.buckets.len() - 1;
-    }
-
-    /// The cells `b` covers, or `None` when too many (or the bounds are not regular).
-    fn cells(&self, b: &Bounds) -> Option<((i32, i32), (i32, i32))> {
-        if !(b.min.x <= b.max.x && b.min.y <= b.max.y) {
-            return None;
-        }
-        let (x0, x1) = (
-            cell_coord(b.min.x, self.inv_cell),
-            cell_coord(b.max.x, self.inv_cell),
-        );
-        let (y0, y1) = (
-            cell_coord(b.min.y, self.inv_cell),
-            cell_coord(b.max.y, self.inv_cell),
-        );
-        let n = (i64::from(x1) - i64::from(x0) + 1) * (i64::from(y1) - i64::from(y0) + 1);
-        (n <= MAX_CELLS).then_some(((x0, x1), (y0, y1)))
-    }
-
-    fn bucket(&self, cx: i32, cy: i32) -> usize {
-        let packed = u64::from(cx as u32) | (u64::from(cy as u32) << 32);
-        (packed.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 32) as usize & self.mask
-    }
-
-    fn insert(&mut self, b: &Bounds, handle: u32) {
-        let Some(((x0, x1), (y0, y1))) = self.cells(b) else {
-            self.big.push(handle);
-            return;
-        };
-        for cy in y0..=y1 {
-            for cx in x0..=x1 {
-                let k = self.bucket(cx, cy);
-                if self.buckets[k].is_empty() {
-                    self.used.push(k);
-                }
-                self.buckets[k].push(handle);
-            }
-        }
-    }
-
-    fn query(&self, q: &Bounds, mut f: impl FnMut(u32)) {
-        for &h in &self.big {
-            f(h);
-        }
-        match self.cells(q) {
-            Some(((x0, x1), (y0, y1))) => {
-                for cy in y0..=y1 {
-                    for cx in x0..=x1 {
-                        for &h in &self.buckets[self.bucket(cx, cy)] {
-                            f(h);
-                        }
-                    }
-                }
-            }
-            None => {
-                for &b in &self.used {
-                    for &h in &self.buckets[b] {
-                        f(h);
-                    }
-                }
-            }
-        }
-    }
 }
 
 /// Moves body `i` by `push` along `axis`, stops its motion into the obstacle, and notes

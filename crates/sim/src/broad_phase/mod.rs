@@ -1,0 +1,523 @@
+//! Broad phases: which pairs of bodies have overlapping bounds and are worth a narrow-phase
+//! test.
+//!
+//! Given each body's [`Bounds`], layer and [`BodyKind`], a [`BroadPhase`] writes the candidate
+//! pairs `(i, j)`, `i < j`, as dense indices (the order of the bodies, which is key order),
+//! sorted and without duplicates: exactly the pairs whose bounds overlap (touching counts, as
+//! [`Bounds::overlaps`]) and that pass two filters applied *inside* the broad phase, so the
+//! pairs are never produced:
+//! - **at least one body is dynamic**: static and kinematic bodies never pair with each other;
+//! - **their layers interact** ([`Interactions`], in `interactions.rs`). A layer that does not
+//!   interact with itself is never swept against itself: its bodies are only ever tested
+//!   against the layers it interacts with (10,000 asteroids that ignore each other cost no
+//!   asteroid–asteroid test).
+//!
+//! This file holds the public types and the orchestration: the moving bodies are counted and
+//! grouped by layer (`tally.rs`), then each pair of interacting layers goes to the chosen
+//! algorithm's structures, and the pairs found, named by handles, are turned into dense
+//! indices and sorted.
+//!
+//! # Algorithms ([`BroadPhaseKind`])
+//! All three produce the same pairs; they differ only in speed.
+//! - `BruteForce` (`brute_force.rs`): every pair, `O(n²)`. The reference, and the fastest
+//!   below a few dozen bodies.
+//! - `SortAndSweep` (`sort_and_sweep.rs`): per layer, the moving bodies sorted by `min.x`,
+//!   kept from the previous call and re-sorted by insertion sort (nearly sorted: about
+//!   `O(n)`). A self-interacting layer is swept against itself; two interacting layers never
+//!   look at pairs within one layer. Static bodies go into a packed tree per layer
+//!   (`static_tree.rs`), which each dynamic body queries in `O(log n + k)`.
+//! - `Grid` (`hash_grid.rs`): a uniform grid per layer, dense over the occupied cells or
+//!   hashed; two interacting layers: the grid of the larger is queried with the bodies of the
+//!   smaller. Static bodies have their own grid per layer, with its own cell size. What every
+//!   grid shares (cell coordinates and size, the bucket hash, the limit on the cells a body
+//!   may cover, the counting-sorted table) is in `grid.rs`, also used by the per-axis stages'
+//!   grids (`fixed_grid.rs`, `mover_grid.rs`).
+//!
+//! **Static bodies are inserted once** (`static_set.rs`). The structures above for static
+//! bodies are built when the static set changes, never per call; per call, only moving
+//! (dynamic and kinematic) bodies are re-sorted or re-hashed, and only dynamic ones query the
+//! static structures, so the per-call cost follows the moving bodies. [`BroadPhase::pairs`]
+//! takes every body and notices a change by comparing the static bodies with the stored ones
+//! (a linear scan, no rebuild); [`BroadPhase::pairs_split`] takes the static bodies apart
+//! with a generation number the caller bumps when they change, and does not look at them
+//! otherwise: with a million static tiles it costs what the moving bodies cost.
+//!
+//! # `Auto`
+//! Decided on every call from two counts only (deterministic, no timing):
+//! - at most 32 bodies in all: `BruteForce` (at most 496 tests, no structure to keep);
+//! - at least as many static as moving bodies: `Grid` (tile maps: a static cell lookup is
+//!   `O(1)` where the static tree is `O(log n)`, and the static grid is built once);
+//! - otherwise `SortAndSweep` (moving crowds: the coherent sort costs about one pass over the
+//!   moving bodies, and unlike a grid it does not care how much body sizes vary).
+//!
+//! Each kind keeps its own structures, so a switch costs one build and nothing else.
+//!
+//! # Determinism
+//! Sorting uses `f64::total_cmp` with the body's key as the tie-break, so every order is a
+//! function of the current input; the output is sorted. No hashed collection, no clock.
+
+mod brute_force;
+mod fixed_grid;
+mod grid;
+mod hash_grid;
+mod interactions;
+mod mover_grid;
+mod sort_and_sweep;
+mod static_set;
+mod static_tree;
+mod tally;
+
+use ricochet_geom::Bounds;
+
+use crate::def::BodyKind;
+
+pub(crate) use fixed_grid::FixedGrid;
+use hash_grid::HashGrid;
+pub use interactions::Interactions;
+pub(crate) use mover_grid::MoverGrid;
+use sort_and_sweep::{Slot, SweepList, SweepView, sweep_cross, sweep_self};
+use static_set::StaticSet;
+use tally::Tally;
+
+/// Which algorithm finds the pairs. All of them find the same pairs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum BroadPhaseKind {
+    /// Every pair is tested: `O(n²)`.
+    BruteForce,
+    /// Sort and sweep along x, re-sorting the previous call's order.
+    SortAndSweep,
+    /// A uniform grid, hashed deterministically.
+    Grid,
+    /// Chosen per call from the number of moving and static bodies (see the module docs).
+    #[default]
+    Auto,
+}
+
+impl BroadPhaseKind {
+    /// The name scenario files and `/stats` use: `brute-force`, `sort-and-sweep`, `grid`,
+    /// `auto`.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            BroadPhaseKind::BruteForce => "brute-force",
+            BroadPhaseKind::SortAndSweep => "sort-and-sweep",
+            BroadPhaseKind::Grid => "grid",
+            BroadPhaseKind::Auto => "auto",
+        }
+    }
+}
+
+/// One body, as the broad phase sees it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BodyEntry {
+    /// A stable id (e.g. the entity): strictly increasing along the slice, as dense order is
+    /// id order. It is how the broad phase recognises a body from one call to the next.
+    pub key: u64,
+    /// The body's bounds (with `min <= max`; other bounds are handled, but slowly).
+    pub bounds: Bounds,
+    /// The body's layer, for [`Interactions`].
+    pub layer: u8,
+    /// Static bodies are indexed once; static and kinematic bodies never pair with each
+    /// other.
+    pub kind: BodyKind,
+}
+
+/// What one call did. Every counter is a function of the input (and, for `static_rebuilds`,
+/// of the calls before), never of time.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct BroadPhaseStats {
+    /// The algorithm that ran (what `Auto` chose).
+    pub kind: BroadPhaseKind,
+    /// Pairs produced.
+    pub pairs: u64,
+    /// Body–body bounds tests made (candidates the structure could not rule out).
+    pub tested: u64,
+    /// Moving (dynamic or kinematic) bodies.
+    pub movers: u64,
+    /// Static bodies.
+    pub statics: u64,
+    /// How many times a static structure was built since the [`BroadPhase`] was made: stays
+    /// put while the static bodies do.
+    pub static_rebuilds: u64,
+    /// Layer combinations present in the scene (moving–moving, including a layer with
+    /// itself, and moving–static) that were never looked at because they do not interact.
+    pub layer_pairs_skipped: u64,
+    /// `SortAndSweep`: how many places bodies moved in the re-sort.
+    pub resorted: u64,
+}
+
+/// The broad phase, keeping its structures (and buffers) from one call to the next.
+#[derive(Debug)]
+pub struct BroadPhase {
+    kind: BroadPhaseKind,
+    chosen: BroadPhaseKind,
+    /// Calls made, to know which per-layer structures are current.
+    frame: u64,
+    statics: StaticSet,
+    static_rebuilds: u64,
+    /// Moving bodies (indices into the caller's slice) grouped by layer, key order within.
+    movers: Vec<u32>,
+    /// `movers[layer_start[l]..layer_start[l + 1]]` are layer `l`'s.
+    layer_start: Vec<u32>,
+    /// Dynamic bodies per layer.
+    dynamic: Vec<u32>,
+    mover_layers: Vec<u8>,
+    /// This call's runs of moving bodies: `(first index, count, layer)`; more than
+    /// [`MAX_RUNS`](tally::MAX_RUNS) means too many to use.
+    runs: Vec<(u32, u32, u8)>,
+    sweeps: Vec<SweepList>,
+    grids: Vec<HashGrid>,
+    scratch: Scratch,
+}
+
+/// Buffers reused across calls.
+#[derive(Debug, Default)]
+struct Scratch {
+    remap: Vec<u32>,
+    fresh: Vec<Slot>,
+    merged: Vec<Slot>,
+    extents: Vec<f64>,
+    stack: Vec<(u32, u32)>,
+    ranges: Vec<(u32, u32)>,
+    all: Vec<(Member, u8)>,
+}
+
+/// A body inside a structure: its bounds, its handle (an index into the caller's slice for a
+/// moving body, or a static index with [`STATIC_BIT`]), and whether it is dynamic.
+#[derive(Clone, Copy, Debug)]
+struct Member {
+    bounds: Bounds,
+    handle: u32,
+    dynamic: bool,
+}
+
+/// Marks a handle as a static body's index (in the [`StaticSet`]).
+const STATIC_BIT: u32 = 1 << 31;
+/// Layer ids are `u8`.
+const LAYERS: usize = 256;
+
+impl BroadPhase {
+    /// A broad phase using `kind`.
+    #[must_use]
+    pub fn new(kind: BroadPhaseKind) -> BroadPhase {
+        BroadPhase {
+            kind,
+            chosen: kind,
+            frame: 0,
+            statics: StaticSet::default(),
+            static_rebuilds: 0,
+            movers: Vec::new(),
+            layer_start: vec![0; LAYERS + 1],
+            dynamic: vec![0; LAYERS],
+            mover_layers: Vec::new(),
+            runs: Vec::new(),
+            sweeps: (0..LAYERS).map(|_| SweepList::default()).collect(),
+            grids: (0..LAYERS).map(|_| HashGrid::default()).collect(),
+            scratch: Scratch::default(),
+        }
+    }
+
+    /// The algorithm the last call ran (what `Auto` picked); before any call, the one asked
+    /// for.
+    #[must_use]
+    pub fn chosen(&self) -> BroadPhaseKind {
+        self.chosen
+    }
+
+    /// Writes into `out` (cleared first) the candidate pairs among `bodies` (keys strictly
+    /// increasing): dense indices `(i, j)`, `i < j`, sorted.
+    ///
+    /// The static bodies are compared with the previous call's (a linear scan); the static
+    /// structures are rebuilt only when they differ.
+    ///
+    /// # Panics
+    /// With `2^31` bodies or more.
+    pub fn pairs(
+        &mut self,
+        bodies: &[BodyEntry],
+        interactions: &Interactions,
+        out: &mut Vec<(u32, u32)>,
+    ) -> BroadPhaseStats {
+        assert!(bodies.len() < STATIC_BIT as usize, "fewer than 2^31 bodies");
+        debug_assert!(
+            bodies.windows(2).all(|w| w[0].key < w[1].key),
+            "keys increase"
+        );
+        // One pass: compare the static bodies with the stored ones, count the moving ones.
+        let st = &mut self.statics;
+        let mut same = st.generation.is_none() && st.loaded;
+        st.dense.clear();
+        let mut tally = Tally::new(&mut self.layer_start, &mut self.dynamic, &mut self.runs);
+        let mut s = 0;
+        for (i, b) in bodies.iter().enumerate() {
+            if b.kind == BodyKind::Static {
+                same = same && st.same(s, b);
+                s += 1;
+                st.dense.push(i as u32);
+            } else {
+                tally.add(b, i as u32);
+            }
+        }
+        tally.flush();
+        if !(same && s == st.keys.len()) {
+            st.load(bodies.iter().filter(|b| b.kind == BodyKind::Static), None);
+        }
+        self.group_movers(bodies, |b| b.kind != BodyKind::Static);
+        self.run(bodies, true, interactions, out)
+    }
+
+    /// Like [`BroadPhase::pairs`], with the static bodies apart: `statics` is read only when
+    /// `static_generation` differs from the previous call's (or on the first call), so the
+    /// caller bumps it whenever a static body is added, removed or changed. `movers` are the
+    /// dynamic and kinematic bodies. Keys are strictly increasing in each slice and unique
+    /// across both; dense indices are positions in the key order of both together.
+    ///
+    /// # Panics
+    /// With `2^31` bodies or more.
+    pub fn pairs_split(
+        &mut self,
+        statics: &[BodyEntry],
+        static_generation: u64,
+        movers: &[BodyEntry],
+        interactions: &Interactions,
+        out: &mut Vec<(u32, u32)>,
+    ) -> BroadPhaseStats {
+        debug_assert!(
+            movers.windows(2).all(|w| w[0].key < w[1].key),
+            "keys increase"
+        );
+        if self.statics.generation != Some(static_generation) || !self.statics.loaded {
+            debug_assert!(
+                statics.windows(2).all(|w| w[0].key < w[1].key),
+                "keys increase"
+            );
+            self.statics.load(statics.iter(), Some(static_generation));
+        }
+        assert!(
+            self.statics.keys.len() + movers.len() < STATIC_BIT as usize,
+            "fewer than 2^31 bodies"
+        );
+        let mut tally = Tally::new(&mut self.layer_start, &mut self.dynamic, &mut self.runs);
+        for (i, b) in movers.iter().enumerate() {
+            tally.add(b, i as u32);
+        }
+        tally.flush();
+        self.group_movers(movers, |_| true);
+        self.run(movers, false, interactions, out)
+    }
+
+    /// This call's moving bodies of `layer`, in key order.
+    fn layer_movers(&self, layer: u8) -> &[u32] {
+        let l = usize::from(layer);
+        &self.movers[self.layer_start[l] as usize..self.layer_start[l + 1] as usize]
+    }
+
+    /// Chooses the algorithm, finds the pairs and resolves them.
+    fn run(
+        &mut self,
+        bodies: &[BodyEntry],
+        all_given: bool,
+        interactions: &Interactions,
+        out: &mut Vec<(u32, u32)>,
+    ) -> BroadPhaseStats {
+        self.frame += 1;
+        out.clear();
+        let n_movers = self.movers.len();
+        let n_statics = self.statics.keys.len();
+        let kind = match self.kind {
+            BroadPhaseKind::Auto if n_movers + n_statics <= 32 => BroadPhaseKind::BruteForce,
+            BroadPhaseKind::Auto if n_statics >= n_movers => BroadPhaseKind::Grid,
+            BroadPhaseKind::Auto => BroadPhaseKind::SortAndSweep,
+            k => k,
+        };
+        self.chosen = kind;
+        let mut stats = BroadPhaseStats {
+            kind,
+            movers: n_movers as u64,
+            statics: n_statics as u64,
+            ..BroadPhaseStats::default()
+        };
+        if kind == BroadPhaseKind::BruteForce {
+            self.brute_force(bodies, interactions, out, &mut stats);
+        } else {
+            self.by_layers(kind, bodies, interactions, out, &mut stats);
+        }
+        self.resolve(bodies, all_given, out);
+        stats.pairs = out.len() as u64;
+        stats.static_rebuilds = self.static_rebuilds;
+        stats
+    }
+
+    /// Per pair of interacting layers: moving–moving through the per-call structures,
+    /// dynamic–static through the static ones.
+    fn by_layers(
+        &mut self,
+        kind: BroadPhaseKind,
+        bodies: &[BodyEntry],
+        interactions: &Interactions,
+        out: &mut Vec<(u32, u32)>,
+        stats: &mut BroadPhaseStats,
+    ) {
+        let built = match kind {
+            BroadPhaseKind::SortAndSweep => &mut self.statics.built_trees,
+            _ => &mut self.statics.built_grids,
+        };
+        if !*built {
+            *built = true;
+            self.statics.build(kind, &mut self.scratch);
+            self.static_rebuilds += 1;
+        }
+        let layers = std::mem::take(&mut self.mover_layers);
+        for (k, &a) in layers.iter().enumerate() {
+            for &b in &layers[k..] {
+                if !interactions.interacts(a, b) {
+                    stats.layer_pairs_skipped += 1;
+                    continue;
+                }
+                let (da, db) = (self.dynamic[usize::from(a)], self.dynamic[usize::from(b)]);
+                if da == 0 && db == 0 {
+                    continue;
+                }
+                if kind == BroadPhaseKind::SortAndSweep {
+                    stats.resorted += self.ensure_sweep(a, bodies);
+                    stats.resorted += self.ensure_sweep(b, bodies);
+                    let mut ranges = std::mem::take(&mut self.scratch.ranges);
+                    let view = |l: u8| SweepView {
+                        list: &self.sweeps[usize::from(l)],
+                        handles: self.layer_movers(l),
+                        bodies,
+                    };
+                    if a == b {
+                        stats.tested += sweep_self(view(a), out);
+                    } else {
+                        stats.tested += sweep_cross(view(a), view(b), &mut ranges, out);
+                    }
+                    self.scratch.ranges = ranges;
+                } else if a == b {
+                    self.ensure_grid(a, bodies);
+                    stats.tested += self.grids[usize::from(a)].self_pairs(out);
+                } else {
+                    // Query the larger layer's grid with the smaller's bodies.
+                    let (na, nb) = (self.layer_movers(a).len(), self.layer_movers(b).len());
+                    let (grid, query) = if na > nb { (a, b) } else { (b, a) };
+                    self.ensure_grid(grid, bodies);
+                    let g = &self.grids[usize::from(grid)];
+                    for &h in self.layer_movers(query) {
+                        let q = member(&bodies[h as usize], h);
+                        stats.tested += g.query(&q.bounds, |m| {
+                            if q.dynamic || m.dynamic {
+                                out.push((q.handle, m.handle));
+                            }
+                        });
+                    }
+                }
+            }
+            if self.dynamic[usize::from(a)] == 0 {
+                continue;
+            }
+            for &b in &self.statics.layers {
+                if !interactions.interacts(a, b) {
+                    stats.layer_pairs_skipped += 1;
+                    continue;
+                }
+                let l = usize::from(a);
+                for k in self.layer_start[l] as usize..self.layer_start[l + 1] as usize {
+                    let h = self.movers[k];
+                    let q = &bodies[h as usize];
+                    if q.kind != BodyKind::Dynamic {
+                        continue;
+                    }
+                    let mut emit = |m: &Member| out.push((h, m.handle));
+                    stats.tested += if kind == BroadPhaseKind::SortAndSweep {
+                        let tree = &self.statics.trees[usize::from(b)];
+                        tree.query(&q.bounds, &mut self.scratch.stack, &mut emit)
+                    } else {
+                        self.statics.grids[usize::from(b)].query(&q.bounds, &mut emit)
+                    };
+                }
+            }
+        }
+        self.mover_layers = layers;
+    }
+
+    /// Brings layer `l`'s sorted list up to this call, once per call. Returns the re-sort's
+    /// moves.
+    fn ensure_sweep(&mut self, l: u8, bodies: &[BodyEntry]) -> u64 {
+        let list = &mut self.sweeps[usize::from(l)];
+        if list.frame == self.frame {
+            return 0;
+        }
+        list.frame = self.frame;
+        let (lo, hi) = (
+            self.layer_start[usize::from(l)] as usize,
+            self.layer_start[usize::from(l) + 1] as usize,
+        );
+        list.update(&self.movers[lo..hi], bodies, &mut self.scratch)
+    }
+
+    /// Builds layer `l`'s grid of moving bodies, once per call.
+    fn ensure_grid(&mut self, l: u8, bodies: &[BodyEntry]) {
+        let (lo, hi) = (
+            self.layer_start[usize::from(l)] as usize,
+            self.layer_start[usize::from(l) + 1] as usize,
+        );
+        let grid = &mut self.grids[usize::from(l)];
+        if grid.frame == self.frame {
+            return;
+        }
+        grid.frame = self.frame;
+        grid.members.clear();
+        grid.members.extend(
+            self.movers[lo..hi]
+                .iter()
+                .map(|&h| member(&bodies[h as usize], h)),
+        );
+        grid.build(&mut self.scratch.extents, false);
+    }
+
+    /// Turns handles into dense indices, orders each pair and sorts them.
+    fn resolve(&self, bodies: &[BodyEntry], all_given: bool, out: &mut [(u32, u32)]) {
+        let st = &self.statics;
+        let dense = |h: u32| -> u32 {
+            match (h & STATIC_BIT != 0, all_given) {
+                (false, true) => h,
+                (true, true) => st.dense[(h & !STATIC_BIT) as usize],
+                // Ranks in the other slice; the first two checks spare a binary search (and
+                // its cache misses) when every static body comes before every moving one.
+                (false, false) => {
+                    let key = bodies[h as usize].key;
+                    let rank = match st.keys.last() {
+                        Some(&last) if last > key => st.keys.partition_point(|&k| k < key),
+                        _ => st.keys.len(),
+                    };
+                    h + rank as u32
+                }
+                (true, false) => {
+                    let s = h & !STATIC_BIT;
+                    let key = st.keys[s as usize];
+                    let rank = match bodies.first() {
+                        Some(first) if first.key < key => bodies.partition_point(|b| b.key < key),
+                        _ => 0,
+                    };
+                    s + rank as u32
+                }
+            }
+        };
+        for p in out.iter_mut() {
+            let (i, j) = (dense(p.0), dense(p.1));
+            *p = (i.min(j), i.max(j));
+        }
+        // One integer comparison per step.
+        out.sort_unstable_by_key(|&(i, j)| (u64::from(i) << 32) | u64::from(j));
+        debug_assert!(out.windows(2).all(|w| w[0] < w[1]), "each pair once");
+    }
+}
+
+/// `b` as a [`Member`] named `handle`.
+fn member(b: &BodyEntry, handle: u32) -> Member {
+    Member {
+        bounds: b.bounds,
+        handle,
+        dynamic: b.kind == BodyKind::Dynamic,
+    }
+}

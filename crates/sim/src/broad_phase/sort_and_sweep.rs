@@ -1,0 +1,330 @@
+//! `SortAndSweep` for moving bodies: per layer, the moving bodies sorted by `min.x`, kept from
+//! the previous call and re-sorted by insertion sort (nearly sorted: about `O(n)`; bodies that
+//! appeared are sorted apart and merged in, and a sort that moves more than `8n` places falls
+//! back to a full sort). A self-interacting layer is swept against itself. Two interacting
+//! layers never look at pairs within one layer: each body of the smaller layer finds its
+//! candidates in the larger one's order by binary search (`[min.x - widest, max.x]`), or,
+//! when that would visit more than the larger layer holds, the two orders are swept together.
+
+use std::cmp::Ordering;
+
+use ricochet_geom::Bounds;
+
+use super::{BodyEntry, Member, Scratch, member};
+
+/// No index: a body gone from a layer's list.
+const NONE: u32 = u32::MAX;
+
+/// `SortAndSweep`: one layer's moving bodies, kept across calls.
+#[derive(Debug, Default)]
+pub(super) struct SweepList {
+    /// The call the list was last brought up to.
+    pub(super) frame: u64,
+    /// The bodies, sorted by `(min.x, local)`: small, so the re-sort moves little.
+    order: Vec<Slot>,
+    /// The keys of the layer's bodies at the last update, in key order (`local` indexes it,
+    /// as it does the layer's handles).
+    keys: Vec<u64>,
+    /// `order[pos[local]].local == local`, so an update reads the caller's bodies in order.
+    pos: Vec<u32>,
+    /// The widest body's `max.x - min.x` (at least 0; NaN ignored).
+    width: f64,
+}
+
+/// A body's place in a [`SweepList`]'s order.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Slot {
+    /// `min.x` as [`order_key`].
+    min: u64,
+    /// `max.x` as [`order_key`] of `max.x + 0.0`: `min <= max` exactly when `min.x <= max.x`
+    /// (besides NaN, which overlaps nothing anyway).
+    max: u64,
+    /// The body's index among its layer's bodies, in key order.
+    local: u32,
+}
+
+impl Slot {
+    /// Body `local` with bounds `b`.
+    #[inline]
+    fn new(b: &Bounds, local: u32) -> Slot {
+        Slot {
+            min: order_key(b.min.x),
+            max: order_key(b.max.x + 0.0),
+            local,
+        }
+    }
+}
+
+/// `f64::total_cmp` as an integer: `order_key(a) < order_key(b)` exactly when `a` comes
+/// first. `-0.0` comes before `+0.0`, so a query bound is normalised with `+ 0.0` first.
+#[inline]
+fn order_key(x: f64) -> u64 {
+    let bits = x.to_bits();
+    bits ^ (((bits as i64 >> 63) as u64) | (1 << 63))
+}
+
+/// The key order as tie-break, so the order is a function of the input, never of the calls
+/// before.
+#[inline]
+fn sweep_order(a: &Slot, b: &Slot) -> Ordering {
+    a.min.cmp(&b.min).then(a.local.cmp(&b.local))
+}
+
+/// A [`SweepList`] with this call's bodies of its layer.
+#[derive(Clone, Copy)]
+pub(super) struct SweepView<'a> {
+    /// The layer's list.
+    pub(super) list: &'a SweepList,
+    /// The layer's bodies (handles into `bodies`), in key order.
+    pub(super) handles: &'a [u32],
+    /// The caller's bodies.
+    pub(super) bodies: &'a [BodyEntry],
+}
+
+impl SweepView<'_> {
+    /// The body `local` of the layer.
+    #[inline]
+    fn member(&self, local: u32) -> Member {
+        let h = self.handles[local as usize];
+        member(&self.bodies[h as usize], h)
+    }
+}
+
+impl SweepList {
+    /// Reconciles the list with this call's bodies of the layer (`handles`, key order):
+    /// bodies gone are dropped, bodies kept get their new bounds, new bodies are sorted and
+    /// merged in. Returns the insertion sort's moves.
+    pub(super) fn update(
+        &mut self,
+        handles: &[u32],
+        bodies: &[BodyEntry],
+        scratch: &mut Scratch,
+    ) -> u64 {
+        // The usual case: the same bodies as last time. One pass in the caller's order.
+        if self.keys.len() == handles.len() {
+            let mut width: f64 = 0.0;
+            let mut same = true;
+            for (local, &h) in handles.iter().enumerate() {
+                let b = &bodies[h as usize];
+                if b.key != self.keys[local] {
+                    same = false;
+                    break;
+                }
+                self.order[self.pos[local] as usize] = Slot::new(&b.bounds, local as u32);
+                // A branch, not `f64::max`: rarely taken, and no dependency chain.
+                let w = b.bounds.max.x - b.bounds.min.x;
+                if w > width {
+                    width = w;
+                }
+            }
+            if same {
+                self.width = width;
+                return insertion_sort(&mut self.order, &mut self.pos);
+            }
+        }
+        // Merge the old keys with the new ones (both ascending).
+        let (remap, fresh) = (&mut scratch.remap, &mut scratch.fresh);
+        remap.clear();
+        remap.resize(self.keys.len(), NONE);
+        fresh.clear();
+        let mut i = 0;
+        for (j, &h) in handles.iter().enumerate() {
+            let b = &bodies[h as usize];
+            while i < self.keys.len() && self.keys[i] < b.key {
+                i += 1;
+            }
+            if i < self.keys.len() && self.keys[i] == b.key {
+                remap[i] = j as u32;
+                i += 1;
+            } else {
+                fresh.push(Slot::new(&b.bounds, j as u32));
+            }
+        }
+        self.keys.clear();
+        self.keys
+            .extend(handles.iter().map(|&h| bodies[h as usize].key));
+        self.order.retain_mut(|s| {
+            let j = remap[s.local as usize];
+            if j != NONE {
+                *s = Slot::new(&bodies[handles[j as usize] as usize].bounds, j);
+            }
+            j != NONE
+        });
+        self.pos.resize(handles.len(), 0);
+        let moved = insertion_sort(&mut self.order, &mut self.pos);
+        if !fresh.is_empty() {
+            fresh.sort_unstable_by(sweep_order);
+            let merged = &mut scratch.merged;
+            merged.clear();
+            merged.reserve(self.order.len() + fresh.len());
+            let (mut i, mut j) = (0, 0);
+            while i < self.order.len() && j < fresh.len() {
+                if sweep_order(&self.order[i], &fresh[j]) == Ordering::Less {
+                    merged.push(self.order[i]);
+                    i += 1;
+                } else {
+                    merged.push(fresh[j]);
+                    j += 1;
+                }
+            }
+            merged.extend_from_slice(&self.order[i..]);
+            merged.extend_from_slice(&fresh[j..]);
+            std::mem::swap(&mut self.order, merged);
+        }
+        for (p, s) in self.order.iter().enumerate() {
+            self.pos[s.local as usize] = p as u32;
+        }
+        self.width = 0.0;
+        for &h in handles {
+            let b = &bodies[h as usize].bounds;
+            self.width = self.width.max(b.max.x - b.min.x);
+        }
+        moved
+    }
+}
+
+/// Insertion sort for a nearly sorted list, keeping `pos` up to date; past `8n + 64` moves
+/// it gives up and sorts.
+fn insertion_sort(order: &mut [Slot], pos: &mut [u32]) -> u64 {
+    let budget = 8 * order.len() as u64 + 64;
+    let mut moved = 0;
+    for i in 1..order.len() {
+        if sweep_order(&order[i - 1], &order[i]) != Ordering::Greater {
+            continue;
+        }
+        let x = order[i];
+        let mut j = i;
+        while j > 0 && sweep_order(&x, &order[j - 1]) == Ordering::Less {
+            order[j] = order[j - 1];
+            pos[order[j].local as usize] = j as u32;
+            j -= 1;
+        }
+        order[j] = x;
+        pos[x.local as usize] = j as u32;
+        moved += (i - j) as u64;
+        if moved > budget {
+            order.sort_unstable_by(sweep_order);
+            for (p, s) in order.iter().enumerate() {
+                pos[s.local as usize] = p as u32;
+            }
+            break;
+        }
+    }
+    moved
+}
+
+/// Tests `p` (whose `max.x` key is `max`) against the bodies of `others` (sorted) ahead of
+/// it, until one starts past its end along x. Returns the tests.
+#[inline]
+fn scan(p: &Member, max: u64, others: &[Slot], v: SweepView, out: &mut Vec<(u32, u32)>) -> u64 {
+    let mut tested = 0;
+    for s in others {
+        if s.min > max {
+            break;
+        }
+        let q = v.member(s.local);
+        if p.dynamic || q.dynamic {
+            tested += 1;
+            if p.bounds.overlaps(&q.bounds) {
+                out.push((p.handle, q.handle));
+            }
+        }
+    }
+    tested
+}
+
+/// All overlapping pairs within one list with a dynamic body. Returns the tests.
+pub(super) fn sweep_self(v: SweepView, out: &mut Vec<(u32, u32)>) -> u64 {
+    let mut tested = 0;
+    let order = &v.list.order;
+    for (k, s) in order.iter().enumerate() {
+        let rest = &order[k + 1..];
+        // Most bodies overlap nothing ahead: look at the body only when something starts
+        // before its end.
+        if rest.first().is_some_and(|next| next.min <= s.max) {
+            tested += scan(&v.member(s.local), s.max, rest, v, out);
+        }
+    }
+    tested
+}
+
+/// All overlapping pairs with one body from each list (and a dynamic one). When the smaller
+/// list's bodies find few candidates by binary search in the larger (a hundred bullets among
+/// ten thousand asteroids), that is all; otherwise the two lists are walked in merged order,
+/// each body scanning only the other list ahead of it.
+pub(super) fn sweep_cross(
+    x: SweepView,
+    y: SweepView,
+    ranges: &mut Vec<(u32, u32)>,
+    out: &mut Vec<(u32, u32)>,
+) -> u64 {
+    let (small, large) = if x.handles.len() <= y.handles.len() {
+        (x, y)
+    } else {
+        (y, x)
+    };
+    ranges.clear();
+    let mut candidates = 0;
+    for &h in small.handles {
+        let (lo, hi) = x_range(&large.list.order, large.list.width, &x.bodies[h as usize]);
+        candidates += hi - lo;
+        if candidates > large.handles.len() {
+            return sweep_merged(x, y, out);
+        }
+        ranges.push((lo as u32, hi as u32));
+    }
+    let mut tested = 0;
+    for (&h, &(lo, hi)) in small.handles.iter().zip(ranges.iter()) {
+        let q = member(&x.bodies[h as usize], h);
+        for s in &large.list.order[lo as usize..hi as usize] {
+            let m = large.member(s.local);
+            if q.dynamic || m.dynamic {
+                tested += 1;
+                if q.bounds.overlaps(&m.bounds) {
+                    out.push((q.handle, m.handle));
+                }
+            }
+        }
+    }
+    tested
+}
+
+/// The slots of `order` (sorted, none wider than `width`) that can overlap `q` along x:
+/// `order[lo..hi]`. Conservative by a relative margin far above rounding error.
+fn x_range(order: &[Slot], width: f64, q: &BodyEntry) -> (usize, usize) {
+    let q = &q.bounds;
+    if [q.min.x, q.min.y, q.max.x, q.max.y]
+        .iter()
+        .any(|v| v.is_nan())
+    {
+        return (0, 0); // overlaps nothing
+    }
+    // Bodies starting before `lower` end before `q.min.x`.
+    let mut lower = q.min.x - width * (1.0 + 1e-12);
+    lower -= lower.abs() * 1e-12 + f64::MIN_POSITIVE;
+    let (lower, upper) = (order_key(lower), order_key(q.max.x + 0.0));
+    let lo = order.partition_point(|s| s.min < lower);
+    let hi = order.partition_point(|s| s.min <= upper);
+    (lo, hi.max(lo))
+}
+
+/// The merged walk of [`sweep_cross`].
+fn sweep_merged(x: SweepView, y: SweepView, out: &mut Vec<(u32, u32)>) -> u64 {
+    let mut tested = 0;
+    let (xs, ys) = (&x.list.order, &y.list.order);
+    let (mut i, mut j) = (0, 0);
+    while i < xs.len() && j < ys.len() {
+        if xs[i].min <= ys[j].min {
+            if ys[j].min <= xs[i].max {
+                tested += scan(&x.member(xs[i].local), xs[i].max, &ys[j..], y, out);
+            }
+            i += 1;
+        } else {
+            if xs[i].min <= ys[j].max {
+                tested += scan(&y.member(ys[j].local), ys[j].max, &xs[i..], x, out);
+            }
+            j += 1;
+        }
+    }
+    tested
+}

@@ -1,0 +1,119 @@
+//! Counting the moving bodies per layer, and grouping them by layer from the counts.
+
+use crate::def::BodyKind;
+
+use super::{BodyEntry, BroadPhase, LAYERS};
+
+impl BroadPhase {
+    /// Groups the moving bodies by layer (a counting sort, so key order is kept within),
+    /// once `layer_start[l + 1]` holds layer `l`'s count.
+    pub(super) fn group_movers(
+        &mut self,
+        bodies: &[BodyEntry],
+        moving: impl Fn(&BodyEntry) -> bool,
+    ) {
+        let counts = &mut self.layer_start;
+        self.mover_layers.clear();
+        for l in 0..LAYERS {
+            if counts[l + 1] > 0 {
+                self.mover_layers.push(l as u8);
+            }
+            counts[l + 1] += counts[l];
+        }
+        self.movers.clear();
+        self.movers.resize(counts[LAYERS] as usize, 0);
+        let mut next: [u32; LAYERS] = [0; LAYERS];
+        next.copy_from_slice(&counts[..LAYERS]);
+        if self.runs.len() <= MAX_RUNS {
+            // Bodies of a layer usually come in a few runs of consecutive indices.
+            for &(start, len, layer) in &self.runs {
+                let at = &mut next[usize::from(layer)];
+                let dst = &mut self.movers[*at as usize..(*at + len) as usize];
+                for (d, i) in dst.iter_mut().zip(start..) {
+                    *d = i;
+                }
+                *at += len;
+            }
+            return;
+        }
+        // Too many runs: scatter body by body, the current layer's cursor in a register.
+        let (mut layer, mut at) = (0, next[0]);
+        for (i, b) in bodies.iter().enumerate() {
+            if !moving(b) {
+                continue;
+            }
+            let l = usize::from(b.layer);
+            if l != layer {
+                next[layer] = at;
+                layer = l;
+                at = next[l];
+            }
+            self.movers[at as usize] = i as u32;
+            at += 1;
+        }
+    }
+}
+
+/// Counts moving bodies per layer (into `counts[layer + 1]`) and dynamic ones (into
+/// `dynamic[layer]`), a run of one layer in registers, and notes the runs of consecutive
+/// indices (up to [`MAX_RUNS`], and one more to say there were more).
+pub(super) struct Tally<'a> {
+    counts: &'a mut [u32],
+    dynamic: &'a mut [u32],
+    runs: &'a mut Vec<(u32, u32, u8)>,
+    /// The current run: its layer, first index, bodies and dynamic bodies.
+    layer: usize,
+    start: u32,
+    n: u32,
+    d: u32,
+}
+
+/// How many runs of consecutive indices [`Tally`] notes before giving up on them.
+pub(super) const MAX_RUNS: usize = 64;
+
+impl<'a> Tally<'a> {
+    /// Starts a tally into `counts`, `dynamic` and `runs`, which it clears.
+    pub(super) fn new(
+        counts: &'a mut [u32],
+        dynamic: &'a mut [u32],
+        runs: &'a mut Vec<(u32, u32, u8)>,
+    ) -> Tally<'a> {
+        counts.fill(0);
+        dynamic.fill(0);
+        runs.clear();
+        Tally {
+            counts,
+            dynamic,
+            runs,
+            layer: 0,
+            start: 0,
+            n: 0,
+            d: 0,
+        }
+    }
+
+    /// Counts body `b`, at index `i`.
+    #[inline]
+    pub(super) fn add(&mut self, b: &BodyEntry, i: u32) {
+        let l = usize::from(b.layer);
+        if l != self.layer || i != self.start + self.n {
+            self.flush();
+            (self.layer, self.start) = (l, i);
+        }
+        self.n += 1;
+        self.d += u32::from(b.kind == BodyKind::Dynamic);
+    }
+
+    /// Adds the current run to the counts; call once after the last [`Tally::add`].
+    pub(super) fn flush(&mut self) {
+        if self.n == 0 {
+            return;
+        }
+        self.counts[self.layer + 1] += self.n;
+        self.dynamic[self.layer] += self.d;
+        if self.runs.len() <= MAX_RUNS {
+            self.runs.push((self.start, self.n, self.layer as u8));
+        }
+        (self.n, self.d) = (0, 0);
+    }
+}
