@@ -43,6 +43,14 @@ pub struct ScenarioFile {
     pub script: Vec<Spanned<EventFile>>,
 }
 
+/// One `[[bodies]]` table parsed on its own (see `chunks.rs`).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodyTable {
+    /// The one body of the table.
+    pub bodies: Vec<Spanned<BodyFile>>,
+}
+
 /// `[world]`.
 #[derive(Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -3,6 +3,7 @@
 //! `file:line:column`, the field, and what was expected.
 
 mod bodies;
+mod chunks;
 mod context;
 pub(crate) mod file;
 mod script;
@@ -12,21 +13,59 @@ use std::collections::BTreeMap;
 
 use crate::scenario::Scenario;
 use bodies::{MAX_SPLIT_BODIES, SplitProblem, body_def, merge, references, split_problem};
+use chunks::split_bodies;
 pub use context::ScenarioError;
 use context::{Ctx, unknown};
-use file::ScenarioFile;
+use file::{BodyFile, BodyTable, ScenarioFile};
 use script::script;
+use std::ops::Range;
 use toml::Spanned;
 use world::world_settings;
 
 /// Parses and checks a scenario. `file` is only used in error messages.
 pub fn load_scenario(text: &str, file: &str) -> Result<Scenario, ScenarioError> {
     let ctx = Ctx { file, text };
-    let raw: ScenarioFile = toml::from_str(text).map_err(|e| {
-        let span = e.span().unwrap_or(0..0);
+    let syntax = |e: toml::de::Error, offset: usize| {
+        let span = e
+            .span()
+            .map_or(offset..offset, |r| r.start + offset..r.end + offset);
         let field = ctx.field_at(span.start);
         ctx.err(span, field, e.message().trim_end().to_owned())
-    })?;
+    };
+    // `[[bodies]]` tables are parsed one at a time, below; the rest now.
+    let (raw, chunks): (ScenarioFile, Vec<Range<usize>>) = match split_bodies(text) {
+        Some((skeleton, chunks)) => {
+            let raw: ScenarioFile = toml::from_str(&skeleton).map_err(|e| syntax(e, 0))?;
+            if !raw.bodies.is_empty() {
+                // Bodies written both ways (an unusual header spelling): parse it all.
+                (toml::from_str(text).map_err(|e| syntax(e, 0))?, Vec::new())
+            } else {
+                (raw, chunks)
+            }
+        }
+        None => (toml::from_str(text).map_err(|e| syntax(e, 0))?, Vec::new()),
+    };
+    let body_at = |k: usize| -> Result<Spanned<BodyFile>, ScenarioError> {
+        let Some(c) = chunks.get(k) else {
+            return Ok(raw.bodies[k].clone());
+        };
+        let parsed: BodyTable = toml::from_str(&text[c.clone()]).map_err(|e| syntax(e, c.start))?;
+        let body = parsed
+            .bodies
+            .into_iter()
+            .next()
+            .unwrap_or_else(|| Spanned::new(0..0, BodyFile::default()));
+        let span = body.span();
+        Ok(Spanned::new(
+            span.start + c.start..span.end + c.start,
+            body.into_inner(),
+        ))
+    };
+    let n_bodies = if chunks.is_empty() {
+        raw.bodies.len()
+    } else {
+        chunks.len()
+    };
     let (world, frames) = world_settings(&ctx, &raw)?;
     let mut templates = BTreeMap::new();
     for (name, t) in &raw.templates {
@@ -71,8 +110,9 @@ pub fn load_scenario(text: &str, file: &str) -> Result<Scenario, ScenarioError> 
         };
         return Err(ctx.err(span, format!("templates.{name}.split"), problem));
     }
-    let mut bodies = Vec::with_capacity(raw.bodies.len());
-    for (i, b) in raw.bodies.iter().enumerate() {
+    let mut bodies = Vec::with_capacity(n_bodies);
+    for i in 0..n_bodies {
+        let b = &body_at(i)?;
         let field = format!("bodies[{i}]");
         let merged = match &b.get_ref().template {
             None => b.get_ref().clone(),
