@@ -8,6 +8,7 @@ mod accuracy;
 mod bench;
 mod collide;
 mod diff;
+mod events;
 mod record;
 mod run;
 mod scene;

@@ -31,10 +31,12 @@
 pub mod broad_phase;
 mod def;
 mod entity;
+mod event;
 mod output;
 mod pipeline;
 mod scenario;
 mod scenario_file;
+mod stage_set;
 mod stages;
 mod world;
 
@@ -43,7 +45,9 @@ pub use def::{
     Split, WorldBounds, WorldDef,
 };
 pub use entity::{Entity, EntityAllocator};
-pub use output::{ContactRecord, EventRecord, FrameOutput, Phase, RemovedBody, Stats};
+pub use event::{FireOutcome, GameEvent, JumpOutcome, Removal, ScriptInput};
+pub use output::{ContactRecord, FrameOutput, Phase, RemovedBody, Stats};
 pub use pipeline::{SLOP, Simulation};
 pub use scenario::{Scenario, ScenarioError, load_scenario};
+pub use stage_set::{Stage, StageSet};
 pub use world::{Inputs, World};

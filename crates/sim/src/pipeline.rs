@@ -29,6 +29,7 @@ use std::collections::BTreeMap;
 use crate::def::{BodyDef, Event};
 use crate::output::FrameOutput;
 use crate::scenario::Scenario;
+use crate::stage_set::Stage as StageId;
 use crate::stages;
 use crate::stages::detect::DetectState;
 use crate::stages::separate::SeparateState;
@@ -40,7 +41,7 @@ pub const SLOP: f64 = 1e-9;
 
 /// A stage: a plain function over the simulation, with a test of whether it has work.
 pub(crate) struct Stage {
-    pub name: &'static str,
+    pub id: StageId,
     pub has_work: fn(&Simulation) -> bool,
     pub run: fn(&mut Simulation, &mut FrameOutput),
 }
@@ -48,72 +49,72 @@ pub(crate) struct Stage {
 /// The stage order. See the module docs.
 pub(crate) const STAGES: [Stage; 14] = [
     Stage {
-        name: "script",
+        id: StageId::Script,
         has_work: stages::script::has_work,
         run: stages::script::run,
     },
     Stage {
-        name: "cull",
+        id: StageId::Cull,
         has_work: stages::rest::has_region,
         run: stages::rest::cull,
     },
     Stage {
-        name: "unground",
+        id: StageId::Unground,
         has_work: stages::motion::has_grounded,
         run: stages::motion::unground,
     },
     Stage {
-        name: "controls",
+        id: StageId::Controls,
         has_work: stages::motion::has_controls,
         run: stages::motion::controls,
     },
     Stage {
-        name: "forces",
+        id: StageId::Forces,
         has_work: stages::motion::has_forces,
         run: stages::motion::forces,
     },
     Stage {
-        name: "move_x",
+        id: StageId::MoveX,
         has_work: stages::motion::has_motion,
         run: stages::motion::move_x,
     },
     Stage {
-        name: "resolve_x",
+        id: StageId::ResolveX,
         has_work: stages::separate::has_work,
         run: stages::separate::resolve_x,
     },
     Stage {
-        name: "move_y",
+        id: StageId::MoveY,
         has_work: stages::motion::has_motion,
         run: stages::motion::move_y,
     },
     Stage {
-        name: "resolve_y",
+        id: StageId::ResolveY,
         has_work: stages::separate::has_work,
         run: stages::separate::resolve_y,
     },
     Stage {
-        name: "turn",
+        id: StageId::Turn,
         has_work: stages::motion::has_turning,
         run: stages::motion::turn,
     },
     Stage {
-        name: "detect",
+        id: StageId::Detect,
         has_work: stages::detect::has_work,
         run: stages::detect::run,
     },
     Stage {
-        name: "lifetimes",
+        id: StageId::Lifetimes,
         has_work: stages::lifetimes::has_work,
         run: stages::lifetimes::run,
     },
     Stage {
-        name: "bounds",
+        id: StageId::Bounds,
         has_work: stages::bounds::has_work,
         run: stages::bounds::run,
     },
     Stage {
-        name: "sleep",
+        id: StageId::Sleep,
         has_work: stages::rest::has_sleep,
         run: stages::rest::sleep,
     },
@@ -122,7 +123,12 @@ pub(crate) const STAGES: [Stage; 14] = [
 /// The stages frame 0 runs: the initial state is scripted and checked, never moved. Lifetimes
 /// count frame 0, so a body lives `lifetime` frames whether it starts there or is spawned
 /// later.
-const FRAME_ZERO: [&str; 4] = ["script", "cull", "detect", "lifetimes"];
+const FRAME_ZERO: [StageId; 4] = [
+    StageId::Script,
+    StageId::Cull,
+    StageId::Detect,
+    StageId::Lifetimes,
+];
 
 /// A running simulation.
 pub struct Simulation {
@@ -241,12 +247,12 @@ impl Simulation {
             }
         }
         for stage in &STAGES {
-            let allowed = self.frame > 0 || FRAME_ZERO.contains(&stage.name);
+            let allowed = self.frame > 0 || FRAME_ZERO.contains(&stage.id);
             if allowed && (stage.has_work)(self) {
                 (stage.run)(self, &mut out);
-                out.stats.stages_run.push(stage.name);
+                out.stats.stages_run.insert(stage.id);
             } else {
-                out.stats.stages_skipped.push(stage.name);
+                out.stats.stages_skipped.insert(stage.id);
             }
         }
         out.stats.bodies = self.world.len();

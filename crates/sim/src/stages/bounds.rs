@@ -1,5 +1,6 @@
 //! The `bounds` stage: wrap around (Asteroids), or remove bodies that left the world.
 
+use crate::event::Removal;
 use crate::output::FrameOutput;
 use crate::pipeline::Simulation;
 use crate::stages::remove::remove;
@@ -35,6 +36,6 @@ pub(crate) fn run(sim: &mut Simulation, out: &mut FrameOutput) {
         }
     }
     for e in gone {
-        remove(sim, out, e, "destroy", "left the world", false);
+        remove(sim, out, e, Removal::LeftWorld, false);
     }
 }

@@ -28,7 +28,8 @@ use ricochet_geom::{Contact, Pose, Shape, Vec2, contact};
 use crate::broad_phase::{BodyEntry, BroadPhase, BroadPhaseKind, Interactions};
 use crate::def::{BodyKind, Doomed, Layers, Response};
 use crate::entity::Entity;
-use crate::output::{ContactRecord, EventRecord, FrameOutput, Phase};
+use crate::event::{GameEvent, Removal};
+use crate::output::{ContactRecord, FrameOutput, Phase};
 use crate::pipeline::{SLOP, Simulation};
 use crate::stages::remove::remove;
 use crate::stages::separate::is_box;
@@ -55,6 +56,8 @@ pub(crate) struct DetectState {
     statics: Vec<BodyEntry>,
     movers: Vec<BodyEntry>,
     pairs: Vec<(u32, u32)>,
+    /// Narrow-phase tests per layer pair this frame, `[a * n + b]`.
+    tests: Vec<u64>,
 }
 
 impl DetectState {
@@ -73,6 +76,7 @@ impl DetectState {
             statics: Vec::new(),
             movers: Vec::new(),
             pairs: Vec::new(),
+            tests: vec![0; n * n],
         }
     }
 }
@@ -121,7 +125,7 @@ fn candidate_pairs(sim: &mut Simulation, out: &mut FrameOutput) -> Vec<(u32, u32
         &mut pairs,
     );
     st.static_generation = Some(generation);
-    out.stats.broad_phase = bp.kind.name();
+    out.stats.broad_phase = Some(bp.kind);
     out.stats.layer_pairs_skipped += bp.layer_pairs_skipped;
     pairs
 }
@@ -133,10 +137,11 @@ pub(crate) fn run(sim: &mut Simulation, out: &mut FrameOutput) {
         out.detect_poses = Some((0..w.len()).map(|i| (w.entity[i], w.pose(i))).collect());
     }
     let pairs = candidate_pairs(sim, out);
-    // Tests per layer pair, counted in a flat table and named once at the end.
+    // Tests per layer pair, counted in a flat table and listed once at the end.
     let n_layers = layers.names().len();
-    let mut per_layer_pair = vec![0u64; n_layers * n_layers];
-    let mut doomed: Vec<(Entity, String)> = Vec::new();
+    let mut per_layer_pair = std::mem::take(&mut sim.detect.tests);
+    // Each doomed body with the body that hit it.
+    let mut doomed: Vec<(Entity, Entity)> = Vec::new();
     let mut swept: Vec<(usize, usize)> = Vec::new();
     let mut woken: Vec<usize> = Vec::new();
     for &(i, j) in &pairs {
@@ -181,21 +186,23 @@ pub(crate) fn run(sim: &mut Simulation, out: &mut FrameOutput) {
         );
     }
     sim.detect.pairs = pairs;
-    for (k, &count) in per_layer_pair.iter().enumerate() {
-        if count > 0 {
+    for (k, count) in per_layer_pair.iter_mut().enumerate() {
+        if *count > 0 {
             let (la, lb) = ((k / n_layers) as u8, (k % n_layers) as u8);
-            let name = format!("{}/{}", layers.name(la), layers.name(lb));
-            out.stats.tests_by_layer_pair.insert(name, count);
+            out.stats.tests_by_layer_pair.push(((la, lb), *count));
+            *count = 0;
         }
     }
+    sim.detect.tests = per_layer_pair;
     run_swept(sim, out, &mut doomed, &swept, &layers, &mut woken);
     for i in woken {
         sim.world.wake(i);
     }
-    doomed.sort();
+    // In id order; a body hit twice is destroyed by the first hit found.
+    doomed.sort_by_key(|(e, _)| *e);
     doomed.dedup_by_key(|(e, _)| *e);
-    for (e, why) in doomed {
-        remove(sim, out, e, "destroy", &why, true);
+    for (e, by) in doomed {
+        remove(sim, out, e, Removal::HitBy(by), true);
     }
 }
 
@@ -205,7 +212,7 @@ pub(crate) fn run(sim: &mut Simulation, out: &mut FrameOutput) {
 fn run_swept(
     sim: &mut Simulation,
     out: &mut FrameOutput,
-    doomed: &mut Vec<(Entity, String)>,
+    doomed: &mut Vec<(Entity, Entity)>,
     swept: &[(usize, usize)],
     layers: &Layers,
     woken: &mut Vec<usize>,
@@ -377,7 +384,7 @@ fn first_touch(gap: impl Fn(f64) -> f64, speed: f64, tol: f64) -> Option<f64> {
 fn respond(
     sim: &mut Simulation,
     out: &mut FrameOutput,
-    doomed: &mut Vec<(Entity, String)>,
+    doomed: &mut Vec<(Entity, Entity)>,
     (i, j): (usize, usize),
     response: Response,
     phase: Phase,
@@ -387,26 +394,27 @@ fn respond(
     let w = &sim.world;
     let mut resolved = Vec2::ZERO;
     let (ea, eb) = (w.entity[i], w.entity[j]);
-    let (na, nb) = (w.name[i].clone(), w.name[j].clone());
     match response {
         Response::Ignore => {}
-        Response::Report => out.events.push(EventRecord {
-            kind: "contact",
-            message: format!("{na} #{ea} touches {nb} #{eb}, depth {}", c.depth),
+        Response::Report => out.events.push(GameEvent::Contact {
+            a: ea,
+            b: eb,
+            depth: c.depth,
         }),
         Response::Destroy(which) => {
             if matches!(which, Doomed::First | Doomed::Both) {
-                doomed.push((ea, format!("hit by {nb} #{eb}")));
+                doomed.push((ea, eb));
             }
             if matches!(which, Doomed::Second | Doomed::Both) {
-                doomed.push((eb, format!("hit by {na} #{ea}")));
+                doomed.push((eb, ea));
             }
         }
         Response::Separate => {
             resolved = separate_along_normal(sim, i, j, c.normal, c.depth);
-            out.events.push(EventRecord {
-                kind: "hit",
-                message: format!("{na} #{ea} and {nb} #{eb} pushed apart by {}", c.depth),
+            out.events.push(GameEvent::PushedApart {
+                a: ea,
+                b: eb,
+                depth: c.depth,
             });
         }
     }

@@ -1,6 +1,7 @@
 //! The `lifetimes` stage: bodies with a lifetime are removed when it runs out. A frozen
 //! body's lifetime is paused with the rest of it.
 
+use crate::event::Removal;
 use crate::output::FrameOutput;
 use crate::pipeline::Simulation;
 use crate::stages::remove::remove;
@@ -24,6 +25,6 @@ pub(crate) fn run(sim: &mut Simulation, out: &mut FrameOutput) {
         }
     }
     for e in expired {
-        remove(sim, out, e, "expire", "expired", false);
+        remove(sim, out, e, Removal::Expired, false);
     }
 }

@@ -2,7 +2,8 @@
 //! the children of a split.
 
 use crate::entity::Entity;
-use crate::output::{EventRecord, FrameOutput, RemovedBody};
+use crate::event::{GameEvent, Removal};
+use crate::output::{FrameOutput, RemovedBody};
 use crate::pipeline::Simulation;
 
 /// Removes `entity` if it is still alive, records it, and, with `split`, spawns its children
@@ -11,8 +12,7 @@ pub(crate) fn remove(
     sim: &mut Simulation,
     out: &mut FrameOutput,
     entity: Entity,
-    kind: &'static str,
-    why: &str,
+    cause: Removal,
     split: bool,
 ) {
     let Some(i) = sim.world.index_of(entity) else {
@@ -28,9 +28,9 @@ pub(crate) fn remove(
         velocity: w.velocity[i],
         kind: w.kind[i],
     };
-    out.events.push(EventRecord {
-        kind,
-        message: format!("{} #{} {why}", removed.name, entity),
+    out.events.push(GameEvent::Removed {
+        body: entity,
+        cause,
     });
     let children = if split {
         std::mem::take(&mut sim.world.split[i])
@@ -46,9 +46,9 @@ pub(crate) fn remove(
         def.position = removed.pose.position + child.offset;
         def.velocity = removed.velocity + child.velocity;
         let e = sim.world.spawn(&def);
-        out.events.push(EventRecord {
-            kind: "spawn",
-            message: format!("{} #{e} split from {} #{entity}", def.name, removed.name),
+        out.events.push(GameEvent::SplitFrom {
+            child: e,
+            parent: entity,
         });
     }
     out.removed.push(removed);

@@ -3,7 +3,8 @@
 use ricochet_geom::Vec2;
 
 use crate::def::{Action, BodyKind, Controller};
-use crate::output::{EventRecord, FrameOutput};
+use crate::event::{FireOutcome, GameEvent, JumpOutcome, Removal, ScriptInput};
+use crate::output::FrameOutput;
 use crate::pipeline::Simulation;
 use crate::stages::remove::remove;
 
@@ -12,21 +13,23 @@ pub(crate) fn has_work(sim: &Simulation) -> bool {
 }
 
 pub(crate) fn run(sim: &mut Simulation, out: &mut FrameOutput) {
-    let events = sim.due_events().to_vec();
-    sim.cursor += events.len();
-    for event in &events {
-        apply(sim, out, &event.action);
+    let start = sim.cursor;
+    sim.cursor += sim.due_events().len();
+    for k in start..sim.cursor {
+        apply(sim, out, k);
     }
     // A body an event named was woken: it moves this frame.
     sim.world.refresh_active();
 }
 
-fn apply(sim: &mut Simulation, out: &mut FrameOutput, action: &Action) {
+/// Applies script event `k`.
+fn apply(sim: &mut Simulation, out: &mut FrameOutput, k: usize) {
+    let action = &sim.scenario.script[k].action;
     if let Action::Spawn { body, template } = action {
         let e = sim.world.spawn(body);
-        out.events.push(EventRecord {
-            kind: "spawn",
-            message: format!("{} #{e} spawned from template {template}", body.name),
+        out.events.push(GameEvent::Spawned {
+            body: e,
+            template: template.clone(),
         });
         return;
     }
@@ -43,76 +46,69 @@ fn apply(sim: &mut Simulation, out: &mut FrameOutput, action: &Action) {
         | Action::Jump { body } => body,
     };
     let Some(i) = sim.world.find(name) else {
-        out.events.push(EventRecord {
-            kind: "missed",
-            message: format!("{}: no body named {name} is alive", action.name()),
+        out.events.push(GameEvent::Missed {
+            action: action.name(),
+            name: name.clone(),
         });
         return;
     };
     let entity = sim.world.entity[i];
     sim.world.wake(i);
     let w = &mut sim.world;
-    let what = match action {
+    let input = match action {
         Action::Destroy { .. } => {
-            remove(
-                sim,
-                out,
-                entity,
-                "destroy",
-                "destroyed by the script",
-                false,
-            );
+            remove(sim, out, entity, Removal::Script, false);
             return;
         }
         Action::SetVelocity { velocity, .. } => {
             if w.kind[i] != BodyKind::Static {
                 w.velocity[i] = *velocity;
             }
-            format!("velocity set to [{}, {}]", velocity.x, velocity.y)
+            ScriptInput::Velocity(*velocity)
         }
         Action::ApplyImpulse { impulse, .. } => {
             if w.kind[i] == BodyKind::Dynamic {
                 w.velocity[i] += *impulse / w.mass[i];
             }
-            format!("impulse [{}, {}]", impulse.x, impulse.y)
+            ScriptInput::Impulse(*impulse)
         }
         Action::SetForce { force, .. } => {
             w.force[i] = *force;
-            format!("force set to [{}, {}]", force.x, force.y)
+            ScriptInput::Force(*force)
         }
         Action::Thrust { on, .. } => {
             w.inputs[i].thrust = *on;
-            format!("thrust {}", if *on { "on" } else { "off" })
+            ScriptInput::Thrust(*on)
         }
         Action::Turn { input, .. } => {
             w.inputs[i].turn = *input;
-            format!("turn {input}")
+            ScriptInput::Turn(*input)
         }
         Action::Move { input, .. } => {
             w.inputs[i].run = *input;
-            format!("move {input}")
+            ScriptInput::Move(*input)
         }
-        Action::Jump { .. } => match &w.controller[i] {
+        Action::Jump { .. } => ScriptInput::Jump(match &w.controller[i] {
             Some(Controller::Runner { jump_speed, .. }) if w.grounded[i] => {
                 w.velocity[i].y = *jump_speed;
                 w.grounded[i] = false;
-                "jump".to_owned()
+                JumpOutcome::Jumped
             }
-            Some(Controller::Runner { .. }) => "jump ignored: not grounded".to_owned(),
-            _ => "jump ignored: not a runner".to_owned(),
-        },
-        Action::Fire { .. } => fire(sim, out, i),
+            Some(Controller::Runner { .. }) => JumpOutcome::NotGrounded,
+            _ => JumpOutcome::NotARunner,
+        }),
+        Action::Fire { .. } => ScriptInput::Fire(fire(sim, out, i)),
         Action::Spawn { .. } => unreachable!("handled above"),
     };
-    out.events.push(EventRecord {
-        kind: "input",
-        message: format!("{name} #{entity}: {what}"),
+    out.events.push(GameEvent::Input {
+        body: entity,
+        input,
     });
 }
 
 /// A ship fires: its bullet template appears `muzzle` ahead, moving at the ship's velocity
 /// plus `bullet_speed` along the heading.
-fn fire(sim: &mut Simulation, out: &mut FrameOutput, i: usize) -> String {
+fn fire(sim: &mut Simulation, out: &mut FrameOutput, i: usize) -> FireOutcome {
     let w = &sim.world;
     let Some(Controller::Ship {
         bullet,
@@ -121,10 +117,10 @@ fn fire(sim: &mut Simulation, out: &mut FrameOutput, i: usize) -> String {
         ..
     }) = &w.controller[i]
     else {
-        return "fire ignored: not a ship".to_owned();
+        return FireOutcome::NotAShip;
     };
     let Some(template) = sim.templates.get(bullet) else {
-        return format!("fire ignored: no template {bullet}");
+        return FireOutcome::NoTemplate(bullet.clone());
     };
     let (s, c) = libm::sincos(w.angle[i]);
     let heading = Vec2::new(c, s);
@@ -132,10 +128,8 @@ fn fire(sim: &mut Simulation, out: &mut FrameOutput, i: usize) -> String {
     def.position = w.position[i] + heading * *muzzle;
     def.velocity = w.velocity[i] + heading * *bullet_speed;
     def.angle = w.angle[i];
-    let e = sim.world.spawn(&def);
-    out.events.push(EventRecord {
-        kind: "spawn",
-        message: format!("{} #{e} fired", def.name),
-    });
-    "fire".to_owned()
+    let ship = w.entity[i];
+    let bullet = sim.world.spawn(&def);
+    out.events.push(GameEvent::Fired { bullet, ship });
+    FireOutcome::Fired
 }

@@ -22,7 +22,8 @@ use ricochet_geom::{Bounds, Primitive, Shape, Vec2, contact};
 use crate::broad_phase::{FixedGrid, cell_coord};
 use crate::def::{BodyKind, Controller, LayerId, Layers, Response};
 use crate::entity::Entity;
-use crate::output::{ContactRecord, EventRecord, FrameOutput, Phase};
+use crate::event::GameEvent;
+use crate::output::{ContactRecord, FrameOutput, Phase};
 use crate::pipeline::{SLOP, Simulation};
 use crate::world::World;
 
@@ -62,6 +63,12 @@ pub(crate) struct SeparateState {
     static_entities: Vec<(Entity, LayerId)>,
     movers: MoverGrid,
     found: Vec<Obstacle>,
+    /// The pass's dynamic boxes, `(lowest coordinate along the axis, dense index)`.
+    order: Vec<(f64, u32)>,
+    /// Their larger sides, for the mover grid's cell size.
+    extents: Vec<f64>,
+    /// Sleeping boxes pushed against, woken after the pass.
+    woken: Vec<usize>,
 }
 
 /// A box that may stop the one being settled: its dense index, bounds and layer (static
@@ -187,8 +194,10 @@ fn resolve(sim: &mut Simulation, out: &mut FrameOutput, axis: usize) {
     // Dynamic boxes settle in order along the axis, lowest (or leftmost) first, and a settled
     // box is solid to the ones after it: a stack resolves bottom-up in one pass, each box
     // landing flush on the one below, with no box pushed back into what held it.
-    let mut order: Vec<(f64, u32)> = Vec::new();
-    let mut extents: Vec<f64> = Vec::new();
+    let mut order = std::mem::take(&mut st.order);
+    let mut extents = std::mem::take(&mut st.extents);
+    order.clear();
+    extents.clear();
     for &i in w.movers() {
         let k = i as usize;
         if !is_box(&w.shape[k]) || w.frozen[k] || !st.separating[usize::from(w.layer[k])] {
@@ -215,7 +224,7 @@ fn resolve(sim: &mut Simulation, out: &mut FrameOutput, axis: usize) {
     }
     let first = out.contacts.len();
     let mut found = std::mem::take(&mut st.found);
-    let mut woken = Vec::new();
+    let mut woken = std::mem::take(&mut st.woken);
     for &(_, i) in &order {
         let i = i as usize;
         // One lookup usually does: it covers the box moved by up to its own size along the
@@ -278,17 +287,11 @@ fn resolve(sim: &mut Simulation, out: &mut FrameOutput, axis: usize) {
                     response: Response::Separate,
                     resolved: moved,
                 });
-                out.events.push(EventRecord {
-                    kind: if axis == 0 { "hit_x" } else { "hit_y" },
-                    message: format!(
-                        "{} #{} pushed {} by {} out of {} #{}",
-                        w.name[i],
-                        w.entity[i],
-                        if axis == 0 { "along x" } else { "along y" },
-                        moved[axis],
-                        w.name[j],
-                        w.entity[j]
-                    ),
+                out.events.push(GameEvent::PushedOut {
+                    body: w.entity[i],
+                    axis: axis as u8,
+                    by: moved[axis],
+                    obstacle: w.entity[j],
                 });
                 // The box moved: go on from the next obstacle, at its new place.
                 continue 'look;
@@ -297,10 +300,13 @@ fn resolve(sim: &mut Simulation, out: &mut FrameOutput, axis: usize) {
         }
         st.movers.insert(&box_bounds(&sim.world, i), i as u32);
     }
-    for j in woken {
+    for j in woken.drain(..) {
         sim.world.wake(j);
     }
     st.found = found;
+    st.order = order;
+    st.extents = extents;
+    st.woken = woken;
     sim.separate = st;
     // The log's convention: a pass's contacts sorted by (a, b).
     out.contacts[first..].sort_by_key(|c| (c.a, c.b));
