@@ -47,7 +47,8 @@ pub use def::{
 pub use entity::{Entity, EntityAllocator};
 pub use event::{FireOutcome, GameEvent, JumpOutcome, Removal, ScriptInput};
 pub use output::{ContactRecord, FrameOutput, Phase, RemovedBody, Stats};
-pub use pipeline::{SLOP, Simulation};
+pub use pipeline::Simulation;
 pub use scenario::{Scenario, ScenarioError, load_scenario};
 pub use stage_set::{Stage, StageSet};
+pub use stages::SLOP;
 pub use world::{Inputs, World};

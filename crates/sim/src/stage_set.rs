@@ -74,6 +74,7 @@ impl Stage {
         }
     }
 
+    /// The stage's bit in a [`StageSet`].
     fn bit(self) -> u16 {
         1 << self as u16
     }

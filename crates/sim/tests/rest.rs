@@ -1,5 +1,5 @@
-//! Skipping bodies nothing is happening to (`crates/sim/src/stages/rest.rs`): the `cull`
-//! stage (the active region) and the `sleep` stage.
+//! Skipping bodies nothing is happening to (`crates/sim/src/stages/cull.rs` and
+//! `sleep.rs`): the `cull` stage (the active region) and the `sleep` stage.
 //!
 //! Both are optimisations: they must never change what happens to a body that is simulated.
 //! So the expected values here come from the same scene run without the feature (frame by

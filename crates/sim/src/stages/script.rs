@@ -2,32 +2,25 @@
 
 use ricochet_geom::Vec2;
 
-use crate::def::{Action, BodyKind, Controller};
+use crate::def::{Action, BodyKind, Controller, Event};
 use crate::event::{FireOutcome, GameEvent, JumpOutcome, Removal, ScriptInput};
-use crate::output::FrameOutput;
-use crate::pipeline::Simulation;
+use crate::stages::StageCtx;
 use crate::stages::remove::remove;
 
-pub(crate) fn has_work(sim: &Simulation) -> bool {
-    !sim.due_events().is_empty()
-}
-
-pub(crate) fn run(sim: &mut Simulation, out: &mut FrameOutput) {
-    let start = sim.cursor;
-    sim.cursor += sim.due_events().len();
-    for k in start..sim.cursor {
-        apply(sim, out, k);
+/// Applies `due`, the script events of this frame.
+pub(crate) fn run(ctx: &mut StageCtx, due: &[Event]) {
+    for event in due {
+        apply(ctx, &event.action);
     }
     // A body an event named was woken: it moves this frame.
-    sim.world.refresh_active();
+    ctx.world.refresh_active();
 }
 
-/// Applies script event `k`.
-fn apply(sim: &mut Simulation, out: &mut FrameOutput, k: usize) {
-    let action = &sim.scenario.script[k].action;
+/// Applies one script action and records what it did.
+fn apply(ctx: &mut StageCtx, action: &Action) {
     if let Action::Spawn { body, template } = action {
-        let e = sim.world.spawn(body);
-        out.events.push(GameEvent::Spawned {
+        let e = ctx.world.spawn(body);
+        ctx.out.events.push(GameEvent::Spawned {
             body: e,
             template: template.clone(),
         });
@@ -45,19 +38,19 @@ fn apply(sim: &mut Simulation, out: &mut FrameOutput, k: usize) {
         | Action::Move { body, .. }
         | Action::Jump { body } => body,
     };
-    let Some(i) = sim.world.find(name) else {
-        out.events.push(GameEvent::Missed {
+    let Some(i) = ctx.world.find(name) else {
+        ctx.out.events.push(GameEvent::Missed {
             action: action.name(),
             name: name.clone(),
         });
         return;
     };
-    let entity = sim.world.entity[i];
-    sim.world.wake(i);
-    let w = &mut sim.world;
+    let entity = ctx.world.entity[i];
+    ctx.world.wake(i);
+    let w = &mut *ctx.world;
     let input = match action {
         Action::Destroy { .. } => {
-            remove(sim, out, entity, Removal::Script, false);
+            remove(ctx, entity, Removal::Script, false);
             return;
         }
         Action::SetVelocity { velocity, .. } => {
@@ -97,10 +90,10 @@ fn apply(sim: &mut Simulation, out: &mut FrameOutput, k: usize) {
             Some(Controller::Runner { .. }) => JumpOutcome::NotGrounded,
             _ => JumpOutcome::NotARunner,
         }),
-        Action::Fire { .. } => ScriptInput::Fire(fire(sim, out, i)),
+        Action::Fire { .. } => ScriptInput::Fire(fire(ctx, i)),
         Action::Spawn { .. } => unreachable!("handled above"),
     };
-    out.events.push(GameEvent::Input {
+    ctx.out.events.push(GameEvent::Input {
         body: entity,
         input,
     });
@@ -108,8 +101,8 @@ fn apply(sim: &mut Simulation, out: &mut FrameOutput, k: usize) {
 
 /// A ship fires: its bullet template appears `muzzle` ahead, moving at the ship's velocity
 /// plus `bullet_speed` along the heading.
-fn fire(sim: &mut Simulation, out: &mut FrameOutput, i: usize) -> FireOutcome {
-    let w = &sim.world;
+fn fire(ctx: &mut StageCtx, i: usize) -> FireOutcome {
+    let w = &mut *ctx.world;
     let Some(Controller::Ship {
         bullet,
         bullet_speed,
@@ -119,7 +112,7 @@ fn fire(sim: &mut Simulation, out: &mut FrameOutput, i: usize) -> FireOutcome {
     else {
         return FireOutcome::NotAShip;
     };
-    let Some(template) = sim.templates.get(bullet) else {
+    let Some(template) = ctx.templates.get(bullet) else {
         return FireOutcome::NoTemplate(bullet.clone());
     };
     let (s, c) = libm::sincos(w.angle[i]);
@@ -129,7 +122,7 @@ fn fire(sim: &mut Simulation, out: &mut FrameOutput, i: usize) -> FireOutcome {
     def.velocity = w.velocity[i] + heading * *bullet_speed;
     def.angle = w.angle[i];
     let ship = w.entity[i];
-    let bullet = sim.world.spawn(&def);
-    out.events.push(GameEvent::Fired { bullet, ship });
+    let bullet = w.spawn(&def);
+    ctx.out.events.push(GameEvent::Fired { bullet, ship });
     FireOutcome::Fired
 }

@@ -23,8 +23,8 @@ use crate::broad_phase::{FixedGrid, cell_coord};
 use crate::def::{BodyKind, Controller, LayerId, Layers, Response};
 use crate::entity::Entity;
 use crate::event::GameEvent;
-use crate::output::{ContactRecord, FrameOutput, Phase};
-use crate::pipeline::{SLOP, Simulation};
+use crate::output::{ContactRecord, Phase};
+use crate::stages::{SLOP, StageCtx};
 use crate::world::World;
 
 /// Whether a shape is resolved per axis: a single axis-aligned box.
@@ -32,21 +32,23 @@ pub(crate) fn is_box(shape: &Shape) -> bool {
     shape.is_single_aabb()
 }
 
-pub(crate) fn has_work(sim: &Simulation) -> bool {
-    let w = &sim.world;
-    sim.separate.any_layer
+/// Whether a layer pair `separate`s and an active dynamic box may need resolving.
+pub(crate) fn has_work(w: &World, st: &SeparateState) -> bool {
+    st.any_layer
         && w.active().iter().any(|&i| {
             let i = i as usize;
             w.kind[i] == BodyKind::Dynamic && is_box(&w.shape[i])
         })
 }
 
-pub(crate) fn resolve_x(sim: &mut Simulation, out: &mut FrameOutput) {
-    resolve(sim, out, 0);
+/// The `resolve_x` stage: the pass along x.
+pub(crate) fn resolve_x(ctx: &mut StageCtx, st: &mut SeparateState) {
+    resolve(ctx, st, 0);
 }
 
-pub(crate) fn resolve_y(sim: &mut Simulation, out: &mut FrameOutput) {
-    resolve(sim, out, 1);
+/// The `resolve_y` stage: the pass along y.
+pub(crate) fn resolve_y(ctx: &mut StageCtx, st: &mut SeparateState) {
+    resolve(ctx, st, 1);
 }
 
 /// What the per-axis stages keep between passes.
@@ -81,6 +83,7 @@ struct Obstacle {
 }
 
 impl SeparateState {
+    /// The state for a scene with these layers.
     pub(crate) fn new(layers: &Layers) -> SeparateState {
         let n = layers.names().len();
         let separating: Vec<bool> = (0..n)
@@ -145,6 +148,7 @@ fn contains(outer: &Bounds, inner: &Bounds) -> bool {
         && inner.max.y <= outer.max.y
 }
 
+/// How much `a` and `b` overlap along `axis` (negative when apart).
 fn overlap(a: &Bounds, b: &Bounds, axis: usize) -> f64 {
     a.max[axis].min(b.max[axis]) - a.min[axis].max(b.min[axis])
 }
@@ -185,12 +189,13 @@ fn obstacles(st: &mut SeparateState, w: &World, q: &Bounds, from: u32, found: &m
     found.dedup_by_key(|o| o.index);
 }
 
-fn resolve(sim: &mut Simulation, out: &mut FrameOutput, axis: usize) {
+/// One per-axis pass: settles every dynamic box along `axis`, lowest first.
+fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
     let phase = if axis == 0 { Phase::X } else { Phase::Y };
-    let mut st = std::mem::take(&mut sim.separate);
-    st.refresh_statics(&sim.world);
-    let w = &sim.world;
-    let layers = &sim.scenario.world.layers;
+    let out = &mut *ctx.out;
+    let layers = &ctx.def.layers;
+    st.refresh_statics(ctx.world);
+    let w = &*ctx.world;
     // Dynamic boxes settle in order along the axis, lowest (or leftmost) first, and a settled
     // box is solid to the ones after it: a stack resolves bottom-up in one pass, each box
     // landing flush on the one below, with no box pushed back into what held it.
@@ -233,7 +238,7 @@ fn resolve(sim: &mut Simulation, out: &mut FrameOutput, axis: usize) {
         let mut region: Option<Bounds> = None;
         let mut next = 0;
         'look: loop {
-            let bi = box_bounds(&sim.world, i);
+            let bi = box_bounds(ctx.world, i);
             if !region.is_some_and(|r| contains(&r, &bi)) {
                 let mut r = bi;
                 let reach = bi.max[axis] - bi.min[axis];
@@ -245,7 +250,7 @@ fn resolve(sim: &mut Simulation, out: &mut FrameOutput, axis: usize) {
                 } else {
                     0
                 };
-                obstacles(&mut st, &sim.world, &r, from, &mut found);
+                obstacles(st, ctx.world, &r, from, &mut found);
                 region = Some(r);
                 next = 0;
             }
@@ -253,7 +258,7 @@ fn resolve(sim: &mut Simulation, out: &mut FrameOutput, axis: usize) {
                 let o = found[next];
                 let (j, bj) = (o.index as usize, o.bounds);
                 next += 1;
-                let w = &sim.world;
+                let w = &*ctx.world;
                 if j == i || layers.response(w.layer[i], o.layer) != Response::Separate {
                     continue;
                 }
@@ -270,7 +275,7 @@ fn resolve(sim: &mut Simulation, out: &mut FrameOutput, axis: usize) {
                     woken.push(j);
                 }
                 let on_static = w.kind[j] == BodyKind::Static;
-                let w = &mut sim.world;
+                let w = &mut *ctx.world;
                 apply_push(w, i, axis, moved[axis]);
                 if axis == 1 && moved[axis] > 0.0 && on_static {
                     w.on_static[i] = true;
@@ -298,16 +303,15 @@ fn resolve(sim: &mut Simulation, out: &mut FrameOutput, axis: usize) {
             }
             break;
         }
-        st.movers.insert(&box_bounds(&sim.world, i), i as u32);
+        st.movers.insert(&box_bounds(ctx.world, i), i as u32);
     }
     for j in woken.drain(..) {
-        sim.world.wake(j);
+        ctx.world.wake(j);
     }
     st.found = found;
     st.order = order;
     st.extents = extents;
     st.woken = woken;
-    sim.separate = st;
     // The log's convention: a pass's contacts sorted by (a, b).
     out.contacts[first..].sort_by_key(|c| (c.a, c.b));
 }
