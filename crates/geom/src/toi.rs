@@ -174,30 +174,29 @@ mod tests {
         assert_eq!(hit.contact.normal, Vec2::new(1.0, 0.0));
     }
 
-    #[test]
-    fn a_grazing_circle_touches_where_the_line_passes_at_the_radii_sum() {
-        // A point-like circle (radius 0.5) crossing above a circle of radius 1 at height
-        // 1.2 (< 1.5): it touches where x^2 + 1.2^2 = 1.5^2, x = -0.9, i.e. t = (10 - 0.9) / 20.
-        let hit = time_of_impact(
+    /// A circle of radius 0.5 flying from x = -10 to x = 10 at `height` past a circle of
+    /// radius 1 resting at the origin.
+    fn fly_past(height: f64) -> Option<Impact> {
+        time_of_impact(
             &circle(0.5),
-            &sweep((-10.0, 1.2), (10.0, 1.2)),
+            &sweep((-10.0, height), (10.0, height)),
             &circle(1.0),
             &sweep((0.0, 0.0), (0.0, 0.0)),
         )
-        .expect("it touches");
+    }
+
+    #[test]
+    fn a_grazing_circle_touches_where_the_line_passes_at_the_radii_sum() {
+        // At height 1.2 (< 1.5) it touches where x^2 + 1.2^2 = 1.5^2, x = -0.9, i.e. at
+        // t = (10 - 0.9) / 20.
+        let hit = fly_past(1.2).expect("it touches");
         let exact = (10.0 - 0.9) / 20.0;
         assert!((hit.t - exact).abs() < 1e-9, "{} vs {exact}", hit.t);
     }
 
     #[test]
     fn shapes_that_pass_apart_never_touch_and_overlapping_ones_touch_at_zero() {
-        let far = time_of_impact(
-            &circle(0.5),
-            &sweep((-10.0, 1.6), (10.0, 1.6)),
-            &circle(1.0),
-            &sweep((0.0, 0.0), (0.0, 0.0)),
-        );
-        assert_eq!(far, None);
+        assert_eq!(fly_past(1.6), None);
         let box_shape = Shape::aabb(Vec2::new(1.0, 1.0)).unwrap();
         let now = time_of_impact(
             &box_shape,
