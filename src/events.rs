@@ -128,3 +128,65 @@ pub fn line(event: &GameEvent, world: &World, out: &FrameOutput) -> EventLine {
         message: message(event, world, out),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use ricochet_sim::{Simulation, load_scenario};
+
+    use super::*;
+
+    /// Frame 1 destroys `old` (slot 0) and spawns `new`, which takes slot 0 again: the text
+    /// names the removed body from the frame's removed list, the new one from the world,
+    /// each with its generation.
+    #[test]
+    fn a_reused_slot_is_worded_with_each_bodys_generation() {
+        let text = r#"
+layers = ["thing"]
+[templates.thing]
+layer = "thing"
+shape = { kind = "circle", radius = 0.5 }
+[[bodies]]
+name = "old"
+template = "thing"
+position = [0, 0]
+[[script]]
+frame = 1
+action = "destroy"
+body = "old"
+[[script]]
+frame = 1
+action = "spawn"
+template = "thing"
+name = "new"
+position = [5, 0]
+[[script]]
+frame = 1
+action = "set_velocity"
+body = "old"
+velocity = [1, 0]
+"#;
+        let scenario = load_scenario(text, "reuse.toml").unwrap();
+        let mut sim = Simulation::new(&scenario);
+        sim.step();
+        let out = sim.step();
+        let lines: Vec<(&str, String)> = out
+            .events
+            .iter()
+            .map(|e| {
+                let l = line(e, &sim.world, &out);
+                (l.kind, l.message)
+            })
+            .collect();
+        assert_eq!(
+            lines,
+            [
+                ("destroy", "old #0:0 destroyed by the script".to_owned()),
+                ("spawn", "new #0:1 spawned from template thing".to_owned()),
+                (
+                    "missed",
+                    "set_velocity: no body named old is alive".to_owned()
+                ),
+            ]
+        );
+    }
+}
