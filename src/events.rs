@@ -142,28 +142,15 @@ mod tests {
     fn a_reused_slot_is_worded_with_each_bodys_generation() {
         let text = r#"
 layers = ["thing"]
+bodies = [{ name = "old", template = "thing", position = [0, 0] }]
+script = [
+    { frame = 1, action = "destroy", body = "old" },
+    { frame = 1, action = "spawn", template = "thing", name = "new", position = [5, 0] },
+    { frame = 1, action = "set_velocity", body = "old", velocity = [1, 0] },
+]
 [templates.thing]
 layer = "thing"
 shape = { kind = "circle", radius = 0.5 }
-[[bodies]]
-name = "old"
-template = "thing"
-position = [0, 0]
-[[script]]
-frame = 1
-action = "destroy"
-body = "old"
-[[script]]
-frame = 1
-action = "spawn"
-template = "thing"
-name = "new"
-position = [5, 0]
-[[script]]
-frame = 1
-action = "set_velocity"
-body = "old"
-velocity = [1, 0]
 "#;
         let scenario = load_scenario(text, "reuse.toml").unwrap();
         let mut sim = Simulation::new(&scenario);
