@@ -107,15 +107,42 @@ fn compare(
     }
 }
 
-/// The `id` of a list element that is an object with one (bodies in `/bodies`).
-fn id_of(v: &Value) -> Option<u64> {
-    v.get("id").and_then(Value::as_u64)
+/// A body's id in a log: its `id` and, in logs that have one, its `generation`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+struct BodyId {
+    id: u64,
+    generation: Option<u64>,
+}
+
+impl std::fmt::Display for BodyId {
+    /// `id:generation`, as the logs write a body, or `id` for a log without generations.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.generation {
+            Some(g) => write!(f, "{}:{g}", self.id),
+            None => write!(f, "{}", self.id),
+        }
+    }
+}
+
+/// The id of the body named by field `id` (and `<id>_generation`, or `generation` next to
+/// `id`) of an object.
+fn body_id(v: &Value, id: &str, generation: &str) -> Option<BodyId> {
+    Some(BodyId {
+        id: v.get(id).and_then(Value::as_u64)?,
+        generation: v.get(generation).and_then(Value::as_u64),
+    })
+}
+
+/// The id of a list element that is an object with one (bodies in `/bodies`): bodies are
+/// matched by id and generation, so a reused slot is another body.
+fn id_of(v: &Value) -> Option<BodyId> {
+    body_id(v, "id", "generation")
 }
 
 fn label(v: &Value) -> String {
     let pair = (
-        v.get("a").and_then(Value::as_u64),
-        v.get("b").and_then(Value::as_u64),
+        body_id(v, "a", "a_generation"),
+        body_id(v, "b", "b_generation"),
     );
     match (id_of(v), v.get("name").and_then(Value::as_str), pair) {
         (Some(id), Some(name), _) => format!("{id} ({name})"),
@@ -136,9 +163,10 @@ fn compare_arrays(
     // every later element shifted by one.
     let by_id = x.iter().chain(y).all(|v| id_of(v).is_some()) && !x.is_empty() && !y.is_empty();
     if by_id {
-        let ys: BTreeMap<u64, &Value> = y.iter().filter_map(|v| id_of(v).map(|i| (i, v))).collect();
+        let ys: BTreeMap<BodyId, &Value> =
+            y.iter().filter_map(|v| id_of(v).map(|i| (i, v))).collect();
         for va in x {
-            let id = id_of(va).unwrap_or_default();
+            let Some(id) = id_of(va) else { continue };
             let len = path.len();
             path.push_str(&format!("[id={id}]"));
             let found = match ys.get(&id) {
@@ -151,14 +179,17 @@ fn compare_arrays(
             }
             path.truncate(len);
         }
-        let xs: Vec<u64> = x.iter().filter_map(id_of).collect();
+        let xs: Vec<BodyId> = x.iter().filter_map(id_of).collect();
         return y
             .iter()
-            .find(|v| !xs.contains(&id_of(v).unwrap_or_default()))
+            .find(|v| id_of(v).is_some_and(|i| !xs.contains(&i)))
             .map(|vb| {
                 *body = Some(label(vb));
                 (
-                    format!("{path}[id={}]", id_of(vb).unwrap_or_default()),
+                    format!(
+                        "{path}[id={}]",
+                        id_of(vb).map(|i| i.to_string()).unwrap_or_default()
+                    ),
                     "missing".to_owned(),
                     vb.to_string(),
                 )

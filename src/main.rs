@@ -9,6 +9,7 @@ mod bench;
 mod check;
 mod collide;
 mod diff;
+mod events;
 mod load;
 mod record;
 mod run;

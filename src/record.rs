@@ -15,7 +15,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use ricochet_geom::{Pose, ShapeDef, Vec2};
-use ricochet_log::foxglove::{Log, LogLevel, Timestamp};
+use ricochet_log::foxglove::{Log, Timestamp};
 use ricochet_log::{ChannelId, LogError, LogWriter};
 use ricochet_sim::{BodyKind, FrameOutput, Layers, RemovedBody, Simulation};
 use serde::Serialize;
@@ -30,6 +30,7 @@ const STATS_SCHEMA: &str = include_str!("schemas/Stats.json");
 #[derive(Serialize)]
 struct BodyMsg<'a> {
     id: u32,
+    generation: u32,
     name: &'a str,
     layer: &'a str,
     shape: ShapeDef,
@@ -51,7 +52,9 @@ struct BodiesMsg<'a> {
 #[derive(Serialize)]
 struct ContactMsg {
     a: u32,
+    a_generation: u32,
     b: u32,
+    b_generation: u32,
     phase: &'static str,
     normal: [f64; 2],
     depth: f64,
@@ -69,7 +72,7 @@ struct ContactsMsg {
 }
 
 #[derive(Serialize)]
-struct StatsMsg<'a> {
+struct StatsMsg {
     frame: u64,
     bodies: usize,
     broad_phase: &'static str,
@@ -81,8 +84,9 @@ struct StatsMsg<'a> {
     asleep: usize,
     stages_run: usize,
     stages_skipped: usize,
-    skipped: &'a [&'static str],
-    tests_by_layer_pair: &'a BTreeMap<String, u64>,
+    skipped: Vec<&'static str>,
+    /// `"a/b"` layer names: sorted by the names, as a JSON object's keys.
+    tests_by_layer_pair: BTreeMap<String, u64>,
     kinetic_energy: f64,
 }
 
@@ -97,6 +101,7 @@ fn pose3(p: &Pose) -> [f64; 3] {
 fn removed_msg<'a>(r: &'a RemovedBody, layers: &'a Layers) -> BodyMsg<'a> {
     BodyMsg {
         id: r.entity.index,
+        generation: r.entity.generation,
         name: &r.name,
         layer: layers.name(r.layer),
         shape: ShapeDef::from_shape(&r.shape),
@@ -175,6 +180,7 @@ impl Recorder {
         let bodies = (0..w.len())
             .map(|i| BodyMsg {
                 id: w.entity[i].index,
+                generation: w.entity[i].generation,
                 name: &w.name[i],
                 layer: layers.name(w.layer[i]),
                 shape: ShapeDef::from_shape(&w.shape[i]),
@@ -197,7 +203,9 @@ impl Recorder {
             .iter()
             .map(|c| ContactMsg {
                 a: c.a.index,
+                a_generation: c.a.generation,
                 b: c.b.index,
+                b_generation: c.b.generation,
                 phase: c.phase.name(),
                 normal: xy(c.normal),
                 depth: c.depth,
@@ -220,7 +228,7 @@ impl Recorder {
         let stats = StatsMsg {
             frame: out.frame,
             bodies: s.bodies,
-            broad_phase: s.broad_phase,
+            broad_phase: s.broad_phase.map_or("", |k| k.name()),
             broad_pairs: s.broad_pairs,
             narrow_tests: s.narrow_tests,
             contacts: s.contacts,
@@ -229,18 +237,18 @@ impl Recorder {
             asleep: s.asleep,
             stages_run: s.stages_run.len(),
             stages_skipped: s.stages_skipped.len(),
-            skipped: &s.stages_skipped,
-            tests_by_layer_pair: &s.tests_by_layer_pair,
+            skipped: s.stages_skipped.iter().map(|st| st.name()).collect(),
+            tests_by_layer_pair: s
+                .tests_by_layer_pair
+                .iter()
+                .map(|&((a, b), n)| (format!("{}/{}", layers.name(a), layers.name(b)), n))
+                .collect(),
             kinetic_energy: s.kinetic_energy,
         };
         self.writer.write(self.stats, t, &stats)?;
         for e in &out.events {
-            let level = match e.kind {
-                "destroy" | "expire" | "missed" => LogLevel::Warning,
-                "input" | "spawn" => LogLevel::Info,
-                _ => LogLevel::Debug,
-            };
-            let log = Log::new(ts, level, e.kind, e.message.clone());
+            let line = crate::events::line(e, w, out);
+            let log = Log::new(ts, line.level, line.kind, line.message);
             self.writer.write(self.events, t, &log)?;
         }
         Ok(())

@@ -7,7 +7,7 @@ use ricochet_log::foxglove::{
     ArrowPrimitive, Color, CubePrimitive, CylinderPrimitive, LinePrimitive, LineType, Point3, Pose,
     Quaternion, SceneEntity, SceneEntityDeletion, SceneUpdate, Timestamp, Vector3,
 };
-use ricochet_sim::{BodyKind, FrameOutput, World};
+use ricochet_sim::{BodyKind, Entity, FrameOutput, World};
 
 /// The frame every entity is drawn in.
 pub const FRAME_ID: &str = "world";
@@ -15,9 +15,10 @@ pub const FRAME_ID: &str = "world";
 /// Thickness of drawn shapes along z, and of outlines.
 const DEPTH: f64 = 0.05;
 
-/// The scene entity id of a body: stable for the body's life.
-pub fn entity_id(index: u32) -> String {
-    format!("body/{index}")
+/// The scene entity id of a body, `body/index:generation`: stable for the body's life, and
+/// never another body's.
+pub fn entity_id(entity: Entity) -> String {
+    format!("body/{entity}")
 }
 
 /// A colour per layer, from a fixed palette, dimmed for static bodies.
@@ -151,7 +152,7 @@ pub fn scene_update(world: &World, out: &FrameOutput, ts: Timestamp) -> SceneUpd
     let mut entities = Vec::with_capacity(world.len() + 1);
     for i in 0..world.len() {
         let mut e = shape_entity(
-            entity_id(world.entity[i].index),
+            entity_id(world.entity[i]),
             ts,
             &world.shape[i],
             world.position[i],
@@ -181,12 +182,12 @@ pub fn scene_update(world: &World, out: &FrameOutput, ts: Timestamp) -> SceneUpd
         });
     }
     entities.push(contacts);
-    // A removed body's id may be reused by a body spawned this frame: deletions are applied
-    // before entities, so the new body still shows.
+    // A removed body's slot may be reused by a body spawned this frame, under another id
+    // (the next generation); deletions are applied before entities anyway.
     let deletions = out
         .removed
         .iter()
-        .map(|r| SceneEntityDeletion::matching_id(ts, entity_id(r.entity.index)))
+        .map(|r| SceneEntityDeletion::matching_id(ts, entity_id(r.entity)))
         .collect();
     SceneUpdate {
         deletions,

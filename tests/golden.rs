@@ -129,11 +129,12 @@ fn golden_a_one_ulp_velocity_change_fails_and_the_diff_names_the_body_and_frame(
     record(&path, &fresh);
     let err = compare(&recording("asteroids", "mcap"), &fresh)
         .expect_err("one ulp must fail the golden test");
-    // Bodies are spawned in file order with ids 0, 1, ...: the index is the id.
-    assert!(err.contains(&format!("body {index} ({name})")), "{err}");
+    // Bodies are spawned in file order with ids 0, 1, ... (generation 0): the index is the
+    // id.
+    assert!(err.contains(&format!("body {index}:0 ({name})")), "{err}");
     assert!(err.contains("first difference: frame 0"), "{err}");
     assert!(
-        err.contains(&format!("bodies[id={index}].velocity[0]")),
+        err.contains(&format!("bodies[id={index}:0].velocity[0]")),
         "{err}"
     );
     assert!(err.contains(BLESS), "{err}");

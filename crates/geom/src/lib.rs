@@ -50,6 +50,7 @@ mod def;
 mod math;
 mod placed;
 mod shape;
+mod toi;
 
 pub use bounds::Bounds;
 pub use case::{Case, CaseBody, CaseError, parse_case_file};
@@ -64,6 +65,7 @@ pub use shape::{
     Aabb, Capsule, Circle, Compound, MAX_COORDINATE, MAX_POLYGON_VERTICES, MIN_SIZE, Obb, Polygon,
     Primitive, Shape, ShapeError, ShapeKind,
 };
+pub use toi::{Impact, Sweep, time_of_impact};
 
 /// The pair functions, one per pairing of primitives, for callers (and benchmarks) that want
 /// to skip the dispatch. Each is a pure function of two shapes placed in one frame.

@@ -11,7 +11,7 @@ use rapier2d_f64::prelude::{
 use ricochet_geom::{Pose, Primitive, Shape, Vec2};
 use ricochet_sim::{
     BodyKind, ContactRecord, Entity, FrameOutput, LayerId, Layers, Phase, Response, SLOP, Scenario,
-    Simulation,
+    Simulation, Stage,
 };
 
 use crate::convert::{overlap_along, pairing, place, reference_contact, size};
@@ -194,7 +194,7 @@ impl Referee {
                 let end = self.check_all_pass(sim, out, poses, &mut report);
                 self.check_swept(sim, out, poses, &end, &mut report);
             }
-            None if out.stats.stages_run.contains(&"detect") => report.mismatch(format!(
+            None if out.stats.stages_run.contains(Stage::Detect) => report.mismatch(format!(
                 "frame {}: detect ran but no poses were captured; set \
                  Simulation::capture_detect_poses",
                 out.frame

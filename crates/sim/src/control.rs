@@ -102,7 +102,6 @@ impl Simulation {
 
     /// Adds (or replaces) a template: what a ship's `bullet` and a body's `split` name.
     pub fn add_template(&mut self, name: &str, def: BodyDef) {
-        self.templates.insert(name.to_owned(), def.clone());
         self.scenario.templates.insert(name.to_owned(), def);
     }
 

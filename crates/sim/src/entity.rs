@@ -13,9 +13,10 @@ pub struct Entity {
     pub generation: u32,
 }
 
+/// `index:generation`, as logs write it (`5:1` is the second body in slot 5).
 impl std::fmt::Display for Entity {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{}", self.index)
+        write!(f, "{}:{}", self.index, self.generation)
     }
 }
 

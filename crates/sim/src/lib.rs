@@ -32,11 +32,13 @@ pub mod broad_phase;
 mod control;
 mod def;
 mod entity;
+mod event;
 #[cfg(feature = "toml")]
 mod load;
 mod output;
 mod pipeline;
 mod scenario;
+mod stage_set;
 mod stages;
 mod world;
 
@@ -46,9 +48,12 @@ pub use def::{
     MAX_FRAMES, Response, RunLengthError, Split, WorldBounds, WorldDef,
 };
 pub use entity::{Entity, EntityAllocator};
+pub use event::{FireOutcome, GameEvent, JumpOutcome, Removal, ScriptInput};
 #[cfg(feature = "toml")]
 pub use load::{ScenarioError, load_scenario};
-pub use output::{ContactRecord, EventRecord, FrameOutput, Phase, RemovedBody, Stats};
-pub use pipeline::{SLOP, Simulation};
+pub use output::{ContactRecord, FrameOutput, Phase, RemovedBody, Stats};
+pub use pipeline::Simulation;
 pub use scenario::Scenario;
+pub use stage_set::{Stage, StageSet};
+pub use stages::SLOP;
 pub use world::{Inputs, World};

@@ -1,12 +1,13 @@
 //! What one frame produces: contacts, events, destroyed bodies and counters. The recorder
 //! turns these into log messages; the simulation never formats or writes anything.
 
-use std::collections::BTreeMap;
-
 use ricochet_geom::{Pose, Shape, Vec2};
 
+use crate::broad_phase::BroadPhaseKind;
 use crate::def::{BodyKind, LayerId, Response};
 use crate::entity::Entity;
+use crate::event::GameEvent;
+use crate::stage_set::StageSet;
 
 /// Which detection pass found a contact.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -60,15 +61,6 @@ pub struct ContactRecord {
     pub resolved: Vec2,
 }
 
-/// A game event: an input, a spawn, a destruction, a collision.
-#[derive(Clone, Debug, PartialEq)]
-pub struct EventRecord {
-    /// What kind of event (`input`, `spawn`, `destroy`, `expire`, `contact`, `hit_x`, ...).
-    pub kind: &'static str,
-    /// A sentence for people.
-    pub message: String,
-}
-
 /// A body removed this frame, as it was just before removal.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RemovedBody {
@@ -93,8 +85,8 @@ pub struct RemovedBody {
 pub struct Stats {
     /// Bodies alive at the end of the frame.
     pub bodies: usize,
-    /// The broad phase `detect` ran (what `auto` chose), or `""` when it did not run.
-    pub broad_phase: &'static str,
+    /// The broad phase `detect` ran (what `auto` chose), or `None` when it did not run.
+    pub broad_phase: Option<BroadPhaseKind>,
     /// Candidate pairs the broad phase found that `detect` kept for the narrow phase (bounds
     /// overlap, layers interact, not both at rest, not two boxes settled per axis).
     pub broad_pairs: u64,
@@ -111,11 +103,12 @@ pub struct Stats {
     /// Bodies asleep at the end of the frame.
     pub asleep: usize,
     /// Stages run.
-    pub stages_run: Vec<&'static str>,
+    pub stages_run: StageSet,
     /// Stages skipped because the scene had nothing for them.
-    pub stages_skipped: Vec<&'static str>,
-    /// Narrow-phase tests per layer pair, `"a/b"` with `a <= b` by layer id.
-    pub tests_by_layer_pair: BTreeMap<String, u64>,
+    pub stages_skipped: StageSet,
+    /// Narrow-phase tests per layer pair `(a, b)` with `a <= b`, sorted by the pair, only
+    /// pairs with tests.
+    pub tests_by_layer_pair: Vec<((LayerId, LayerId), u64)>,
     /// Kinetic energy of the dynamic bodies at the end of the frame.
     pub kinetic_energy: f64,
 }
@@ -129,7 +122,7 @@ pub struct FrameOutput {
     /// by `(a, b)`.
     pub contacts: Vec<ContactRecord>,
     /// Events in the order they happened.
-    pub events: Vec<EventRecord>,
+    pub events: Vec<GameEvent>,
     /// Bodies removed this frame.
     pub removed: Vec<RemovedBody>,
     /// Counters.

@@ -24,105 +24,19 @@
 //! The motion stages visit only the *active* bodies ([`World::active`]): moving, not frozen,
 //! not asleep. Static bodies are never visited after they are indexed.
 
-use std::collections::BTreeMap;
-
-use crate::def::{BodyDef, Event};
+use crate::def::Event;
 use crate::output::FrameOutput;
 use crate::scenario::Scenario;
-use crate::stages;
+use crate::stage_set::Stage;
 use crate::stages::detect::DetectState;
 use crate::stages::separate::SeparateState;
+use crate::stages::{StageCtx, bounds, cull, detect, lifetimes, motion, script, separate, sleep};
 use crate::world::World;
-
-/// How far two solid bodies may still overlap after `separate` has pushed them apart, in
-/// world units: positions are set exactly flush, so what remains is rounding.
-pub const SLOP: f64 = 1e-9;
-
-/// A stage: a plain function over the simulation, with a test of whether it has work.
-pub(crate) struct Stage {
-    pub name: &'static str,
-    pub has_work: fn(&Simulation) -> bool,
-    pub run: fn(&mut Simulation, &mut FrameOutput),
-}
-
-/// The stage order. See the module docs.
-pub(crate) const STAGES: [Stage; 14] = [
-    Stage {
-        name: "script",
-        has_work: stages::script::has_work,
-        run: stages::script::run,
-    },
-    Stage {
-        name: "cull",
-        has_work: stages::rest::has_region,
-        run: stages::rest::cull,
-    },
-    Stage {
-        name: "unground",
-        has_work: stages::motion::has_grounded,
-        run: stages::motion::unground,
-    },
-    Stage {
-        name: "controls",
-        has_work: stages::motion::has_controls,
-        run: stages::motion::controls,
-    },
-    Stage {
-        name: "forces",
-        has_work: stages::motion::has_forces,
-        run: stages::motion::forces,
-    },
-    Stage {
-        name: "move_x",
-        has_work: stages::motion::has_motion,
-        run: stages::motion::move_x,
-    },
-    Stage {
-        name: "resolve_x",
-        has_work: stages::separate::has_work,
-        run: stages::separate::resolve_x,
-    },
-    Stage {
-        name: "move_y",
-        has_work: stages::motion::has_motion,
-        run: stages::motion::move_y,
-    },
-    Stage {
-        name: "resolve_y",
-        has_work: stages::separate::has_work,
-        run: stages::separate::resolve_y,
-    },
-    Stage {
-        name: "turn",
-        has_work: stages::motion::has_turning,
-        run: stages::motion::turn,
-    },
-    Stage {
-        name: "detect",
-        has_work: stages::detect::has_work,
-        run: stages::detect::run,
-    },
-    Stage {
-        name: "lifetimes",
-        has_work: stages::lifetimes::has_work,
-        run: stages::lifetimes::run,
-    },
-    Stage {
-        name: "bounds",
-        has_work: stages::bounds::has_work,
-        run: stages::bounds::run,
-    },
-    Stage {
-        name: "sleep",
-        has_work: stages::rest::has_sleep,
-        run: stages::rest::sleep,
-    },
-];
 
 /// The stages frame 0 runs: the initial state is scripted and checked, never moved. Lifetimes
 /// count frame 0, so a body lives `lifetime` frames whether it starts there or is spawned
 /// later.
-const FRAME_ZERO: [&str; 4] = ["script", "cull", "detect", "lifetimes"];
+const FRAME_ZERO: [Stage; 4] = [Stage::Script, Stage::Cull, Stage::Detect, Stage::Lifetimes];
 
 /// A running simulation.
 pub struct Simulation {
@@ -134,14 +48,12 @@ pub struct Simulation {
     pub(crate) frame: u64,
     /// Index of the next script event.
     pub(crate) cursor: usize,
-    /// Templates by name (shared with the scenario; cloned once for spawning).
-    pub(crate) templates: BTreeMap<String, BodyDef>,
     /// Whether each frame reports every body's pose at the start of `detect`
     /// ([`FrameOutput::detect_poses`]). Off by default: it costs a copy per frame.
     pub capture_detect_poses: bool,
     /// The body the active region follows, once found.
     pub(crate) focus: Option<crate::Entity>,
-    /// The broad phase and buffers of `detect`.
+    /// The broad phase and buffers of `detect` (given to it each frame).
     pub(crate) detect: DetectState,
     /// The obstacle grids of `resolve_x` and `resolve_y`.
     pub(crate) separate: SeparateState,
@@ -188,10 +100,10 @@ impl Simulation {
         Simulation::with_world(scenario, world)
     }
 
+    /// A simulation of `scenario` with its bodies already in `world`.
     fn with_world(scenario: Scenario, world: World) -> Simulation {
         let layers = &scenario.world.layers;
         Simulation {
-            templates: scenario.templates.clone(),
             detect: DetectState::new(layers, scenario.world.broad_phase),
             separate: SeparateState::new(layers),
             scenario,
@@ -216,10 +128,61 @@ impl Simulation {
     }
 
     /// The script events due at the current frame.
-    pub(crate) fn due_events(&self) -> &[Event] {
+    fn due_events(&self) -> &[Event] {
         let rest = &self.scenario.script[self.cursor..];
         let n = rest.iter().take_while(|e| e.frame == self.frame).count();
         &rest[..n]
+    }
+
+    /// Whether the scene has anything for `stage` to do this frame.
+    fn has_work(&self, stage: Stage) -> bool {
+        let (w, def) = (&self.world, &self.scenario.world);
+        match stage {
+            Stage::Script => !self.due_events().is_empty(),
+            Stage::Cull => cull::has_work(def),
+            Stage::Unground => motion::has_grounded(w),
+            Stage::Controls => motion::has_controls(w),
+            Stage::Forces => motion::has_forces(w, def),
+            Stage::MoveX | Stage::MoveY => motion::has_motion(w),
+            Stage::ResolveX | Stage::ResolveY => separate::has_work(w, &self.separate),
+            Stage::Turn => motion::has_turning(w),
+            Stage::Detect => detect::has_work(w, def),
+            Stage::Lifetimes => lifetimes::has_work(w),
+            Stage::Bounds => bounds::has_work(def),
+            Stage::Sleep => sleep::has_work(def),
+        }
+    }
+
+    /// Runs `stage`, handing it what it works on and the state it keeps.
+    fn run(&mut self, stage: Stage, out: &mut FrameOutput) {
+        let dt = self.scenario.world.dt;
+        let due = self.due_events().len();
+        let mut ctx = StageCtx {
+            world: &mut self.world,
+            def: &self.scenario.world,
+            templates: &self.scenario.templates,
+            out,
+        };
+        match stage {
+            Stage::Script => {
+                let events = &self.scenario.script[self.cursor..self.cursor + due];
+                self.cursor += due;
+                script::run(&mut ctx, events);
+            }
+            Stage::Cull => cull::run(&mut ctx, &mut self.focus),
+            Stage::Unground => motion::unground(ctx.world),
+            Stage::Controls => motion::controls(ctx.world),
+            Stage::Forces => motion::forces(ctx.world, ctx.def),
+            Stage::MoveX => motion::move_x(ctx.world, dt),
+            Stage::ResolveX => separate::resolve_x(&mut ctx, &mut self.separate),
+            Stage::MoveY => motion::move_y(ctx.world, dt),
+            Stage::ResolveY => separate::resolve_y(&mut ctx, &mut self.separate),
+            Stage::Turn => motion::turn(ctx.world, dt),
+            Stage::Detect => detect::run(&mut ctx, &mut self.detect, self.capture_detect_poses),
+            Stage::Lifetimes => lifetimes::run(&mut ctx),
+            Stage::Bounds => bounds::run(&mut ctx),
+            Stage::Sleep => sleep::run(&mut ctx),
+        }
     }
 
     /// Runs one frame and reports what happened.
@@ -240,13 +203,13 @@ impl Simulation {
                 w.start_position[i] = w.position[i];
             }
         }
-        for stage in &STAGES {
-            let allowed = self.frame > 0 || FRAME_ZERO.contains(&stage.name);
-            if allowed && (stage.has_work)(self) {
-                (stage.run)(self, &mut out);
-                out.stats.stages_run.push(stage.name);
+        for stage in Stage::ALL {
+            let allowed = self.frame > 0 || FRAME_ZERO.contains(&stage);
+            if allowed && self.has_work(stage) {
+                self.run(stage, &mut out);
+                out.stats.stages_run.insert(stage);
             } else {
-                out.stats.stages_skipped.push(stage.name);
+                out.stats.stages_skipped.insert(stage);
             }
         }
         out.stats.bodies = self.world.len();

@@ -1,12 +1,14 @@
-//! Skipping bodies nothing is happening to (`crates/sim/src/stages/rest.rs`): the `cull`
-//! stage (the active region) and the `sleep` stage.
+//! Skipping bodies nothing is happening to (`crates/sim/src/stages/cull.rs` and
+//! `sleep.rs`): the `cull` stage (the active region) and the `sleep` stage.
 //!
 //! Both are optimisations: they must never change what happens to a body that is simulated.
 //! So the expected values here come from the same scene run without the feature (frame by
 //! frame, digest by digest), or from exact arithmetic on the same `f64` operations the
 //! stages do (semi-implicit Euler: `x += v * dt`, frame 0 does not move).
 
-use ricochet_sim::{FrameOutput, Phase, Simulation, Stats, load_scenario};
+use ricochet_sim::{
+    FrameOutput, GameEvent, Phase, Removal, Simulation, Stage, StageSet, Stats, load_scenario,
+};
 
 fn sim(text: &str) -> Simulation {
     let s = load_scenario(text, "rest.toml").unwrap_or_else(|e| panic!("{e}\n{text}"));
@@ -16,8 +18,8 @@ fn sim(text: &str) -> Simulation {
 /// The stats without the stage lists (a run with `cull` or `sleep` lists that stage).
 fn stats_without_stages(s: &Stats) -> Stats {
     Stats {
-        stages_run: Vec::new(),
-        stages_skipped: Vec::new(),
+        stages_run: StageSet::EMPTY,
+        stages_skipped: StageSet::EMPTY,
         ..s.clone()
     }
 }
@@ -202,8 +204,16 @@ impl Totals {
         self.contacts += out.contacts.len();
         self.events += out.events.len();
         self.removed += out.removed.len();
-        self.contact_events += out.events.iter().filter(|e| e.kind == "contact").count();
-        self.hits += out.events.iter().filter(|e| e.kind == "hit").count();
+        self.contact_events += out
+            .events
+            .iter()
+            .filter(|e| matches!(e, GameEvent::Contact { .. }))
+            .count();
+        self.hits += out
+            .events
+            .iter()
+            .filter(|e| matches!(e, GameEvent::PushedApart { .. }))
+            .count();
         self.per_axis += out
             .contacts
             .iter()
@@ -232,8 +242,16 @@ fn culling_that_freezes_nothing_changes_nothing() {
         totals.add(a);
         assert_eq!(b.stats.frozen, 0, "frame {}: froze a body", b.frame);
         assert!(c.world.frozen.iter().all(|f| !f), "frame {}", b.frame);
-        assert!(b.stats.stages_run.contains(&"cull"), "frame {}", b.frame);
-        assert!(!a.stats.stages_run.contains(&"cull"), "frame {}", a.frame);
+        assert!(
+            b.stats.stages_run.contains(Stage::Cull),
+            "frame {}",
+            b.frame
+        );
+        assert!(
+            !a.stats.stages_run.contains(Stage::Cull),
+            "frame {}",
+            a.frame
+        );
         assert_eq!(
             stats_without_stages(&a.stats),
             stats_without_stages(&b.stats),
@@ -255,7 +273,11 @@ fn sleeping_that_never_triggers_changes_nothing() {
         assert_eq!(b.stats.asleep, 0, "frame {}: a body fell asleep", b.frame);
         assert!(s.world.asleep.iter().all(|f| !f), "frame {}", b.frame);
         if b.frame > 0 {
-            assert!(b.stats.stages_run.contains(&"sleep"), "frame {}", b.frame);
+            assert!(
+                b.stats.stages_run.contains(Stage::Sleep),
+                "frame {}",
+                b.frame
+            );
         }
         assert_eq!(
             stats_without_stages(&a.stats),
@@ -455,7 +477,13 @@ fn a_sleeping_box_wakes_when_something_lands_on_it() {
                 !sleepy.world.asleep[lone],
                 "frame {frame}: lone still asleep after the landing"
             );
-            assert!(b.events.iter().any(|e| e.kind == "hit_y"), "{:?}", b.events);
+            assert!(
+                b.events
+                    .iter()
+                    .any(|e| matches!(e, GameEvent::PushedOut { axis: 1, .. })),
+                "{:?}",
+                b.events
+            );
         }
         asleep_before = sleepy.world.asleep[lone];
     }
@@ -726,7 +754,13 @@ lifetime = 40
             assert_eq!(out.removed.len(), 1, "{:?}", out.removed);
             assert_eq!(out.removed[0].name, "rock");
             assert!(
-                out.events.iter().any(|e| e.kind == "expire"),
+                out.events.iter().any(|e| matches!(
+                    e,
+                    GameEvent::Removed {
+                        cause: Removal::Expired,
+                        ..
+                    }
+                )),
                 "{:?}",
                 out.events
             );

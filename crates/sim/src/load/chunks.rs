@@ -20,6 +20,63 @@ fn header(line: &str) -> Option<(&str, bool)> {
     rest.split(']').next().map(|n| (n.trim(), false))
 }
 
+/// Where the TOML scanner is at the end of a line: inside a multi-line string, or how deep
+/// inside arrays and inline tables (a value may span lines; a header line never does).
+#[derive(Default)]
+struct Scanner {
+    /// The closing quotes of the multi-line string we are in.
+    string: Option<&'static str>,
+    /// `[` and `{` opened by values and not yet closed.
+    depth: usize,
+}
+
+impl Scanner {
+    fn at_top(&self) -> bool {
+        self.string.is_none() && self.depth == 0
+    }
+
+    /// Follows one line. A line that is a header (at the top) opens no value: it is skipped.
+    fn line(&mut self, line: &str) {
+        let b = line.as_bytes();
+        let mut k = 0;
+        if self.at_top() && header(line).is_some() {
+            return;
+        }
+        while k < b.len() {
+            if let Some(close) = self.string {
+                match line[k..].find(close) {
+                    Some(at) => {
+                        self.string = None;
+                        k += at + close.len();
+                        continue;
+                    }
+                    None => return,
+                }
+            }
+            match b[k] {
+                b'#' => return,
+                q @ (b'"' | b'\'') => {
+                    let triple = if q == b'"' { "\"\"\"" } else { "\'\'\'" };
+                    if line[k..].starts_with(triple) {
+                        self.string = Some(triple);
+                        k += 3;
+                        continue;
+                    }
+                    // A one-line string: to its closing quote (basic strings escape with \).
+                    k += 1;
+                    while k < b.len() && b[k] != q {
+                        k += if q == b'"' && b[k] == b'\\' { 2 } else { 1 };
+                    }
+                }
+                b'[' | b'{' => self.depth += 1,
+                b']' | b'}' => self.depth = self.depth.saturating_sub(1),
+                _ => {}
+            }
+            k += 1;
+        }
+    }
+}
+
 /// Whether a header belongs to the body table above it (`[bodies.shape]`).
 fn in_body(name: &str) -> bool {
     name.strip_prefix("bodies")
@@ -32,13 +89,13 @@ fn in_body(name: &str) -> bool {
 pub(crate) fn split_bodies(text: &str) -> Option<(String, Vec<Range<usize>>)> {
     let mut chunks: Vec<Range<usize>> = Vec::new();
     let mut open: Option<usize> = None;
-    // Inside a multi-line string, a line that looks like a header is text.
-    let mut in_string: Option<&str> = None;
+    let mut scan = Scanner::default();
     let mut at = 0;
     for line in text.split_inclusive('\n') {
         let start = at;
         at += line.len();
-        if in_string.is_none()
+        // A header starts a line outside any string, array or inline table.
+        if scan.at_top()
             && let Some((name, array)) = header(line)
         {
             if array && name == "bodies" {
@@ -52,16 +109,7 @@ pub(crate) fn split_bodies(text: &str) -> Option<(String, Vec<Range<usize>>)> {
                 chunks.push(s..start);
             }
         }
-        for quote in ["\"\"\"", "'''"] {
-            let n = line.matches(quote).count();
-            if n % 2 == 1 {
-                in_string = match in_string {
-                    Some(q) if q == quote => None,
-                    None => Some(quote),
-                    other => other,
-                };
-            }
-        }
+        scan.line(line);
     }
     if let Some(s) = open {
         chunks.push(s..text.len());
@@ -102,6 +150,14 @@ mod tests {
         assert_eq!(skeleton.len(), text.len());
         assert!(skeleton.contains("[[script]]\nframe = 1\n"));
         assert!(!skeleton.contains("bodies"));
+    }
+
+    #[test]
+    fn a_line_of_a_multi_line_array_is_no_header() {
+        let text = "layers = [\"a\"]\n[[bodies]]\nlayer = \"a\"\nshape = { kind = \"polygon\", vertices = [\n  [1, 0], [0, 1], [-1, 0],\n] }\n[[bodies]]\nlayer = \"a\"\n";
+        let (_, chunks) = split_bodies(text).unwrap();
+        assert_eq!(chunks.len(), 2);
+        assert!(text[chunks[0].clone()].ends_with("] }\n"));
     }
 
     #[test]

@@ -24,6 +24,12 @@ use world::world_settings;
 
 /// Parses and checks a scenario. `file` is only used in error messages.
 pub fn load_scenario(text: &str, file: &str) -> Result<Scenario, ScenarioError> {
+    load(text, file, true)
+}
+
+/// [`load_scenario`], with `[[bodies]]` tables parsed one at a time (`chunked`) or with the
+/// whole file (the tests check that both give the same scenario or the same error).
+fn load(text: &str, file: &str, chunked: bool) -> Result<Scenario, ScenarioError> {
     let ctx = Ctx { file, text };
     let syntax = |e: toml::de::Error, offset: usize| {
         let span = e
@@ -33,18 +39,19 @@ pub fn load_scenario(text: &str, file: &str) -> Result<Scenario, ScenarioError> 
         ctx.err(span, field, e.message().trim_end().to_owned())
     };
     // `[[bodies]]` tables are parsed one at a time, below; the rest now.
-    let (raw, chunks): (ScenarioFile, Vec<Range<usize>>) = match split_bodies(text) {
-        Some((skeleton, chunks)) => {
-            let raw: ScenarioFile = toml::from_str(&skeleton).map_err(|e| syntax(e, 0))?;
-            if !raw.bodies.is_empty() {
-                // Bodies written both ways (an unusual header spelling): parse it all.
-                (toml::from_str(text).map_err(|e| syntax(e, 0))?, Vec::new())
-            } else {
-                (raw, chunks)
+    let (raw, chunks): (ScenarioFile, Vec<Range<usize>>) =
+        match split_bodies(text).filter(|_| chunked) {
+            Some((skeleton, chunks)) => {
+                let raw: ScenarioFile = toml::from_str(&skeleton).map_err(|e| syntax(e, 0))?;
+                if !raw.bodies.is_empty() {
+                    // Bodies written both ways (an unusual header spelling): parse it all.
+                    (toml::from_str(text).map_err(|e| syntax(e, 0))?, Vec::new())
+                } else {
+                    (raw, chunks)
+                }
             }
-        }
-        None => (toml::from_str(text).map_err(|e| syntax(e, 0))?, Vec::new()),
-    };
+            None => (toml::from_str(text).map_err(|e| syntax(e, 0))?, Vec::new()),
+        };
     let body_at = |k: usize| -> Result<Spanned<BodyFile>, ScenarioError> {
         let Some(c) = chunks.get(k) else {
             return Ok(raw.bodies[k].clone());
@@ -196,4 +203,35 @@ pub fn load_scenario(text: &str, file: &str) -> Result<Scenario, ScenarioError> 
         bodies,
         script,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::load;
+
+    /// Every shipped scenario and every bad one gives the same scenario, or the same error,
+    /// parsed a body table at a time as parsed whole.
+    #[test]
+    fn parsing_body_tables_one_at_a_time_changes_nothing() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        let mut files = Vec::new();
+        for dir in ["scenarios", "tests/data/bad-scenarios"] {
+            for e in std::fs::read_dir(root.join(dir)).unwrap() {
+                let p = e.unwrap().path();
+                if p.extension().is_some_and(|x| x == "toml") {
+                    files.push(p);
+                }
+            }
+        }
+        assert!(files.len() > 30, "{files:?}");
+        for p in files {
+            let text = std::fs::read_to_string(&p).unwrap();
+            let name = p.display().to_string();
+            assert_eq!(
+                load(&text, &name, true),
+                load(&text, &name, false),
+                "{name}"
+            );
+        }
+    }
 }

@@ -1,20 +1,23 @@
 //! The `bounds` stage: wrap around (Asteroids), or remove bodies that left the world.
 
-use crate::output::FrameOutput;
-use crate::pipeline::Simulation;
+use crate::def::WorldDef;
+use crate::event::Removal;
+use crate::stages::StageCtx;
 use crate::stages::remove::remove;
 
-pub(crate) fn has_work(sim: &Simulation) -> bool {
-    sim.scenario.world.bounds.is_some()
+/// Whether the world has bounds.
+pub(crate) fn has_work(def: &WorldDef) -> bool {
+    def.bounds.is_some()
 }
 
-pub(crate) fn run(sim: &mut Simulation, out: &mut FrameOutput) {
-    let Some(b) = sim.scenario.world.bounds else {
+/// Wraps the active bodies that crossed the bounds, or removes them.
+pub(crate) fn run(ctx: &mut StageCtx) {
+    let Some(b) = ctx.def.bounds else {
         return;
     };
     let size = b.max - b.min;
     let mut gone = Vec::new();
-    let w = &mut sim.world;
+    let w = &mut *ctx.world;
     // Only active bodies move: static, frozen and sleeping ones stay where they were.
     for k in 0..w.active().len() {
         let i = w.active()[k] as usize;
@@ -35,6 +38,6 @@ pub(crate) fn run(sim: &mut Simulation, out: &mut FrameOutput) {
         }
     }
     for e in gone {
-        remove(sim, out, e, "destroy", "left the world", false);
+        remove(ctx, e, Removal::LeftWorld, false);
     }
 }

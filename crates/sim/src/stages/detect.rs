@@ -23,18 +23,22 @@
 //! first that destroys it, so a bullet never passes through a rock, and hits the first one
 //! on its path. Rotation during the frame is not swept (the end angles are used).
 
-use ricochet_geom::{Contact, Pose, Shape, Vec2, contact};
+use ricochet_geom::{Contact, Pose, Sweep, Vec2, contact, time_of_impact};
 
 use crate::broad_phase::{BodyEntry, BroadPhase, BroadPhaseKind, Interactions};
-use crate::def::{BodyKind, Doomed, Layers, Response};
+use crate::def::{BodyKind, Doomed, Layers, Response, WorldDef};
 use crate::entity::Entity;
-use crate::output::{ContactRecord, EventRecord, FrameOutput, Phase};
-use crate::pipeline::{SLOP, Simulation};
+use crate::event::{GameEvent, Removal};
+use crate::output::{ContactRecord, Phase};
+use crate::stages::push::separate_along_normal;
 use crate::stages::remove::remove;
 use crate::stages::separate::is_box;
+use crate::stages::{SLOP, StageCtx};
+use crate::world::World;
 
-pub(crate) fn has_work(sim: &Simulation) -> bool {
-    sim.world.len() >= 2 && sim.scenario.world.layers.any(|r| r != Response::Ignore)
+/// Whether there are two bodies and a layer pair that does not `ignore`.
+pub(crate) fn has_work(w: &World, def: &WorldDef) -> bool {
+    w.len() >= 2 && def.layers.any(|r| r != Response::Ignore)
 }
 
 /// What `detect` keeps from one frame to the next: the broad phase (its sorted lists and
@@ -47,7 +51,6 @@ pub(crate) struct DetectState {
     interactions: Interactions,
     /// Per layer, whether all its bodies were boxes when `interactions` was built.
     box_only: Vec<bool>,
-    layers: Layers,
     /// Layers with a swept pair.
     sweeping: Vec<bool>,
     /// The static generation `statics` was built at.
@@ -55,9 +58,12 @@ pub(crate) struct DetectState {
     statics: Vec<BodyEntry>,
     movers: Vec<BodyEntry>,
     pairs: Vec<(u32, u32)>,
+    /// Narrow-phase tests per layer pair this frame, `[a * n + b]`.
+    tests: Vec<u64>,
 }
 
 impl DetectState {
+    /// The state for a scene with these layers, with the scenario's broad phase.
     pub(crate) fn new(layers: &Layers, kind: BroadPhaseKind) -> DetectState {
         let n = layers.names().len();
         let box_only = vec![false; n];
@@ -65,7 +71,6 @@ impl DetectState {
             broad_phase: BroadPhase::new(kind),
             interactions: interactions(layers, &box_only),
             box_only,
-            layers: layers.clone(),
             sweeping: (0..n)
                 .map(|l| (0..n).any(|m| layers.sweeps(l as u8, m as u8)))
                 .collect(),
@@ -73,10 +78,12 @@ impl DetectState {
             statics: Vec::new(),
             movers: Vec::new(),
             pairs: Vec::new(),
+            tests: vec![0; n * n],
         }
     }
 }
 
+/// The layer pairs `detect` pairs up, given which layers hold only boxes.
 fn interactions(layers: &Layers, box_only: &[bool]) -> Interactions {
     Interactions::from_fn(box_only.len(), |a, b| match layers.response(a, b) {
         Response::Ignore => false,
@@ -86,15 +93,14 @@ fn interactions(layers: &Layers, box_only: &[bool]) -> Interactions {
 }
 
 /// Fills the broad phase's inputs and finds the candidate pairs (dense indices, sorted).
-fn candidate_pairs(sim: &mut Simulation, out: &mut FrameOutput) -> Vec<(u32, u32)> {
-    let st = &mut sim.detect;
-    let w = &mut sim.world;
+fn candidate_pairs(ctx: &mut StageCtx, st: &mut DetectState) -> Vec<(u32, u32)> {
+    let w = &mut *ctx.world;
     let changed = (0..st.box_only.len()).any(|l| st.box_only[l] != w.only_boxes(l as u8));
     if changed {
         for (l, b) in st.box_only.iter_mut().enumerate() {
             *b = w.only_boxes(l as u8);
         }
-        st.interactions = interactions(&st.layers, &st.box_only);
+        st.interactions = interactions(&ctx.def.layers, &st.box_only);
     }
     if st.static_generation != Some(w.static_generation()) {
         st.statics.clear();
@@ -121,27 +127,31 @@ fn candidate_pairs(sim: &mut Simulation, out: &mut FrameOutput) -> Vec<(u32, u32
         &mut pairs,
     );
     st.static_generation = Some(generation);
-    out.stats.broad_phase = bp.kind.name();
-    out.stats.layer_pairs_skipped += bp.layer_pairs_skipped;
+    ctx.out.stats.broad_phase = Some(bp.kind);
+    ctx.out.stats.layer_pairs_skipped += bp.layer_pairs_skipped;
     pairs
 }
 
-pub(crate) fn run(sim: &mut Simulation, out: &mut FrameOutput) {
-    let layers = sim.scenario.world.layers.clone();
-    if sim.capture_detect_poses {
-        let w = &sim.world;
-        out.detect_poses = Some((0..w.len()).map(|i| (w.entity[i], w.pose(i))).collect());
+/// Runs the pass. With `capture_poses`, every body's pose at the start of it goes into
+/// [`crate::FrameOutput::detect_poses`].
+pub(crate) fn run(ctx: &mut StageCtx, st: &mut DetectState, capture_poses: bool) {
+    let def = ctx.def;
+    let layers = &def.layers;
+    if capture_poses {
+        let w = &ctx.world;
+        ctx.out.detect_poses = Some((0..w.len()).map(|i| (w.entity[i], w.pose(i))).collect());
     }
-    let pairs = candidate_pairs(sim, out);
-    // Tests per layer pair, counted in a flat table and named once at the end.
+    let pairs = candidate_pairs(ctx, st);
+    // Tests per layer pair, counted in a flat table and listed once at the end.
     let n_layers = layers.names().len();
-    let mut per_layer_pair = vec![0u64; n_layers * n_layers];
-    let mut doomed: Vec<(Entity, String)> = Vec::new();
+    let mut per_layer_pair = std::mem::take(&mut st.tests);
+    // Each doomed body with the body that hit it.
+    let mut doomed: Vec<(Entity, Entity)> = Vec::new();
     let mut swept: Vec<(usize, usize)> = Vec::new();
     let mut woken: Vec<usize> = Vec::new();
     for &(i, j) in &pairs {
         let (i, j) = (i as usize, j as usize);
-        let w = &sim.world;
+        let w = &ctx.world;
         let resting = |k: usize| w.kind[k] == BodyKind::Static || w.asleep[k];
         if w.frozen[i] || w.frozen[j] || (resting(i) && resting(j)) {
             continue;
@@ -150,14 +160,14 @@ pub(crate) fn run(sim: &mut Simulation, out: &mut FrameOutput) {
         if response == Response::Separate && is_box(&w.shape[i]) && is_box(&w.shape[j]) {
             continue;
         }
-        out.stats.broad_pairs += 1;
+        ctx.out.stats.broad_pairs += 1;
         let (la, lb) = (w.layer[i].min(w.layer[j]), w.layer[i].max(w.layer[j]));
         per_layer_pair[usize::from(la) * n_layers + usize::from(lb)] += 1;
         if response != Response::Separate && layers.sweeps(w.layer[i], w.layer[j]) {
             swept.push((i, j));
             continue;
         }
-        out.stats.narrow_tests += 1;
+        ctx.out.stats.narrow_tests += 1;
         let (pose_a, pose_b) = (w.pose(i), w.pose(j));
         let c = contact(&w.shape[i], &pose_a, &w.shape[j], &pose_b);
         let threshold = if response == Response::Separate {
@@ -170,8 +180,7 @@ pub(crate) fn run(sim: &mut Simulation, out: &mut FrameOutput) {
         }
         woken.extend([i, j].into_iter().filter(|&k| w.asleep[k]));
         respond(
-            sim,
-            out,
+            ctx,
             &mut doomed,
             (i, j),
             response,
@@ -180,22 +189,24 @@ pub(crate) fn run(sim: &mut Simulation, out: &mut FrameOutput) {
             (pose_a, pose_b),
         );
     }
-    sim.detect.pairs = pairs;
-    for (k, &count) in per_layer_pair.iter().enumerate() {
-        if count > 0 {
+    st.pairs = pairs;
+    for (k, count) in per_layer_pair.iter_mut().enumerate() {
+        if *count > 0 {
             let (la, lb) = ((k / n_layers) as u8, (k % n_layers) as u8);
-            let name = format!("{}/{}", layers.name(la), layers.name(lb));
-            out.stats.tests_by_layer_pair.insert(name, count);
+            ctx.out.stats.tests_by_layer_pair.push(((la, lb), *count));
+            *count = 0;
         }
     }
-    run_swept(sim, out, &mut doomed, &swept, &layers, &mut woken);
+    st.tests = per_layer_pair;
+    run_swept(ctx, &mut doomed, &swept, layers, &mut woken);
     for i in woken {
-        sim.world.wake(i);
+        ctx.world.wake(i);
     }
-    doomed.sort();
+    // In id order; a body hit twice is destroyed by the first hit found.
+    doomed.sort_by_key(|(e, _)| *e);
     doomed.dedup_by_key(|(e, _)| *e);
-    for (e, why) in doomed {
-        remove(sim, out, e, "destroy", &why, true);
+    for (e, by) in doomed {
+        remove(ctx, e, Removal::HitBy(by), true);
     }
 }
 
@@ -203,9 +214,8 @@ pub(crate) fn run(sim: &mut Simulation, out: &mut FrameOutput) {
 /// its hits in time order, stopping at the first hit that destroys it. So a bullet hits the
 /// first rock on its path and no other, however fast it goes.
 fn run_swept(
-    sim: &mut Simulation,
-    out: &mut FrameOutput,
-    doomed: &mut Vec<(Entity, String)>,
+    ctx: &mut StageCtx,
+    doomed: &mut Vec<(Entity, Entity)>,
     swept: &[(usize, usize)],
     layers: &Layers,
     woken: &mut Vec<usize>,
@@ -219,9 +229,15 @@ fn run_swept(
     }
     let mut hits = Vec::new();
     for &(i, j) in swept {
-        out.stats.narrow_tests += 1;
-        let w = &sim.world;
-        if let Some((toi, contact, poses)) = time_of_impact(w, i, j) {
+        ctx.out.stats.narrow_tests += 1;
+        let w = &ctx.world;
+        // Straight from the frame's start to its end, at the end angles.
+        let sweep = |k: usize| Sweep {
+            start: w.start_position[k],
+            end: w.position[k],
+            angle: w.angle[k],
+        };
+        if let Some(impact) = time_of_impact(&w.shape[i], &sweep(i), &w.shape[j], &sweep(j)) {
             // The mover is the body that went further: a bullet against a drifting rock.
             let travel = |k: usize| (w.position[k] - w.start_position[k]).length();
             let mover = if travel(j) > travel(i) {
@@ -231,10 +247,10 @@ fn run_swept(
             };
             hits.push(Hit {
                 mover,
-                toi,
+                toi: impact.t,
                 pair: (i, j),
-                contact,
-                poses,
+                contact: impact.contact,
+                poses: (impact.pose_a, impact.pose_b),
             });
         }
     }
@@ -250,7 +266,7 @@ fn run_swept(
         if spent.contains(&hit.mover) {
             continue;
         }
-        let w = &sim.world;
+        let w = &ctx.world;
         let response = layers.response(w.layer[hit.pair.0], w.layer[hit.pair.1]);
         woken.extend(
             [hit.pair.0, hit.pair.1]
@@ -259,8 +275,7 @@ fn run_swept(
         );
         let before = doomed.len();
         respond(
-            sim,
-            out,
+            ctx,
             doomed,
             hit.pair,
             response,
@@ -274,143 +289,44 @@ fn run_swept(
     }
 }
 
-/// How close a swept test must get, relative to the smaller shape's size.
-const TOI_TOLERANCE: f64 = 1e-9;
-
-/// The first moment in `[0, 1]` of this frame's motion (both bodies moving in straight
-/// lines from their start to their end positions, at their end angles) when bodies `i` and
-/// `j` come within `tol` of touching. Returns the time, the contact there and the two poses.
-///
-/// Each pair of convex parts is searched on its own, and the earliest touch wins. With the
-/// angles fixed, the signed distance between two convex parts is a convex function of `t`
-/// (the distance from a point moving on a line to a convex set), which makes the search
-/// exact: conservative advancement first (distance ÷ relative speed can never step past the
-/// first touch, and is quick when heading straight in); if that crawls, as on a grazing
-/// path, a golden-section search finds the closest approach, and bisection the first
-/// moment before it within `tol`.
-fn time_of_impact(w: &crate::World, i: usize, j: usize) -> Option<(f64, Contact, (Pose, Pose))> {
-    let (si, sj) = (w.start_position[i], w.start_position[j]);
-    let (di, dj) = (w.position[i] - si, w.position[j] - sj);
-    let speed = (di - dj).length();
-    let size = |k: usize| w.shape[k].bounds(&w.pose(k)).half_extents().length();
-    let tol = TOI_TOLERANCE * size(i).min(size(j));
-    let poses = |t: f64| {
-        (
-            Pose::new(si + di * t, w.angle[i]),
-            Pose::new(sj + dj * t, w.angle[j]),
-        )
-    };
-    let mut first: Option<f64> = None;
-    for pa in w.shape[i].primitives() {
-        for pb in w.shape[j].primitives() {
-            let (sa, sb) = (Shape::Primitive(*pa), Shape::Primitive(*pb));
-            let gap = |t: f64| {
-                let (pa, pb) = poses(t);
-                -contact(&sa, &pa, &sb, &pb).depth
-            };
-            if let Some(t) = first_touch(gap, speed, tol)
-                && first.is_none_or(|f| t < f)
-            {
-                first = Some(t);
-            }
-        }
-    }
-    let t = first?;
-    let (pa, pb) = poses(t);
-    Some((t, contact(&w.shape[i], &pa, &w.shape[j], &pb), (pa, pb)))
-}
-
-/// The first `t` in `[0, 1]` with `gap(t) <= tol`, for a convex `gap`.
-fn first_touch(gap: impl Fn(f64) -> f64, speed: f64, tol: f64) -> Option<f64> {
-    let mut t = 0.0;
-    let mut g = gap(t);
-    for _ in 0..16 {
-        if g <= tol {
-            return Some(t);
-        }
-        if speed == 0.0 {
-            return None;
-        }
-        t += g / speed;
-        if t > 1.0 {
-            return None;
-        }
-        g = gap(t);
-    }
-    if g <= tol {
-        return Some(t);
-    }
-    // Closest approach on [t, 1] (a convex function is unimodal).
-    const INV_PHI: f64 = 0.618_033_988_749_894_8;
-    let (mut lo, mut hi) = (t, 1.0);
-    for _ in 0..80 {
-        let m1 = hi - (hi - lo) * INV_PHI;
-        let m2 = lo + (hi - lo) * INV_PHI;
-        if gap(m1) <= gap(m2) {
-            hi = m2;
-        } else {
-            lo = m1;
-        }
-    }
-    let closest = 0.5 * (lo + hi);
-    if gap(closest) > tol {
-        return None;
-    }
-    // The gap falls from above tol at t to at most tol at `closest`: bisect the crossing.
-    let (mut above, mut below) = (t, closest);
-    for _ in 0..80 {
-        let mid = 0.5 * (above + below);
-        if gap(mid) > tol {
-            above = mid;
-        } else {
-            below = mid;
-        }
-    }
-    Some(below)
-}
-
 /// Records a contact and applies its response.
-#[expect(
-    clippy::too_many_arguments,
-    reason = "one call site per pass; a struct would only rename them"
-)]
 fn respond(
-    sim: &mut Simulation,
-    out: &mut FrameOutput,
-    doomed: &mut Vec<(Entity, String)>,
+    ctx: &mut StageCtx,
+    doomed: &mut Vec<(Entity, Entity)>,
     (i, j): (usize, usize),
     response: Response,
     phase: Phase,
     c: Contact,
     (pose_a, pose_b): (Pose, Pose),
 ) {
-    let w = &sim.world;
+    let w = &ctx.world;
     let mut resolved = Vec2::ZERO;
     let (ea, eb) = (w.entity[i], w.entity[j]);
-    let (na, nb) = (w.name[i].clone(), w.name[j].clone());
     match response {
         Response::Ignore => {}
-        Response::Report => out.events.push(EventRecord {
-            kind: "contact",
-            message: format!("{na} #{ea} touches {nb} #{eb}, depth {}", c.depth),
+        Response::Report => ctx.out.events.push(GameEvent::Contact {
+            a: ea,
+            b: eb,
+            depth: c.depth,
         }),
         Response::Destroy(which) => {
             if matches!(which, Doomed::First | Doomed::Both) {
-                doomed.push((ea, format!("hit by {nb} #{eb}")));
+                doomed.push((ea, eb));
             }
             if matches!(which, Doomed::Second | Doomed::Both) {
-                doomed.push((eb, format!("hit by {na} #{ea}")));
+                doomed.push((eb, ea));
             }
         }
         Response::Separate => {
-            resolved = separate_along_normal(sim, i, j, c.normal, c.depth);
-            out.events.push(EventRecord {
-                kind: "hit",
-                message: format!("{na} #{ea} and {nb} #{eb} pushed apart by {}", c.depth),
+            resolved = separate_along_normal(ctx.world, i, j, c.normal, c.depth);
+            ctx.out.events.push(GameEvent::PushedApart {
+                a: ea,
+                b: eb,
+                depth: c.depth,
             });
         }
     }
-    out.contacts.push(ContactRecord {
+    ctx.out.contacts.push(ContactRecord {
         a: ea,
         b: eb,
         phase,
@@ -422,50 +338,4 @@ fn respond(
         response,
         resolved,
     });
-}
-
-/// Pushes the dynamic body (or both, half each) apart along `normal` (from `i` to `j`), and
-/// removes the velocity that drives them into each other. Returns the push on the body that
-/// moved (`j`'s when both did).
-fn separate_along_normal(
-    sim: &mut Simulation,
-    i: usize,
-    j: usize,
-    normal: Vec2,
-    depth: f64,
-) -> Vec2 {
-    let w = &mut sim.world;
-    let (di, dj) = (
-        w.kind[i] == BodyKind::Dynamic,
-        w.kind[j] == BodyKind::Dynamic,
-    );
-    let share = if di && dj { 0.5 } else { 1.0 };
-    let mut pushed = Vec2::ZERO;
-    if di {
-        let p = -normal * (depth * share);
-        w.position[i] += p;
-        let vn = w.velocity[i].dot(normal);
-        if vn > 0.0 {
-            w.velocity[i] -= normal * vn;
-        }
-        if normal.y < -0.7 {
-            w.grounded[i] = true;
-            w.on_static[i] |= w.kind[j] == BodyKind::Static;
-        }
-        pushed = p;
-    }
-    if dj {
-        let p = normal * (depth * share);
-        w.position[j] += p;
-        let vn = w.velocity[j].dot(normal);
-        if vn < 0.0 {
-            w.velocity[j] -= normal * vn;
-        }
-        if normal.y > 0.7 {
-            w.grounded[j] = true;
-            w.on_static[j] |= w.kind[i] == BodyKind::Static;
-        }
-        pushed = p;
-    }
-    pushed
 }

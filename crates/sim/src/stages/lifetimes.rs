@@ -1,17 +1,20 @@
 //! The `lifetimes` stage: bodies with a lifetime are removed when it runs out. A frozen
 //! body's lifetime is paused with the rest of it.
 
-use crate::output::FrameOutput;
-use crate::pipeline::Simulation;
+use crate::event::Removal;
+use crate::stages::StageCtx;
 use crate::stages::remove::remove;
+use crate::world::World;
 
-pub(crate) fn has_work(sim: &Simulation) -> bool {
-    sim.world.any_lifetime()
+/// Whether any body has a lifetime.
+pub(crate) fn has_work(w: &World) -> bool {
+    w.any_lifetime()
 }
 
-pub(crate) fn run(sim: &mut Simulation, out: &mut FrameOutput) {
+/// Counts down the lifetimes of the bodies not frozen, and removes those that ran out.
+pub(crate) fn run(ctx: &mut StageCtx) {
     let mut expired = Vec::new();
-    let w = &mut sim.world;
+    let w = &mut *ctx.world;
     for (i, life) in w.lifetime.iter_mut().enumerate() {
         if w.frozen[i] {
             continue;
@@ -24,6 +27,6 @@ pub(crate) fn run(sim: &mut Simulation, out: &mut FrameOutput) {
         }
     }
     for e in expired {
-        remove(sim, out, e, "expire", "expired", false);
+        remove(ctx, e, Removal::Expired, false);
     }
 }

@@ -1,11 +1,38 @@
-//! The stages, one file per concept. Each is a plain function over the simulation; see
-//! [`crate::pipeline`] for their order.
+//! The stages, one file per concept. Each is a plain function of what it needs: the
+//! [`StageCtx`] (the world, the scenario's world settings, the templates, the frame's
+//! output), its own state where it keeps some, or just the world. The pipeline
+//! (`pipeline.rs`) owns that state and calls them in order; no stage knows the pipeline.
+
+use std::collections::BTreeMap;
+
+use crate::def::{BodyDef, WorldDef};
+use crate::output::FrameOutput;
+use crate::world::World;
 
 pub(crate) mod bounds;
+pub(crate) mod cull;
 pub(crate) mod detect;
 pub(crate) mod lifetimes;
 pub(crate) mod motion;
+pub(crate) mod push;
 pub(crate) mod remove;
-pub(crate) mod rest;
 pub(crate) mod script;
 pub(crate) mod separate;
+pub(crate) mod sleep;
+
+/// How far two solid bodies may still overlap after `separate` has pushed them apart, in
+/// world units: positions are set exactly flush, so what remains is rounding.
+pub const SLOP: f64 = 1e-9;
+
+/// What a stage works on: the bodies, the scenario's world settings (layer matrix, gravity,
+/// step, bounds, active region, sleeping) and templates, read-only, and the frame's output.
+pub(crate) struct StageCtx<'a> {
+    /// The bodies.
+    pub world: &'a mut World,
+    /// The scenario's world settings; the one layer matrix every stage reads.
+    pub def: &'a WorldDef,
+    /// Templates by name, for spawns, bullets and split children.
+    pub templates: &'a BTreeMap<String, BodyDef>,
+    /// What this frame produced so far.
+    pub out: &'a mut FrameOutput,
+}

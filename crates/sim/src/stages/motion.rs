@@ -2,12 +2,11 @@
 
 use ricochet_geom::Vec2;
 
-use crate::def::{BodyKind, Controller};
-use crate::output::FrameOutput;
-use crate::pipeline::Simulation;
+use crate::def::{BodyKind, Controller, WorldDef};
+use crate::world::World;
 
-pub(crate) fn has_grounded(sim: &Simulation) -> bool {
-    let w = &sim.world;
+/// Whether an active body is grounded.
+pub(crate) fn has_grounded(w: &World) -> bool {
     w.active().iter().any(|&i| w.grounded[i as usize])
 }
 
@@ -15,8 +14,7 @@ pub(crate) fn has_grounded(sim: &Simulation) -> bool {
 /// (a `separate` normal pointing up) grounds it again. The script ran first, so a `jump`
 /// saw the previous frame's answer.
 /// Sleeping and frozen bodies keep theirs: they are exactly where they were.
-pub(crate) fn unground(sim: &mut Simulation, _out: &mut FrameOutput) {
-    let w = &mut sim.world;
+pub(crate) fn unground(w: &mut World) {
     for k in 0..w.active().len() {
         let i = w.active()[k] as usize;
         w.grounded[i] = false;
@@ -24,8 +22,8 @@ pub(crate) fn unground(sim: &mut Simulation, _out: &mut FrameOutput) {
     }
 }
 
-pub(crate) fn has_controls(sim: &Simulation) -> bool {
-    let w = &sim.world;
+/// Whether an active body has a controller.
+pub(crate) fn has_controls(w: &World) -> bool {
     w.any_controller()
         && w.active()
             .iter()
@@ -34,8 +32,7 @@ pub(crate) fn has_controls(sim: &Simulation) -> bool {
 
 /// Inputs become velocities: a ship's turn input sets its angular velocity, a runner's or
 /// walker's sets its x velocity. Thrust is a force, applied in `forces`.
-pub(crate) fn controls(sim: &mut Simulation, _out: &mut FrameOutput) {
-    let w = &mut sim.world;
+pub(crate) fn controls(w: &mut World) {
     if !w.any_controller() {
         return;
     }
@@ -55,8 +52,7 @@ pub(crate) fn controls(sim: &mut Simulation, _out: &mut FrameOutput) {
 }
 
 /// The ship's engine force along its heading, when the engine is on.
-fn thrust(sim: &Simulation, i: usize) -> Vec2 {
-    let w = &sim.world;
+fn thrust(w: &World, i: usize) -> Vec2 {
     match &w.controller[i] {
         Some(Controller::Ship { thrust, .. }) if w.inputs[i].thrust => {
             let (s, c) = libm::sincos(w.angle[i]);
@@ -66,9 +62,9 @@ fn thrust(sim: &Simulation, i: usize) -> Vec2 {
     }
 }
 
-pub(crate) fn has_forces(sim: &Simulation) -> bool {
-    let w = &sim.world;
-    let g = sim.scenario.world.gravity;
+/// Whether any force (gravity, thrust, a constant force) acts on a body.
+pub(crate) fn has_forces(w: &World, def: &WorldDef) -> bool {
+    let g = def.gravity;
     let dynamic = |i: usize| w.kind[i] == BodyKind::Dynamic;
     // Gravity first (its first dynamic body usually answers), then thrust (only controlled
     // bodies have inputs), then a constant force on an active body.
@@ -87,31 +83,29 @@ pub(crate) fn has_forces(sim: &Simulation) -> bool {
 }
 
 /// `a = sum(f) / m` with gravity as the force `m * g * gravity_scale`; `v += a * dt`.
-pub(crate) fn forces(sim: &mut Simulation, _out: &mut FrameOutput) {
-    let dt = sim.dt();
-    let g = sim.scenario.world.gravity;
-    for k in 0..sim.world.active().len() {
-        let i = sim.world.active()[k] as usize;
-        if sim.world.kind[i] != BodyKind::Dynamic {
+pub(crate) fn forces(w: &mut World, def: &WorldDef) {
+    let (dt, g) = (def.dt, def.gravity);
+    for k in 0..w.active().len() {
+        let i = w.active()[k] as usize;
+        if w.kind[i] != BodyKind::Dynamic {
             continue;
         }
-        let m = sim.world.mass[i];
-        let sum = sim.world.force[i] + thrust(sim, i) + g * (m * sim.world.gravity_scale[i]);
+        let m = w.mass[i];
+        let sum = w.force[i] + thrust(w, i) + g * (m * w.gravity_scale[i]);
         let a = sum / m;
-        sim.world.velocity[i] += a * dt;
+        w.velocity[i] += a * dt;
     }
 }
 
-pub(crate) fn has_motion(sim: &Simulation) -> bool {
-    let w = &sim.world;
+/// Whether an active body has a velocity.
+pub(crate) fn has_motion(w: &World) -> bool {
     w.active()
         .iter()
         .any(|&i| w.velocity[i as usize] != Vec2::ZERO)
 }
 
-fn move_axis(sim: &mut Simulation, axis: usize) {
-    let dt = sim.dt();
-    let w = &mut sim.world;
+/// `position[axis] += velocity[axis] * dt` for every active body.
+fn move_axis(w: &mut World, dt: f64, axis: usize) {
     for k in 0..w.active().len() {
         let i = w.active()[k] as usize;
         w.position[i][axis] += w.velocity[i][axis] * dt;
@@ -119,26 +113,24 @@ fn move_axis(sim: &mut Simulation, axis: usize) {
 }
 
 /// `x += vx * dt`.
-pub(crate) fn move_x(sim: &mut Simulation, _out: &mut FrameOutput) {
-    move_axis(sim, 0);
+pub(crate) fn move_x(w: &mut World, dt: f64) {
+    move_axis(w, dt, 0);
 }
 
 /// `y += vy * dt`.
-pub(crate) fn move_y(sim: &mut Simulation, _out: &mut FrameOutput) {
-    move_axis(sim, 1);
+pub(crate) fn move_y(w: &mut World, dt: f64) {
+    move_axis(w, dt, 1);
 }
 
-pub(crate) fn has_turning(sim: &Simulation) -> bool {
-    let w = &sim.world;
+/// Whether an active body has an angular velocity.
+pub(crate) fn has_turning(w: &World) -> bool {
     w.active()
         .iter()
         .any(|&i| w.angular_velocity[i as usize] != 0.0)
 }
 
 /// `angle += angular_velocity * dt`.
-pub(crate) fn turn(sim: &mut Simulation, _out: &mut FrameOutput) {
-    let dt = sim.dt();
-    let w = &mut sim.world;
+pub(crate) fn turn(w: &mut World, dt: f64) {
     for k in 0..w.active().len() {
         let i = w.active()[k] as usize;
         w.angle[i] += w.angular_velocity[i] * dt;

@@ -2,23 +2,17 @@
 //! the children of a split.
 
 use crate::entity::Entity;
-use crate::output::{EventRecord, FrameOutput, RemovedBody};
-use crate::pipeline::Simulation;
+use crate::event::{GameEvent, Removal};
+use crate::output::RemovedBody;
+use crate::stages::StageCtx;
 
 /// Removes `entity` if it is still alive, records it, and, with `split`, spawns its children
 /// at its position with its velocity added to theirs.
-pub(crate) fn remove(
-    sim: &mut Simulation,
-    out: &mut FrameOutput,
-    entity: Entity,
-    kind: &'static str,
-    why: &str,
-    split: bool,
-) {
-    let Some(i) = sim.world.index_of(entity) else {
+pub(crate) fn remove(ctx: &mut StageCtx, entity: Entity, cause: Removal, split: bool) {
+    let w = &mut *ctx.world;
+    let Some(i) = w.index_of(entity) else {
         return;
     };
-    let w = &sim.world;
     let removed = RemovedBody {
         entity,
         name: w.name[i].clone(),
@@ -28,28 +22,28 @@ pub(crate) fn remove(
         velocity: w.velocity[i],
         kind: w.kind[i],
     };
-    out.events.push(EventRecord {
-        kind,
-        message: format!("{} #{} {why}", removed.name, entity),
+    ctx.out.events.push(GameEvent::Removed {
+        body: entity,
+        cause,
     });
     let children = if split {
-        std::mem::take(&mut sim.world.split[i])
+        std::mem::take(&mut w.split[i])
     } else {
         Vec::new()
     };
-    sim.world.despawn(i);
+    w.despawn(i);
     for child in children {
-        let Some(template) = sim.templates.get(&child.template) else {
+        let Some(template) = ctx.templates.get(&child.template) else {
             continue;
         };
         let mut def = template.clone();
         def.position = removed.pose.position + child.offset;
         def.velocity = removed.velocity + child.velocity;
-        let e = sim.world.spawn(&def);
-        out.events.push(EventRecord {
-            kind: "spawn",
-            message: format!("{} #{e} split from {} #{entity}", def.name, removed.name),
+        let e = w.spawn(&def);
+        ctx.out.events.push(GameEvent::SplitFrom {
+            child: e,
+            parent: entity,
         });
     }
-    out.removed.push(removed);
+    ctx.out.removed.push(removed);
 }

@@ -2,31 +2,27 @@
 
 use ricochet_geom::Vec2;
 
-use crate::def::{Action, BodyKind, Controller};
-use crate::output::{EventRecord, FrameOutput};
-use crate::pipeline::Simulation;
+use crate::def::{Action, BodyKind, Controller, Event};
+use crate::event::{FireOutcome, GameEvent, JumpOutcome, Removal, ScriptInput};
+use crate::stages::StageCtx;
 use crate::stages::remove::remove;
 
-pub(crate) fn has_work(sim: &Simulation) -> bool {
-    !sim.due_events().is_empty()
-}
-
-pub(crate) fn run(sim: &mut Simulation, out: &mut FrameOutput) {
-    let events = sim.due_events().to_vec();
-    sim.cursor += events.len();
-    for event in &events {
-        apply(sim, out, &event.action);
+/// Applies `due`, the script events of this frame.
+pub(crate) fn run(ctx: &mut StageCtx, due: &[Event]) {
+    for event in due {
+        apply(ctx, &event.action);
     }
     // A body an event named was woken: it moves this frame.
-    sim.world.refresh_active();
+    ctx.world.refresh_active();
 }
 
-fn apply(sim: &mut Simulation, out: &mut FrameOutput, action: &Action) {
+/// Applies one script action and records what it did.
+fn apply(ctx: &mut StageCtx, action: &Action) {
     if let Action::Spawn { body, template } = action {
-        let e = sim.world.spawn(body);
-        out.events.push(EventRecord {
-            kind: "spawn",
-            message: format!("{} #{e} spawned from template {template}", body.name),
+        let e = ctx.world.spawn(body);
+        ctx.out.events.push(GameEvent::Spawned {
+            body: e,
+            template: template.clone(),
         });
         return;
     }
@@ -42,78 +38,71 @@ fn apply(sim: &mut Simulation, out: &mut FrameOutput, action: &Action) {
         | Action::Move { body, .. }
         | Action::Jump { body } => body,
     };
-    let Some(i) = sim.world.find(name) else {
-        out.events.push(EventRecord {
-            kind: "missed",
-            message: format!("{}: no body named {name} is alive", action.name()),
+    let Some(i) = ctx.world.find(name) else {
+        ctx.out.events.push(GameEvent::Missed {
+            action: action.name(),
+            name: name.clone(),
         });
         return;
     };
-    let entity = sim.world.entity[i];
-    sim.world.wake(i);
-    let w = &mut sim.world;
-    let what = match action {
+    let entity = ctx.world.entity[i];
+    ctx.world.wake(i);
+    let w = &mut *ctx.world;
+    let input = match action {
         Action::Destroy { .. } => {
-            remove(
-                sim,
-                out,
-                entity,
-                "destroy",
-                "destroyed by the script",
-                false,
-            );
+            remove(ctx, entity, Removal::Script, false);
             return;
         }
         Action::SetVelocity { velocity, .. } => {
             if w.kind[i] != BodyKind::Static {
                 w.velocity[i] = *velocity;
             }
-            format!("velocity set to [{}, {}]", velocity.x, velocity.y)
+            ScriptInput::Velocity(*velocity)
         }
         Action::ApplyImpulse { impulse, .. } => {
             if w.kind[i] == BodyKind::Dynamic {
                 w.velocity[i] += *impulse / w.mass[i];
             }
-            format!("impulse [{}, {}]", impulse.x, impulse.y)
+            ScriptInput::Impulse(*impulse)
         }
         Action::SetForce { force, .. } => {
             w.force[i] = *force;
-            format!("force set to [{}, {}]", force.x, force.y)
+            ScriptInput::Force(*force)
         }
         Action::Thrust { on, .. } => {
             w.inputs[i].thrust = *on;
-            format!("thrust {}", if *on { "on" } else { "off" })
+            ScriptInput::Thrust(*on)
         }
         Action::Turn { input, .. } => {
             w.inputs[i].turn = *input;
-            format!("turn {input}")
+            ScriptInput::Turn(*input)
         }
         Action::Move { input, .. } => {
             w.inputs[i].run = *input;
-            format!("move {input}")
+            ScriptInput::Move(*input)
         }
-        Action::Jump { .. } => match &w.controller[i] {
+        Action::Jump { .. } => ScriptInput::Jump(match &w.controller[i] {
             Some(Controller::Runner { jump_speed, .. }) if w.grounded[i] => {
                 w.velocity[i].y = *jump_speed;
                 w.grounded[i] = false;
-                "jump".to_owned()
+                JumpOutcome::Jumped
             }
-            Some(Controller::Runner { .. }) => "jump ignored: not grounded".to_owned(),
-            _ => "jump ignored: not a runner".to_owned(),
-        },
-        Action::Fire { .. } => fire(sim, out, i),
+            Some(Controller::Runner { .. }) => JumpOutcome::NotGrounded,
+            _ => JumpOutcome::NotARunner,
+        }),
+        Action::Fire { .. } => ScriptInput::Fire(fire(ctx, i)),
         Action::Spawn { .. } => unreachable!("handled above"),
     };
-    out.events.push(EventRecord {
-        kind: "input",
-        message: format!("{name} #{entity}: {what}"),
+    ctx.out.events.push(GameEvent::Input {
+        body: entity,
+        input,
     });
 }
 
 /// A ship fires: its bullet template appears `muzzle` ahead, moving at the ship's velocity
 /// plus `bullet_speed` along the heading.
-fn fire(sim: &mut Simulation, out: &mut FrameOutput, i: usize) -> String {
-    let w = &sim.world;
+fn fire(ctx: &mut StageCtx, i: usize) -> FireOutcome {
+    let w = &mut *ctx.world;
     let Some(Controller::Ship {
         bullet,
         bullet_speed,
@@ -121,10 +110,10 @@ fn fire(sim: &mut Simulation, out: &mut FrameOutput, i: usize) -> String {
         ..
     }) = &w.controller[i]
     else {
-        return "fire ignored: not a ship".to_owned();
+        return FireOutcome::NotAShip;
     };
-    let Some(template) = sim.templates.get(bullet) else {
-        return format!("fire ignored: no template {bullet}");
+    let Some(template) = ctx.templates.get(bullet) else {
+        return FireOutcome::NoTemplate(bullet.clone());
     };
     let (s, c) = libm::sincos(w.angle[i]);
     let heading = Vec2::new(c, s);
@@ -132,10 +121,8 @@ fn fire(sim: &mut Simulation, out: &mut FrameOutput, i: usize) -> String {
     def.position = w.position[i] + heading * *muzzle;
     def.velocity = w.velocity[i] + heading * *bullet_speed;
     def.angle = w.angle[i];
-    let e = sim.world.spawn(&def);
-    out.events.push(EventRecord {
-        kind: "spawn",
-        message: format!("{} #{e} fired", def.name),
-    });
-    "fire".to_owned()
+    let ship = w.entity[i];
+    let bullet = w.spawn(&def);
+    ctx.out.events.push(GameEvent::Fired { bullet, ship });
+    FireOutcome::Fired
 }

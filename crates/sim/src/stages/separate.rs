@@ -22,8 +22,9 @@ use ricochet_geom::{Bounds, Primitive, Shape, Vec2, contact};
 use crate::broad_phase::{FixedGrid, MoverGrid};
 use crate::def::{BodyKind, Controller, LayerId, Layers, Response};
 use crate::entity::Entity;
-use crate::output::{ContactRecord, EventRecord, FrameOutput, Phase};
-use crate::pipeline::{SLOP, Simulation};
+use crate::event::GameEvent;
+use crate::output::{ContactRecord, Phase};
+use crate::stages::{SLOP, StageCtx};
 use crate::world::World;
 
 /// Whether a shape is resolved per axis: a single axis-aligned box.
@@ -31,21 +32,23 @@ pub(crate) fn is_box(shape: &Shape) -> bool {
     shape.is_single_aabb()
 }
 
-pub(crate) fn has_work(sim: &Simulation) -> bool {
-    let w = &sim.world;
-    sim.separate.any_layer
+/// Whether a layer pair `separate`s and an active dynamic box may need resolving.
+pub(crate) fn has_work(w: &World, st: &SeparateState) -> bool {
+    st.any_layer
         && w.active().iter().any(|&i| {
             let i = i as usize;
             w.kind[i] == BodyKind::Dynamic && is_box(&w.shape[i])
         })
 }
 
-pub(crate) fn resolve_x(sim: &mut Simulation, out: &mut FrameOutput) {
-    resolve(sim, out, 0);
+/// The `resolve_x` stage: the pass along x.
+pub(crate) fn resolve_x(ctx: &mut StageCtx, st: &mut SeparateState) {
+    resolve(ctx, st, 0);
 }
 
-pub(crate) fn resolve_y(sim: &mut Simulation, out: &mut FrameOutput) {
-    resolve(sim, out, 1);
+/// The `resolve_y` stage: the pass along y.
+pub(crate) fn resolve_y(ctx: &mut StageCtx, st: &mut SeparateState) {
+    resolve(ctx, st, 1);
 }
 
 /// What the per-axis stages keep between passes.
@@ -62,6 +65,12 @@ pub(crate) struct SeparateState {
     static_entities: Vec<(Entity, LayerId)>,
     movers: MoverGrid,
     found: Vec<Obstacle>,
+    /// The pass's dynamic boxes, `(lowest coordinate along the axis, dense index)`.
+    order: Vec<(f64, u32)>,
+    /// Their larger sides, for the mover grid's cell size.
+    extents: Vec<f64>,
+    /// Sleeping boxes pushed against, woken after the pass.
+    woken: Vec<usize>,
 }
 
 /// A box that may stop the one being settled: its dense index, bounds and layer (static
@@ -74,6 +83,7 @@ struct Obstacle {
 }
 
 impl SeparateState {
+    /// The state for a scene with these layers.
     pub(crate) fn new(layers: &Layers) -> SeparateState {
         let n = layers.names().len();
         let separating: Vec<bool> = (0..n)
@@ -138,6 +148,7 @@ fn contains(outer: &Bounds, inner: &Bounds) -> bool {
         && inner.max.y <= outer.max.y
 }
 
+/// How much `a` and `b` overlap along `axis` (negative when apart).
 fn overlap(a: &Bounds, b: &Bounds, axis: usize) -> f64 {
     a.max[axis].min(b.max[axis]) - a.min[axis].max(b.min[axis])
 }
@@ -178,17 +189,20 @@ fn obstacles(st: &mut SeparateState, w: &World, q: &Bounds, from: u32, found: &m
     found.dedup_by_key(|o| o.index);
 }
 
-fn resolve(sim: &mut Simulation, out: &mut FrameOutput, axis: usize) {
+/// One per-axis pass: settles every dynamic box along `axis`, lowest first.
+fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
     let phase = if axis == 0 { Phase::X } else { Phase::Y };
-    let mut st = std::mem::take(&mut sim.separate);
-    st.refresh_statics(&sim.world);
-    let w = &sim.world;
-    let layers = &sim.scenario.world.layers;
+    let out = &mut *ctx.out;
+    let layers = &ctx.def.layers;
+    st.refresh_statics(ctx.world);
+    let w = &*ctx.world;
     // Dynamic boxes settle in order along the axis, lowest (or leftmost) first, and a settled
     // box is solid to the ones after it: a stack resolves bottom-up in one pass, each box
     // landing flush on the one below, with no box pushed back into what held it.
-    let mut order: Vec<(f64, u32)> = Vec::new();
-    let mut extents: Vec<f64> = Vec::new();
+    let mut order = std::mem::take(&mut st.order);
+    let mut extents = std::mem::take(&mut st.extents);
+    order.clear();
+    extents.clear();
     for &i in w.movers() {
         let k = i as usize;
         if !is_box(&w.shape[k]) || w.frozen[k] || !st.separating[usize::from(w.layer[k])] {
@@ -215,7 +229,7 @@ fn resolve(sim: &mut Simulation, out: &mut FrameOutput, axis: usize) {
     }
     let first = out.contacts.len();
     let mut found = std::mem::take(&mut st.found);
-    let mut woken = Vec::new();
+    let mut woken = std::mem::take(&mut st.woken);
     for &(_, i) in &order {
         let i = i as usize;
         // One lookup usually does: it covers the box moved by up to its own size along the
@@ -224,7 +238,7 @@ fn resolve(sim: &mut Simulation, out: &mut FrameOutput, axis: usize) {
         let mut region: Option<Bounds> = None;
         let mut next = 0;
         'look: loop {
-            let bi = box_bounds(&sim.world, i);
+            let bi = box_bounds(ctx.world, i);
             if !region.is_some_and(|r| contains(&r, &bi)) {
                 let mut r = bi;
                 let reach = bi.max[axis] - bi.min[axis];
@@ -236,7 +250,7 @@ fn resolve(sim: &mut Simulation, out: &mut FrameOutput, axis: usize) {
                 } else {
                     0
                 };
-                obstacles(&mut st, &sim.world, &r, from, &mut found);
+                obstacles(st, ctx.world, &r, from, &mut found);
                 region = Some(r);
                 next = 0;
             }
@@ -244,7 +258,7 @@ fn resolve(sim: &mut Simulation, out: &mut FrameOutput, axis: usize) {
                 let o = found[next];
                 let (j, bj) = (o.index as usize, o.bounds);
                 next += 1;
-                let w = &sim.world;
+                let w = &*ctx.world;
                 if j == i || layers.response(w.layer[i], o.layer) != Response::Separate {
                     continue;
                 }
@@ -261,7 +275,7 @@ fn resolve(sim: &mut Simulation, out: &mut FrameOutput, axis: usize) {
                     woken.push(j);
                 }
                 let on_static = w.kind[j] == BodyKind::Static;
-                let w = &mut sim.world;
+                let w = &mut *ctx.world;
                 apply_push(w, i, axis, moved[axis]);
                 if axis == 1 && moved[axis] > 0.0 && on_static {
                     w.on_static[i] = true;
@@ -278,30 +292,26 @@ fn resolve(sim: &mut Simulation, out: &mut FrameOutput, axis: usize) {
                     response: Response::Separate,
                     resolved: moved,
                 });
-                out.events.push(EventRecord {
-                    kind: if axis == 0 { "hit_x" } else { "hit_y" },
-                    message: format!(
-                        "{} #{} pushed {} by {} out of {} #{}",
-                        w.name[i],
-                        w.entity[i],
-                        if axis == 0 { "along x" } else { "along y" },
-                        moved[axis],
-                        w.name[j],
-                        w.entity[j]
-                    ),
+                out.events.push(GameEvent::PushedOut {
+                    body: w.entity[i],
+                    axis: axis as u8,
+                    by: moved[axis],
+                    obstacle: w.entity[j],
                 });
                 // The box moved: go on from the next obstacle, at its new place.
                 continue 'look;
             }
             break;
         }
-        st.movers.insert(&box_bounds(&sim.world, i), i as u32);
+        st.movers.insert(&box_bounds(ctx.world, i), i as u32);
     }
-    for j in woken {
-        sim.world.wake(j);
+    for j in woken.drain(..) {
+        ctx.world.wake(j);
     }
     st.found = found;
-    sim.separate = st;
+    st.order = order;
+    st.extents = extents;
+    st.woken = woken;
     // The log's convention: a pass's contacts sorted by (a, b).
     out.contacts[first..].sort_by_key(|c| (c.a, c.b));
 }

@@ -1,0 +1,142 @@
+//! What happened in a frame, as data: the game events the stages raise. The simulation never
+//! formats them; the recorder turns each into a line of text for the log.
+//!
+//! Every body is named by its [`Entity`] (index and generation). A body alive at the end of
+//! the frame is found with [`crate::World::index_of`]; one removed during the frame is in
+//! [`crate::FrameOutput::removed`].
+
+use ricochet_geom::Vec2;
+
+use crate::entity::Entity;
+
+/// One game event, in the order it happened within its frame.
+#[derive(Clone, Debug, PartialEq)]
+pub enum GameEvent {
+    /// A script event set an input or edited a body's motion.
+    Input {
+        /// The body the script named.
+        body: Entity,
+        /// What the script did to it.
+        input: ScriptInput,
+    },
+    /// A script event named a body that is not alive; nothing happened.
+    Missed {
+        /// The action's name in the scenario file (`destroy`, `fire`, ...).
+        action: &'static str,
+        /// The body name the event gave.
+        name: String,
+    },
+    /// A script event spawned a body from a template.
+    Spawned {
+        /// The new body.
+        body: Entity,
+        /// The template's name.
+        template: String,
+    },
+    /// A ship fired: its bullet template spawned ahead of it.
+    Fired {
+        /// The new bullet.
+        bullet: Entity,
+        /// The ship that fired it.
+        ship: Entity,
+    },
+    /// A destroyed body's split child spawned where the body was.
+    SplitFrom {
+        /// The new body.
+        child: Entity,
+        /// The body it split from (removed this frame).
+        parent: Entity,
+    },
+    /// A body was removed.
+    Removed {
+        /// The body (in [`crate::FrameOutput::removed`]).
+        body: Entity,
+        /// Why.
+        cause: Removal,
+    },
+    /// Two bodies in a `report` layer pair overlap.
+    Contact {
+        /// The body with the lower id.
+        a: Entity,
+        /// The body with the higher id.
+        b: Entity,
+        /// Penetration depth.
+        depth: f64,
+    },
+    /// Two bodies in a `separate` layer pair were pushed apart along the contact normal.
+    PushedApart {
+        /// The body with the lower id.
+        a: Entity,
+        /// The body with the higher id.
+        b: Entity,
+        /// The depth they overlapped by.
+        depth: f64,
+    },
+    /// A box was pushed out of another along one axis (`resolve_x`, `resolve_y`).
+    PushedOut {
+        /// The box that moved.
+        body: Entity,
+        /// `0` for x, `1` for y.
+        axis: u8,
+        /// The signed distance it moved along the axis.
+        by: f64,
+        /// The box it was pushed out of.
+        obstacle: Entity,
+    },
+}
+
+/// What a script event did to a body it found.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ScriptInput {
+    /// `set_velocity` (ignored by static bodies).
+    Velocity(Vec2),
+    /// `apply_impulse` (only dynamic bodies respond).
+    Impulse(Vec2),
+    /// `set_force`.
+    Force(Vec2),
+    /// `thrust`: the engine on or off.
+    Thrust(bool),
+    /// `turn`, the input from -1 to 1.
+    Turn(f64),
+    /// `move`, the input from -1 to 1.
+    Move(f64),
+    /// `jump`, and whether it happened.
+    Jump(JumpOutcome),
+    /// `fire`, and whether it happened.
+    Fire(FireOutcome),
+}
+
+/// The outcome of a `jump` input.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum JumpOutcome {
+    /// The runner jumped.
+    Jumped,
+    /// Ignored: the runner was in the air.
+    NotGrounded,
+    /// Ignored: the body has no runner controller.
+    NotARunner,
+}
+
+/// The outcome of a `fire` input.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum FireOutcome {
+    /// A bullet was spawned (the [`GameEvent::Fired`] just before this input says which).
+    Fired,
+    /// Ignored: the body has no ship controller.
+    NotAShip,
+    /// Ignored: the ship's bullet template does not exist; its name.
+    NoTemplate(String),
+}
+
+/// Why a body was removed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Removal {
+    /// A `destroy` script event.
+    Script,
+    /// A `destroy` response: hit by this body.
+    HitBy(Entity),
+    /// It left the world bounds.
+    LeftWorld,
+    /// Its lifetime ran out.
+    Expired,
+}
