@@ -32,6 +32,7 @@
 pub mod bench;
 mod convert;
 mod motion;
+mod pairs;
 mod referee;
 mod summary;
 mod swept;

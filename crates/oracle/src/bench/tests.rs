@@ -1,0 +1,203 @@
+//! The rapier scene and the contact comparison on small scenes.
+
+use ricochet_geom::{Pose, Primitive, Shape, Vec2};
+use ricochet_sim::{BodyKind, Entity, Simulation};
+
+use super::scene::collider_pose;
+use super::{CONTACT_TOLERANCE, RapierScene, compare_contacts};
+use crate::convert::place;
+
+fn shapes() -> Vec<Shape> {
+    vec![
+        Shape::circle(0.5).unwrap(),
+        Shape::Primitive(Primitive::circle(Vec2::new(0.3, -0.2), 0.5).unwrap()),
+        Shape::aabb(Vec2::new(0.5, 0.25)).unwrap(),
+        Shape::Primitive(Primitive::aabb(Vec2::new(0.1, 0.4), Vec2::new(0.5, 0.25)).unwrap()),
+        Shape::obb(Vec2::new(0.5, 0.25)).unwrap(),
+        Shape::Primitive(Primitive::obb(Vec2::new(0.2, 0.1), Vec2::new(0.5, 0.25), 0.3).unwrap()),
+        Shape::capsule(Vec2::new(-0.5, 0.0), Vec2::new(0.5, 0.1), 0.2).unwrap(),
+        Shape::polygon(&[
+            Vec2::new(0.0, 0.0),
+            Vec2::new(1.0, 0.1),
+            Vec2::new(0.4, 0.9),
+        ])
+        .unwrap(),
+    ]
+}
+
+#[test]
+fn collider_poses_are_the_referees_placement() {
+    let pose = Pose::new(Vec2::new(3.25, -7.5), 0.7);
+    for s in shapes() {
+        let (expected, _) = place(&s, &pose, Vec2::ZERO).unwrap();
+        assert_eq!(collider_pose(&s, &pose).unwrap(), expected, "{s:?}");
+    }
+}
+
+const SMALL_SCENE: &str = r#"
+layers = ["a", "b"]
+collide = [{ a = "a", b = "b", response = "report" }]
+[[bodies]]
+layer = "a"
+shape = { kind = "circle", radius = 0.5 }
+velocity = [1, 0]
+[[bodies]]
+layer = "b"
+kind = "static"
+shape = { kind = "aabb", half_extents = [0.5, 0.5] }
+position = [0.8, 0]
+[[bodies]]
+layer = "b"
+shape = { kind = "polygon", vertices = [[0, 0], [1, 0], [0, 1]] }
+position = [10, 0]
+"#;
+
+/// Two bodies overlapping by 0.2 along x and a third far away: rapier finds exactly the
+/// overlapping pair, and the comparison agrees with Ricochet's frame.
+#[test]
+fn rapier_and_ricochet_agree_on_a_small_scene() {
+    let scenario = ricochet_sim::load_scenario(SMALL_SCENE, "t.toml").unwrap();
+    let mut sim = Simulation::new(&scenario);
+    let mut rapier = RapierScene::new(&sim).unwrap();
+    for _ in 0..3 {
+        let out = sim.step();
+        rapier.sync(&sim).unwrap();
+        rapier.step();
+        let pairs = rapier.penetrating();
+        assert_eq!(pairs.len(), 1, "{pairs:?}");
+        let agreement = compare_contacts(&sim, &out, &pairs, CONTACT_TOLERANCE);
+        assert!(agreement.all_agree(), "{agreement:?}");
+        assert_eq!(agreement.both, 1);
+    }
+}
+
+/// The comparison catches a Ricochet that misses a contact, invents one, or logs a wrong
+/// depth at other poses.
+#[test]
+fn a_missing_invented_or_wrong_contact_is_a_disagreement() {
+    let scenario = ricochet_sim::load_scenario(SMALL_SCENE, "t.toml").unwrap();
+    let mut sim = Simulation::new(&scenario);
+    let mut rapier = RapierScene::new(&sim).unwrap();
+    let out = sim.step();
+    rapier.sync(&sim).unwrap();
+    rapier.step();
+    let pairs = rapier.penetrating();
+    assert_eq!(out.contacts.len(), 1);
+
+    let mut missing = out.clone();
+    missing.contacts.clear();
+    let a = compare_contacts(&sim, &missing, &pairs, CONTACT_TOLERANCE);
+    assert_eq!((a.compared, a.rapier_only), (1, 1), "{a:?}");
+    assert!(a.details[0].contains("Ricochet logged no contact"), "{a:?}");
+
+    let mut invented = out.clone();
+    let mut fake = invented.contacts[0].clone();
+    fake.b = sim.world.entity[2];
+    fake.pose_b = sim.world.pose(2);
+    invented.contacts.push(fake);
+    let a = compare_contacts(&sim, &invented, &pairs, CONTACT_TOLERANCE);
+    assert_eq!((a.compared, a.ricochet_only, a.agreed), (2, 1, 1), "{a:?}");
+
+    let mut wrong = out.clone();
+    wrong.contacts[0].pose_a.position.x -= 0.05;
+    let a = compare_contacts(&sim, &wrong, &pairs, CONTACT_TOLERANCE);
+    // The record no longer sits at the end-of-frame poses: checked at its own poses
+    // (wrong depth there), and rapier's end-of-frame pair is then missing from Ricochet.
+    assert_eq!((a.ricochet_only, a.rapier_only), (1, 1), "{a:?}");
+}
+
+/// Kinematic and static bodies never collide with each other in Ricochet; rapier is set
+/// up the same way (only dynamic bodies' colliders enable fixed–fixed pairs).
+#[test]
+fn pairs_without_a_dynamic_body_are_not_tested_by_either_engine() {
+    let text = r#"
+layers = ["a"]
+collide = [{ a = "a", b = "a", response = "report" }]
+[[bodies]]
+layer = "a"
+kind = "kinematic"
+shape = { kind = "circle", radius = 0.5 }
+velocity = [1, 0]
+[[bodies]]
+layer = "a"
+kind = "static"
+shape = { kind = "aabb", half_extents = [0.5, 0.5] }
+position = [0.5, 0]
+[[bodies]]
+layer = "a"
+kind = "static"
+shape = { kind = "circle", radius = 0.5 }
+position = [0.5, 0.5]
+"#;
+    let scenario = ricochet_sim::load_scenario(text, "t.toml").unwrap();
+    let mut sim = Simulation::new(&scenario);
+    let mut rapier = RapierScene::new(&sim).unwrap();
+    for _ in 0..2 {
+        let out = sim.step();
+        rapier.sync(&sim).unwrap();
+        rapier.step();
+        assert!(out.contacts.is_empty());
+        assert!(rapier.penetrating().is_empty());
+    }
+}
+
+/// A scene of 40 layers: rapier's 32 collision groups cannot name them, so the layer filter
+/// asks the matrix through the pair hook. Bodies sit on layers past 32: the `report` pair
+/// (35, 36) is found, the overlapping `ignore` pair (37, 38) is not, and (1, 33) — whose
+/// bits would alias (33 mod 32 = 1) if groups were used — only when its response says so.
+#[test]
+fn more_than_32_layers_filter_by_the_matrix() {
+    use crate::pairs::LayerFilter;
+    use ricochet_sim::{BodyDef, Layers, Response, Scenario, WorldDef};
+
+    let mut layers = Layers::new((0..40).map(|k| format!("l{k}")).collect());
+    layers.set(35, 36, Response::Report);
+    layers.set(1, 33, Response::Report);
+    assert!(!LayerFilter::new(&layers).uses_groups());
+    let circle = |name: &str, layer: u8, x: f64, kind: BodyKind| BodyDef {
+        name: name.to_owned(),
+        layer,
+        kind,
+        shape: Shape::circle(0.5).unwrap(),
+        position: Vec2::new(x, 0.0),
+        ..BodyDef::default()
+    };
+    let bodies = vec![
+        circle("a35", 35, 0.0, BodyKind::Dynamic),
+        circle("b36", 36, 0.8, BodyKind::Static),
+        circle("c37", 37, 10.0, BodyKind::Dynamic),
+        circle("d38", 38, 10.8, BodyKind::Static),
+        circle("e1", 1, 20.0, BodyKind::Dynamic),
+        circle("f33", 33, 20.8, BodyKind::Static),
+        circle("g1", 1, 30.0, BodyKind::Dynamic),
+        circle("h1", 1, 30.8, BodyKind::Static),
+    ];
+    let scenario = Scenario {
+        name: "layers".to_owned(),
+        world: WorldDef {
+            layers,
+            ..WorldDef::default()
+        },
+        frames: 3,
+        templates: std::collections::BTreeMap::new(),
+        bodies,
+        script: Vec::new(),
+    };
+    let mut sim = Simulation::new(&scenario);
+    let mut rapier = RapierScene::new(&sim).unwrap();
+    let e = |i: usize| sim.world.entity[i];
+    let expected: Vec<(Entity, Entity)> = vec![(e(0), e(1)), (e(4), e(5))];
+    for _ in 0..3 {
+        let out = sim.step();
+        rapier.sync(&sim).unwrap();
+        rapier.step();
+        let pairs = rapier.penetrating();
+        assert_eq!(pairs.keys().copied().collect::<Vec<_>>(), expected);
+        let agreement = compare_contacts(&sim, &out, &pairs, CONTACT_TOLERANCE);
+        assert!(agreement.all_agree(), "{agreement:?}");
+        assert_eq!(agreement.both, 2);
+    }
+    // The referee filters its own pipeline the same way.
+    let summary = crate::validate(&scenario, 3, crate::Tolerances::default());
+    assert!(summary.passed(), "{}", crate::summary_table(&summary));
+}
