@@ -15,7 +15,7 @@
 
 use ricochet_geom::{Shape, Vec2};
 use ricochet_sim::{
-    BodyDef, BodyKind, Controller, LayerId, Response, Scenario, WorldBounds, WorldDef,
+    BodyDef, BodyKind, Controller, LayerId, Layers, Response, Scenario, WorldBounds, WorldDef,
 };
 
 use crate::{Rng, layers, scenario};
@@ -109,6 +109,21 @@ impl Scene {
     }
 }
 
+/// The world of every bench scene: 60 Hz, `gravity`, wrapping round the bounds `min`..`max`.
+fn wrapping_world(gravity: Vec2, min: Vec2, max: Vec2, layers: Layers) -> WorldDef {
+    WorldDef {
+        dt: DT,
+        gravity,
+        bounds: Some(WorldBounds {
+            min,
+            max,
+            wrap: true,
+        }),
+        layers,
+        ..WorldDef::default()
+    }
+}
+
 /// A convex polygon of `n` vertices on a circle of `radius`, at jittered angles (points on a
 /// circle in counter-clockwise order are always strictly convex).
 fn round_polygon(rng: &mut Rng, n: usize, radius: f64) -> Shape {
@@ -141,17 +156,7 @@ pub fn asteroids(n: usize, frames: u64) -> Scenario {
         ],
     );
     l.set_fast(BULLET);
-    let world = WorldDef {
-        dt: DT,
-        gravity: Vec2::ZERO,
-        bounds: Some(WorldBounds {
-            min: Vec2::ZERO,
-            max: Vec2::splat(side),
-            wrap: true,
-        }),
-        layers: l,
-        ..WorldDef::default()
-    };
+    let world = wrapping_world(Vec2::ZERO, Vec2::ZERO, Vec2::splat(side), l);
     let mut bodies = Vec::with_capacity(n + BULLETS + 1);
     bodies.push(BodyDef {
         name: "ship".to_owned(),
@@ -258,23 +263,18 @@ pub fn platformer(tiles: usize, actors: usize, frames: u64) -> Scenario {
             ..BodyDef::default()
         });
     }
-    let world = WorldDef {
-        dt: DT,
-        gravity: Vec2::new(0.0, -20.0),
-        bounds: Some(WorldBounds {
-            min: Vec2::new(0.0, -10.0),
-            max: Vec2::new(width as f64, floor as f64 * FLOOR_SPACING + 10.0),
-            wrap: true,
-        }),
-        layers: layers(
+    let world = wrapping_world(
+        Vec2::new(0.0, -20.0),
+        Vec2::new(0.0, -10.0),
+        Vec2::new(width as f64, floor as f64 * FLOOR_SPACING + 10.0),
+        layers(
             &["tile", "actor"],
             &[
                 (TILE, ACTOR, Response::Separate),
                 (ACTOR, ACTOR, Response::Report),
             ],
         ),
-        ..WorldDef::default()
-    };
+    );
     scenario(name, world, bodies, frames)
 }
 
@@ -335,23 +335,18 @@ pub fn rain(n: usize, frames: u64) -> Scenario {
             ..BodyDef::default()
         });
     }
-    let world = WorldDef {
-        dt: DT,
-        gravity: Vec2::new(0.0, -9.81),
-        bounds: Some(WorldBounds {
-            min: Vec2::ZERO,
-            max: Vec2::splat(side),
-            wrap: true,
-        }),
-        layers: layers(
+    let world = wrapping_world(
+        Vec2::new(0.0, -9.81),
+        Vec2::ZERO,
+        Vec2::splat(side),
+        layers(
             &["drop", "ground"],
             &[
                 (DROP, GROUND, Response::Report),
                 (DROP, DROP, Response::Report),
             ],
         ),
-        ..WorldDef::default()
-    };
+    );
     scenario(name, world, bodies, frames)
 }
 

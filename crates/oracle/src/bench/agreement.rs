@@ -11,8 +11,9 @@ use crate::OracleError;
 use crate::referee::{Recheck, body, depth, recheck, threshold};
 
 /// How one frame's (or a whole run's) contact sets compare. Every compared item either
-/// agrees or is counted as a disagreement with a sentence in `details`.
-#[derive(Clone, Debug, Default, PartialEq)]
+/// agrees or is counted as a disagreement with a sentence in `details`. Serialisable: the
+/// bench sends it from the process that ran the scene.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ContactAgreement {
     /// Items compared: end-of-frame pairs (from either engine) plus contact records checked
     /// at their own poses.

@@ -1,7 +1,7 @@
 //! The rapier scene and the contact comparison on small scenes.
 
 use ricochet_geom::{Pose, Primitive, Shape, Vec2};
-use ricochet_sim::{BodyKind, Entity, Simulation};
+use ricochet_sim::{BodyKind, Entity, Scenario, Simulation};
 
 use super::scene::collider_pose;
 use super::{CONTACT_TOLERANCE, RapierScene, compare_contacts};
@@ -57,18 +57,32 @@ position = [10, 0]
 #[test]
 fn rapier_and_ricochet_agree_on_a_small_scene() {
     let scenario = ricochet_sim::load_scenario(SMALL_SCENE, "t.toml").unwrap();
-    let mut sim = Simulation::new(&scenario);
+    step_together(&scenario, 3, 1);
+}
+
+/// Steps Ricochet and rapier together for `frames` frames: every frame rapier finds `both`
+/// penetrating pairs, Ricochet the same, and the comparison agrees. Returns the simulation
+/// and rapier's pairs of the last frame.
+fn step_together(
+    scenario: &Scenario,
+    frames: usize,
+    both: u64,
+) -> (Simulation, Vec<(Entity, Entity)>) {
+    let mut sim = Simulation::new(scenario);
     let mut rapier = RapierScene::new(&sim).unwrap();
-    for _ in 0..3 {
+    let mut last = Vec::new();
+    for _ in 0..frames {
         let out = sim.step();
         rapier.sync(&sim).unwrap();
         rapier.step();
         let pairs = rapier.penetrating();
-        assert_eq!(pairs.len(), 1, "{pairs:?}");
+        assert_eq!(pairs.len() as u64, both, "{pairs:?}");
         let agreement = compare_contacts(&sim, &out, &pairs, CONTACT_TOLERANCE);
         assert!(agreement.all_agree(), "{agreement:?}");
-        assert_eq!(agreement.both, 1);
+        assert_eq!(agreement.both, both);
+        last = pairs.into_keys().collect();
     }
+    (sim, last)
 }
 
 /// The comparison catches a Ricochet that misses a contact, invents one, or logs a wrong
@@ -148,55 +162,40 @@ position = [0.5, 0.5]
 #[test]
 fn more_than_32_layers_filter_by_the_matrix() {
     use crate::pairs::LayerFilter;
-    use ricochet_sim::{BodyDef, Layers, Response, Scenario, WorldDef};
+    use ricochet_sim::{BodyDef, Response, WorldDef};
 
-    let mut layers = Layers::new((0..40).map(|k| format!("l{k}")).collect());
-    layers.set(35, 36, Response::Report);
-    layers.set(1, 33, Response::Report);
+    let names: Vec<String> = (0..40).map(|k| format!("l{k}")).collect();
+    let names: Vec<&str> = names.iter().map(String::as_str).collect();
+    let layers = ricochet_scenes::layers(
+        &names,
+        &[(35, 36, Response::Report), (1, 33, Response::Report)],
+    );
     assert!(!LayerFilter::new(&layers).uses_groups());
-    let circle = |name: &str, layer: u8, x: f64, kind: BodyKind| BodyDef {
-        name: name.to_owned(),
-        layer,
-        kind,
-        shape: Shape::circle(0.5).unwrap(),
-        position: Vec2::new(x, 0.0),
-        ..BodyDef::default()
+    // Pairs 0.2 deep, 10 apart: (35, 36) report, (37, 38) ignore, (1, 33) report, (1, 1)
+    // ignore; the first body of each pair is dynamic, the second static.
+    let pairs = [(35, 36), (37, 38), (1, 33), (1, 1)];
+    let bodies = pairs
+        .iter()
+        .enumerate()
+        .flat_map(|(k, &(a, b))| {
+            let x = 10.0 * k as f64;
+            [(a, x, BodyKind::Dynamic), (b, x + 0.8, BodyKind::Static)]
+        })
+        .map(|(layer, x, kind)| BodyDef {
+            layer,
+            kind,
+            position: Vec2::new(x, 0.0),
+            ..BodyDef::default()
+        })
+        .collect();
+    let world = WorldDef {
+        layers,
+        ..WorldDef::default()
     };
-    let bodies = vec![
-        circle("a35", 35, 0.0, BodyKind::Dynamic),
-        circle("b36", 36, 0.8, BodyKind::Static),
-        circle("c37", 37, 10.0, BodyKind::Dynamic),
-        circle("d38", 38, 10.8, BodyKind::Static),
-        circle("e1", 1, 20.0, BodyKind::Dynamic),
-        circle("f33", 33, 20.8, BodyKind::Static),
-        circle("g1", 1, 30.0, BodyKind::Dynamic),
-        circle("h1", 1, 30.8, BodyKind::Static),
-    ];
-    let scenario = Scenario {
-        name: "layers".to_owned(),
-        world: WorldDef {
-            layers,
-            ..WorldDef::default()
-        },
-        frames: 3,
-        templates: std::collections::BTreeMap::new(),
-        bodies,
-        script: Vec::new(),
-    };
-    let mut sim = Simulation::new(&scenario);
-    let mut rapier = RapierScene::new(&sim).unwrap();
+    let scenario = ricochet_scenes::scenario("layers", world, bodies, 3);
+    let (sim, last) = step_together(&scenario, 3, 2);
     let e = |i: usize| sim.world.entity[i];
-    let expected: Vec<(Entity, Entity)> = vec![(e(0), e(1)), (e(4), e(5))];
-    for _ in 0..3 {
-        let out = sim.step();
-        rapier.sync(&sim).unwrap();
-        rapier.step();
-        let pairs = rapier.penetrating();
-        assert_eq!(pairs.keys().copied().collect::<Vec<_>>(), expected);
-        let agreement = compare_contacts(&sim, &out, &pairs, CONTACT_TOLERANCE);
-        assert!(agreement.all_agree(), "{agreement:?}");
-        assert_eq!(agreement.both, 2);
-    }
+    assert_eq!(last, [(e(0), e(1)), (e(4), e(5))]);
     // The referee filters its own pipeline the same way.
     let summary = crate::validate(&scenario, 3, crate::Tolerances::default());
     assert!(summary.passed(), "{}", crate::summary_table(&summary));

@@ -65,43 +65,6 @@ pub fn percentiles(times: &[Duration]) -> (f64, f64) {
     let rank = (n * 95).div_ceil(100).max(1);
     (median, ms[rank - 1])
 }
-/// How one scene's contact sets compared (the run's [`ContactAgreement`], sent from the
-/// child process as JSON).
-#[derive(Clone, Debug, Default, Serialize, Deserialize)]
-#[allow(
-    missing_docs,
-    reason = "the fields of ContactAgreement, documented there"
-)]
-pub struct Agreement {
-    pub compared: u64,
-    pub agreed: u64,
-    pub both: u64,
-    pub touching: u64,
-    pub rapier_cached: u64,
-    pub at_record_poses: u64,
-    pub excluded: u64,
-    pub ricochet_only: u64,
-    pub rapier_only: u64,
-    pub details: Vec<String>,
-}
-
-impl From<&ContactAgreement> for Agreement {
-    fn from(a: &ContactAgreement) -> Agreement {
-        Agreement {
-            compared: a.compared,
-            agreed: a.agreed,
-            both: a.both,
-            touching: a.touching,
-            rapier_cached: a.rapier_cached,
-            at_record_poses: a.at_record_poses,
-            excluded: a.excluded,
-            ricochet_only: a.ricochet_only,
-            rapier_only: a.rapier_only,
-            details: a.details.clone(),
-        }
-    }
-}
-
 /// One scene's figures.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Row {
@@ -120,7 +83,7 @@ pub struct Row {
     /// Rapier's 95th percentile (nearest rank).
     pub rapier_p95_ms: f64,
     /// How the contact sets compared over the run.
-    pub agreement: Agreement,
+    pub agreement: ContactAgreement,
     /// Peak resident set after Ricochet's setup and frame 0, MB (`None` off Linux).
     pub ricochet_mb: Option<f64>,
     /// Peak resident set at the end of the scene, MB (`None` off Linux).
@@ -140,7 +103,7 @@ impl Row {
     /// Whether every compared contact agreed.
     #[must_use]
     pub fn agrees(&self) -> bool {
-        self.agreement.agreed == self.agreement.compared
+        self.agreement.all_agree()
     }
 }
 /// Runs one scene: both engines, `frames` timed frames after frame 0.
@@ -216,7 +179,7 @@ pub fn run_scene(
         ricochet_p95_ms,
         rapier_median_ms,
         rapier_p95_ms,
-        agreement: Agreement::from(&agreement),
+        agreement,
         ricochet_mb,
         peak_mb,
         ricochet_alone_median_ms,
