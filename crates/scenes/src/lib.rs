@@ -4,8 +4,9 @@
 //!
 //! **Owns:** the benchmark scenes ([`bench`](mod@bench): `asteroids-N`, `platformer-T-A`,
 //! `rain-N` and their names), the accuracy scenes and their exact answers ([`accuracy`]:
-//! projectile, spring and orbit, drop, the bullet field), and the one seeded generator
-//! [`Rng`] (SplitMix64). Scenes are [`Scenario`] values built from `WorldDef`, `BodyDef` and
+//! projectile, spring and orbit, drop, the bullet field), the test scenes of tiles, boxes
+//! and balls ([`tiles`]), and the one seeded generator [`Rng`] (SplitMix64). Scenes are
+//! [`Scenario`] values built from `WorldDef`, `BodyDef` and
 //! `Layers`, identical to the bit to what the same scene written as a scenario file loads.
 //!
 //! **Never:** steps a simulation, measures or times anything, links rapier, does I/O, or
@@ -21,6 +22,7 @@
 pub mod accuracy;
 pub mod bench;
 mod rng;
+pub mod tiles;
 
 pub use rng::Rng;
 

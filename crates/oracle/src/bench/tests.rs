@@ -1,7 +1,7 @@
 //! The rapier scene and the contact comparison on small scenes.
 
 use ricochet_geom::{Pose, Primitive, Shape, Vec2};
-use ricochet_sim::{BodyKind, Entity, Scenario, Simulation};
+use ricochet_sim::{BodyDef, BodyKind, Entity, Response, Scenario, Simulation, WorldDef};
 
 use super::scene::collider_pose;
 use super::{CONTACT_TOLERANCE, RapierScene, compare_contacts};
@@ -34,29 +34,56 @@ fn collider_poses_are_the_referees_placement() {
     }
 }
 
-const SMALL_SCENE: &str = r#"
-layers = ["a", "b"]
-collide = [{ a = "a", b = "b", response = "report" }]
-[[bodies]]
-layer = "a"
-shape = { kind = "circle", radius = 0.5 }
-velocity = [1, 0]
-[[bodies]]
-layer = "b"
-kind = "static"
-shape = { kind = "aabb", half_extents = [0.5, 0.5] }
-position = [0.8, 0]
-[[bodies]]
-layer = "b"
-shape = { kind = "polygon", vertices = [[0, 0], [1, 0], [0, 1]] }
-position = [10, 0]
-"#;
+/// A body of `shape` at `(x, 0)` moving at `(vx, 0)`.
+fn body(layer: u8, kind: BodyKind, shape: Shape, x: f64, vx: f64) -> BodyDef {
+    BodyDef {
+        layer,
+        kind,
+        shape,
+        position: Vec2::new(x, 0.0),
+        velocity: Vec2::new(vx, 0.0),
+        ..BodyDef::default()
+    }
+}
+
+/// A scene of `bodies` in which the listed layer pairs `report`.
+fn scene(names: &[&str], reports: &[(u8, u8)], bodies: Vec<BodyDef>) -> Scenario {
+    let pairs: Vec<_> = reports
+        .iter()
+        .map(|&(a, b)| (a, b, Response::Report))
+        .collect();
+    let world = WorldDef {
+        layers: ricochet_scenes::layers(names, &pairs),
+        ..WorldDef::default()
+    };
+    ricochet_scenes::scenario("t", world, bodies, 600)
+}
+
+/// A moving ball overlapping a static box by 0.2 along x, and a triangle far away.
+fn small_scene() -> Scenario {
+    let triangle = Shape::polygon(&[Vec2::ZERO, Vec2::X, Vec2::Y]).unwrap();
+    scene(
+        &["a", "b"],
+        &[(0, 1)],
+        vec![
+            body(0, BodyKind::Dynamic, Shape::circle(0.5).unwrap(), 0.0, 1.0),
+            body(
+                1,
+                BodyKind::Static,
+                Shape::aabb(Vec2::splat(0.5)).unwrap(),
+                0.8,
+                0.0,
+            ),
+            body(1, BodyKind::Dynamic, triangle, 10.0, 0.0),
+        ],
+    )
+}
 
 /// Two bodies overlapping by 0.2 along x and a third far away: rapier finds exactly the
 /// overlapping pair, and the comparison agrees with Ricochet's frame.
 #[test]
 fn rapier_and_ricochet_agree_on_a_small_scene() {
-    let scenario = ricochet_sim::load_scenario(SMALL_SCENE, "t.toml").unwrap();
+    let scenario = small_scene();
     step_together(&scenario, 3, 1);
 }
 
@@ -89,7 +116,7 @@ fn step_together(
 /// depth at other poses.
 #[test]
 fn a_missing_invented_or_wrong_contact_is_a_disagreement() {
-    let scenario = ricochet_sim::load_scenario(SMALL_SCENE, "t.toml").unwrap();
+    let scenario = small_scene();
     let mut sim = Simulation::new(&scenario);
     let mut rapier = RapierScene::new(&sim).unwrap();
     let out = sim.step();
@@ -124,35 +151,26 @@ fn a_missing_invented_or_wrong_contact_is_a_disagreement() {
 /// up the same way (only dynamic bodies' colliders enable fixed–fixed pairs).
 #[test]
 fn pairs_without_a_dynamic_body_are_not_tested_by_either_engine() {
-    let text = r#"
-layers = ["a"]
-collide = [{ a = "a", b = "a", response = "report" }]
-[[bodies]]
-layer = "a"
-kind = "kinematic"
-shape = { kind = "circle", radius = 0.5 }
-velocity = [1, 0]
-[[bodies]]
-layer = "a"
-kind = "static"
-shape = { kind = "aabb", half_extents = [0.5, 0.5] }
-position = [0.5, 0]
-[[bodies]]
-layer = "a"
-kind = "static"
-shape = { kind = "circle", radius = 0.5 }
-position = [0.5, 0.5]
-"#;
-    let scenario = ricochet_sim::load_scenario(text, "t.toml").unwrap();
-    let mut sim = Simulation::new(&scenario);
-    let mut rapier = RapierScene::new(&sim).unwrap();
-    for _ in 0..2 {
-        let out = sim.step();
-        rapier.sync(&sim).unwrap();
-        rapier.step();
-        assert!(out.contacts.is_empty());
-        assert!(rapier.penetrating().is_empty());
-    }
+    let mut ball = body(
+        0,
+        BodyKind::Kinematic,
+        Shape::circle(0.5).unwrap(),
+        0.0,
+        1.0,
+    );
+    ball.position = Vec2::ZERO;
+    let mut peg = body(0, BodyKind::Static, Shape::circle(0.5).unwrap(), 0.5, 0.0);
+    peg.position.y = 0.5;
+    let block = body(
+        0,
+        BodyKind::Static,
+        Shape::aabb(Vec2::splat(0.5)).unwrap(),
+        0.5,
+        0.0,
+    );
+    let scenario = scene(&["a"], &[(0, 0)], vec![ball, block, peg]);
+    let (sim, _) = step_together(&scenario, 2, 0);
+    assert_eq!(sim.world.len(), 3);
 }
 
 /// A scene of 40 layers: rapier's 32 collision groups cannot name them, so the layer filter
@@ -162,37 +180,26 @@ position = [0.5, 0.5]
 #[test]
 fn more_than_32_layers_filter_by_the_matrix() {
     use crate::pairs::LayerFilter;
-    use ricochet_sim::{BodyDef, Response, WorldDef};
 
     let names: Vec<String> = (0..40).map(|k| format!("l{k}")).collect();
     let names: Vec<&str> = names.iter().map(String::as_str).collect();
-    let layers = ricochet_scenes::layers(
-        &names,
-        &[(35, 36, Response::Report), (1, 33, Response::Report)],
-    );
-    assert!(!LayerFilter::new(&layers).uses_groups());
     // Pairs 0.2 deep, 10 apart: (35, 36) report, (37, 38) ignore, (1, 33) report, (1, 1)
     // ignore; the first body of each pair is dynamic, the second static.
     let pairs = [(35, 36), (37, 38), (1, 33), (1, 1)];
+    let circle = || Shape::circle(0.5).unwrap();
     let bodies = pairs
         .iter()
         .enumerate()
         .flat_map(|(k, &(a, b))| {
             let x = 10.0 * k as f64;
-            [(a, x, BodyKind::Dynamic), (b, x + 0.8, BodyKind::Static)]
-        })
-        .map(|(layer, x, kind)| BodyDef {
-            layer,
-            kind,
-            position: Vec2::new(x, 0.0),
-            ..BodyDef::default()
+            [
+                body(a, BodyKind::Dynamic, circle(), x, 0.0),
+                body(b, BodyKind::Static, circle(), x + 0.8, 0.0),
+            ]
         })
         .collect();
-    let world = WorldDef {
-        layers,
-        ..WorldDef::default()
-    };
-    let scenario = ricochet_scenes::scenario("layers", world, bodies, 3);
+    let scenario = scene(&names, &[(35, 36), (1, 33)], bodies);
+    assert!(!LayerFilter::new(&scenario.world.layers).uses_groups());
     let (sim, last) = step_together(&scenario, 3, 2);
     let e = |i: usize| sim.world.entity[i];
     assert_eq!(last, [(e(0), e(1)), (e(4), e(5))]);

@@ -42,6 +42,15 @@ fn mb(v: Option<f64>) -> String {
     v.map_or_else(|| "n/a".to_owned(), |v| format!("{v:.1}"))
 }
 
+/// One line of the table: twelve cells, right-aligned but for the scene's name.
+fn line(s: &mut String, c: [String; 12]) {
+    let _ = writeln!(
+        s,
+        "{:<26} {:>8} {:>6} {:>10} {:>10} {:>10} {:>10} {:>8} {:>19} {:>9} {:>9} {:>10}",
+        c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7], c[8], c[9], c[10], c[11]
+    );
+}
+
 /// The table of every scene.
 #[must_use]
 pub fn table(rows: &[Row]) -> String {
@@ -77,28 +86,26 @@ pub fn table(rows: &[Row]) -> String {
         ],
     ];
     for h in heads {
-        let _ = writeln!(
-            s,
-            "{:<26} {:>8} {:>6} {:>10} {:>10} {:>10} {:>10} {:>8} {:>19} {:>9} {:>9} {:>10}",
-            h[0], h[1], h[2], h[3], h[4], h[5], h[6], h[7], h[8], h[9], h[10], h[11]
-        );
+        line(&mut s, h.map(str::to_owned));
     }
     for r in rows {
-        let _ = writeln!(
-            s,
-            "{:<26} {:>8} {:>6} {:>10.3} {:>10.3} {:>10.3} {:>10.3} {:>8} {:>19} {:>9} {:>9} {:>10.3}",
-            r.scene,
-            r.bodies,
-            r.frames,
-            r.ricochet_median_ms,
-            r.ricochet_p95_ms,
-            r.rapier_median_ms,
-            r.rapier_p95_ms,
-            sig3(r.ratio()),
-            format!("{}/{}", r.agreement.agreed, r.agreement.compared),
-            mb(r.ricochet_mb),
-            mb(r.peak_mb),
-            r.ricochet_alone_median_ms
+        let ms = |v: f64| format!("{v:.3}");
+        line(
+            &mut s,
+            [
+                r.scene.clone(),
+                r.bodies.to_string(),
+                r.frames.to_string(),
+                ms(r.ricochet_median_ms),
+                ms(r.ricochet_p95_ms),
+                ms(r.rapier_median_ms),
+                ms(r.rapier_p95_ms),
+                sig3(r.ratio()),
+                format!("{}/{}", r.agreement.agreed, r.agreement.compared),
+                mb(r.ricochet_mb),
+                mb(r.peak_mb),
+                ms(r.ricochet_alone_median_ms),
+            ],
         );
     }
     s
