@@ -1,16 +1,24 @@
 //! Each named rule fires on a scene built for it, and only there; a deliberately broken
 //! narrow phase (a contact record edited before `check_frame`) is caught.
 
-use ricochet_geom::Vec2;
+use ricochet_geom::{Shape, Vec2};
 use ricochet_oracle::{FrameReport, Referee, Tolerances, rules};
-use ricochet_sim::{FrameOutput, Phase, Simulation, load_scenario};
+use ricochet_scenes::{layers, scenario};
+use ricochet_sim::{
+    BodyDef, BodyKind, FrameOutput, Phase, Response, Scenario, Simulation, WorldDef, load_scenario,
+};
 
 /// Runs `toml` for frames `0..=frames`, checking each; returns the reports.
 fn run(toml: &str, frames: u64) -> Vec<FrameReport> {
     let scenario = load_scenario(toml, "test.toml").unwrap_or_else(|e| panic!("{e}"));
-    let mut sim = Simulation::new(&scenario);
+    check(&scenario, frames)
+}
+
+/// Runs `scenario` for frames `0..=frames`, checking each; returns the reports.
+fn check(scenario: &Scenario, frames: u64) -> Vec<FrameReport> {
+    let mut sim = Simulation::new(scenario);
     sim.capture_detect_poses = true;
-    let mut referee = Referee::new(&scenario, Tolerances::default());
+    let mut referee = Referee::new(scenario, Tolerances::default());
     (0..=frames)
         .map(|_| {
             let out = sim.step();
@@ -58,33 +66,47 @@ fn static_and_kinematic_bodies_overlapping_are_explained_as_static_static() {
     }
 }
 
+/// The ball (id 0, radius 0.5) 0.3 deep in the left side of the wall (id 1, a static 2×2
+/// box at the origin), `separate`, and `third` (id 2), a static body of the wall's layer.
+fn ball_in_wall(third: BodyDef) -> Scenario {
+    let ball = BodyDef {
+        name: "ball".to_owned(),
+        shape: Shape::circle(0.5).unwrap(),
+        position: Vec2::new(-1.2, 0.0),
+        ..BodyDef::default()
+    };
+    let wall = BodyDef {
+        name: "wall".to_owned(),
+        layer: 1,
+        kind: BodyKind::Static,
+        shape: Shape::aabb(Vec2::ONE).unwrap(),
+        ..BodyDef::default()
+    };
+    let third = BodyDef {
+        layer: 1,
+        kind: BodyKind::Static,
+        ..third
+    };
+    let world = WorldDef {
+        layers: layers(&["ball", "wall"], &[(0, 1, Response::Separate)]),
+        ..WorldDef::default()
+    };
+    scenario("ball-in-wall", world, vec![ball, wall, third], 600)
+}
+
 #[test]
 fn a_push_that_ends_a_later_contact_is_explained_as_moved_in_pass() {
     // The ball (id 0) sits 0.3 deep in the wall (id 1) and just touches the ledge (id 2).
     // Pair (0, 1) comes first and pushes the ball 0.3 to the left, clear of the ledge, so
     // Ricochet tests (0, 2) at the pushed pose and finds nothing; rapier, at the detect
     // poses, finds both.
-    let reports = run(
-        r#"
-        layers = ["ball", "wall"]
-        collide = [{ a = "ball", b = "wall", response = "separate" }]
-        [[bodies]]
-        name = "ball"
-        layer = "ball"
-        shape = { kind = "circle", radius = 0.5 }
-        position = [-1.2, 0]
-        [[bodies]]
-        name = "wall"
-        layer = "wall"
-        kind = "static"
-        shape = { kind = "aabb", half_extents = [1, 1] }
-        [[bodies]]
-        name = "ledge"
-        layer = "wall"
-        kind = "static"
-        shape = { kind = "obb", half_extents = [0.55, 0.075] }
-        position = [-0.55, 0.525]
-        "#,
+    let reports = check(
+        &ball_in_wall(BodyDef {
+            name: "ledge".to_owned(),
+            shape: Shape::obb(Vec2::new(0.55, 0.075)).unwrap(),
+            position: Vec2::new(-0.55, 0.525),
+            ..BodyDef::default()
+        }),
         0,
     );
     assert_clean(&reports);
@@ -103,27 +125,13 @@ fn a_push_that_starts_a_later_contact_is_explained_as_moved_in_pass() {
     // touch at the detect poses (0.005 apart) though their bounds overlapped, so the broad
     // phase listed the pair: Ricochet logs (0, 2) at the pushed pose, rapier has no such
     // pair at the detect poses.
-    let reports = run(
-        r#"
-        layers = ["ball", "wall"]
-        collide = [{ a = "ball", b = "wall", response = "separate" }]
-        [[bodies]]
-        name = "ball"
-        layer = "ball"
-        shape = { kind = "circle", radius = 0.5 }
-        position = [-1.2, 0]
-        [[bodies]]
-        name = "wall"
-        layer = "wall"
-        kind = "static"
-        shape = { kind = "aabb", half_extents = [1, 1] }
-        [[bodies]]
-        name = "rock"
-        layer = "wall"
-        kind = "static"
-        shape = { kind = "circle", radius = 0.9 }
-        position = [-2.59, 0.55]
-        "#,
+    let reports = check(
+        &ball_in_wall(BodyDef {
+            name: "rock".to_owned(),
+            shape: Shape::circle(0.9).unwrap(),
+            position: Vec2::new(-2.59, 0.55),
+            ..BodyDef::default()
+        }),
         0,
     );
     assert_clean(&reports);
