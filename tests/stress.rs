@@ -2,8 +2,12 @@
 //! number): far from the origin, extreme sizes and masses, a deep stack, a long run, extreme
 //! timesteps, degenerate geometry, and properties of random small scenes.
 
-use ricochet_geom::{Vec2, contact};
-use ricochet_sim::{BodyKind, FrameOutput, Phase, SLOP, Simulation, World, load_scenario};
+use ricochet_geom::{Shape, Vec2, contact};
+use ricochet_scenes::{layers, scenario};
+use ricochet_sim::{
+    BodyDef, BodyKind, FrameOutput, Phase, Response, SLOP, Simulation, World, WorldDef,
+    load_scenario,
+};
 
 use crate::util::root;
 
@@ -48,40 +52,49 @@ fn worst_solid_overlap(s: &Simulation) -> f64 {
     worst
 }
 
+/// A body of `layer` and `shape` at `at`, moving at `velocity`.
+fn body(name: &str, layer: u8, shape: Shape, at: Vec2, velocity: Vec2) -> BodyDef {
+    BodyDef {
+        name: name.to_owned(),
+        layer,
+        shape,
+        position: at,
+        velocity,
+        ..BodyDef::default()
+    }
+}
+
 /// The stress version of the shapes scene, moved by `offset`.
-fn shifted_scene(offset: f64) -> String {
-    format!(
-        r#"
-        hz = 60
-        layers = ["a", "b"]
-        [[collide]]
-        a = "a"
-        b = "b"
-        response = "report"
-        [[bodies]]
-        layer = "a"
-        shape = {{ kind = "polygon", vertices = [[-1, -1], [1, -1], [1.3, 0.5], [0, 1.2], [-1.2, 0.4]] }}
-        position = [{x0}, {y0}]
-        velocity = [2, 0.5]
-        angular_velocity = 1.1
-        [[bodies]]
-        layer = "b"
-        shape = {{ kind = "capsule", a = [-1.5, 0], b = [1.5, 0], radius = 0.4 }}
-        position = [{x1}, {y1}]
-        velocity = [-1.5, 0]
-        angular_velocity = -0.7
-        [[bodies]]
-        layer = "b"
-        shape = {{ kind = "obb", half_extents = [0.8, 0.3] }}
-        position = [{x2}, {y0}]
-        velocity = [-2.5, 0.2]
-        "#,
-        x0 = offset - 6.0,
-        y0 = offset,
-        x1 = offset + 6.0,
-        y1 = offset + 0.3,
-        x2 = offset + 9.0,
-    )
+fn shifted_scene(offset: f64) -> Simulation {
+    let v = Vec2::new;
+    let polygon = Shape::polygon(&[
+        v(-1.0, -1.0),
+        v(1.0, -1.0),
+        v(1.3, 0.5),
+        v(0.0, 1.2),
+        v(-1.2, 0.4),
+    ])
+    .unwrap();
+    let capsule = Shape::capsule(v(-1.5, 0.0), v(1.5, 0.0), 0.4).unwrap();
+    let obb = Shape::obb(v(0.8, 0.3)).unwrap();
+    let mut bodies = vec![
+        body("body", 0, polygon, v(offset - 6.0, offset), v(2.0, 0.5)),
+        body(
+            "body",
+            1,
+            capsule,
+            v(offset + 6.0, offset + 0.3),
+            v(-1.5, 0.0),
+        ),
+        body("body", 1, obb, v(offset + 9.0, offset), v(-2.5, 0.2)),
+    ];
+    bodies[0].angular_velocity = 1.1;
+    bodies[1].angular_velocity = -0.7;
+    let world = WorldDef {
+        layers: layers(&["a", "b"], &[(0, 1, Response::Report)]),
+        ..WorldDef::default()
+    };
+    Simulation::new(&scenario("shifted", world, bodies, 600))
 }
 
 /// Far from the origin: positions are stored to ulp(offset) = 2.2e-16 * offset, so after n
@@ -89,9 +102,9 @@ fn shifted_scene(offset: f64) -> String {
 #[test]
 fn the_same_scene_far_from_the_origin_gives_the_same_contacts_and_relative_motion() {
     let frames = 300u64;
-    let reference = run(&mut sim(&shifted_scene(0.0)), frames);
+    let reference = run(&mut shifted_scene(0.0), frames);
     for offset in [1e4, 1e6] {
-        let mut s = sim(&shifted_scene(offset));
+        let mut s = shifted_scene(offset);
         let outs = run(&mut s, frames);
         let tol = frames as f64 * 4.0 * f64::EPSILON * offset;
         for (r, o) in reference.iter().zip(&outs) {
@@ -127,7 +140,7 @@ fn the_same_scene_far_from_the_origin_gives_the_same_contacts_and_relative_motio
                 }
             }
         }
-        let mut r = sim(&shifted_scene(0.0));
+        let mut r = shifted_scene(0.0);
         run(&mut r, frames);
         for i in 0..s.world.len() {
             let rel = s.world.position[i] - Vec2::splat(offset);
@@ -254,40 +267,33 @@ fn tiny_and_huge_timesteps_are_handled() {
 
 #[test]
 fn coincident_bodies_and_corner_on_corner_hits_get_finite_normals_and_a_fixed_choice() {
-    let text = r#"
-        hz = 60
-        layers = ["solid", "probe"]
-        [[collide]]
-        a = "solid"
-        b = "solid"
-        response = "separate"
-        [[collide]]
-        a = "probe"
-        b = "solid"
-        response = "report"
-        [[bodies]]
-        name = "wall"
-        layer = "solid"
-        kind = "static"
-        shape = { kind = "aabb", half_extents = [1, 1] }
-        [[bodies]]
-        name = "twin"
-        layer = "solid"
-        shape = { kind = "aabb", half_extents = [1, 1] }
-        [[bodies]]
-        name = "corner"
-        layer = "solid"
-        shape = { kind = "aabb", half_extents = [0.5, 0.5] }
-        position = [1.6, 1.6]
-        velocity = [-6, -6]
-        [[bodies]]
-        name = "still"
-        layer = "probe"
-        shape = { kind = "circle", radius = 0.5 }
-        position = [0, 0]
-    "#;
-    let mut a = sim(text);
-    let mut b = sim(text);
+    // `wall` (static) and `twin` coincide; `corner` hits both corner on corner; `still`
+    // (a probe, reported) sits at their common centre.
+    let (v, square) = (Vec2::new, |h: f64| Shape::aabb(Vec2::splat(h)).unwrap());
+    let mut wall = body("wall", 0, square(1.0), Vec2::ZERO, Vec2::ZERO);
+    wall.kind = BodyKind::Static;
+    let bodies = vec![
+        wall,
+        body("twin", 0, square(1.0), Vec2::ZERO, Vec2::ZERO),
+        body("corner", 0, square(0.5), v(1.6, 1.6), v(-6.0, -6.0)),
+        body(
+            "still",
+            1,
+            Shape::circle(0.5).unwrap(),
+            Vec2::ZERO,
+            Vec2::ZERO,
+        ),
+    ];
+    let world = WorldDef {
+        layers: layers(
+            &["solid", "probe"],
+            &[(0, 0, Response::Separate), (1, 0, Response::Report)],
+        ),
+        ..WorldDef::default()
+    };
+    let scene = scenario("coincident", world, bodies, 600);
+    let mut a = Simulation::new(&scene);
+    let mut b = Simulation::new(&scene);
     for _ in 0..=30 {
         let (oa, ob) = (a.step(), b.step());
         assert_eq!(oa, ob, "the same choice every run");

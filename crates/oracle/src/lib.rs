@@ -7,10 +7,12 @@
 //! compared with rapier's broad and narrow phase at the detect poses; every swept pair cast
 //! by parry along the frame's motion; each difference explained by a named rule of
 //! [`rules`]); the free-flight comparison [`compare_motion`];
-//! the [`ValidationSummary`] with its printable [`summary_table`]; and the rapier side of
-//! `ricochet bench` ([`bench`](mod@bench): rapier's collision-only pipeline on the same shapes and
-//! poses, and the rule by which two contact sets agree). See
-//! `docs/validation.md` for the rules, the tolerances and the figures.
+//! the [`ValidationSummary`] with its printable [`summary_table`]; the rapier side of
+//! `ricochet bench` ([`bench`](mod@bench): rapier's collision-only pipeline on the same
+//! shapes and poses, and the rule by which two contact sets agree, judged with the referee's
+//! own recheck); and the one layer filter both use (`pairs.rs`: rapier's collision groups
+//! up to 32 layers, the layer matrix as a pair hook beyond). See `docs/validation.md` for
+//! the rules, the tolerances and the figures.
 //!
 //! **Never:** feeds anything back into the simulation (it only reads a [`Simulation`] and
 //! its [`FrameOutput`]), does I/O, reads the clock, or hides a difference under a blanket
@@ -32,6 +34,7 @@
 pub mod bench;
 mod convert;
 mod motion;
+mod pairs;
 mod referee;
 mod summary;
 mod swept;

@@ -4,17 +4,15 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 
-use rapier2d_f64::prelude::{
-    ActiveCollisionTypes, ActiveHooks, ColliderBuilder, Group, InteractionGroups,
-    InteractionTestMode, PairContacts, PairFilterContext, PhysicsHooks, PhysicsWorld, SolverFlags,
-};
+use rapier2d_f64::prelude::{ActiveCollisionTypes, ColliderBuilder, PhysicsWorld};
 use ricochet_geom::{Pose, Primitive, Shape, Vec2};
 use ricochet_sim::{
     BodyKind, ContactRecord, Entity, FrameOutput, LayerId, Layers, Phase, Response, SLOP, Scenario,
     Simulation, Stage,
 };
 
-use crate::convert::{overlap_along, pairing, place, reference_contact, size};
+use crate::convert::{ReferenceContact, overlap_along, pairing, place, reference_contact, size};
+use crate::pairs::{LayerFilter, penetration};
 use crate::{OracleError, Tolerances, rules};
 
 /// What one frame's check found.
@@ -114,7 +112,7 @@ pub(crate) fn depth(
 }
 
 /// The depth at which a response starts: `SLOP` for `separate`, 0 otherwise.
-fn threshold(response: Response) -> f64 {
+pub(crate) fn threshold(response: Response) -> f64 {
     if response == Response::Separate {
         SLOP
     } else {
@@ -122,22 +120,34 @@ fn threshold(response: Response) -> f64 {
     }
 }
 
-/// Filters rapier's pairs by the layer matrix when it has more layers than rapier has
-/// collision groups (32): the layer id is the collider's `user_data` high half.
-struct LayerHooks<'a> {
-    layers: &'a Layers,
+/// A contact record recomputed by parry at the record's own poses (see [`recheck`]).
+pub(crate) enum Recheck {
+    /// Parry's depth is within the tolerance of the record's.
+    Agrees(ReferenceContact),
+    /// Parry finds the shapes overlapping to another depth.
+    Differs(ReferenceContact),
+    /// Parry finds the shapes apart.
+    Apart,
 }
 
-impl PhysicsHooks for LayerHooks<'_> {
-    fn filter_contact_pair(&self, ctx: &PairFilterContext) -> Option<SolverFlags> {
-        let layer = |h| {
-            ctx.colliders
-                .get(h)
-                .and_then(|c| LayerId::try_from(c.user_data >> 64).ok())
-        };
-        let (a, b) = (layer(ctx.collider1)?, layer(ctx.collider2)?);
-        (self.layers.response(a, b) != Response::Ignore).then_some(SolverFlags::default())
-    }
+/// Recomputes a contact record (of shapes `a` and `b`) at its own poses: parry's answer, and
+/// whether its depth is within `tol` of the record's. Part 1 of [`Referee::check_frame`]
+/// (with the pair's relative depth tolerance) and the bench's records at other poses (with
+/// its absolute one) both judge a record by this.
+pub(crate) fn recheck(
+    a: &Shape,
+    b: &Shape,
+    c: &ContactRecord,
+    tol: f64,
+) -> Result<Recheck, OracleError> {
+    let prediction = tol + (-c.depth).max(0.0);
+    Ok(
+        match reference_contact(a, &c.pose_a, b, &c.pose_b, prediction)? {
+            Some(r) if (r.depth - c.depth).abs() <= tol => Recheck::Agrees(r),
+            Some(r) => Recheck::Differs(r),
+            None => Recheck::Apart,
+        },
+    )
 }
 
 /// Compares Ricochet's frames with rapier's answers at the same poses. See the crate docs
@@ -256,10 +266,23 @@ impl Referee {
             b.shape_name()
         );
         let tol = self.depth_tol(a.shape, b.shape);
-        let prediction = tol + (-c.depth).max(0.0);
-        let r = match reference_contact(a.shape, &c.pose_a, b.shape, &c.pose_b, prediction) {
-            Ok(Some(r)) => r,
-            Ok(None) => {
+        let r = match recheck(a.shape, b.shape, c, tol) {
+            Ok(Recheck::Agrees(r)) => {
+                report.worst_depth_error = report.worst_depth_error.max((c.depth - r.depth).abs());
+                r
+            }
+            Ok(Recheck::Differs(r)) => {
+                let depth_err = (c.depth - r.depth).abs();
+                report.worst_depth_error = report.worst_depth_error.max(depth_err);
+                report.mismatch(format!(
+                    "{who} (phase {}): depth {:e} vs rapier {:e} (error {depth_err:e} > {tol:e})",
+                    c.phase.name(),
+                    c.depth,
+                    r.depth
+                ));
+                return;
+            }
+            Ok(Recheck::Apart) => {
                 report.mismatch(format!(
                     "{who} (phase {}): Ricochet depth {:e}, rapier finds the shapes apart",
                     c.phase.name(),
@@ -272,17 +295,6 @@ impl Referee {
                 return;
             }
         };
-        let depth_err = (c.depth - r.depth).abs();
-        report.worst_depth_error = report.worst_depth_error.max(depth_err);
-        if depth_err > tol {
-            report.mismatch(format!(
-                "{who} (phase {}): depth {:e} vs rapier {:e} (error {depth_err:e} > {tol:e})",
-                c.phase.name(),
-                c.depth,
-                r.depth
-            ));
-            return;
-        }
         let normal_err = angle_between(c.normal, r.normal);
         if normal_err <= self.tol.normal {
             report.worst_normal_error = report.worst_normal_error.max(normal_err);
@@ -439,56 +451,24 @@ impl Referee {
     ) -> Result<BTreeSet<(Entity, Entity)>, OracleError> {
         let mut world = PhysicsWorld::new();
         world.integration_parameters.normalized_prediction_distance = 0.0;
-        let n_layers = self.layers.names().len();
-        let use_groups = n_layers <= 32;
+        let filter = LayerFilter::new(&self.layers);
         for (k, (e, pose)) in poses.iter().enumerate() {
             let b = body(sim, out, *e).ok_or(OracleError::Conversion("unknown body"))?;
             let (p, shape) = place(b.shape, pose, Vec2::ZERO)?;
-            let mut builder = ColliderBuilder::new(shape)
+            let builder = ColliderBuilder::new(shape)
                 .position(p)
-                .active_collision_types(ActiveCollisionTypes::all())
-                .user_data((u128::from(b.layer) << 64) | k as u128);
-            if use_groups {
-                let mut filter = 0u32;
-                for other in 0..n_layers {
-                    let other = LayerId::try_from(other).unwrap_or(LayerId::MAX);
-                    if self.layers.response(b.layer, other) != Response::Ignore {
-                        filter |= 1 << other;
-                    }
-                }
-                builder = builder.collision_groups(InteractionGroups::new(
-                    Group::from_bits_retain(1 << b.layer),
-                    Group::from_bits_retain(filter),
-                    InteractionTestMode::And,
-                ));
-            } else {
-                builder = builder.active_hooks(ActiveHooks::FILTER_CONTACT_PAIRS);
-            }
-            world.colliders.insert(builder.build());
+                .active_collision_types(ActiveCollisionTypes::all());
+            world
+                .colliders
+                .insert(filter.collider(builder, b.layer, k).build());
         }
-        let hooks = LayerHooks {
-            layers: &self.layers,
-        };
-        world.detect_collisions(&hooks, &());
+        world.detect_collisions(&filter, &());
         let mut pairs = BTreeSet::new();
         for pair in world.narrow_phase.contact_pairs() {
-            let PairContacts::Rigid(rigid) = &pair.contacts else {
-                continue;
-            };
-            let penetrating = rigid
-                .manifolds
-                .iter()
-                .flat_map(|m| m.points.iter())
-                .any(|p| p.dist < 0.0);
-            if !penetrating {
+            if penetration(pair).is_none() {
                 continue;
             }
-            let index = |h| {
-                world
-                    .colliders
-                    .get(h)
-                    .map(|c| (c.user_data & u128::from(u64::MAX)) as usize)
-            };
+            let index = |h| world.colliders.get(h).map(crate::pairs::index);
             let (Some(i), Some(j)) = (index(pair.collider1), index(pair.collider2)) else {
                 continue;
             };

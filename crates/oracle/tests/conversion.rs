@@ -6,6 +6,7 @@ use std::f64::consts::FRAC_PI_4;
 
 use ricochet_geom::{Pose, Primitive, Shape, Vec2, contact};
 use ricochet_oracle::reference_contact;
+use ricochet_scenes::Rng;
 
 fn v(x: f64, y: f64) -> Vec2 {
     Vec2::new(x, y)
@@ -167,18 +168,6 @@ fn compound_is_its_deepest_part_pair() {
     );
 }
 
-/// A small xorshift generator: the same poses on every run.
-struct Rng(u64);
-
-impl Rng {
-    fn range(&mut self, lo: f64, hi: f64) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        lo + (hi - lo) * ((self.0 >> 11) as f64 / (1u64 << 53) as f64)
-    }
-}
-
 /// One shape of each kind with every option used (offsets, own angle, compound parts).
 fn one_of_each(scale: f64) -> Vec<Shape> {
     let s = |x: f64, y: f64| v(x * scale, y * scale);
@@ -209,7 +198,7 @@ fn one_of_each(scale: f64) -> Vec<Shape> {
 /// agree to 1e-12 of the size, the normal to 1e-9 rad.
 #[test]
 fn every_pairing_agrees_on_random_poses() {
-    let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+    let mut rng = Rng::new(0x9e37_79b9_7f4a_7c15);
     for (scale, far) in [(1.0, 0.0), (1.0, 1e6), (1e-3, 0.0)] {
         let shapes = one_of_each(scale);
         for a in &shapes {

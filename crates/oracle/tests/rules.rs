@@ -1,16 +1,25 @@
 //! Each named rule fires on a scene built for it, and only there; a deliberately broken
 //! narrow phase (a contact record edited before `check_frame`) is caught.
 
-use ricochet_geom::Vec2;
+use ricochet_geom::{Primitive, Shape, Vec2};
 use ricochet_oracle::{FrameReport, Referee, Tolerances, rules};
-use ricochet_sim::{FrameOutput, Phase, Simulation, load_scenario};
+use ricochet_scenes::{layers, scenario};
+use ricochet_sim::{
+    BodyDef, BodyKind, Doomed, FrameOutput, Phase, Response, Scenario, Simulation, WorldDef,
+    load_scenario,
+};
 
 /// Runs `toml` for frames `0..=frames`, checking each; returns the reports.
 fn run(toml: &str, frames: u64) -> Vec<FrameReport> {
     let scenario = load_scenario(toml, "test.toml").unwrap_or_else(|e| panic!("{e}"));
-    let mut sim = Simulation::new(&scenario);
+    check(&scenario, frames)
+}
+
+/// Runs `scenario` for frames `0..=frames`, checking each; returns the reports.
+fn check(scenario: &Scenario, frames: u64) -> Vec<FrameReport> {
+    let mut sim = Simulation::new(scenario);
     sim.capture_detect_poses = true;
-    let mut referee = Referee::new(&scenario, Tolerances::default());
+    let mut referee = Referee::new(scenario, Tolerances::default());
     (0..=frames)
         .map(|_| {
             let out = sim.step();
@@ -58,33 +67,47 @@ fn static_and_kinematic_bodies_overlapping_are_explained_as_static_static() {
     }
 }
 
+/// The ball (id 0, radius 0.5) 0.3 deep in the left side of the wall (id 1, a static 2×2
+/// box at the origin), `separate`, and `third` (id 2), a static body of the wall's layer.
+fn ball_in_wall(third: BodyDef) -> Scenario {
+    let ball = BodyDef {
+        name: "ball".to_owned(),
+        shape: Shape::circle(0.5).unwrap(),
+        position: Vec2::new(-1.2, 0.0),
+        ..BodyDef::default()
+    };
+    let wall = BodyDef {
+        name: "wall".to_owned(),
+        layer: 1,
+        kind: BodyKind::Static,
+        shape: Shape::aabb(Vec2::ONE).unwrap(),
+        ..BodyDef::default()
+    };
+    let third = BodyDef {
+        layer: 1,
+        kind: BodyKind::Static,
+        ..third
+    };
+    let world = WorldDef {
+        layers: layers(&["ball", "wall"], &[(0, 1, Response::Separate)]),
+        ..WorldDef::default()
+    };
+    scenario("ball-in-wall", world, vec![ball, wall, third], 600)
+}
+
 #[test]
 fn a_push_that_ends_a_later_contact_is_explained_as_moved_in_pass() {
     // The ball (id 0) sits 0.3 deep in the wall (id 1) and just touches the ledge (id 2).
     // Pair (0, 1) comes first and pushes the ball 0.3 to the left, clear of the ledge, so
     // Ricochet tests (0, 2) at the pushed pose and finds nothing; rapier, at the detect
     // poses, finds both.
-    let reports = run(
-        r#"
-        layers = ["ball", "wall"]
-        collide = [{ a = "ball", b = "wall", response = "separate" }]
-        [[bodies]]
-        name = "ball"
-        layer = "ball"
-        shape = { kind = "circle", radius = 0.5 }
-        position = [-1.2, 0]
-        [[bodies]]
-        name = "wall"
-        layer = "wall"
-        kind = "static"
-        shape = { kind = "aabb", half_extents = [1, 1] }
-        [[bodies]]
-        name = "ledge"
-        layer = "wall"
-        kind = "static"
-        shape = { kind = "obb", half_extents = [0.55, 0.075] }
-        position = [-0.55, 0.525]
-        "#,
+    let reports = check(
+        &ball_in_wall(BodyDef {
+            name: "ledge".to_owned(),
+            shape: Shape::obb(Vec2::new(0.55, 0.075)).unwrap(),
+            position: Vec2::new(-0.55, 0.525),
+            ..BodyDef::default()
+        }),
         0,
     );
     assert_clean(&reports);
@@ -103,27 +126,13 @@ fn a_push_that_starts_a_later_contact_is_explained_as_moved_in_pass() {
     // touch at the detect poses (0.005 apart) though their bounds overlapped, so the broad
     // phase listed the pair: Ricochet logs (0, 2) at the pushed pose, rapier has no such
     // pair at the detect poses.
-    let reports = run(
-        r#"
-        layers = ["ball", "wall"]
-        collide = [{ a = "ball", b = "wall", response = "separate" }]
-        [[bodies]]
-        name = "ball"
-        layer = "ball"
-        shape = { kind = "circle", radius = 0.5 }
-        position = [-1.2, 0]
-        [[bodies]]
-        name = "wall"
-        layer = "wall"
-        kind = "static"
-        shape = { kind = "aabb", half_extents = [1, 1] }
-        [[bodies]]
-        name = "rock"
-        layer = "wall"
-        kind = "static"
-        shape = { kind = "circle", radius = 0.9 }
-        position = [-2.59, 0.55]
-        "#,
+    let reports = check(
+        &ball_in_wall(BodyDef {
+            name: "rock".to_owned(),
+            shape: Shape::circle(0.9).unwrap(),
+            position: Vec2::new(-2.59, 0.55),
+            ..BodyDef::default()
+        }),
         0,
     );
     assert_clean(&reports);
@@ -348,72 +357,85 @@ fn a_box_centred_on_a_box_ties_between_x_and_y() {
     assert_eq!(count(&wrong, rules::TIED_NORMAL), 0);
 }
 
-/// A fast layer of bullets (radius 0.1 unless given) against static targets, `destroy = "a"`:
-/// the bullet goes, the target stays. Bullets fly 10 units a frame.
-fn swept_scene(bodies: &str) -> String {
-    format!(
-        r#"
-        layers = ["bullet", "target"]
-        fast_layers = ["bullet"]
-        collide = [{{ a = "bullet", b = "target", response = "destroy", destroy = "a" }}]
-        [templates.target]
-        layer = "target"
-        kind = "static"
-        shape = {{ kind = "circle", radius = 0.5 }}
-        {bodies}
-        "#
-    )
+/// A fast layer of bullets against static targets, `destroy = "a"`: the bullet goes, the
+/// target stays. Bullets fly 10 units a frame.
+fn swept_scene(bodies: Vec<BodyDef>) -> Scenario {
+    let mut l = layers(
+        &["bullet", "target"],
+        &[(0, 1, Response::Destroy(Doomed::First))],
+    );
+    l.set_fast(0);
+    let world = WorldDef {
+        layers: l,
+        ..WorldDef::default()
+    };
+    scenario("swept", world, bodies, 600)
+}
+
+/// A bullet of `shape` at `at`, moving at `velocity`.
+fn bullet(shape: Shape, at: Vec2, velocity: Vec2) -> BodyDef {
+    BodyDef {
+        shape,
+        position: at,
+        velocity,
+        ..BodyDef::default()
+    }
+}
+
+/// A static target of `shape` at `at`.
+fn target(shape: Shape, at: Vec2) -> BodyDef {
+    BodyDef {
+        name: "target".to_owned(),
+        layer: 1,
+        kind: BodyKind::Static,
+        shape,
+        position: at,
+        ..BodyDef::default()
+    }
 }
 
 #[test]
 fn swept_hits_of_every_kind_are_first_touches() {
-    let reports = run(
-        &swept_scene(
-            r#"
-            [[bodies]]
-            layer = "bullet"
-            shape = { kind = "circle", radius = 0.1 }
-            position = [-10, 0]
-            velocity = [600, 0]
-            [[bodies]]
-            layer = "bullet"
-            shape = { kind = "capsule", a = [-0.3, 0], b = [0.3, 0], radius = 0.05 }
-            position = [-10, 5]
-            angle = 0.4
-            velocity = [600, 30]
-            [[bodies]]
-            layer = "bullet"
-            shape = { kind = "polygon", vertices = [[0.3, 0], [-0.2, 0.15], [-0.2, -0.15]] }
-            position = [5, -15]
-            velocity = [0, 600]
-            [[bodies]]
-            layer = "bullet"
-            shape = { kind = "obb", half_extents = [0.3, 0.05], angle = 0.3 }
-            position = [15, 10]
-            velocity = [-600, 0]
-            [[bodies]]
-            template = "target"
-            shape = { kind = "obb", half_extents = [0.1, 2], angle = 0.2 }
-            position = [-3, 0]
-            [[bodies]]
-            template = "target"
-            shape = { kind = "capsule", a = [0, -1], b = [0, 1], radius = 0.3 }
-            position = [-2, 5.3]
-            [[bodies]]
-            template = "target"
-            shape = { kind = "compound", parts = [
-              { kind = "aabb", half_extents = [1, 0.2] },
-              { kind = "polygon", vertices = [[0, 0.2], [0.5, 1], [-0.5, 1]] },
-            ] }
-            position = [5, -7]
-            [[bodies]]
-            template = "target"
-            shape = { kind = "aabb", half_extents = [0.5, 0.5] }
-            position = [9, 10.2]
-            "#,
-        ),
-        2,
+    let v = Vec2::new;
+    let p = |p: Result<Primitive, _>| Shape::Primitive(p.unwrap());
+    let mut capsule = bullet(
+        Shape::capsule(v(-0.3, 0.0), v(0.3, 0.0), 0.05).unwrap(),
+        v(-10.0, 5.0),
+        v(600.0, 30.0),
     );
+    capsule.angle = 0.4;
+    let triangle = [v(0.3, 0.0), v(-0.2, 0.15), v(-0.2, -0.15)];
+    let roof = [v(0.0, 0.2), v(0.5, 1.0), v(-0.5, 1.0)];
+    let compound = Shape::compound(vec![
+        Primitive::aabb(Vec2::ZERO, v(1.0, 0.2)).unwrap(),
+        Primitive::polygon(&roof).unwrap(),
+    ])
+    .unwrap();
+    let bodies = vec![
+        bullet(Shape::circle(0.1).unwrap(), v(-10.0, 0.0), v(600.0, 0.0)),
+        capsule,
+        bullet(
+            Shape::polygon(&triangle).unwrap(),
+            v(5.0, -15.0),
+            v(0.0, 600.0),
+        ),
+        bullet(
+            p(Primitive::obb(Vec2::ZERO, v(0.3, 0.05), 0.3)),
+            v(15.0, 10.0),
+            v(-600.0, 0.0),
+        ),
+        target(
+            p(Primitive::obb(Vec2::ZERO, v(0.1, 2.0), 0.2)),
+            v(-3.0, 0.0),
+        ),
+        target(
+            Shape::capsule(v(0.0, -1.0), v(0.0, 1.0), 0.3).unwrap(),
+            v(-2.0, 5.3),
+        ),
+        target(compound, v(5.0, -7.0)),
+        target(Shape::aabb(v(0.5, 0.5)).unwrap(), v(9.0, 10.2)),
+    ];
+    let reports = check(&swept_scene(bodies), 2);
     assert_clean(&reports);
     // Frame 1: every bullet hits its target, at the first touch.
     assert_eq!(reports[1].swept_confirmed, 4, "{:#?}", reports[1]);
@@ -424,22 +446,13 @@ fn swept_hits_of_every_kind_are_first_touches() {
 fn a_bullet_through_two_targets_stops_at_the_first() {
     // Both targets lie on this frame's 10-unit path; the bullet dies on the first, and
     // parry's touch with the second is explained as `first-hit`.
-    let reports = run(
-        &swept_scene(
-            r#"
-            [[bodies]]
-            layer = "bullet"
-            shape = { kind = "circle", radius = 0.1 }
-            position = [-5, 0]
-            velocity = [600, 0]
-            [[bodies]]
-            template = "target"
-            position = [-1, 0]
-            [[bodies]]
-            template = "target"
-            position = [2, 0]
-            "#,
-        ),
+    let ball = |r: f64| Shape::circle(r).unwrap();
+    let reports = check(
+        &swept_scene(vec![
+            bullet(ball(0.1), Vec2::new(-5.0, 0.0), Vec2::new(600.0, 0.0)),
+            target(ball(0.5), Vec2::new(-1.0, 0.0)),
+            target(ball(0.5), Vec2::new(2.0, 0.0)),
+        ]),
         1,
     );
     assert_clean(&reports);
@@ -450,22 +463,16 @@ fn a_bullet_through_two_targets_stops_at_the_first() {
 /// A bullet of radius 0.5 flying along y = 10 from x = -10 to 0 in frame 1, past a target of
 /// radius 0.5 at `(x, 11 - overlap)`: the path grazes it, `overlap` deep at most.
 fn graze(x: f64, overlap: f64) -> Vec<FrameReport> {
-    run(
-        &swept_scene(&format!(
-            r#"
-            [[bodies]]
-            layer = "bullet"
-            shape = {{ kind = "circle", radius = 0.5 }}
-            position = [-10, 10]
-            velocity = [600, 0]
-            [[bodies]]
-            template = "target"
-            position = [{x}, {}]
-            "#,
-            11.0 - overlap
-        )),
-        1,
-    )
+    check(&graze_scene(x, overlap), 1)
+}
+
+/// The scene of [`graze`].
+fn graze_scene(x: f64, overlap: f64) -> Scenario {
+    let ball = Shape::circle(0.5).unwrap();
+    swept_scene(vec![
+        bullet(ball.clone(), Vec2::new(-10.0, 10.0), Vec2::new(600.0, 0.0)),
+        target(ball, Vec2::new(x, 11.0 - overlap)),
+    ])
 }
 
 #[test]
@@ -497,7 +504,7 @@ fn a_graze_that_ends_overlapping_is_logged_at_the_first_touch_or_explained() {
 fn a_missed_swept_hit_is_caught() {
     // The bullet passes 0.03 deep through the target; delete Ricochet's swept record and
     // the referee must report the hit parry's shape cast finds.
-    let scenario = load_scenario(&swept_graze_toml(0.03), "t.toml").unwrap();
+    let scenario = graze_scene(-5.0, 0.03);
     let mut sim = Simulation::new(&scenario);
     sim.capture_detect_poses = true;
     let mut referee = Referee::new(&scenario, Tolerances::default());
@@ -514,22 +521,6 @@ fn a_missed_swept_hit_is_caught() {
         "{}",
         r.details[0]
     );
-}
-
-fn swept_graze_toml(overlap: f64) -> String {
-    swept_scene(&format!(
-        r#"
-        [[bodies]]
-        layer = "bullet"
-        shape = {{ kind = "circle", radius = 0.5 }}
-        position = [-10, 10]
-        velocity = [600, 0]
-        [[bodies]]
-        template = "target"
-        position = [-5, {}]
-        "#,
-        11.0 - overlap
-    ))
 }
 
 #[test]

@@ -5,6 +5,7 @@
 
 use proptest::prelude::*;
 use ricochet_geom::{Bounds, Vec2};
+use ricochet_scenes::Rng;
 use ricochet_sim::BodyKind;
 use ricochet_sim::broad_phase::{
     BodyEntry, BroadPhase, BroadPhaseKind, BroadPhaseStats, Interactions,
@@ -35,27 +36,6 @@ fn reference(bodies: &[BodyEntry], interactions: &Interactions) -> Vec<(u32, u32
 
 fn split(bodies: &[BodyEntry]) -> (Vec<BodyEntry>, Vec<BodyEntry>) {
     bodies.iter().partition(|b| b.kind == BodyKind::Static)
-}
-
-/// A small deterministic generator for the frame-to-frame changes.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        // xorshift64*
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
-    }
-
-    fn below(&mut self, n: u64) -> u64 {
-        self.next() % n
-    }
-
-    fn unit(&mut self) -> f64 {
-        (self.next() >> 11) as f64 / (1u64 << 53) as f64
-    }
 }
 
 fn kind_of(k: u8) -> BodyKind {
@@ -232,7 +212,7 @@ proptest! {
         frames in 2usize..12,
     ) {
         let interactions = interactions(bits);
-        let mut rng = Rng(seed | 1);
+        let mut rng = Rng::new(seed);
         let mut bodies = bodies;
         let mut checker = Checker::new();
         for _ in 0..frames {
@@ -257,7 +237,7 @@ proptest! {
             let removals = rng.below(4);
             for _ in 0..removals {
                 if !bodies.is_empty() {
-                    let i = rng.below(bodies.len() as u64) as usize;
+                    let i = rng.below(bodies.len());
                     if bodies[i].kind != BodyKind::Static || statics_change {
                         bodies.remove(i);
                     }
@@ -265,9 +245,9 @@ proptest! {
             }
             let spawns = rng.below(5);
             for _ in 0..spawns {
-                let key = rng.below(4 * bodies.len() as u64 + 16);
+                let key = rng.below(4 * bodies.len() + 16) as u64;
                 if let Err(at) = bodies.binary_search_by_key(&key, |b| b.key) {
-                    let family = [0, 0, 0, 10, 11, 13][rng.below(6) as usize];
+                    let family = [0, 0, 0, 10, 11, 13][rng.below(6)];
                     let (cx, cy) = (rng.below(40) as i8 - 20, rng.below(40) as i8 - 20);
                     let bounds = make_bounds(family, cx, cy, key as u8, (key >> 3) as u8);
                     let kind = if statics_change { kind_of(key as u8) } else { kind_of(key as u8 % 2) };

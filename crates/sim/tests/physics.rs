@@ -1,13 +1,10 @@
 //! The physics against exact answers: semi-implicit Euler's closed form, and per-axis
 //! separation's landing, corner and wall cases.
 
-use ricochet_geom::Vec2;
-use ricochet_sim::{FrameOutput, Phase, SLOP, Simulation, load_scenario};
-
-fn sim(toml: &str) -> Simulation {
-    let s = load_scenario(toml, "test.toml").unwrap_or_else(|e| panic!("{e}"));
-    Simulation::new(&s)
-}
+use ricochet_geom::{Shape, Vec2};
+use ricochet_scenes::tiles::Tiles;
+use ricochet_scenes::{layers, scenario};
+use ricochet_sim::{BodyDef, FrameOutput, Phase, SLOP, Simulation, WorldDef};
 
 /// Semi-implicit Euler with constant acceleration `a`: `v_n = v0 + n a dt`,
 /// `x_n = x0 + n v0 dt + n(n+1)/2 a dt²` (not the continuous parabola's `n²/2`).
@@ -26,27 +23,16 @@ fn bound(x0: Vec2, v0: Vec2, a: Vec2, dt: f64, n: u64) -> f64 {
     4.0 * nf * f64::EPSILON * scale
 }
 
-#[test]
-fn a_projectile_follows_the_semi_implicit_euler_closed_form() {
-    let mut s = sim(r#"
-        dt = 0.01
-        layers = ["ball"]
-        world.gravity = [0, -9.81]
-        [[bodies]]
-        layer = "ball"
-        shape = { kind = "circle", radius = 0.1 }
-        mass = 3
-        position = [1, 2]
-        velocity = [3, 10]
-    "#);
-    let (x0, v0, a, dt) = (
-        Vec2::new(1.0, 2.0),
-        Vec2::new(3.0, 10.0),
-        Vec2::new(0.0, -9.81),
-        0.01,
-    );
+/// Steps frame 0, then `frames` frames: body 0 stays within [`bound`] of [`closed_form`]
+/// from `(x0, v0, a, dt)`. `also` sees the simulation, the frame and the position.
+fn follows_closed_form(
+    s: &mut Simulation,
+    (x0, v0, a, dt): (Vec2, Vec2, Vec2, f64),
+    frames: u64,
+    mut also: impl FnMut(&Simulation, u64, Vec2),
+) {
     s.step(); // frame 0: the initial state
-    for n in 1..=500u64 {
+    for n in 1..=frames {
         s.step();
         let x = s.world.position[0];
         let want = closed_form(x0, v0, a, dt, n);
@@ -55,15 +41,43 @@ fn a_projectile_follows_the_semi_implicit_euler_closed_form() {
             (x - want).abs().max_element() <= tol,
             "frame {n}: {x} vs {want} (bound {tol})"
         );
-        // And it is not the continuous parabola: that differs by n a dt²/2.
-        let parabola = x0 + v0 * (n as f64 * dt) + a * 0.5 * (n as f64 * dt).powi(2);
-        assert!((x - parabola).y.abs() > 0.4 * n as f64 * 9.81 * dt * dt);
+        also(s, n, x);
     }
 }
 
 #[test]
+fn a_projectile_follows_the_semi_implicit_euler_closed_form() {
+    let ball = BodyDef {
+        shape: Shape::circle(0.1).unwrap(),
+        mass: 3.0,
+        position: Vec2::new(1.0, 2.0),
+        velocity: Vec2::new(3.0, 10.0),
+        ..BodyDef::default()
+    };
+    let world = WorldDef {
+        dt: 0.01,
+        gravity: Vec2::new(0.0, -9.81),
+        layers: layers(&["ball"], &[]),
+        ..WorldDef::default()
+    };
+    let mut s = Simulation::new(&scenario("projectile", world, vec![ball], 600));
+    let (x0, v0, a, dt) = (
+        Vec2::new(1.0, 2.0),
+        Vec2::new(3.0, 10.0),
+        Vec2::new(0.0, -9.81),
+        0.01,
+    );
+    follows_closed_form(&mut s, (x0, v0, a, dt), 500, |_, n, x| {
+        // And it is not the continuous parabola: that differs by n a dt²/2.
+        let parabola = x0 + v0 * (n as f64 * dt) + a * 0.5 * (n as f64 * dt).powi(2);
+        assert!((x - parabola).y.abs() > 0.4 * n as f64 * 9.81 * dt * dt);
+    });
+}
+
+#[test]
 fn a_thrusting_ship_follows_the_closed_form() {
-    let mut s = sim(r#"
+    let ship = ricochet_sim::load_scenario(
+        r#"
         dt = 0.02
         layers = ["ship", "bullet"]
         [templates.bullet]
@@ -81,38 +95,21 @@ fn a_thrusting_ship_follows_the_closed_form() {
         frame = 0
         action = "thrust"
         body = "ship"
-    "#);
+    "#,
+        "ship.toml",
+    );
+    let mut s = Simulation::new(&ship.unwrap_or_else(|e| panic!("{e}")));
     let heading = Vec2::new(libm::cos(0.5), libm::sin(0.5));
     let (x0, v0, a, dt) = (Vec2::ZERO, Vec2::new(1.0, -1.0), heading * 3.5, 0.02);
-    s.step();
-    for n in 1..=300u64 {
-        s.step();
-        let x = s.world.position[0];
-        let want = closed_form(x0, v0, a, dt, n);
-        let tol = bound(x0, v0, a, dt, n);
-        assert!(
-            (x - want).abs().max_element() <= tol,
-            "frame {n}: {x} vs {want} (bound {tol})"
-        );
+    follows_closed_form(&mut s, (x0, v0, a, dt), 300, |s, _, _| {
         assert_eq!(s.world.angle[0], 0.5, "no turn input, no turning");
-    }
+    });
 }
 
-const FLOOR: &str = r#"
-    hz = 60
-    layers = ["tile", "box"]
-    world.gravity = [0, -20]
-    [[collide]]
-    a = "box"
-    b = "tile"
-    response = "separate"
-    [[bodies]]
-    name = "floor"
-    layer = "tile"
-    kind = "static"
-    shape = { kind = "aabb", half_extents = [10, 1] }
-    position = [0, -1]
-"#;
+/// A floor (top at y = 0) under gravity `[0, -20]`; boxes `separate` from it.
+fn floor() -> Tiles {
+    Tiles::new("box", -20.0).tile("floor", [10.0, 1.0], [0.0, -1.0])
+}
 
 /// Overlap of two boxes given as (centre, half extents), on both axes.
 fn box_overlap(c1: Vec2, h1: Vec2, c2: Vec2, h2: Vec2) -> Vec2 {
@@ -121,15 +118,7 @@ fn box_overlap(c1: Vec2, h1: Vec2, c2: Vec2, h2: Vec2) -> Vec2 {
 
 #[test]
 fn a_falling_box_lands_flush_and_grounded() {
-    let mut s = sim(&format!(
-        "{FLOOR}
-        [[bodies]]
-        name = \"box\"
-        layer = \"box\"
-        shape = {{ kind = \"aabb\", half_extents = [0.5, 0.5] }}
-        position = [0.3, 3]
-    "
-    ));
+    let mut s = Simulation::new(&floor().aabb("box", [0.5, 0.5], [0.3, 3.0]).scenario());
     let mut landed_at = None;
     for frame in 0..=240u64 {
         let out = s.step();
@@ -172,23 +161,13 @@ fn a_falling_box_lands_flush_and_grounded() {
 fn a_corner_hit_resolves_along_one_axis_only() {
     // The box reaches the corner diagonally: after the x move it is still above the block,
     // after the y move it overlaps by 0.08 vertically and 0.15 horizontally.
-    let mut s = sim(r#"
-        hz = 60
-        layers = ["tile", "box"]
-        [[collide]]
-        a = "box"
-        b = "tile"
-        response = "separate"
-        [[bodies]]
-        layer = "tile"
-        kind = "static"
-        shape = { kind = "aabb", half_extents = [1, 1] }
-        [[bodies]]
-        layer = "box"
-        shape = { kind = "aabb", half_extents = [0.5, 0.5] }
-        position = [-1.45, 1.52]
-        velocity = [6, -6]
-    "#);
+    let mut s = Simulation::new(
+        &Tiles::new("box", 0.0)
+            .tile("body", [1.0, 1.0], [0.0, 0.0])
+            .aabb("body", [0.5, 0.5], [-1.45, 1.52])
+            .with(|b| b.velocity = Vec2::new(6.0, -6.0))
+            .scenario(),
+    );
     s.step();
     let out: FrameOutput = s.step();
     assert_eq!(out.contacts.len(), 1, "{:?}", out.contacts);
@@ -206,25 +185,13 @@ fn a_corner_hit_resolves_along_one_axis_only() {
 
 #[test]
 fn a_body_running_into_a_wall_stops_flush() {
-    let mut s = sim(r#"
-        hz = 60
-        layers = ["tile", "box"]
-        [[collide]]
-        a = "box"
-        b = "tile"
-        response = "separate"
-        [[bodies]]
-        name = "wall"
-        layer = "tile"
-        kind = "static"
-        shape = { kind = "aabb", half_extents = [0.5, 5] }
-        position = [5.5, 0]
-        [[bodies]]
-        name = "box"
-        layer = "box"
-        shape = { kind = "aabb", half_extents = [0.5, 0.5] }
-        velocity = [10, 0]
-    "#);
+    let mut s = Simulation::new(
+        &Tiles::new("box", 0.0)
+            .tile("wall", [0.5, 5.0], [5.5, 0.0])
+            .aabb("box", [0.5, 0.5], [0.0, 0.0])
+            .with(|b| b.velocity = Vec2::new(10.0, 0.0))
+            .scenario(),
+    );
     let mut hits = 0;
     for _ in 0..=60 {
         let out = s.step();

@@ -6,8 +6,11 @@
 //! frame, digest by digest), or from exact arithmetic on the same `f64` operations the
 //! stages do (semi-implicit Euler: `x += v * dt`, frame 0 does not move).
 
+use ricochet_geom::Vec2;
+use ricochet_scenes::tiles::Tiles;
 use ricochet_sim::{
-    FrameOutput, GameEvent, Phase, Removal, Simulation, Stage, StageSet, Stats, load_scenario,
+    Action, Event, FrameOutput, GameEvent, Phase, Removal, Simulation, Stage, StageSet, Stats,
+    load_scenario,
 };
 
 fn sim(text: &str) -> Simulation {
@@ -292,50 +295,23 @@ fn sleeping_that_never_triggers_changes_nothing() {
     assert_eq!(moving_frames, 300, "frames 1 to 300 all have motion");
 }
 
+/// A static floor (top at y = 0, 20 wide) under gravity `[0, -20]`, for boxes solid to it
+/// and to each other.
+fn boxes_on_a_floor() -> Tiles {
+    Tiles::new("box", -20.0)
+        .solid()
+        .tile("floor", [10.0, 1.0], [0.0, -1.0])
+}
+
 /// Boxes dropped onto a static floor (top at y = 0) under gravity `[0, -20]`: `lone` on its
-/// own, and `low` with `high` falling onto it (a stack of two). `extra` is appended (more
-/// bodies).
-fn boxes(world_extra: &str, extra: &str) -> String {
-    format!(
-        r#"
-hz = 60
-layers = ["tile", "box"]
-collide = [
-  {{ a = "box", b = "tile", response = "separate" }},
-  {{ a = "box", b = "box", response = "separate" }},
-]
-
-[world]
-gravity = [0, -20]
-{world_extra}
-
-[[bodies]]
-name = "floor"
-layer = "tile"
-kind = "static"
-shape = {{ kind = "aabb", half_extents = [10, 1] }}
-position = [0, -1]
-
-[[bodies]]
-name = "lone"
-layer = "box"
-shape = {{ kind = "aabb", half_extents = [0.5, 0.5] }}
-position = [-4.3, 3.1]
-
-[[bodies]]
-name = "low"
-layer = "box"
-shape = {{ kind = "aabb", half_extents = [0.7, 0.35] }}
-position = [2.15, 1.7]
-
-[[bodies]]
-name = "high"
-layer = "box"
-shape = {{ kind = "aabb", half_extents = [0.4, 0.6] }}
-position = [2.4, 3.9]
-{extra}
-"#
-    )
+/// own, and `low` with `high` falling onto it (a stack of two); boxes are solid to each
+/// other. More bodies can be added to the builder.
+fn boxes(sleep_after: Option<u32>) -> Tiles {
+    boxes_on_a_floor()
+        .sleep_after(sleep_after)
+        .aabb("lone", [0.5, 0.5], [-4.3, 3.1])
+        .aabb("low", [0.7, 0.35], [2.15, 1.7])
+        .aabb("high", [0.4, 0.6], [2.4, 3.9])
 }
 
 /// Dense index of the live body named `name` (the lowest id with that name).
@@ -377,8 +353,8 @@ fn assert_sleepers_rest(sim: &Simulation, frame: u64) {
 
 #[test]
 fn resting_boxes_fall_asleep_without_changing_any_state() {
-    let mut plain = sim(&boxes("", ""));
-    let mut sleepy = sim(&boxes("sleep_after = 10", ""));
+    let mut plain = Simulation::new(&boxes(None).scenario());
+    let mut sleepy = Simulation::new(&boxes(Some(10)).scenario());
     // The lone box and the bottom of the stack rest on the static floor and sleep; the top
     // of the stack rests on a dynamic box, so it never sleeps (it would float if that box
     // moved away).
@@ -426,18 +402,14 @@ fn resting_boxes_fall_asleep_without_changing_any_state() {
 
 /// A small box that falls from high above `lone` (top at y = 1 once it rests) and lands on
 /// it long after `lone` fell asleep.
-const DROPPER: &str = r#"
-[[bodies]]
-name = "dropper"
-layer = "box"
-shape = { kind = "aabb", half_extents = [0.3, 0.3] }
-position = [-4.1, 80]
-"#;
+fn with_dropper(scene: Tiles) -> Simulation {
+    Simulation::new(&scene.aabb("dropper", [0.3, 0.3], [-4.1, 80.0]).scenario())
+}
 
 #[test]
 fn a_sleeping_box_wakes_when_something_lands_on_it() {
-    let mut plain = sim(&boxes("", DROPPER));
-    let mut sleepy = sim(&boxes("sleep_after = 10", DROPPER));
+    let mut plain = with_dropper(boxes(None));
+    let mut sleepy = with_dropper(boxes(Some(10)));
     let (lone, dropper) = (index(&sleepy, "lone"), index(&sleepy, "dropper"));
     let (e_lone, e_dropper) = (sleepy.world.entity[lone], sleepy.world.entity[dropper]);
     // Free fall from rest, semi-implicit Euler: after n moves it has fallen
@@ -781,11 +753,11 @@ lifetime = 40
     assert!((post.y - 183.0 / 60.0).abs() < 1e-12, "{}", post.y);
 }
 
-/// Steps a scene with and without `sleep_after = 10` (the `SLEEP` placeholder in `[world]`)
-/// and asserts the digests agree on every frame.
-fn sleeping_changes_nothing(text: &str, frames: u64) -> (Simulation, Simulation) {
-    let mut plain = sim(&text.replace("SLEEP", ""));
-    let mut sleepy = sim(&text.replace("SLEEP", "sleep_after = 10"));
+/// Steps a scene with and without `sleep_after = 10` and asserts the digests agree on every
+/// frame.
+fn sleeping_changes_nothing(scene: Tiles, frames: u64) -> (Simulation, Simulation) {
+    let mut plain = Simulation::new(&scene.clone().scenario());
+    let mut sleepy = Simulation::new(&scene.sleep_after(Some(10)).scenario());
     for frame in 0..=frames {
         plain.step();
         let out = sleepy.step();
@@ -808,40 +780,16 @@ fn a_woken_body_is_simulated_from_the_next_frame() {
     // `sitter` rests on the ledge, 0.01 from its right edge (x = 2), and falls asleep; the
     // gravity-free `bowler` rolls into it at frame 43 and pushes it half the depth (0.055)
     // past the edge. Without sleeping it rolls off the corner and falls from frame 44.
-    let text = r#"
-hz = 60
-layers = ["tile", "ball"]
-collide = [
-  { a = "ball", b = "tile", response = "separate" },
-  { a = "ball", b = "ball", response = "separate" },
-]
-
-[world]
-gravity = [0, -20]
-SLEEP
-
-[[bodies]]
-name = "ledge"
-layer = "tile"
-kind = "static"
-shape = { kind = "aabb", half_extents = [25, 1] }
-position = [-23, -1]
-
-[[bodies]]
-name = "sitter"
-layer = "ball"
-shape = { kind = "circle", radius = 0.5 }
-position = [1.99, 0.5]
-
-[[bodies]]
-name = "bowler"
-layer = "ball"
-shape = { kind = "circle", radius = 0.5 }
-position = [-20.4, 0.5]
-velocity = [30, 0]
-gravity_scale = 0
-"#;
-    let (plain, sleepy) = sleeping_changes_nothing(text, 80);
+    let scene = Tiles::new("ball", -20.0)
+        .solid()
+        .tile("ledge", [25.0, 1.0], [-23.0, -1.0])
+        .ball("sitter", 0.5, [1.99, 0.5])
+        .ball("bowler", 0.5, [-20.4, 0.5])
+        .with(|b| {
+            b.velocity = Vec2::new(30.0, 0.0);
+            b.gravity_scale = 0.0;
+        });
+    let (plain, sleepy) = sleeping_changes_nothing(scene, 80);
     assert!(plain.world.position[index(&plain, "sitter")].y < 0.2);
     assert_eq!(sleepy.world.active(), active_as_documented(&sleepy));
 }
@@ -852,39 +800,17 @@ fn a_box_asleep_on_a_box_falls_when_that_box_slides_away() {
     // frame 10. At frame 60 the script sends `low` sliding right at 3 units/s; from frame
     // 79 it no longer holds `top` up (x overlap 0.5 - 0.5000000000000002 < 0), and without
     // sleeping `top` falls from then on.
-    let text = r#"
-hz = 60
-layers = ["tile", "box"]
-collide = [
-  { a = "box", b = "tile", response = "separate" },
-  { a = "box", b = "box", response = "separate" },
-]
-script = [{ frame = 60, action = "set_velocity", body = "low", velocity = [3, 0] }]
-
-[world]
-gravity = [0, -20]
-SLEEP
-
-[[bodies]]
-name = "floor"
-layer = "tile"
-kind = "static"
-shape = { kind = "aabb", half_extents = [10, 1] }
-position = [0, -1]
-
-[[bodies]]
-name = "low"
-layer = "box"
-shape = { kind = "aabb", half_extents = [0.5, 0.5] }
-position = [0, 0.5]
-
-[[bodies]]
-name = "top"
-layer = "box"
-shape = { kind = "aabb", half_extents = [0.5, 0.5] }
-position = [0, 1.5]
-"#;
-    let (plain, sleepy) = sleeping_changes_nothing(text, 120);
+    let scene = boxes_on_a_floor()
+        .aabb("low", [0.5, 0.5], [0.0, 0.5])
+        .aabb("top", [0.5, 0.5], [0.0, 1.5])
+        .event(Event {
+            frame: 60,
+            action: Action::SetVelocity {
+                body: "low".to_owned(),
+                velocity: Vec2::new(3.0, 0.0),
+            },
+        });
+    let (plain, sleepy) = sleeping_changes_nothing(scene, 120);
     // Without sleeping, `top` lands on the floor (y = 0.5).
     assert_eq!(plain.world.position[index(&plain, "top")].y, 0.5);
     assert_eq!(sleepy.world.position[index(&sleepy, "top")].y, 0.5);

@@ -1,47 +1,52 @@
 //! Fast bodies never pass through what they hit: swept tests (time of impact) for pairs in
 //! `fast_layers`, checked at 10,000 units/s against a 0.5-unit asteroid and a thin wall.
 
-use ricochet_sim::{Phase, Simulation, load_scenario};
+use ricochet_geom::{Shape, Vec2};
+use ricochet_scenes::{layers, scenario};
+use ricochet_sim::{BodyDef, BodyKind, Doomed, Phase, Response, Simulation, WorldDef};
 
-/// A bullet (radius 0.05) at 10,000 units/s along +x, 60 Hz: 166.7 units a frame.
-fn scene(fast: bool, targets: &str) -> Simulation {
-    let fast = if fast {
-        r#"fast_layers = ["bullet"]"#
-    } else {
-        ""
-    };
-    let text = format!(
-        r#"
-        hz = 60
-        layers = ["bullet", "rock", "wall"]
-        {fast}
-        [[collide]]
-        a = "bullet"
-        b = "rock"
-        response = "destroy"
-        [[collide]]
-        a = "bullet"
-        b = "wall"
-        response = "report"
-        [[bodies]]
-        name = "bullet"
-        layer = "bullet"
-        shape = {{ kind = "circle", radius = 0.05 }}
-        position = [-30, 0.2]
-        velocity = [10000, 0]
-        {targets}
-        "#
-    );
-    Simulation::new(&load_scenario(&text, "tunnel.toml").unwrap_or_else(|e| panic!("{e}")))
+const BULLET: u8 = 0;
+const ROCK: u8 = 1;
+const WALL: u8 = 2;
+
+/// A body of `layer` named `name`: a circle of `radius` at `at`.
+fn disc(name: &str, layer: u8, radius: f64, at: Vec2) -> BodyDef {
+    BodyDef {
+        name: name.to_owned(),
+        layer,
+        shape: Shape::circle(radius).unwrap(),
+        position: at,
+        ..BodyDef::default()
+    }
 }
 
-const ROCK: &str = r#"
-    [[bodies]]
-    name = "rock"
-    layer = "rock"
-    shape = { kind = "circle", radius = 0.5 }
-    position = [40, 0]
-"#;
+/// A bullet (radius 0.05) at 10,000 units/s along +x, 60 Hz: 166.7 units a frame. Rocks
+/// destroy it (and it them); walls report.
+fn scene(fast: bool, targets: Vec<BodyDef>) -> Simulation {
+    let mut l = layers(
+        &["bullet", "rock", "wall"],
+        &[
+            (BULLET, ROCK, Response::Destroy(Doomed::Both)),
+            (BULLET, WALL, Response::Report),
+        ],
+    );
+    if fast {
+        l.set_fast(BULLET);
+    }
+    let world = WorldDef {
+        layers: l,
+        ..WorldDef::default()
+    };
+    let mut bullet = disc("bullet", BULLET, 0.05, Vec2::new(-30.0, 0.2));
+    bullet.velocity = Vec2::new(10_000.0, 0.0);
+    let bodies = std::iter::once(bullet).chain(targets).collect();
+    Simulation::new(&scenario("tunnel", world, bodies, 600))
+}
+
+/// The rock of radius 0.5 at x = 40, on the bullet's path.
+fn rock() -> Vec<BodyDef> {
+    vec![disc("rock", ROCK, 0.5, Vec2::new(40.0, 0.0))]
+}
 
 fn alive(sim: &Simulation, name: &str) -> bool {
     sim.world.find(name).is_some()
@@ -50,7 +55,7 @@ fn alive(sim: &Simulation, name: &str) -> bool {
 #[test]
 fn without_sweeping_the_bullet_tunnels_through_the_rock() {
     // The control: proves the scene really is a tunnelling case.
-    let mut sim = scene(false, ROCK);
+    let mut sim = scene(false, rock());
     for _ in 0..3 {
         sim.step();
     }
@@ -63,7 +68,7 @@ fn without_sweeping_the_bullet_tunnels_through_the_rock() {
 
 #[test]
 fn a_swept_bullet_at_10000_units_per_second_hits_a_half_unit_rock() {
-    let mut sim = scene(true, ROCK);
+    let mut sim = scene(true, rock());
     sim.step();
     let out = sim.step();
     assert!(
@@ -89,16 +94,12 @@ fn a_swept_bullet_at_10000_units_per_second_hits_a_half_unit_rock() {
 
 #[test]
 fn a_swept_bullet_hits_only_the_first_rock_on_its_path() {
-    let rocks: String = [60.0, 20.0, 100.0]
+    let rocks = [60.0, 20.0, 100.0]
         .iter()
         .enumerate()
-        .map(|(k, x)| {
-            format!(
-                "[[bodies]]\nname = \"rock{k}\"\nlayer = \"rock\"\nshape = {{ kind = \"circle\", radius = 0.5 }}\nposition = [{x}, 0]\n"
-            )
-        })
+        .map(|(k, &x)| disc(&format!("rock{k}"), ROCK, 0.5, Vec2::new(x, 0.0)))
         .collect();
-    let mut sim = scene(true, &rocks);
+    let mut sim = scene(true, rocks);
     sim.step();
     let out = sim.step();
     assert_eq!(out.contacts.len(), 1, "{:?}", out.contacts);
@@ -111,16 +112,16 @@ fn a_swept_bullet_hits_only_the_first_rock_on_its_path() {
 
 #[test]
 fn a_swept_bullet_never_passes_a_thin_wall() {
-    let wall = r#"
-        [[bodies]]
-        name = "wall"
-        layer = "wall"
-        kind = "static"
-        shape = { kind = "obb", half_extents = [0.01, 5] }
-        position = [50, 0]
-        angle = 0.3
-    "#;
-    let mut unswept = scene(false, wall);
+    let wall = vec![BodyDef {
+        name: "wall".to_owned(),
+        layer: WALL,
+        kind: BodyKind::Static,
+        shape: Shape::obb(Vec2::new(0.01, 5.0)).unwrap(),
+        position: Vec2::new(50.0, 0.0),
+        angle: 0.3,
+        ..BodyDef::default()
+    }];
+    let mut unswept = scene(false, wall.clone());
     let mut swept = scene(true, wall);
     let (mut missed, mut hits) = (0, Vec::new());
     for _ in 0..4 {
@@ -144,26 +145,16 @@ fn a_swept_bullet_never_passes_a_thin_wall() {
 /// A grazing path: the bullet's path passes `miss` between centres of a rock of radius 0.5,
 /// the bullet itself radius 0.5, at 600 units/s (10 units a frame).
 fn graze(miss: f64) -> Vec<ricochet_sim::ContactRecord> {
-    let text = format!(
-        r#"
-        hz = 60
-        layers = ["bullet", "rock"]
-        fast_layers = ["bullet"]
-        [[collide]]
-        a = "bullet"
-        b = "rock"
-        response = "report"
-        [[bodies]]
-        layer = "bullet"
-        shape = {{ kind = "circle", radius = 0.5 }}
-        position = [-5, {miss:?}]
-        velocity = [600, 0]
-        [[bodies]]
-        layer = "rock"
-        shape = {{ kind = "circle", radius = 0.5 }}
-        "#
-    );
-    let mut sim = Simulation::new(&load_scenario(&text, "graze.toml").unwrap());
+    let mut l = layers(&["bullet", "rock"], &[(BULLET, ROCK, Response::Report)]);
+    l.set_fast(BULLET);
+    let world = WorldDef {
+        layers: l,
+        ..WorldDef::default()
+    };
+    let mut bullet = disc("body", BULLET, 0.5, Vec2::new(-5.0, miss));
+    bullet.velocity = Vec2::new(600.0, 0.0);
+    let rock = disc("body", ROCK, 0.5, Vec2::ZERO);
+    let mut sim = Simulation::new(&scenario("graze", world, vec![bullet, rock], 600));
     (0..3).flat_map(|_| sim.step().contacts).collect()
 }
 

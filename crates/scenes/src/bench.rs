@@ -1,0 +1,421 @@
+//! The benchmark scenes of `ricochet bench`, seeded, so every run builds the same scene:
+//!
+//! - `asteroids-N`: `N` asteroids (circles and convex polygons of radius 0.5 to 3, random
+//!   velocities and spins), 100 bullets (layer `bullet`, in `fast_layers`: swept), one ship,
+//!   in a wrap-around world of side `sqrt(N) * 20`. Asteroids ignore each other; bullets and
+//!   the ship `report` against asteroids, so nothing is destroyed and the body count stays
+//!   the same for the whole run (a benchmark of a shrinking world would measure nothing).
+//! - `platformer-T-A`: `T` static 1×1 AABB tiles in floors 5 units apart (every floor but the
+//!   lowest has a one-tile gap every 8 tiles, offset from floor to floor), `A` dynamic 0.8×0.8
+//!   boxes under gravity that patrol (`walker`), fall through the gaps and `separate` from the
+//!   tiles per axis; actors `report` against each other. The world wraps along x.
+//! - `rain-N`: `N` shapes of all five kinds (circle, aabb, obb, capsule, polygon), spinning
+//!   and falling through `max(10, N/10)` static shapes of all five kinds; every pair `report`s
+//!   (so nothing moves anything), in a wrap-around world of side `sqrt(N) * 8`.
+
+use ricochet_geom::{Shape, Vec2};
+use ricochet_sim::{
+    BodyDef, BodyKind, Controller, LayerId, Layers, Response, Scenario, WorldBounds, WorldDef,
+};
+
+use crate::{Rng, layers, scenario};
+
+/// The scenes `ricochet bench` runs when none is named.
+pub const DEFAULT_SCENES: [&str; 3] = ["asteroids-10000", "platformer-10000-100", "rain-10000"];
+
+/// Seconds per step of every scene.
+const DT: f64 = 1.0 / 60.0;
+/// Bullets in an `asteroids-N` scene.
+pub const BULLETS: usize = 100;
+/// Bullet speed, units/s: 1 unit a frame, five times a bullet's size.
+const BULLET_SPEED: f64 = 60.0;
+/// Vertical distance between two platformer floors.
+const FLOOR_SPACING: f64 = 5.0;
+
+/// A built-in scene and its size, parsed from its name.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Scene {
+    /// `asteroids-N`.
+    Asteroids {
+        /// `N`.
+        asteroids: usize,
+    },
+    /// `platformer-T-A`.
+    Platformer {
+        /// `T`: static tiles.
+        tiles: usize,
+        /// `A`: walking actors.
+        actors: usize,
+    },
+    /// `rain-N`.
+    Rain {
+        /// `N`: falling shapes.
+        shapes: usize,
+    },
+}
+
+/// A scene name that is not `asteroids-N`, `platformer-T-A` or `rain-N`; displays the reason.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SceneNameError(String);
+
+impl std::fmt::Display for SceneNameError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for SceneNameError {}
+
+impl Scene {
+    /// Parses `asteroids-N`, `platformer-T-A` or `rain-N` (counts at least 1, `_` allowed
+    /// between digits).
+    pub fn parse(name: &str) -> Result<Scene, SceneNameError> {
+        let count = |s: &str| -> Result<usize, SceneNameError> {
+            let n: usize = s.replace('_', "").parse().map_err(|e| {
+                SceneNameError(format!("scene {name:?}: {s:?} is not a count: {e}"))
+            })?;
+            if n == 0 {
+                return Err(SceneNameError(format!(
+                    "scene {name:?}: counts must be at least 1"
+                )));
+            }
+            Ok(n)
+        };
+        let parts: Vec<&str> = name.split('-').collect();
+        match parts.as_slice() {
+            ["asteroids", n] => Ok(Scene::Asteroids {
+                asteroids: count(n)?,
+            }),
+            ["platformer", t, a] => Ok(Scene::Platformer {
+                tiles: count(t)?,
+                actors: count(a)?,
+            }),
+            ["rain", n] => Ok(Scene::Rain { shapes: count(n)? }),
+            _ => Err(SceneNameError(format!(
+                "unknown scene {name:?}: expected asteroids-N, platformer-TILES-ACTORS or rain-N \
+                 (for example asteroids-10000, platformer-10000-1000, rain-10000)"
+            ))),
+        }
+    }
+
+    /// The scene for a run of `frames` frames.
+    #[must_use]
+    pub fn build(self, frames: u64) -> Scenario {
+        match self {
+            Scene::Asteroids { asteroids: n } => asteroids(n, frames),
+            Scene::Platformer { tiles, actors } => platformer(tiles, actors, frames),
+            Scene::Rain { shapes } => rain(shapes, frames),
+        }
+    }
+}
+
+/// The world of every bench scene: 60 Hz, `gravity`, wrapping round the bounds `min`..`max`.
+fn wrapping_world(gravity: Vec2, min: Vec2, max: Vec2, layers: Layers) -> WorldDef {
+    WorldDef {
+        dt: DT,
+        gravity,
+        bounds: Some(WorldBounds {
+            min,
+            max,
+            wrap: true,
+        }),
+        layers,
+        ..WorldDef::default()
+    }
+}
+
+/// A convex polygon of `n` vertices on a circle of `radius`, at jittered angles (points on a
+/// circle in counter-clockwise order are always strictly convex).
+fn round_polygon(rng: &mut Rng, n: usize, radius: f64) -> Shape {
+    let step = std::f64::consts::TAU / n as f64;
+    let phase = rng.range(0.0, step);
+    let vertices: Vec<Vec2> = (0..n)
+        .map(|k| {
+            let a = phase + step * k as f64 + rng.range(-0.25, 0.25) * step;
+            let (s, c) = libm::sincos(a);
+            Vec2::new(c, s) * radius
+        })
+        .collect();
+    Shape::polygon(&vertices).expect("points on a circle, counter-clockwise, are convex")
+}
+
+/// `asteroids-N`: see the module docs.
+#[must_use]
+pub fn asteroids(n: usize, frames: u64) -> Scenario {
+    let name = &format!("asteroids-{n}");
+    const SHIP: LayerId = 0;
+    const ASTEROID: LayerId = 1;
+    const BULLET: LayerId = 2;
+    let mut rng = Rng::new(0xa57e_0001 ^ n as u64);
+    let side = (n as f64).sqrt() * 20.0;
+    let mut l = layers(
+        &["ship", "asteroid", "bullet"],
+        &[
+            (SHIP, ASTEROID, Response::Report),
+            (BULLET, ASTEROID, Response::Report),
+        ],
+    );
+    l.set_fast(BULLET);
+    let world = wrapping_world(Vec2::ZERO, Vec2::ZERO, Vec2::splat(side), l);
+    let mut bodies = Vec::with_capacity(n + BULLETS + 1);
+    bodies.push(BodyDef {
+        name: "ship".to_owned(),
+        layer: SHIP,
+        shape: Shape::polygon(&[
+            Vec2::new(1.0, 0.0),
+            Vec2::new(-0.7, 0.6),
+            Vec2::new(-0.7, -0.6),
+        ])
+        .expect("a counter-clockwise triangle"),
+        position: Vec2::splat(side * 0.5),
+        velocity: Vec2::new(2.0, 1.0),
+        angular_velocity: 0.5,
+        ..BodyDef::default()
+    });
+    for k in 0..n {
+        let radius = rng.range(0.5, 3.0);
+        let shape = if k % 2 == 0 {
+            Shape::circle(radius).expect("a positive radius")
+        } else {
+            let sides = 5 + rng.below(4);
+            round_polygon(&mut rng, sides, radius)
+        };
+        bodies.push(BodyDef {
+            name: "asteroid".to_owned(),
+            layer: ASTEROID,
+            shape,
+            position: Vec2::new(rng.range(0.0, side), rng.range(0.0, side)),
+            angle: rng.range(0.0, std::f64::consts::TAU),
+            velocity: {
+                let speed = rng.range(0.5, 5.0);
+                rng.velocity(speed)
+            },
+            angular_velocity: rng.range(-1.0, 1.0),
+            ..BodyDef::default()
+        });
+    }
+    // Long enough that no bullet expires during the run: the body count stays the same.
+    let lifetime = u32::try_from(frames.saturating_add(60)).unwrap_or(u32::MAX);
+    for _ in 0..BULLETS {
+        bodies.push(BodyDef {
+            name: "bullet".to_owned(),
+            layer: BULLET,
+            shape: Shape::circle(0.1).expect("a positive radius"),
+            position: Vec2::new(rng.range(0.0, side), rng.range(0.0, side)),
+            velocity: rng.velocity(BULLET_SPEED),
+            lifetime: Some(lifetime),
+            ..BodyDef::default()
+        });
+    }
+    scenario(name, world, bodies, frames)
+}
+
+/// `platformer-T-A`: see the module docs.
+#[must_use]
+pub fn platformer(tiles: usize, actors: usize, frames: u64) -> Scenario {
+    let name = &format!("platformer-{tiles}-{actors}");
+    const TILE: LayerId = 0;
+    const ACTOR: LayerId = 1;
+    let mut rng = Rng::new(0x91a7_0002 ^ ((tiles as u64) << 20) ^ actors as u64);
+    // Floors sqrt(8 T) tiles wide, so the level is about as wide as it is tall in world units
+    // (floors are 5 apart); a multiple of 8, so the gap pattern continues across the wrap.
+    let width = ((8.0 * tiles as f64).sqrt().ceil() as usize)
+        .div_ceil(8)
+        .max(2)
+        * 8;
+    let mut bodies = Vec::with_capacity(tiles + actors);
+    let mut floor = 0usize;
+    'floors: loop {
+        for col in 0..width {
+            if bodies.len() == tiles {
+                break 'floors;
+            }
+            if floor > 0 && (col + 3 * floor) % 8 == 4 {
+                continue;
+            }
+            bodies.push(BodyDef {
+                name: "tile".to_owned(),
+                layer: TILE,
+                kind: BodyKind::Static,
+                shape: Shape::aabb(Vec2::splat(0.5)).expect("positive half extents"),
+                position: Vec2::new(col as f64 + 0.5, floor as f64 * FLOOR_SPACING),
+                ..BodyDef::default()
+            });
+        }
+        floor += 1;
+    }
+    // Actors start above the complete floors (`floor` is the first incomplete one).
+    let floors = floor.max(1);
+    for k in 0..actors {
+        let f = rng.below(floors) as f64;
+        let speed = rng.range(1.0, 3.0) * if rng.unit() < 0.5 { -1.0 } else { 1.0 };
+        bodies.push(BodyDef {
+            name: "actor".to_owned(),
+            layer: ACTOR,
+            shape: Shape::aabb(Vec2::splat(0.4)).expect("positive half extents"),
+            // Half of them standing on the floor (its top is at +0.5), half dropping from
+            // up to 2.5 above it (the next floor's bottom is at +4.5).
+            position: Vec2::new(
+                rng.range(0.5, width as f64 - 0.5),
+                f * FLOOR_SPACING + 0.9 + if k % 2 == 0 { 0.0 } else { rng.range(0.1, 2.5) },
+            ),
+            controller: Some(Controller::Walker { speed }),
+            ..BodyDef::default()
+        });
+    }
+    let world = wrapping_world(
+        Vec2::new(0.0, -20.0),
+        Vec2::new(0.0, -10.0),
+        Vec2::new(width as f64, floor as f64 * FLOOR_SPACING + 10.0),
+        layers(
+            &["tile", "actor"],
+            &[
+                (TILE, ACTOR, Response::Separate),
+                (ACTOR, ACTOR, Response::Report),
+            ],
+        ),
+    );
+    scenario(name, world, bodies, frames)
+}
+
+/// One shape of kind `k % 5` (circle, aabb, obb, capsule, polygon) about `size` across.
+fn any_shape(rng: &mut Rng, k: usize, size: f64) -> Shape {
+    let r = |rng: &mut Rng| rng.range(0.5, 1.0) * size;
+    match k % 5 {
+        0 => Shape::circle(r(rng)).expect("a positive radius"),
+        1 => Shape::aabb(Vec2::new(r(rng), r(rng))).expect("positive half extents"),
+        2 => Shape::obb(Vec2::new(r(rng), r(rng) * 0.5)).expect("positive half extents"),
+        3 => {
+            let half = r(rng);
+            let radius = r(rng) * 0.4;
+            Shape::capsule(Vec2::new(-half, 0.0), Vec2::new(half, 0.0), radius)
+                .expect("a positive radius")
+        }
+        _ => {
+            let sides = 3 + rng.below(6);
+            let radius = r(rng);
+            round_polygon(rng, sides, radius)
+        }
+    }
+}
+
+/// `rain-N`: see the module docs.
+#[must_use]
+pub fn rain(n: usize, frames: u64) -> Scenario {
+    let name = &format!("rain-{n}");
+    const DROP: LayerId = 0;
+    const GROUND: LayerId = 1;
+    let mut rng = Rng::new(0x7a14_0003 ^ n as u64);
+    let side = ((n as f64).sqrt() * 8.0).max(40.0);
+    let statics = (n / 10).max(10);
+    let mut bodies = Vec::with_capacity(n + statics);
+    for k in 0..statics {
+        // Bars, platforms, pegs, rails and rocks, three times a drop's size.
+        let shape = any_shape(&mut rng, k, 2.4);
+        bodies.push(BodyDef {
+            name: "ground".to_owned(),
+            layer: GROUND,
+            kind: BodyKind::Static,
+            shape,
+            position: Vec2::new(rng.range(0.0, side), rng.range(0.0, side)),
+            angle: rng.range(-0.6, 0.6),
+            ..BodyDef::default()
+        });
+    }
+    for k in 0..n {
+        let shape = any_shape(&mut rng, k, 0.8);
+        bodies.push(BodyDef {
+            name: "drop".to_owned(),
+            layer: DROP,
+            shape,
+            position: Vec2::new(rng.range(0.0, side), rng.range(0.0, side)),
+            angle: rng.range(0.0, std::f64::consts::TAU),
+            velocity: Vec2::new(rng.range(-1.0, 1.0), rng.range(-2.0, 0.0)),
+            angular_velocity: rng.range(-2.0, 2.0),
+            ..BodyDef::default()
+        });
+    }
+    let world = wrapping_world(
+        Vec2::new(0.0, -9.81),
+        Vec2::ZERO,
+        Vec2::splat(side),
+        layers(
+            &["drop", "ground"],
+            &[
+                (DROP, GROUND, Response::Report),
+                (DROP, DROP, Response::Report),
+            ],
+        ),
+    );
+    scenario(name, world, bodies, frames)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn scene_names_parse() {
+        assert_eq!(
+            Scene::parse("asteroids-10000").unwrap(),
+            Scene::Asteroids { asteroids: 10000 }
+        );
+        assert_eq!(
+            Scene::parse("platformer-1_000_000-1000").unwrap(),
+            Scene::Platformer {
+                tiles: 1_000_000,
+                actors: 1000
+            }
+        );
+        assert_eq!(Scene::parse("rain-5").unwrap(), Scene::Rain { shapes: 5 });
+        for bad in [
+            "asteroids",
+            "asteroids-0",
+            "asteroids-x",
+            "platformer-10",
+            "snow-5",
+        ] {
+            assert!(Scene::parse(bad).is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn scenes_have_the_asked_sizes_and_are_deterministic() {
+        let s = Scene::parse("platformer-1000-30").unwrap().build(10);
+        assert_eq!(s.bodies.len(), 1030);
+        let tiles = s
+            .bodies
+            .iter()
+            .filter(|b| b.kind == BodyKind::Static)
+            .count();
+        assert_eq!(tiles, 1000);
+        let a = Scene::parse("asteroids-300").unwrap().build(10);
+        assert_eq!(a.bodies.len(), 300 + BULLETS + 1);
+        assert_eq!(a, Scene::parse("asteroids-300").unwrap().build(10));
+        let r = Scene::parse("rain-100").unwrap().build(10);
+        assert_eq!(r.bodies.len(), 110);
+        let kinds: std::collections::BTreeSet<&str> = r
+            .bodies
+            .iter()
+            .map(|b| match &b.shape {
+                Shape::Primitive(p) => p.kind().name(),
+                Shape::Compound(_) => "compound",
+            })
+            .collect();
+        assert_eq!(kinds.len(), 5, "{kinds:?}");
+    }
+
+    #[test]
+    fn no_compound_reaches_rapier() {
+        for s in [
+            Scene::Asteroids { asteroids: 50 }.build(1),
+            Scene::Rain { shapes: 50 }.build(1),
+        ] {
+            assert!(
+                s.bodies
+                    .iter()
+                    .all(|b| matches!(b.shape, Shape::Primitive(_)))
+            );
+        }
+    }
+}

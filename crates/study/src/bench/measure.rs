@@ -1,0 +1,202 @@
+//! The measurement of `ricochet bench`: one scene stepped by both engines, each step timed,
+//! the contact sets compared on every frame, the process's peak memory read.
+//!
+//! Frame 0 (the initial state) is stepped by both engines untimed (rapier's first step builds
+//! its tree from scratch). Then for each of `frames` frames: Ricochet's `Simulation::step()`
+//! is timed; every moving body's pose is copied into rapier (untimed); rapier's
+//! `CollisionPipeline::step` is timed; the two contact sets are compared
+//! ([`ricochet_oracle::bench::compare_contacts`] documents the rule) on every frame, frame 0
+//! included.
+//!
+//! Memory is the process's peak resident set (`VmHWM` in `/proc/self/status`, reset at the
+//! scene's start by writing `5` to `/proc/self/clear_refs`): `ricochet_mb` is read once
+//! Ricochet's world is built and has stepped frame 0, before rapier's world exists (the
+//! scenario and the simulation's copy of it both count: `Simulation::new` clones it);
+//! `peak_mb` at the end of the scene, both engines alive. Both include the process's own
+//! few megabytes; the caller runs each scene in a fresh process so that they do not include
+//! heap the allocator kept from an earlier scene.
+//!
+//! Wall time is measured with [`Instant`]: it is a benchmark figure, and never reaches a log
+//! or a test assertion.
+
+use std::time::{Duration, Instant};
+
+use anyhow::Context;
+use ricochet_oracle::bench::{CONTACT_TOLERANCE, ContactAgreement, RapierScene, compare_contacts};
+use ricochet_scenes::bench::Scene;
+use ricochet_sim::Simulation;
+use serde::{Deserialize, Serialize};
+
+/// A field of `/proc/self/status` (`VmHWM`, `VmRSS`), in megabytes; `None` off Linux.
+fn status_mb(field: &str) -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with(field))?;
+    let kb: f64 = line
+        .trim_start_matches(field)
+        .trim_start_matches(':')
+        .trim()
+        .trim_end_matches("kB")
+        .trim()
+        .parse()
+        .ok()?;
+    Some(kb / 1024.0)
+}
+
+/// Resets `VmHWM` to the current resident set (Linux 4.0 and later).
+fn reset_peak() {
+    // Off Linux, or without permission, the peak simply keeps counting from process start.
+    let _ = std::fs::write("/proc/self/clear_refs", "5");
+}
+
+/// Per-frame times: median and 95th percentile (nearest rank), milliseconds.
+#[must_use]
+pub fn percentiles(times: &[Duration]) -> (f64, f64) {
+    if times.is_empty() {
+        return (f64::NAN, f64::NAN);
+    }
+    let mut ms: Vec<f64> = times.iter().map(|t| t.as_secs_f64() * 1e3).collect();
+    ms.sort_by(f64::total_cmp);
+    let n = ms.len();
+    let median = if n % 2 == 1 {
+        ms[n / 2]
+    } else {
+        0.5 * (ms[n / 2 - 1] + ms[n / 2])
+    };
+    let rank = (n * 95).div_ceil(100).max(1);
+    (median, ms[rank - 1])
+}
+/// One scene's figures.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Row {
+    /// The scene's name as asked.
+    pub scene: String,
+    /// Bodies in the scene.
+    pub bodies: usize,
+    /// Timed frames.
+    pub frames: u64,
+    /// Ricochet's median time per frame.
+    pub ricochet_median_ms: f64,
+    /// Ricochet's 95th percentile (nearest rank).
+    pub ricochet_p95_ms: f64,
+    /// Rapier's median time per frame.
+    pub rapier_median_ms: f64,
+    /// Rapier's 95th percentile (nearest rank).
+    pub rapier_p95_ms: f64,
+    /// How the contact sets compared over the run.
+    pub agreement: ContactAgreement,
+    /// Peak resident set after Ricochet's setup and frame 0, MB (`None` off Linux).
+    pub ricochet_mb: Option<f64>,
+    /// Peak resident set at the end of the scene, MB (`None` off Linux).
+    pub peak_mb: Option<f64>,
+    /// Median of `frames` more Ricochet steps with rapier idle: Ricochet with the caches to
+    /// itself (between interleaved steps, rapier's step evicts Ricochet's data).
+    pub ricochet_alone_median_ms: f64,
+}
+
+impl Row {
+    /// Rapier's median over Ricochet's.
+    #[must_use]
+    pub fn ratio(&self) -> f64 {
+        self.rapier_median_ms / self.ricochet_median_ms
+    }
+
+    /// Whether every compared contact agreed.
+    #[must_use]
+    pub fn agrees(&self) -> bool {
+        self.agreement.all_agree()
+    }
+}
+/// Runs one scene: both engines, `frames` timed frames after frame 0.
+/// `name` is the scene's name as asked (it names the row); `progress` hears what the run is
+/// doing (`NAME: N bodies, F frames`, the setup time, a note every 30 s).
+pub fn run_scene(
+    name: &str,
+    scene: Scene,
+    frames: u64,
+    mut progress: impl FnMut(&str),
+) -> anyhow::Result<Row> {
+    reset_peak();
+    let setup = Instant::now();
+    let scenario = scene.build(frames);
+    let mut sim = Simulation::from_scenario(scenario);
+    let bodies = sim.world.len();
+    progress(&format!("{name}: {bodies} bodies, {frames} frames"));
+    let out0 = sim.step();
+    let ricochet_mb = status_mb("VmHWM");
+    let mut rapier = RapierScene::new(&sim).with_context(|| format!("{name}: rapier scene"))?;
+    rapier.step();
+    let mut agreement = compare_contacts(&sim, &out0, &rapier.penetrating(), CONTACT_TOLERANCE);
+    drop(out0);
+    progress(&format!(
+        "{name}: set up in {:.1} s",
+        setup.elapsed().as_secs_f64()
+    ));
+    let mut ricochet_times = Vec::with_capacity(usize::try_from(frames).unwrap_or(0));
+    let mut rapier_times = Vec::with_capacity(ricochet_times.capacity());
+    let started = Instant::now();
+    let mut last_note = Instant::now();
+    for frame in 1..=frames {
+        let t = Instant::now();
+        let out = sim.step();
+        ricochet_times.push(t.elapsed());
+        rapier
+            .sync(&sim)
+            .with_context(|| format!("{name}: frame {frame}"))?;
+        let t = Instant::now();
+        rapier.step();
+        rapier_times.push(t.elapsed());
+        agreement.add(&compare_contacts(
+            &sim,
+            &out,
+            &rapier.penetrating(),
+            CONTACT_TOLERANCE,
+        ));
+        if last_note.elapsed() > Duration::from_secs(30) {
+            progress(&format!(
+                "{name}: frame {frame}/{frames} after {:.0} s",
+                started.elapsed().as_secs_f64()
+            ));
+            last_note = Instant::now();
+        }
+    }
+    let peak_mb = status_mb("VmHWM");
+    // The same number of frames again, Ricochet alone (rapier's world stays, untouched).
+    let mut alone_times = Vec::with_capacity(ricochet_times.len());
+    for _ in 0..frames {
+        let t = Instant::now();
+        let out = sim.step();
+        alone_times.push(t.elapsed());
+        drop(out);
+    }
+    let (ricochet_alone_median_ms, _) = percentiles(&alone_times);
+    let (ricochet_median_ms, ricochet_p95_ms) = percentiles(&ricochet_times);
+    let (rapier_median_ms, rapier_p95_ms) = percentiles(&rapier_times);
+    Ok(Row {
+        scene: name.to_owned(),
+        bodies,
+        frames,
+        ricochet_median_ms,
+        ricochet_p95_ms,
+        rapier_median_ms,
+        rapier_p95_ms,
+        agreement,
+        ricochet_mb,
+        peak_mb,
+        ricochet_alone_median_ms,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn percentiles_are_nearest_rank() {
+        let t: Vec<Duration> = (1..=100).map(Duration::from_millis).collect();
+        let (median, p95) = percentiles(&t);
+        assert!((median - 50.5).abs() < 1e-9);
+        assert!((p95 - 95.0).abs() < 1e-9);
+        let (median, p95) = percentiles(&[Duration::from_millis(3)]);
+        assert_eq!((median, p95), (3.0, 3.0));
+    }
+}

@@ -1,0 +1,9 @@
+//! The benchmark behind `ricochet bench`: Ricochet's full step against rapier2d's
+//! collision-only pipeline, on the scenes of [`ricochet_scenes::bench`], in the same process
+//! on the same frames. [`measure`](mod@measure) runs one scene; [`report`] makes the table,
+//! the CSV and each scene's contact summary.
+
+pub mod measure;
+pub mod report;
+
+pub use measure::{Row, run_scene};
