@@ -38,7 +38,7 @@ fn body(world: &World, out: &FrameOutput, e: Entity) -> String {
 fn kind(event: &GameEvent) -> &'static str {
     match event {
         GameEvent::Input { .. } => "input",
-        GameEvent::Missed { .. } => "missed",
+        GameEvent::Missed { .. } | GameEvent::Gone { .. } => "missed",
         GameEvent::Spawned { .. } | GameEvent::Fired { .. } | GameEvent::SplitFrom { .. } => {
             "spawn"
         }
@@ -78,6 +78,7 @@ fn message(event: &GameEvent, world: &World, out: &FrameOutput) -> String {
     match event {
         GameEvent::Input { body: e, input } => format!("{}: {}", body(*e), input_text(input)),
         GameEvent::Missed { action, name } => format!("{action}: no body named {name} is alive"),
+        GameEvent::Gone { action, body: e } => format!("{action}: body #{e} is no longer alive"),
         GameEvent::Spawned { body: e, template } => {
             format!("{} spawned from template {template}", body(*e))
         }
@@ -160,7 +161,7 @@ shape = { kind = "circle", radius = 0.5 }
             .events
             .iter()
             .map(|e| {
-                let l = line(e, &sim.world, &out);
+                let l = line(e, sim.world(), &out);
                 (l.kind, l.message)
             })
             .collect();

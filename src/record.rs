@@ -173,8 +173,8 @@ impl Recorder {
     pub fn record(&mut self, sim: &Simulation, out: &FrameOutput) -> Result<(), LogError> {
         let t = out.frame * self.dt_ns;
         let ts = Timestamp::from_nanos(t);
-        let w = &sim.world;
-        let layers = &sim.scenario.world.layers;
+        let w = sim.world();
+        let layers = &sim.scenario().world.layers;
         self.writer
             .write(self.scene, t, &crate::scene::scene_update(w, out, ts))?;
         let bodies = (0..w.len())

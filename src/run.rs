@@ -84,7 +84,7 @@ pub fn run(
         }
         let out = sim.step();
         contacts += out.contacts.len() as u64;
-        peak_bodies = peak_bodies.max(sim.world.len());
+        peak_bodies = peak_bodies.max(sim.world().len());
         recorder
             .record(&sim, &out)
             .with_context(|| format!("writing frame {} to {}", out.frame, output.display()))?;
@@ -115,7 +115,7 @@ pub fn run(
     eprintln!(
         "{}: {stepped} frames, {} bodies at the end ({peak_bodies} at most), {contacts} contacts, {:.3} s wall, {:.0} frames/s -> {}{note}",
         scenario.name,
-        sim.world.len(),
+        sim.world().len(),
         wall,
         ran as f64 / wall.max(1e-9),
         output.display()

@@ -33,8 +33,8 @@ fn digest(scenario: &Path) -> String {
     format!(
         "frames {}\nbodies {}\nhash {:016x}\n",
         s.frames,
-        sim.world.len(),
-        sim.world.digest()
+        sim.world().len(),
+        sim.world().digest()
     )
 }
 

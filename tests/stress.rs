@@ -36,8 +36,8 @@ fn assert_finite(w: &World) {
 
 /// The worst overlap left between two solid bodies at the end of a frame.
 fn worst_solid_overlap(s: &Simulation) -> f64 {
-    let w = &s.world;
-    let layers = &s.scenario.world.layers;
+    let w = s.world();
+    let layers = &s.scenario().world.layers;
     let mut worst: f64 = 0.0;
     for i in 0..w.len() {
         for j in i + 1..w.len() {
@@ -142,12 +142,12 @@ fn the_same_scene_far_from_the_origin_gives_the_same_contacts_and_relative_motio
         }
         let mut r = shifted_scene(0.0);
         run(&mut r, frames);
-        for i in 0..s.world.len() {
-            let rel = s.world.position[i] - Vec2::splat(offset);
+        for i in 0..s.world().len() {
+            let rel = s.world().position[i] - Vec2::splat(offset);
             assert!(
-                (rel - r.world.position[i]).abs().max_element() <= tol,
+                (rel - r.world().position[i]).abs().max_element() <= tol,
                 "offset {offset}: body {i} {rel} vs {}",
-                r.world.position[i]
+                r.world().position[i]
             );
         }
     }
@@ -158,11 +158,11 @@ fn sizes_from_a_millimetre_to_a_kilometre_and_mass_ratios_of_ten_thousand() {
     let mut s = sim(&scenario_file("stress/extreme-sizes.toml"));
     for frame in 0..=600 {
         s.step();
-        assert_finite(&s.world);
+        assert_finite(s.world());
         let worst = worst_solid_overlap(&s);
         assert!(worst <= 1e-6, "frame {frame}: overlap {worst}");
     }
-    let w = &s.world;
+    let w = s.world();
     let at = |name: &str| w.position[w.find(name).unwrap()];
     assert!((at("grain").y - 0.001).abs() <= 1e-9, "{}", at("grain"));
     assert!((at("boulder").y - 1.0).abs() <= 1e-9, "{}", at("boulder"));
@@ -177,14 +177,14 @@ fn sizes_from_a_millimetre_to_a_kilometre_and_mass_ratios_of_ten_thousand() {
 #[test]
 fn a_stack_of_fifty_boxes_rests_for_ten_thousand_frames_without_creep_or_jitter() {
     let mut s = sim(&scenario_file("stress/stack-50.toml"));
-    assert_eq!(s.world.len(), 51);
+    assert_eq!(s.world().len(), 51);
     let mut settled: Option<Vec<Vec2>> = None;
     for frame in 0..=10_000u64 {
         s.step();
         let worst = worst_solid_overlap(&s);
         assert!(worst <= SLOP, "frame {frame}: overlap {worst}");
         if frame >= 120 {
-            let now: Vec<Vec2> = s.world.position.clone();
+            let now: Vec<Vec2> = s.world().position.clone();
             match &settled {
                 None => settled = Some(now),
                 Some(then) => {
@@ -196,23 +196,23 @@ fn a_stack_of_fifty_boxes_rests_for_ten_thousand_frames_without_creep_or_jitter(
                     assert!(drift <= SLOP, "frame {frame}: the stack moved by {drift}");
                 }
             }
-            for i in 1..s.world.len() {
+            for i in 1..s.world().len() {
                 assert!(
-                    s.world.grounded[i],
+                    s.world().grounded[i],
                     "frame {frame}: {} is not grounded",
-                    s.world.name[i]
+                    s.world().name[i]
                 );
             }
         }
     }
     // Box k rests with its centre at k + 0.5.
-    for i in 1..s.world.len() {
-        let k: f64 = s.world.name[i][3..].parse().unwrap();
+    for i in 1..s.world().len() {
+        let k: f64 = s.world().name[i][3..].parse().unwrap();
         assert!(
-            (s.world.position[i].y - (k + 0.5)).abs() <= 1e-9,
+            (s.world().position[i].y - (k + 0.5)).abs() <= 1e-9,
             "{}: {}",
-            s.world.name[i],
-            s.world.position[i]
+            s.world().name[i],
+            s.world().position[i]
         );
     }
 }
@@ -227,8 +227,8 @@ fn a_million_frames_of_asteroids_stay_finite_bounded_and_flat_in_memory() {
     for frame in 0..=1_000_000u64 {
         s.step();
         if frame % 10_000 == 0 {
-            assert_finite(&s.world);
-            for p in &s.world.position {
+            assert_finite(s.world());
+            for p in &s.world().position {
                 assert!(
                     p.x >= bounds.min.x
                         && p.x < bounds.max.x
@@ -238,14 +238,14 @@ fn a_million_frames_of_asteroids_stay_finite_bounded_and_flat_in_memory() {
                 );
             }
         }
-        peak = peak.max(s.world.len());
+        peak = peak.max(s.world().len());
     }
     assert!(peak <= 60, "bodies never pile up: at most {peak}");
     // Nothing that grows per frame is kept: the world's columns hold only live bodies.
     assert!(
-        s.world.position.capacity() <= 64,
+        s.world().position.capacity() <= 64,
         "{}",
-        s.world.position.capacity()
+        s.world().position.capacity()
     );
 }
 
@@ -258,7 +258,7 @@ fn tiny_and_huge_timesteps_are_handled() {
         let mut s = sim(&changed);
         for frame in 0..=2_000 {
             s.step();
-            assert_finite(&s.world);
+            assert_finite(s.world());
             let worst = worst_solid_overlap(&s);
             assert!(worst <= SLOP, "dt {dt}, frame {frame}: overlap {worst}");
         }
@@ -304,10 +304,10 @@ fn coincident_bodies_and_corner_on_corner_hits_get_finite_normals_and_a_fixed_ch
             );
             assert!(c.depth.is_finite());
         }
-        assert_finite(&a.world);
+        assert_finite(a.world());
     }
     // The twin started exactly inside the wall and was pushed out along one axis.
-    let twin = a.world.position[a.world.find("twin").unwrap()];
+    let twin = a.world().position[a.world().find("twin").unwrap()];
     assert!(
         twin.x.abs() >= 2.0 - SLOP || twin.y.abs() >= 2.0 - SLOP,
         "{twin}"
@@ -400,8 +400,8 @@ mod properties {
             for frame in 0..=120 {
                 a.step();
                 b.step();
-                for i in 0..a.world.len() {
-                    let (p, q) = (a.world.position[i], b.world.position[i]);
+                for i in 0..a.world().len() {
+                    let (p, q) = (a.world().position[i], b.world().position[i]);
                     prop_assert!((p.x + q.x).abs() <= 1e-9 && (p.y - q.y).abs() <= 1e-9, "frame {}: {} vs {}", frame, p, q);
                 }
             }
@@ -412,7 +412,7 @@ mod properties {
             let mut s = sim(&text);
             for frame in 0..=180 {
                 let out = s.step();
-                assert_finite(&s.world);
+                assert_finite(s.world());
                 for c in &out.contacts {
                     prop_assert!(c.depth.is_finite() && c.normal.is_finite() && c.point.is_finite());
                     prop_assert!(c.phase != Phase::Swept, "nothing here is fast");

@@ -51,8 +51,8 @@ pub fn scenario(text: &str) {
     let steps = scenario.frames.clamp(1, MAX_STEPS);
     for _ in 0..steps {
         let out = sim.step();
-        assert_eq!(out.stats.bodies, sim.world.len(), "frame {}", out.frame);
-        if sim.world.len() > MAX_LIVE_BODIES {
+        assert_eq!(out.stats.bodies, sim.world().len(), "frame {}", out.frame);
+        if sim.world().len() > MAX_LIVE_BODIES {
             break;
         }
     }

@@ -216,8 +216,8 @@ pub fn compare_motion(scenario: &Scenario, frames: u64) -> MotionReport {
             let rb = &world.bodies[t.handle];
             let p_rapier = from_vector(rb.translation());
             let a_rapier = rb.rotation().angle();
-            let p = sim.world.position[t.index];
-            let a = sim.world.angle[t.index];
+            let p = sim.world().position[t.index];
+            let a = sim.world().angle[t.index];
 
             let scale = 1.0_f64
                 .max(t.x0.length())

@@ -73,8 +73,8 @@ pub(crate) struct Body<'a> {
 
 /// The body `e` as it was this frame: alive at its end, or removed during it.
 pub(crate) fn body<'a>(sim: &'a Simulation, out: &'a FrameOutput, e: Entity) -> Option<Body<'a>> {
-    if let Some(i) = sim.world.index_of(e) {
-        let w = &sim.world;
+    if let Some(i) = sim.world().index_of(e) {
+        let w = sim.world();
         return Some(Body {
             name: &w.name[i],
             shape: &w.shape[i],
@@ -217,7 +217,7 @@ impl Referee {
 
     /// Keeps every body's end-of-frame position for the next frame's swept checks.
     fn remember(&mut self, sim: &Simulation, frame: u64) {
-        let w = &sim.world;
+        let w = sim.world();
         let positions = (0..w.len()).map(|i| (w.entity[i], w.position[i])).collect();
         self.previous = Some((frame, positions));
     }

@@ -86,8 +86,8 @@ impl Referee {
         e: Entity,
         detect: &Pose,
     ) -> Option<Vec2> {
-        if let Some(i) = sim.world.index_of(e) {
-            return Some(sim.world.start_position[i]);
+        if let Some(i) = sim.world().index_of(e) {
+            return Some(sim.world().start_position[i]);
         }
         if let Some((frame, positions)) = &self.previous
             && *frame + 1 == out.frame

@@ -17,7 +17,7 @@ use std::f64::consts::PI;
 
 use ricochet_geom::{Shape, Vec2};
 use ricochet_sim::{
-    Action, BodyDef, BodyKind, Doomed, Event, Layers, Response, Scenario, WorldDef,
+    Action, BodyDef, BodyKind, Doomed, Event, Layers, Response, Scenario, ScriptAction, WorldDef,
 };
 
 use crate::{Rng, layers, scenario};
@@ -158,9 +158,9 @@ impl Harmonic {
         (1..=steps)
             .map(|s| Event {
                 frame: s,
-                action: Action::SetForce {
-                    body: "mass".to_owned(),
-                    force: self.force(s, dt, None),
+                action: ScriptAction::Body {
+                    name: "mass".to_owned(),
+                    action: Action::SetForce(self.force(s, dt, None)),
                 },
             })
             .collect()

@@ -9,6 +9,7 @@
 
 use ricochet_geom::{Pose, Vec2};
 
+use crate::action::Action;
 use crate::def::{BodyDef, WorldDef};
 use crate::entity::Entity;
 use crate::pipeline::Simulation;
@@ -201,6 +202,38 @@ impl Simulation {
             return Err(ControlError::OutOfRange { field: "velocity" });
         }
         self.world.set_velocity(i, velocity);
+        Ok(())
+    }
+
+    /// Sets the constant force on a body (newtons: mass units · units/s²), and wakes it.
+    ///
+    /// # Errors
+    /// The body is not alive, or the force is not finite.
+    pub fn set_force(&mut self, e: Entity, force: Vec2) -> Result<(), ControlError> {
+        let i = self.index(e)?;
+        if !force.is_finite() {
+            return Err(ControlError::OutOfRange { field: "force" });
+        }
+        self.world.force[i] = force;
+        self.world.wake(i);
+        self.world.refresh_active();
+        Ok(())
+    }
+
+    /// Sends an input to a body: it takes effect at the start of the next step (after that
+    /// frame's script events; several actions in the order sent), and the step's output
+    /// reports it as a [`crate::GameEvent::Input`] (or [`crate::GameEvent::Removed`] for
+    /// [`Action::Destroy`]). A ship that fires spawns its bullet then.
+    ///
+    /// # Errors
+    /// The body is not alive, or a value is out of range (a non-finite vector, a turn or
+    /// move input outside -1 to 1); nothing is queued.
+    pub fn apply(&mut self, e: Entity, action: Action) -> Result<(), ControlError> {
+        self.index(e)?;
+        if let Some(field) = action.out_of_range() {
+            return Err(ControlError::OutOfRange { field });
+        }
+        self.pending.push((e, action));
         Ok(())
     }
 

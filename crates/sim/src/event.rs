@@ -26,6 +26,14 @@ pub enum GameEvent {
         /// The body name the event gave.
         name: String,
     },
+    /// An action sent with [`crate::Simulation::apply`] found its body gone by the step;
+    /// nothing happened.
+    Gone {
+        /// The action's name (`fire`, `thrust`, ...).
+        action: &'static str,
+        /// The body it was sent to.
+        body: Entity,
+    },
     /// A script event spawned a body from a template.
     Spawned {
         /// The new body.

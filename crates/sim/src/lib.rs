@@ -10,24 +10,56 @@
 //! calls platform trigonometry. Geometry comes from `ricochet-geom`; what a frame produced
 //! goes back to the caller, which decides how to record it.
 //!
+//! # Embedding it in a game
+//!
+//! A scene built in code, stepped, sent an input, and its contacts and events read. Bodies
+//! are addressed by [`Entity`] (index and generation): a removed body's id never names
+//! another body.
+//!
 //! ```
-//! let text = r#"
-//! hz = 60
-//! layers = ["ball"]
-//! [[bodies]]
-//! layer = "ball"
-//! shape = { kind = "circle", radius = 0.5 }
-//! velocity = [1, 0]
-//! "#;
-//! let scenario = ricochet_sim::load_scenario(text, "ball.toml").unwrap();
-//! let mut sim = ricochet_sim::Simulation::new(&scenario);
-//! for _ in 0..=60 {
-//!     sim.step();
-//! }
-//! // One second at 1 unit/s, in 60 steps of 1/60 s.
-//! assert!((sim.world.position[0].x - 1.0).abs() < 1e-12);
+//! use ricochet_geom::{Shape, Vec2};
+//! use ricochet_sim::{
+//!     Action, BodyDef, BodyKind, GameEvent, Layers, Response, ScriptInput, Simulation, WorldDef,
+//! };
+//!
+//! let mut layers = Layers::new(vec!["ball".into(), "wall".into()]);
+//! layers.set(0, 1, Response::Report);
+//! let mut sim = Simulation::from_def(WorldDef { layers, ..WorldDef::default() })?;
+//! let ball = sim.spawn(&BodyDef {
+//!     shape: Shape::circle(0.5)?,
+//!     ..BodyDef::default()
+//! });
+//! let wall = sim.spawn(&BodyDef {
+//!     layer: 1,
+//!     kind: BodyKind::Static,
+//!     shape: Shape::aabb(Vec2::new(0.5, 5.0))?,
+//!     position: Vec2::new(3.25, 0.0), // its left face at x = 2.75
+//!     ..BodyDef::default()
+//! });
+//! sim.step(); // frame 0: the initial state
+//! sim.apply(ball, Action::SetVelocity(Vec2::new(60.0, 0.0)))?;
+//! let out = sim.step(); // the input is applied, then the ball moves 1 unit
+//! assert_eq!(out.events[0], GameEvent::Input {
+//!     body: ball,
+//!     input: ScriptInput::Velocity(Vec2::new(60.0, 0.0)),
+//! });
+//! let x = sim.position(ball).unwrap().x; // 60 units/s for 1/60 s
+//! assert!((x - 1.0).abs() < 1e-15);
+//! let out = sim.step(); // the ball (radius 0.5) at x = 2 reaches 2.5: no contact yet
+//! assert!(out.contacts.is_empty());
+//! let out = sim.step(); // at x = 3 it overlaps the face at 2.75 by 0.5 + (3 - 2.75)
+//! let c = &out.contacts[0];
+//! assert_eq!((c.a, c.b, c.normal), (ball, wall, Vec2::new(1.0, 0.0)));
+//! assert!((c.depth - 0.75).abs() < 1e-12);
+//! assert!(matches!(out.events[0], GameEvent::Contact { a, b, .. } if (a, b) == (ball, wall)));
+//! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
+//!
+//! Scenario files load into the same definitions ([`load_scenario`], feature `toml`, on by
+//! default); `examples/asteroids_in_code.rs` builds an Asteroids scene and reads a
+//! destruction as a typed [`GameEvent`].
 
+mod action;
 pub mod broad_phase;
 mod control;
 mod def;
@@ -42,10 +74,11 @@ mod stage_set;
 mod stages;
 mod world;
 
+pub use action::{Action, Event, ScriptAction};
 pub use control::ControlError;
 pub use def::{
-    Action, ActiveRegion, BodyDef, BodyKind, Controller, Doomed, Event, LayerId, Layers,
-    MAX_FRAMES, Response, RunLengthError, Split, WorldBounds, WorldDef,
+    ActiveRegion, BodyDef, BodyKind, Controller, Doomed, LayerId, Layers, MAX_FRAMES, Response,
+    RunLengthError, Split, WorldBounds, WorldDef,
 };
 pub use entity::{Entity, EntityAllocator};
 pub use event::{FireOutcome, GameEvent, JumpOutcome, Removal, ScriptInput};

@@ -24,7 +24,8 @@
 //! The motion stages visit only the *active* bodies ([`World::active`]): moving, not frozen,
 //! not asleep. Static bodies are never visited after they are indexed.
 
-use crate::def::Event;
+use crate::action::{Action, Event};
+use crate::entity::Entity;
 use crate::output::FrameOutput;
 use crate::scenario::Scenario;
 use crate::stage_set::Stage;
@@ -40,10 +41,10 @@ const FRAME_ZERO: [Stage; 4] = [Stage::Script, Stage::Cull, Stage::Detect, Stage
 
 /// A running simulation.
 pub struct Simulation {
-    /// The scenario it runs.
-    pub scenario: Scenario,
+    /// The scenario it runs (its bodies moved into the world).
+    pub(crate) scenario: Scenario,
     /// The bodies.
-    pub world: World,
+    pub(crate) world: World,
     /// The next frame to run.
     pub(crate) frame: u64,
     /// Index of the next script event.
@@ -51,6 +52,8 @@ pub struct Simulation {
     /// Whether each frame reports every body's pose at the start of `detect`
     /// ([`FrameOutput::detect_poses`]). Off by default: it costs a copy per frame.
     pub capture_detect_poses: bool,
+    /// Actions sent with [`Simulation::apply`], applied at the start of the next step.
+    pub(crate) pending: Vec<(Entity, Action)>,
     /// The body the active region follows, once found.
     pub(crate) focus: Option<crate::Entity>,
     /// The broad phase and buffers of `detect` (given to it each frame).
@@ -111,8 +114,24 @@ impl Simulation {
             frame: 0,
             cursor: 0,
             capture_detect_poses: false,
+            pending: Vec::new(),
             focus: None,
         }
+    }
+
+    /// The bodies, to read: a write goes through the simulation's methods
+    /// ([`Simulation::set_position`], [`Simulation::apply`], ...), which keep the broad
+    /// phase's and the sleep stage's caches right.
+    #[must_use]
+    pub fn world(&self) -> &World {
+        &self.world
+    }
+
+    /// The scenario it runs: world settings, templates and script (its bodies are in the
+    /// world). Read-only: the stages' state is built from it once.
+    #[must_use]
+    pub fn scenario(&self) -> &Scenario {
+        &self.scenario
     }
 
     /// The frame the next [`step`](Self::step) will run.
@@ -138,7 +157,7 @@ impl Simulation {
     fn has_work(&self, stage: Stage) -> bool {
         let (w, def) = (&self.world, &self.scenario.world);
         match stage {
-            Stage::Script => !self.due_events().is_empty(),
+            Stage::Script => !self.due_events().is_empty() || !self.pending.is_empty(),
             Stage::Cull => cull::has_work(def),
             Stage::Unground => motion::has_grounded(w),
             Stage::Controls => motion::has_controls(w),
@@ -167,7 +186,8 @@ impl Simulation {
             Stage::Script => {
                 let events = &self.scenario.script[self.cursor..self.cursor + due];
                 self.cursor += due;
-                script::run(&mut ctx, events);
+                script::run(&mut ctx, events, &self.pending);
+                self.pending.clear();
             }
             Stage::Cull => cull::run(&mut ctx, &mut self.focus),
             Stage::Unground => motion::unground(ctx.world),

@@ -4,7 +4,8 @@
 
 use std::collections::BTreeMap;
 
-use crate::def::{BodyDef, Event, WorldDef};
+use crate::action::Event;
+use crate::def::{BodyDef, WorldDef};
 
 /// A checked scenario, ready to simulate.
 #[derive(Clone, Debug, PartialEq)]

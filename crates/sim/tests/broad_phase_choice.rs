@@ -43,7 +43,7 @@ fn every_broad_phase_gives_the_same_simulation() {
             for (k, out) in outs.iter().enumerate() {
                 let kind = KINDS[k];
                 let what = format!("{name} frame {frame} {kind:?}");
-                assert_eq!(sims[k].world.digest(), sims[0].world.digest(), "{what}");
+                assert_eq!(sims[k].world().digest(), sims[0].world().digest(), "{what}");
                 assert_eq!(out.contacts, reference.contacts, "{what}");
                 assert_eq!(out.events, reference.events, "{what}");
                 assert_eq!(out.removed, reference.removed, "{what}");

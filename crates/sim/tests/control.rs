@@ -4,7 +4,8 @@
 use ricochet_geom::{Shape, Vec2};
 use ricochet_sim::broad_phase::BroadPhaseKind;
 use ricochet_sim::{
-    BodyDef, BodyKind, ControlError, Layers, Response, Simulation, WorldBounds, WorldDef,
+    Action, BodyDef, BodyKind, ControlError, Event, GameEvent, Layers, Response, Scenario,
+    ScriptAction, ScriptInput, Simulation, WorldBounds, WorldDef,
 };
 
 const KINDS: [BroadPhaseKind; 4] = [
@@ -166,4 +167,88 @@ fn set_velocity_moves_a_body_and_never_a_static_one() {
     );
     assert_eq!(sim.position(wall), Some(Vec2::new(10.0, 0.0)));
     assert_eq!(sim.velocity(wall), Some(Vec2::ZERO));
+}
+
+/// Actions sent with `apply` take effect at the next step, after that frame's script events,
+/// in the order sent; one sent to a body removed before the step is reported, not applied.
+#[test]
+fn applied_actions_follow_the_script_in_the_order_sent() {
+    let scenario = Scenario {
+        world: world(BroadPhaseKind::Auto, Response::Ignore),
+        bodies: vec![
+            BodyDef {
+                name: "a".to_owned(),
+                ..circle(0, BodyKind::Dynamic, 0.0)
+            },
+            BodyDef {
+                name: "b".to_owned(),
+                ..circle(0, BodyKind::Dynamic, 10.0)
+            },
+        ],
+        script: vec![Event {
+            frame: 1,
+            action: ScriptAction::Body {
+                name: "a".to_owned(),
+                action: Action::SetVelocity(Vec2::new(1.0, 0.0)),
+            },
+        }],
+        ..Scenario::default()
+    };
+    let mut sim = Simulation::from_scenario(scenario);
+    let (a, b) = (
+        sim.entity_named("a").unwrap(),
+        sim.entity_named("b").unwrap(),
+    );
+    sim.step();
+    // Sent before frame 1: applied after the script's set_velocity, so the last one wins.
+    sim.apply(a, Action::SetVelocity(Vec2::new(2.0, 0.0)))
+        .unwrap();
+    sim.apply(a, Action::SetVelocity(Vec2::new(3.0, 0.0)))
+        .unwrap();
+    sim.apply(b, Action::Destroy).unwrap();
+    assert_eq!(
+        sim.position(a),
+        Some(Vec2::ZERO),
+        "nothing happens before the step"
+    );
+    let out = sim.step();
+    let inputs: Vec<_> = out
+        .events
+        .iter()
+        .filter_map(|e| match e {
+            GameEvent::Input { body, input } => Some((*body, input.clone())),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(
+        inputs,
+        vec![
+            (a, ScriptInput::Velocity(Vec2::new(1.0, 0.0))),
+            (a, ScriptInput::Velocity(Vec2::new(2.0, 0.0))),
+            (a, ScriptInput::Velocity(Vec2::new(3.0, 0.0))),
+        ]
+    );
+    assert_eq!(sim.velocity(a), Some(Vec2::new(3.0, 0.0)));
+    assert_eq!(sim.position(a), Some(Vec2::new(3.0 * (1.0 / 60.0), 0.0)));
+    assert!(!sim.contains(b));
+    // b is gone: an action sent to it now is refused at once ...
+    assert_eq!(sim.apply(b, Action::Jump), Err(ControlError::NoSuchBody(b)));
+    // ... and one sent to a body removed before the step is reported as gone.
+    sim.apply(a, Action::Thrust(true)).unwrap();
+    sim.despawn(a).unwrap();
+    let out = sim.step();
+    assert_eq!(
+        out.events,
+        vec![GameEvent::Gone {
+            action: "thrust",
+            body: a
+        }]
+    );
+    // Out-of-range values are refused and never queued.
+    let c = sim.spawn(&circle(0, BodyKind::Dynamic, 0.0));
+    assert_eq!(
+        sim.apply(c, Action::Turn(1.5)),
+        Err(ControlError::OutOfRange { field: "input" })
+    );
+    assert!(sim.step().events.is_empty());
 }

@@ -34,7 +34,7 @@ fn follows_closed_form(
     s.step(); // frame 0: the initial state
     for n in 1..=frames {
         s.step();
-        let x = s.world.position[0];
+        let x = s.world().position[0];
         let want = closed_form(x0, v0, a, dt, n);
         let tol = bound(x0, v0, a, dt, n);
         assert!(
@@ -102,7 +102,7 @@ fn a_thrusting_ship_follows_the_closed_form() {
     let heading = Vec2::new(libm::cos(0.5), libm::sin(0.5));
     let (x0, v0, a, dt) = (Vec2::ZERO, Vec2::new(1.0, -1.0), heading * 3.5, 0.02);
     follows_closed_form(&mut s, (x0, v0, a, dt), 300, |s, _, _| {
-        assert_eq!(s.world.angle[0], 0.5, "no turn input, no turning");
+        assert_eq!(s.world().angle[0], 0.5, "no turn input, no turning");
     });
 }
 
@@ -125,7 +125,7 @@ fn a_falling_box_lands_flush_and_grounded() {
         let o = box_overlap(
             Vec2::new(0.0, -1.0),
             Vec2::new(10.0, 1.0),
-            s.world.position[1],
+            s.world().position[1],
             Vec2::splat(0.5),
         );
         assert!(
@@ -133,7 +133,7 @@ fn a_falling_box_lands_flush_and_grounded() {
             "frame {frame}: box sunk {} into the floor",
             o.y
         );
-        if s.world.grounded[1] && landed_at.is_none() {
+        if s.world().grounded[1] && landed_at.is_none() {
             landed_at = Some(frame);
             assert!(
                 out.contacts.iter().all(|c| c.phase == Phase::Y),
@@ -145,14 +145,15 @@ fn a_falling_box_lands_flush_and_grounded() {
     // Free fall from 2.5 above the floor at 20 units/s² takes 0.5 s: about frame 30.
     let landed = landed_at.expect("the box lands");
     assert!((29..=32).contains(&landed), "landed at frame {landed}");
-    assert!(s.world.grounded[1]);
+    assert!(s.world().grounded[1]);
     assert!(
-        (s.world.position[1].y - 0.5).abs() <= SLOP,
+        (s.world().position[1].y - 0.5).abs() <= SLOP,
         "{}",
-        s.world.position[1]
+        s.world().position[1]
     );
     assert_eq!(
-        s.world.position[1].x, 0.3,
+        s.world().position[1].x,
+        0.3,
         "a vertical landing never moves x"
     );
 }
@@ -176,11 +177,11 @@ fn a_corner_hit_resolves_along_one_axis_only() {
     assert_eq!(c.resolved.x, 0.0, "nothing along x");
     assert!((c.resolved.y - 0.08).abs() < 1e-12, "{:?}", c.resolved);
     assert_eq!(
-        s.world.velocity[1],
+        s.world().velocity[1],
         Vec2::new(6.0, 0.0),
         "x velocity kept, y stopped"
     );
-    assert!(s.world.grounded[1]);
+    assert!(s.world().grounded[1]);
 }
 
 #[test]
@@ -203,9 +204,9 @@ fn a_body_running_into_a_wall_stops_flush() {
     }
     assert_eq!(hits, 1, "one hit, then it rests flush");
     assert!(
-        (s.world.position[1].x - 4.5).abs() <= SLOP,
+        (s.world().position[1].x - 4.5).abs() <= SLOP,
         "{}",
-        s.world.position[1]
+        s.world().position[1]
     );
-    assert_eq!(s.world.velocity[1].x, 0.0);
+    assert_eq!(s.world().velocity[1].x, 0.0);
 }

@@ -9,8 +9,8 @@
 use ricochet_geom::Vec2;
 use ricochet_scenes::tiles::Tiles;
 use ricochet_sim::{
-    Action, Event, FrameOutput, GameEvent, Phase, Removal, Simulation, Stage, StageSet, Stats,
-    load_scenario,
+    Action, Event, FrameOutput, GameEvent, Phase, Removal, ScriptAction, Simulation, Stage,
+    StageSet, Stats, load_scenario,
 };
 
 fn sim(text: &str) -> Simulation {
@@ -29,7 +29,7 @@ fn stats_without_stages(s: &Stats) -> Stats {
 
 /// `World::active` is documented as the moving bodies that are neither frozen nor asleep.
 fn active_as_documented(sim: &Simulation) -> Vec<u32> {
-    let w = &sim.world;
+    let w = sim.world();
     w.movers()
         .iter()
         .copied()
@@ -52,11 +52,11 @@ fn run_side_by_side(
         assert_eq!(a.frame, frame);
         assert_eq!(b.frame, frame);
         assert_eq!(
-            plain.world.digest(),
-            featured.world.digest(),
+            plain.world().digest(),
+            featured.world().digest(),
             "frame {frame}: digests differ\nplain: {:?}\nfeatured: {:?}",
-            plain.world.position,
-            featured.world.position
+            plain.world().position,
+            featured.world().position
         );
         assert_eq!(a.contacts, b.contacts, "frame {frame}: contacts differ");
         assert_eq!(a.events, b.events, "frame {frame}: events differ");
@@ -244,7 +244,7 @@ fn culling_that_freezes_nothing_changes_nothing() {
     run_side_by_side(&mut plain, &mut culled, 300, |a, b, _, c| {
         totals.add(a);
         assert_eq!(b.stats.frozen, 0, "frame {}: froze a body", b.frame);
-        assert!(c.world.frozen.iter().all(|f| !f), "frame {}", b.frame);
+        assert!(c.world().frozen.iter().all(|f| !f), "frame {}", b.frame);
         assert!(
             b.stats.stages_run.contains(Stage::Cull),
             "frame {}",
@@ -274,7 +274,7 @@ fn sleeping_that_never_triggers_changes_nothing() {
     run_side_by_side(&mut plain, &mut sleepy, 300, |a, b, _, s| {
         totals.add(a);
         assert_eq!(b.stats.asleep, 0, "frame {}: a body fell asleep", b.frame);
-        assert!(s.world.asleep.iter().all(|f| !f), "frame {}", b.frame);
+        assert!(s.world().asleep.iter().all(|f| !f), "frame {}", b.frame);
         if b.frame > 0 {
             assert!(
                 b.stats.stages_run.contains(Stage::Sleep),
@@ -316,14 +316,14 @@ fn boxes(sleep_after: Option<u32>) -> Tiles {
 
 /// Dense index of the live body named `name` (the lowest id with that name).
 fn index(sim: &Simulation, name: &str) -> usize {
-    sim.world
+    sim.world()
         .find(name)
         .unwrap_or_else(|| panic!("no body named {name}"))
 }
 
 /// Asserts what the docs promise a sleeper: zero velocity, `grounded` kept, not integrated.
 fn assert_sleepers_rest(sim: &Simulation, frame: u64) {
-    let w = &sim.world;
+    let w = sim.world();
     for i in 0..w.len() {
         if w.asleep[i] {
             assert_eq!(
@@ -366,19 +366,19 @@ fn resting_boxes_fall_asleep_without_changing_any_state() {
         let b = sleepy.step();
         // Skipping a body at a fixed point of the step changes nothing: not one bit.
         assert_eq!(
-            plain.world.digest(),
-            sleepy.world.digest(),
+            plain.world().digest(),
+            sleepy.world().digest(),
             "frame {frame}: digests differ\nplain: {:?} {:?}\nsleepy: {:?} {:?}",
-            plain.world.position,
-            plain.world.velocity,
-            sleepy.world.position,
-            sleepy.world.velocity,
+            plain.world().position,
+            plain.world().velocity,
+            sleepy.world().position,
+            sleepy.world().velocity,
         );
         assert_eq!(
             a.stats.asleep, 0,
             "frame {frame}: nothing sleeps without sleep_after"
         );
-        assert_eq!(b.stats.asleep, sleepy.world.sleeping(), "frame {frame}");
+        assert_eq!(b.stats.asleep, sleepy.world().sleeping(), "frame {frame}");
         assert_sleepers_rest(&sleepy, frame);
         contacts_plain += a.contacts.len();
         contacts_sleepy += b.contacts.len();
@@ -388,7 +388,7 @@ fn resting_boxes_fall_asleep_without_changing_any_state() {
         all_asleep > 0,
         "the two boxes on the floor were never both asleep"
     );
-    assert_eq!(sleepy.world.sleeping(), n_boxes, "all asleep at the end");
+    assert_eq!(sleepy.world().sleeping(), n_boxes, "all asleep at the end");
     // Every box resting in the plain run is pushed out of what holds it once a frame.
     assert!(
         contacts_sleepy < contacts_plain,
@@ -411,7 +411,7 @@ fn a_sleeping_box_wakes_when_something_lands_on_it() {
     let mut plain = with_dropper(boxes(None));
     let mut sleepy = with_dropper(boxes(Some(10)));
     let (lone, dropper) = (index(&sleepy, "lone"), index(&sleepy, "dropper"));
-    let (e_lone, e_dropper) = (sleepy.world.entity[lone], sleepy.world.entity[dropper]);
+    let (e_lone, e_dropper) = (sleepy.world().entity[lone], sleepy.world().entity[dropper]);
     // Free fall from rest, semi-implicit Euler: after n moves it has fallen
     // n(n+1)/2 g dt². It overlaps `lone` once its bottom (y - 0.3) passes 1: after 78.7.
     let dt = 1.0 / 60.0;
@@ -428,13 +428,13 @@ fn a_sleeping_box_wakes_when_something_lands_on_it() {
         let a = plain.step();
         let b = sleepy.step();
         assert_eq!(
-            plain.world.digest(),
-            sleepy.world.digest(),
+            plain.world().digest(),
+            sleepy.world().digest(),
             "frame {frame}: digests differ\nplain: {:?} {:?}\nsleepy: {:?} {:?}",
-            plain.world.position,
-            plain.world.velocity,
-            sleepy.world.position,
-            sleepy.world.velocity,
+            plain.world().position,
+            plain.world().velocity,
+            sleepy.world().position,
+            sleepy.world().velocity,
         );
         assert!(a.contacts.len() >= b.contacts.len(), "frame {frame}");
         assert_sleepers_rest(&sleepy, frame);
@@ -446,7 +446,7 @@ fn a_sleeping_box_wakes_when_something_lands_on_it() {
             landed_at = Some(frame);
             assert!(asleep_before, "frame {frame}: lone was not asleep when hit");
             assert!(
-                !sleepy.world.asleep[lone],
+                !sleepy.world().asleep[lone],
                 "frame {frame}: lone still asleep after the landing"
             );
             assert!(
@@ -457,7 +457,7 @@ fn a_sleeping_box_wakes_when_something_lands_on_it() {
                 b.events
             );
         }
-        asleep_before = sleepy.world.asleep[lone];
+        asleep_before = sleepy.world().asleep[lone];
     }
     assert_eq!(
         landed_at,
@@ -466,7 +466,7 @@ fn a_sleeping_box_wakes_when_something_lands_on_it() {
     );
     // Both settle again: the two boxes on the floor end asleep; the stack's top and the
     // dropper rest on dynamic boxes, so they never sleep.
-    assert_eq!(sleepy.world.sleeping(), 2);
+    assert_eq!(sleepy.world().sleeping(), 2);
 }
 
 /// The exact semi-implicit Euler step of one coordinate: `x += v * dt`.
@@ -545,7 +545,7 @@ impl Model {
 
     fn assert_matches(&self, sim: &Simulation, frame: u64, frozen: bool) {
         let i = index(sim, self.name);
-        let w = &sim.world;
+        let w = sim.world();
         assert_eq!(w.frozen[i], frozen, "frame {frame}: {} frozen", self.name);
         assert_eq!(
             (w.position[i].x.to_bits(), w.position[i].y.to_bits()),
@@ -603,7 +603,8 @@ lifetime = 1000
     ));
     assert_eq!(s.dt(), dt);
     assert_eq!(
-        s.world.position[1].x, rock_x,
+        s.world().position[1].x,
+        rock_x,
         "the file holds the exact value"
     );
     let mut rock = Model {
@@ -628,7 +629,7 @@ lifetime = 1000
         }
         let out = s.step();
         assert_eq!(
-            s.world.position[0].x.to_bits(),
+            s.world().position[0].x.to_bits(),
             px.to_bits(),
             "frame {frame}: player"
         );
@@ -636,9 +637,9 @@ lifetime = 1000
         rock.assert_matches(&s, frame, frozen);
         if first_thawed.is_none() {
             // Bit for bit where it started, with its lifetime paused.
-            assert_eq!(s.world.position[1], ricochet_geom::Vec2::new(rock_x, 0.0));
+            assert_eq!(s.world().position[1], ricochet_geom::Vec2::new(rock_x, 0.0));
             assert_eq!(
-                s.world.lifetime[1],
+                s.world().lifetime[1],
                 Some(1000),
                 "frame {frame}: lifetime paused"
             );
@@ -711,10 +712,10 @@ lifetime = 40
         assert_eq!(out.stats.frozen, frozen, "frame {frame}");
         if frame >= 150 {
             assert_eq!(out.stats.frozen, 0, "frame {frame}: frozen without a focus");
-            assert!(s.world.find("player").is_none());
+            assert!(s.world().find("player").is_none());
         } else {
             assert_eq!(
-                s.world.position[0].x.to_bits(),
+                s.world().position[0].x.to_bits(),
                 px.to_bits(),
                 "frame {frame}"
             );
@@ -742,7 +743,7 @@ lifetime = 40
             rock.assert_matches(&s, frame, rock_frozen);
             assert_eq!(rock_frozen, frame < 150, "frame {frame}");
         } else {
-            assert!(s.world.find("rock").is_none(), "frame {frame}");
+            assert!(s.world().find("rock").is_none(), "frame {frame}");
         }
     }
     // By hand: the region's left edge px - 20 passes the post's right edge -4.75 after 91.5
@@ -762,15 +763,15 @@ fn sleeping_changes_nothing(scene: Tiles, frames: u64) -> (Simulation, Simulatio
         plain.step();
         let out = sleepy.step();
         assert_eq!(
-            plain.world.digest(),
-            sleepy.world.digest(),
+            plain.world().digest(),
+            sleepy.world().digest(),
             "frame {frame}: digests differ (asleep {:?}, active {:?})\nplain:  {:?}\nsleepy: {:?}",
-            sleepy.world.asleep,
-            sleepy.world.active(),
-            plain.world.position,
-            sleepy.world.position,
+            sleepy.world().asleep,
+            sleepy.world().active(),
+            plain.world().position,
+            sleepy.world().position,
         );
-        assert_eq!(out.stats.asleep, sleepy.world.sleeping(), "frame {frame}");
+        assert_eq!(out.stats.asleep, sleepy.world().sleeping(), "frame {frame}");
     }
     (plain, sleepy)
 }
@@ -790,8 +791,8 @@ fn a_woken_body_is_simulated_from_the_next_frame() {
             b.gravity_scale = 0.0;
         });
     let (plain, sleepy) = sleeping_changes_nothing(scene, 80);
-    assert!(plain.world.position[index(&plain, "sitter")].y < 0.2);
-    assert_eq!(sleepy.world.active(), active_as_documented(&sleepy));
+    assert!(plain.world().position[index(&plain, "sitter")].y < 0.2);
+    assert_eq!(sleepy.world().active(), active_as_documented(&sleepy));
 }
 
 #[test]
@@ -805,13 +806,13 @@ fn a_box_asleep_on_a_box_falls_when_that_box_slides_away() {
         .aabb("top", [0.5, 0.5], [0.0, 1.5])
         .event(Event {
             frame: 60,
-            action: Action::SetVelocity {
-                body: "low".to_owned(),
-                velocity: Vec2::new(3.0, 0.0),
+            action: ScriptAction::Body {
+                name: "low".to_owned(),
+                action: Action::SetVelocity(Vec2::new(3.0, 0.0)),
             },
         });
     let (plain, sleepy) = sleeping_changes_nothing(scene, 120);
     // Without sleeping, `top` lands on the floor (y = 0.5).
-    assert_eq!(plain.world.position[index(&plain, "top")].y, 0.5);
-    assert_eq!(sleepy.world.position[index(&sleepy, "top")].y, 0.5);
+    assert_eq!(plain.world().position[index(&plain, "top")].y, 0.5);
+    assert_eq!(sleepy.world().position[index(&sleepy, "top")].y, 0.5);
 }

@@ -49,7 +49,7 @@ fn rock() -> Vec<BodyDef> {
 }
 
 fn alive(sim: &Simulation, name: &str) -> bool {
-    sim.world.find(name).is_some()
+    sim.world().find(name).is_some()
 }
 
 #[test]
@@ -63,7 +63,7 @@ fn without_sweeping_the_bullet_tunnels_through_the_rock() {
         alive(&sim, "rock"),
         "an unswept bullet skips over a 0.5-unit rock"
     );
-    assert!(sim.world.position[0].x > 300.0);
+    assert!(sim.world().position[0].x > 300.0);
 }
 
 #[test]

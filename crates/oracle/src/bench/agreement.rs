@@ -124,11 +124,11 @@ pub fn compare_contacts(
     tol: f64,
 ) -> ContactAgreement {
     let mut report = ContactAgreement::default();
-    let w = &sim.world;
-    let layers = &sim.scenario.world.layers;
+    let w = sim.world();
+    let layers = &sim.scenario().world.layers;
     let frame = out.frame;
     let wrapped = |e: Entity| -> bool {
-        let (Some(b), Some(i)) = (sim.scenario.world.bounds, w.index_of(e)) else {
+        let (Some(b), Some(i)) = (sim.scenario().world.bounds, w.index_of(e)) else {
             return false;
         };
         let size = b.max - b.min;
@@ -250,7 +250,7 @@ fn fresh_depth(
     (ea, eb): (Entity, Entity),
     tol: f64,
 ) -> Result<f64, OracleError> {
-    let w = &sim.world;
+    let w = sim.world();
     let (Some(a), Some(b), Some(ia), Some(ib)) = (
         body(sim, out, ea),
         body(sim, out, eb),

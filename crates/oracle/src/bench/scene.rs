@@ -67,7 +67,7 @@ impl RapierScene {
     ///
     /// [`step`]: RapierScene::step
     pub fn new(sim: &Simulation) -> Result<RapierScene, OracleError> {
-        let w = &sim.world;
+        let w = sim.world();
         let mut scene = RapierScene {
             pipeline: CollisionPipeline::new(),
             islands: IslandManager::new(),
@@ -77,9 +77,9 @@ impl RapierScene {
             colliders: ColliderSet::new(),
             moving: Vec::new(),
             entities: w.entity.clone(),
-            layers: sim.scenario.world.layers.clone(),
+            layers: sim.scenario().world.layers.clone(),
         };
-        let filter = LayerFilter::new(&sim.scenario.world.layers);
+        let filter = LayerFilter::new(&sim.scenario().world.layers);
         for i in 0..w.len() {
             let pose = collider_pose(&w.shape[i], &w.pose(i))?;
             // The shape in its own frame: the collider's pose carries the whole placement.
@@ -106,7 +106,7 @@ impl RapierScene {
     ///
     /// Fails when the simulation gained or lost bodies: the bench scenes keep their count.
     pub fn sync(&mut self, sim: &Simulation) -> Result<(), OracleError> {
-        let w = &sim.world;
+        let w = sim.world();
         if w.entity != self.entities {
             return Err(OracleError::Conversion(
                 "the simulation spawned or removed bodies; the bench needs a stable body set",

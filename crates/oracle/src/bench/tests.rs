@@ -133,8 +133,8 @@ fn a_missing_invented_or_wrong_contact_is_a_disagreement() {
 
     let mut invented = out.clone();
     let mut fake = invented.contacts[0].clone();
-    fake.b = sim.world.entity[2];
-    fake.pose_b = sim.world.pose(2);
+    fake.b = sim.world().entity[2];
+    fake.pose_b = sim.world().pose(2);
     invented.contacts.push(fake);
     let a = compare_contacts(&sim, &invented, &pairs, CONTACT_TOLERANCE);
     assert_eq!((a.compared, a.ricochet_only, a.agreed), (2, 1, 1), "{a:?}");
@@ -170,7 +170,7 @@ fn pairs_without_a_dynamic_body_are_not_tested_by_either_engine() {
     );
     let scenario = scene(&["a"], &[(0, 0)], vec![ball, block, peg]);
     let (sim, _) = step_together(&scenario, 2, 0);
-    assert_eq!(sim.world.len(), 3);
+    assert_eq!(sim.world().len(), 3);
 }
 
 /// A scene of 40 layers: rapier's 32 collision groups cannot name them, so the layer filter
@@ -201,7 +201,7 @@ fn more_than_32_layers_filter_by_the_matrix() {
     let scenario = scene(&names, &[(35, 36), (1, 33)], bodies);
     assert!(!LayerFilter::new(&scenario.world.layers).uses_groups());
     let (sim, last) = step_together(&scenario, 3, 2);
-    let e = |i: usize| sim.world.entity[i];
+    let e = |i: usize| sim.world().entity[i];
     assert_eq!(last, [(e(0), e(1)), (e(4), e(5))]);
     // The referee filters its own pipeline the same way.
     let summary = crate::validate(&scenario, 3, crate::Tolerances::default());

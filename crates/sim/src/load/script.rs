@@ -2,7 +2,8 @@
 
 use std::collections::BTreeMap;
 
-use crate::def::{Action, BodyDef, Event};
+use crate::action::{Action, Event, ScriptAction};
+use crate::def::BodyDef;
 use crate::load::context::{Ctx, ScenarioError, finite, unknown, vec2, within_world};
 use crate::load::file::{ActionFile, EventFile, ScenarioFile};
 
@@ -73,6 +74,12 @@ pub(crate) fn script(
                 ))
             }
         };
+        let named = |b: &String, action: Action| -> Result<ScriptAction, ScenarioError> {
+            Ok(ScriptAction::Body {
+                name: body(b)?,
+                action,
+            })
+        };
         let v = |f: &str, v: [f64; 2]| {
             if v.iter().all(|x| finite(*x)) {
                 Ok(vec2(v))
@@ -119,38 +126,26 @@ pub(crate) fn script(
                     }
                     def.angle = *a;
                 }
-                Action::Spawn {
+                ScriptAction::Spawn {
                     body: Box::new(def),
                     template: template.clone(),
                 }
             }
-            ActionFile::Destroy { body: b } => Action::Destroy { body: body(b)? },
-            ActionFile::SetVelocity { body: b, velocity } => Action::SetVelocity {
-                body: body(b)?,
-                velocity: v("velocity", *velocity)?,
-            },
-            ActionFile::ApplyImpulse { body: b, impulse } => Action::ApplyImpulse {
-                body: body(b)?,
-                impulse: v("impulse", *impulse)?,
-            },
-            ActionFile::SetForce { body: b, force } => Action::SetForce {
-                body: body(b)?,
-                force: v("force", *force)?,
-            },
-            ActionFile::Thrust { body: b, on } => Action::Thrust {
-                body: body(b)?,
-                on: *on,
-            },
-            ActionFile::Turn { body: b, input: x } => Action::Turn {
-                body: body(b)?,
-                input: input(*x)?,
-            },
-            ActionFile::Fire { body: b } => Action::Fire { body: body(b)? },
-            ActionFile::Move { body: b, input: x } => Action::Move {
-                body: body(b)?,
-                input: input(*x)?,
-            },
-            ActionFile::Jump { body: b } => Action::Jump { body: body(b)? },
+            ActionFile::Destroy { body: b } => named(b, Action::Destroy)?,
+            ActionFile::SetVelocity { body: b, velocity } => {
+                named(b, Action::SetVelocity(v("velocity", *velocity)?))?
+            }
+            ActionFile::ApplyImpulse { body: b, impulse } => {
+                named(b, Action::ApplyImpulse(v("impulse", *impulse)?))?
+            }
+            ActionFile::SetForce { body: b, force } => {
+                named(b, Action::SetForce(v("force", *force)?))?
+            }
+            ActionFile::Thrust { body: b, on } => named(b, Action::Thrust(*on))?,
+            ActionFile::Turn { body: b, input: x } => named(b, Action::Turn(input(*x)?))?,
+            ActionFile::Fire { body: b } => named(b, Action::Fire)?,
+            ActionFile::Move { body: b, input: x } => named(b, Action::Move(input(*x)?))?,
+            ActionFile::Jump { body: b } => named(b, Action::Jump)?,
         };
         events.push(Event {
             frame: frame.unsigned_abs(),

@@ -1,87 +1,88 @@
-//! The `script` stage: this frame's scripted events, in file order.
+//! The `script` stage: this frame's scripted events, in file order, then the actions the
+//! game sent with [`crate::Simulation::apply`], in the order sent.
 
 use ricochet_geom::Vec2;
 
-use crate::def::{Action, BodyKind, Controller, Event};
+use crate::action::{Action, Event, ScriptAction};
+use crate::def::{BodyKind, Controller};
+use crate::entity::Entity;
 use crate::event::{FireOutcome, GameEvent, JumpOutcome, Removal, ScriptInput};
 use crate::stages::StageCtx;
 use crate::stages::remove::remove;
 
-/// Applies `due`, the script events of this frame.
-pub(crate) fn run(ctx: &mut StageCtx, due: &[Event]) {
+/// Applies `due`, the script events of this frame, then `sent`, the actions the game sent
+/// since the last step, in the order sent.
+pub(crate) fn run(ctx: &mut StageCtx, due: &[Event], sent: &[(Entity, Action)]) {
     for event in due {
-        apply(ctx, &event.action);
+        match &event.action {
+            ScriptAction::Spawn { body, template } => {
+                let e = ctx.world.spawn(body);
+                ctx.out.events.push(GameEvent::Spawned {
+                    body: e,
+                    template: template.clone(),
+                });
+            }
+            ScriptAction::Body { name, action } => match ctx.world.find(name) {
+                Some(i) => apply(ctx, i, action),
+                None => ctx.out.events.push(GameEvent::Missed {
+                    action: action.name(),
+                    name: name.clone(),
+                }),
+            },
+        }
+    }
+    for (entity, action) in sent {
+        match ctx.world.index_of(*entity) {
+            Some(i) => apply(ctx, i, action),
+            None => ctx.out.events.push(GameEvent::Gone {
+                action: action.name(),
+                body: *entity,
+            }),
+        }
     }
     // A body an event named was woken: it moves this frame.
     ctx.world.refresh_active();
 }
 
-/// Applies one script action and records what it did.
-fn apply(ctx: &mut StageCtx, action: &Action) {
-    if let Action::Spawn { body, template } = action {
-        let e = ctx.world.spawn(body);
-        ctx.out.events.push(GameEvent::Spawned {
-            body: e,
-            template: template.clone(),
-        });
-        return;
-    }
-    let name = match action {
-        Action::Spawn { .. } => unreachable!("handled above"),
-        Action::Destroy { body }
-        | Action::SetVelocity { body, .. }
-        | Action::ApplyImpulse { body, .. }
-        | Action::SetForce { body, .. }
-        | Action::Thrust { body, .. }
-        | Action::Turn { body, .. }
-        | Action::Fire { body }
-        | Action::Move { body, .. }
-        | Action::Jump { body } => body,
-    };
-    let Some(i) = ctx.world.find(name) else {
-        ctx.out.events.push(GameEvent::Missed {
-            action: action.name(),
-            name: name.clone(),
-        });
-        return;
-    };
+/// Applies one action to body `i` and records what it did.
+fn apply(ctx: &mut StageCtx, i: usize, action: &Action) {
     let entity = ctx.world.entity[i];
     ctx.world.wake(i);
     let w = &mut *ctx.world;
     let input = match action {
-        Action::Destroy { .. } => {
+        Action::Destroy => {
             remove(ctx, entity, Removal::Script, false);
             return;
         }
-        Action::SetVelocity { velocity, .. } => {
+        Action::SetVelocity(velocity) => {
             if w.kind[i] != BodyKind::Static {
                 w.velocity[i] = *velocity;
             }
             ScriptInput::Velocity(*velocity)
         }
-        Action::ApplyImpulse { impulse, .. } => {
+        Action::ApplyImpulse(impulse) => {
             if w.kind[i] == BodyKind::Dynamic {
                 w.velocity[i] += *impulse / w.mass[i];
             }
             ScriptInput::Impulse(*impulse)
         }
-        Action::SetForce { force, .. } => {
+        Action::SetForce(force) => {
             w.force[i] = *force;
             ScriptInput::Force(*force)
         }
-        Action::Thrust { on, .. } => {
+        Action::Thrust(on) => {
             w.inputs[i].thrust = *on;
             ScriptInput::Thrust(*on)
         }
-        Action::Turn { input, .. } => {
+        Action::Turn(input) => {
             w.inputs[i].turn = *input;
             ScriptInput::Turn(*input)
         }
-        Action::Move { input, .. } => {
+        Action::Move(input) => {
             w.inputs[i].run = *input;
             ScriptInput::Move(*input)
         }
-        Action::Jump { .. } => ScriptInput::Jump(match &w.controller[i] {
+        Action::Jump => ScriptInput::Jump(match &w.controller[i] {
             Some(Controller::Runner { jump_speed, .. }) if w.grounded[i] => {
                 w.velocity[i].y = *jump_speed;
                 w.grounded[i] = false;
@@ -90,8 +91,7 @@ fn apply(ctx: &mut StageCtx, action: &Action) {
             Some(Controller::Runner { .. }) => JumpOutcome::NotGrounded,
             _ => JumpOutcome::NotARunner,
         }),
-        Action::Fire { .. } => ScriptInput::Fire(fire(ctx, i)),
-        Action::Spawn { .. } => unreachable!("handled above"),
+        Action::Fire => ScriptInput::Fire(fire(ctx, i)),
     };
     ctx.out.events.push(GameEvent::Input {
         body: entity,

@@ -149,7 +149,7 @@ fn projectile_end(scenario: &Scenario, steps: u64) -> Vec2 {
     for _ in 0..=steps {
         sim.step();
     }
-    sim.world.position[0]
+    sim.world().position[0]
 }
 
 fn projectile_rows() -> anyhow::Result<Vec<Row>> {
@@ -195,7 +195,7 @@ fn harmonic_run(
     k: u32,
     state: bool,
     seconds: f64,
-) -> Errors {
+) -> anyhow::Result<Errors> {
     let mut sim = Simulation::new(scenario);
     let dt = sim.dt();
     let steps = steps_in(seconds, hz * k);
@@ -204,16 +204,18 @@ fn harmonic_run(
     sim.step();
     for s in 1..=steps {
         // What a `set_force` event at frame s does, before anything moves.
-        sim.world.force[0] = h.force(s, dt, state.then(|| sim.world.position[0]));
+        let body = sim.world().entity[0];
+        let force = h.force(s, dt, state.then(|| sim.world().position[0]));
+        sim.set_force(body, force)?;
         sim.step();
         if s % u64::from(k) == 0 {
             let (x, _) = h.exact(s as f64 * dt);
-            let (p, v) = (sim.world.position[0], sim.world.velocity[0]);
+            let (p, v) = (sim.world().position[0], sim.world().velocity[0]);
             position = position.max((p - x).length());
             energy = energy.max((h.energy(p, v) - e0).abs() / e0);
         }
     }
-    vec![("position", position), ("energy", energy)]
+    Ok(vec![("position", position), ("energy", energy)])
 }
 
 fn harmonic_rows(h: &Harmonic) -> anyhow::Result<Vec<Row>> {
@@ -223,10 +225,10 @@ fn harmonic_rows(h: &Harmonic) -> anyhow::Result<Vec<Row>> {
             let scenario = h.scenario(hz * k, Vec::new());
             // Measured over the whole run; timed over at most its first 10 s, which cost the
             // same per step: short runs are the ones other processes disturb least.
-            let errors = harmonic_run(h, &scenario, hz, k, state, h.seconds);
+            let errors = harmonic_run(h, &scenario, hz, k, state, h.seconds)?;
             let seconds = h.seconds.min(TIMED_SECONDS);
             let t = timed(seconds, || {
-                Ok(harmonic_run(h, &scenario, hz, k, state, seconds))
+                harmonic_run(h, &scenario, hz, k, state, seconds)
             })?;
             Ok(Timed {
                 errors,
@@ -254,10 +256,11 @@ fn set_force_script_matches() -> anyhow::Result<bool> {
     let mut other = Simulation::new(&direct);
     other.step();
     for s in 1..=steps {
-        other.world.force[0] = h.force(s, dt, None);
+        let body = other.world().entity[0];
+        other.set_force(body, h.force(s, dt, None))?;
         other.step();
     }
-    Ok(sim.world.digest() == other.world.digest())
+    Ok(sim.world().digest() == other.world().digest())
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -277,14 +280,14 @@ fn drop_run(scenario: &Scenario, k: u32, steps: u64) -> (Option<u64>, f64) {
     let mut rest_error = 0.0_f64;
     sim.step();
     // The floor's top as its bounds compute it, plus the half height (one rounding each).
-    let rest = sim.world.position[floor].y + FLOOR_HALF + BOX_HALF;
+    let rest = sim.world().position[floor].y + FLOOR_HALF + BOX_HALF;
     for s in 1..=steps {
         let out = sim.step();
         if landed.is_none() && out.contacts.iter().any(|c| c.phase == Phase::Y) {
             landed = Some(s);
         }
         if landed.is_some() && s % u64::from(k) == 0 {
-            rest_error = rest_error.max((sim.world.position[ball].y - rest).abs());
+            rest_error = rest_error.max((sim.world().position[ball].y - rest).abs());
         }
     }
     (landed, rest_error)

@@ -119,7 +119,7 @@ pub fn run_scene(
     let setup = Instant::now();
     let scenario = scene.build(frames);
     let mut sim = Simulation::from_scenario(scenario);
-    let bodies = sim.world.len();
+    let bodies = sim.world().len();
     progress(&format!("{name}: {bodies} bodies, {frames} frames"));
     let out0 = sim.step();
     let ricochet_mb = status_mb("VmHWM");
