@@ -15,6 +15,7 @@ mod record;
 mod run;
 mod scene;
 mod validate;
+mod validation_channel;
 
 use std::path::PathBuf;
 use std::process::ExitCode;

@@ -154,7 +154,7 @@ impl Recorder {
         let id = self.writer.add_json_channel(
             "/validation",
             "ricochet.Validation",
-            crate::validate::SCHEMA,
+            crate::validation_channel::SCHEMA,
         )?;
         self.validation = Some(id);
         Ok(())
@@ -163,7 +163,7 @@ impl Recorder {
     /// Writes the referee's verdict on a frame to `/validation`.
     pub fn record_validation(&mut self, r: &ricochet_oracle::FrameReport) -> Result<(), LogError> {
         if let Some(ch) = self.validation {
-            let msg = crate::validate::ValidationMsg::from_report(r);
+            let msg = crate::validation_channel::ValidationMsg::from_report(r);
             self.writer.write(ch, r.frame * self.dt_ns, &msg)?;
         }
         Ok(())

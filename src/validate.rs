@@ -11,46 +11,11 @@ use std::process::ExitCode;
 
 use ricochet_oracle::{FrameReport, Referee, Tolerances, compare_motion, summary_table};
 use ricochet_sim::{FrameOutput, Scenario, Simulation};
-use serde::Serialize;
 
 /// Test-only hook: when this environment variable is set, every contact's depth is scaled by
 /// 1.01 before the referee sees it, as a broken narrow phase would report it. The tests use
 /// it to prove that `validate` fails on a wrong narrow phase.
 pub const CORRUPT_CONTACTS_HOOK: &str = "RICOCHET_TEST_CORRUPT_CONTACTS";
-
-/// The `/validation` channel's message.
-#[derive(Serialize)]
-pub struct ValidationMsg<'a> {
-    frame: u64,
-    contacts_compared: u64,
-    mismatches: u64,
-    worst_depth_error: f64,
-    worst_normal_error: f64,
-    pairs_confirmed: u64,
-    swept_confirmed: u64,
-    explained: &'a std::collections::BTreeMap<&'static str, u64>,
-    details: &'a [String],
-}
-
-/// The JSON Schema of `/validation`.
-pub const SCHEMA: &str = include_str!("schemas/Validation.json");
-
-impl<'a> ValidationMsg<'a> {
-    /// The message for one frame's report.
-    pub fn from_report(r: &'a FrameReport) -> ValidationMsg<'a> {
-        ValidationMsg {
-            frame: r.frame,
-            contacts_compared: r.contacts_compared,
-            mismatches: r.mismatches,
-            worst_depth_error: r.worst_depth_error,
-            worst_normal_error: r.worst_normal_error,
-            pairs_confirmed: r.pairs_confirmed,
-            swept_confirmed: r.swept_confirmed,
-            explained: &r.explained,
-            details: &r.details,
-        }
-    }
-}
 
 /// Checks one frame, applying the test hook if it is set.
 pub fn check(referee: &mut Referee, sim: &Simulation, out: &FrameOutput) -> FrameReport {

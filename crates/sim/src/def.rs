@@ -1,7 +1,6 @@
 //! Validated definitions: what a scenario file loads into (Box2D's `b2WorldDef` and
 //! `b2BodyDef`), each with a `Default`.
 
-use crate::broad_phase::BroadPhaseKind;
 use ricochet_geom::{Shape, Vec2};
 
 /// Index of a layer in [`Layers::names`].
@@ -269,6 +268,35 @@ impl Layers {
     #[must_use]
     pub fn any(&self, pred: impl Fn(Response) -> bool) -> bool {
         self.matrix.iter().any(|r| pred(*r))
+    }
+}
+
+/// Which broad phase finds candidate pairs (the `broad_phase` module). All of them find the
+/// same pairs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum BroadPhaseKind {
+    /// Every pair is tested: `O(n²)`.
+    BruteForce,
+    /// Sort and sweep along x, re-sorting the previous call's order.
+    SortAndSweep,
+    /// A uniform grid, hashed deterministically.
+    Grid,
+    /// Chosen per call from the number of moving and static bodies (see the module docs).
+    #[default]
+    Auto,
+}
+
+impl BroadPhaseKind {
+    /// The name scenario files and `/stats` use: `brute-force`, `sort-and-sweep`, `grid`,
+    /// `auto`.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            BroadPhaseKind::BruteForce => "brute-force",
+            BroadPhaseKind::SortAndSweep => "sort-and-sweep",
+            BroadPhaseKind::Grid => "grid",
+            BroadPhaseKind::Auto => "auto",
+        }
     }
 }
 

@@ -79,33 +79,7 @@ use sort_and_sweep::{Slot, SweepList, SweepView, sweep_cross, sweep_self};
 use static_set::StaticSet;
 use tally::Tally;
 
-/// Which algorithm finds the pairs. All of them find the same pairs.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum BroadPhaseKind {
-    /// Every pair is tested: `O(n²)`.
-    BruteForce,
-    /// Sort and sweep along x, re-sorting the previous call's order.
-    SortAndSweep,
-    /// A uniform grid, hashed deterministically.
-    Grid,
-    /// Chosen per call from the number of moving and static bodies (see the module docs).
-    #[default]
-    Auto,
-}
-
-impl BroadPhaseKind {
-    /// The name scenario files and `/stats` use: `brute-force`, `sort-and-sweep`, `grid`,
-    /// `auto`.
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            BroadPhaseKind::BruteForce => "brute-force",
-            BroadPhaseKind::SortAndSweep => "sort-and-sweep",
-            BroadPhaseKind::Grid => "grid",
-            BroadPhaseKind::Auto => "auto",
-        }
-    }
-}
+pub use crate::def::BroadPhaseKind;
 
 /// One body, as the broad phase sees it.
 #[derive(Clone, Copy, Debug, PartialEq)]
