@@ -12,7 +12,10 @@ mod world;
 use std::collections::BTreeMap;
 
 use crate::scenario::Scenario;
-use bodies::{MAX_SPLIT_BODIES, SplitProblem, body_def, merge, references, split_problem};
+use bodies::{
+    MAX_SPLIT_BODIES, SplitProblem, body_def, merge, names_sorted, references, shared_name,
+    split_problem,
+};
 use chunks::split_bodies;
 pub use context::ScenarioError;
 use context::{Ctx, unknown};
@@ -154,24 +157,10 @@ fn load(text: &str, file: &str, chunked: bool) -> Result<Scenario, ScenarioError
     }
     if let Some(r) = &raw.world.active_region {
         let focus = r.focus.get_ref();
-        let same: Vec<String> = bodies
-            .iter()
-            .enumerate()
-            .filter(|(_, b)| &b.name == focus)
-            .map(|(i, _)| format!("bodies[{i}]"))
-            .collect();
-        if same.len() > 1 {
-            return Err(ctx.err(
-                r.focus.span(),
-                "world.active_region.focus",
-                format!(
-                    "{} bodies are named \"{focus}\" ({}): name the one to follow apart",
-                    same.len(),
-                    same.join(", ")
-                ),
-            ));
+        if let Some(problem) = shared_name(&names_sorted(&bodies), focus, "the one to follow") {
+            return Err(ctx.err(r.focus.span(), "world.active_region.focus", problem));
         }
-        if same.is_empty() {
+        if !bodies.iter().any(|b| &b.name == focus) {
             let mut names: Vec<&str> = bodies.iter().map(|b| b.name.as_str()).collect();
             names.sort_unstable();
             names.dedup();

@@ -4,6 +4,7 @@ use std::collections::BTreeMap;
 
 use crate::action::{Action, Event, ScriptAction};
 use crate::def::BodyDef;
+use crate::load::bodies::{names_sorted, shared_name};
 use crate::load::context::{Ctx, ScenarioError, finite, unknown, vec2, within_world};
 use crate::load::file::{ActionFile, EventFile, ScenarioFile};
 
@@ -24,6 +25,7 @@ pub(crate) fn script(
     }
     names.sort_unstable();
     names.dedup();
+    let by_name = names_sorted(bodies);
     let mut events = Vec::with_capacity(raw.script.len());
     for (i, e) in raw.script.iter().enumerate() {
         let field = format!("script[{i}]");
@@ -45,22 +47,8 @@ pub(crate) fn script(
             ));
         }
         let body = |name: &String| -> Result<String, ScenarioError> {
-            let same: Vec<String> = bodies
-                .iter()
-                .enumerate()
-                .filter(|(_, b)| &b.name == name)
-                .map(|(i, _)| format!("bodies[{i}]"))
-                .collect();
-            if same.len() > 1 {
-                return Err(fail(
-                    "body",
-                    format!(
-                        "{} bodies are named \"{name}\" ({}): name the one this event is \
-                         for apart from the others",
-                        same.len(),
-                        same.join(", ")
-                    ),
-                ));
+            if let Some(problem) = shared_name(&by_name, name, "the one this event is for") {
+                return Err(fail("body", problem));
             }
             if names.binary_search(&name.as_str()).is_ok() {
                 Ok(name.clone())
