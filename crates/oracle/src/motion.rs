@@ -146,6 +146,25 @@ pub fn rapier_free_flight(scenario: &Scenario, frames: u64) -> Vec<(usize, Vec2)
         .collect()
 }
 
+/// The worse of two errors, NaN winning: a comparison that can't be made (an infinite or NaN
+/// state on either side) must fail, never pass because `f64::max` drops NaN.
+fn worst(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() {
+        f64::NAN
+    } else {
+        a.max(b)
+    }
+}
+
+/// `err / bound`, or NaN (a failure) when the bound itself is not a finite positive number.
+fn ratio(err: f64, bound: f64) -> f64 {
+    if bound.is_finite() && bound > 0.0 {
+        err / bound
+    } else {
+        f64::NAN
+    }
+}
+
 /// Runs the scenario's dynamic and kinematic bodies in free flight (every layer pair
 /// ignored, no script, controllers, lifetimes, world bounds, culling or sleeping) for
 /// `frames` steps in both Ricochet and rapier, and compares positions and angles after
@@ -226,8 +245,8 @@ pub fn compare_motion(scenario: &Scenario, frames: u64) -> MotionReport {
             let err = (p_rapier - p).length();
             let bound = MOTION_POSITION_RELATIVE * nf * scale;
             let r = &mut t.report;
-            r.max_position_error = r.max_position_error.max(err);
-            r.worst_position_ratio = r.worst_position_ratio.max(err / bound);
+            r.max_position_error = worst(r.max_position_error, err);
+            r.worst_position_ratio = worst(r.worst_position_ratio, ratio(err, bound));
 
             let raw = angle_difference(a_rapier, a);
             r.raw_angle_difference = r.raw_angle_difference.max(raw.abs());
@@ -235,19 +254,16 @@ pub fn compare_motion(scenario: &Scenario, frames: u64) -> MotionReport {
             let lag = nf * (step - libm::atan(step));
             let corrected = angle_difference(a_rapier + lag, a).abs();
             let abound = MOTION_ANGLE_PER_FRAME * nf * (1.0 + a.abs());
-            r.max_angle_error = r.max_angle_error.max(corrected);
-            r.worst_angle_ratio = r.worst_angle_ratio.max(corrected / abound);
+            r.max_angle_error = worst(r.max_angle_error, corrected);
+            r.worst_angle_ratio = worst(r.worst_angle_ratio, ratio(corrected, abound));
         }
     }
 
     let bodies: Vec<BodyMotion> = tracked.into_iter().map(|t| t.report).collect();
     MotionReport {
         frames,
-        max_position_error: bodies
-            .iter()
-            .map(|b| b.max_position_error)
-            .fold(0.0, f64::max),
-        max_angle_error: bodies.iter().map(|b| b.max_angle_error).fold(0.0, f64::max),
+        max_position_error: bodies.iter().map(|b| b.max_position_error).fold(0.0, worst),
+        max_angle_error: bodies.iter().map(|b| b.max_angle_error).fold(0.0, worst),
         bodies,
     }
 }

@@ -79,3 +79,24 @@ fn every_scenario_flies_the_same_in_both_engines() {
         );
     }
 }
+
+/// An overflowing body (issue 11: gravity 1e308 times a scale of 1e308 is infinite) can't
+/// be compared, so free flight fails; `f64::max` used to drop the NaN and report a pass.
+#[test]
+fn an_infinite_state_never_passes() {
+    let s = load_scenario(
+        r#"
+        layers = ["a"]
+        world.gravity = [0, -1e308]
+        [[bodies]]
+        layer = "a"
+        shape = { kind = "circle", radius = 1 }
+        gravity_scale = 1e308
+        "#,
+        "overflow.toml",
+    )
+    .unwrap();
+    let r = compare_motion(&s, 5);
+    assert!(!r.passed(), "{r:?}");
+    assert!(!r.bodies[0].passed());
+}

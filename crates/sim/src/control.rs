@@ -15,6 +15,19 @@ use crate::entity::Entity;
 use crate::pipeline::Simulation;
 use crate::scenario::Scenario;
 
+/// A body whose state is no longer a finite number (an overflow: gravity of 1e308, a force
+/// past what `f64` holds): nothing after it can be trusted, so a run stops there.
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+#[error("body {body} has a non-finite {field}: {value:?}")]
+pub struct NonFinite {
+    /// The body (the lowest id with a non-finite field).
+    pub body: Entity,
+    /// `position`, `velocity`, `angle` or `angular_velocity`.
+    pub field: &'static str,
+    /// The value (`[x, y]` as written, or `[angle, 0]`).
+    pub value: [f64; 2],
+}
+
 /// Why a definition built in code or a call on a body was refused.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum ControlError {
@@ -235,6 +248,36 @@ impl Simulation {
         }
         self.pending.push((e, action));
         Ok(())
+    }
+
+    /// The first moving body, in id order, whose position, velocity, angle or angular
+    /// velocity is not finite, if any. Static bodies never change, and every value a body
+    /// starts with is checked finite, so only moving bodies are looked at (one pass over
+    /// them: call it after each step when a run must stop at the first overflow).
+    #[must_use]
+    pub fn first_non_finite(&self) -> Option<NonFinite> {
+        let w = &self.world;
+        w.movers().iter().find_map(|&i| {
+            let i = i as usize;
+            let (p, v) = (w.position[i], w.velocity[i]);
+            let (a, av) = (w.angle[i], w.angular_velocity[i]);
+            let bad = if !p.is_finite() {
+                Some(("position", [p.x, p.y]))
+            } else if !v.is_finite() {
+                Some(("velocity", [v.x, v.y]))
+            } else if !a.is_finite() {
+                Some(("angle", [a, 0.0]))
+            } else if !av.is_finite() {
+                Some(("angular_velocity", [av, 0.0]))
+            } else {
+                None
+            };
+            bad.map(|(field, value)| NonFinite {
+                body: w.entity[i],
+                field,
+                value,
+            })
+        })
     }
 
     /// Removes a body now, without a split and without an event (the game removed it).

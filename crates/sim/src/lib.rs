@@ -75,7 +75,7 @@ mod stages;
 mod world;
 
 pub use action::{Action, Event, ScriptAction};
-pub use control::ControlError;
+pub use control::{ControlError, NonFinite};
 pub use def::{
     ActiveRegion, BodyDef, BodyKind, Controller, Doomed, LayerId, Layers, MAX_FRAMES, Response,
     RunLengthError, Split, WorldBounds, WorldDef,

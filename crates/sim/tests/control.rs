@@ -252,3 +252,29 @@ fn applied_actions_follow_the_script_in_the_order_sent() {
     );
     assert!(sim.step().events.is_empty());
 }
+
+/// Gravity 1e308 times a scale of 1e308 overflows to -inf at once: the first step leaves the
+/// body at y = -inf (issue 11), and `first_non_finite` names it, its field and value.
+#[test]
+fn an_overflowing_body_is_named() {
+    let mut world = world(BroadPhaseKind::Auto, Response::Ignore);
+    world.gravity = Vec2::new(0.0, -1e308);
+    let mut sim = Simulation::from_def(world).unwrap();
+    let calm = sim.spawn(&BodyDef {
+        gravity_scale: 0.0,
+        ..circle(0, BodyKind::Dynamic, 0.0)
+    });
+    let falling = sim.spawn(&BodyDef {
+        gravity_scale: 1e308,
+        ..circle(0, BodyKind::Dynamic, 5.0)
+    });
+    sim.step();
+    assert_eq!(sim.first_non_finite(), None, "frame 0 moves nothing");
+    sim.step();
+    let bad = sim.first_non_finite().unwrap();
+    // v = -inf after the forces; y = 0 + -inf * dt = -inf.
+    assert_eq!(bad.body, falling);
+    assert_eq!(bad.field, "position");
+    assert_eq!(bad.value, [5.0, f64::NEG_INFINITY]);
+    assert!(sim.position(calm).unwrap().is_finite());
+}
