@@ -10,6 +10,7 @@ mod check;
 mod collide;
 mod diff;
 mod load;
+mod out;
 mod record;
 mod run;
 mod scene;
@@ -174,6 +175,13 @@ fn main() -> ExitCode {
         frames: None,
         validate: false,
     });
+    // An error that ends a command is exit code 1 ("the run failed"), except for `diff`, whose
+    // 1 means "the logs differ": there it is 2, like an unreadable file.
+    let failed = if matches!(command, Command::Diff { .. }) {
+        2
+    } else {
+        1
+    };
     let result = match command {
         Command::Collide { file } => collide::run(&file),
         Command::Run {
@@ -200,9 +208,16 @@ fn main() -> ExitCode {
     };
     match result {
         Ok(code) => code,
+        // The reader of our output went away (`| head`): nothing more to say.
+        Err(e)
+            if e.downcast_ref::<out::WriteError>()
+                .is_some_and(out::WriteError::is_closed) =>
+        {
+            ExitCode::SUCCESS
+        }
         Err(e) => {
-            eprintln!("error: {e:#}");
-            ExitCode::from(1)
+            out::error(&format!("error: {e:#}"));
+            ExitCode::from(failed)
         }
     }
 }
