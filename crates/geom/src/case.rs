@@ -126,9 +126,13 @@ fn case(value: serde_json::Value, line: Option<usize>) -> Result<Case, CaseError
         field,
         problem,
     };
-    // An unknown key's path ends with the key itself (`a.angel`).
+    // An unknown key's path ends with the key itself (`a.angel`); an empty key at the top
+    // has an empty path, written `""`.
     let def: CaseDef = serde_path_to_error::deserialize(&value).map_err(|e| {
-        let field = e.path().to_string();
+        let field = match e.path().to_string() {
+            p if p.is_empty() => "\"\"".to_owned(),
+            p => p,
+        };
         fail(field, e.into_inner().to_string())
     })?;
     let Some(id) = id.clone() else {
