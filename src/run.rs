@@ -49,6 +49,15 @@ pub fn run(
         ));
         return Ok(ExitCode::from(2));
     }
+    let interrupted = Arc::new(AtomicBool::new(false));
+    {
+        let flag = Arc::clone(&interrupted);
+        // SIGINT, SIGTERM and SIGHUP (ctrlc's `termination` feature) all stop the run at the
+        // next frame and finish the log. Installed before the log is created, so that no such
+        // signal leaves its temporary file behind. If a handler can't be installed (one
+        // already is), the signal just ends the process, and an old output file stays whole.
+        let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
+    }
     let frames = frames.unwrap_or(scenario.frames);
     // Created before the first step: an unwritable path fails now, not after the run. The
     // log goes to a temporary file renamed onto `output` when it is complete, so an existing
@@ -60,14 +69,6 @@ pub fn run(
             return Ok(ExitCode::from(2));
         }
     };
-    let interrupted = Arc::new(AtomicBool::new(false));
-    {
-        let flag = Arc::clone(&interrupted);
-        // SIGINT, SIGTERM and SIGHUP (ctrlc's `termination` feature) all stop the run at the
-        // next frame and finish the log. If a handler can't be installed (one already is),
-        // the signal just ends the process, and the old output file stays as it was.
-        let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
-    }
     let progress = (std::io::stderr().is_terminal() && frames >= PROGRESS_FROM).then(|| {
         let bar = indicatif::ProgressBar::new(frames + 1);
         bar.set_style(
