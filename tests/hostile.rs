@@ -623,3 +623,46 @@ fn help_and_version_into_a_full_or_closed_stdout_do_not_panic() {
     assert_no_panic("collide - < /dev/null", &o);
     assert_eq!(o.status.code(), Some(0));
 }
+
+#[test]
+fn run_writes_through_a_link_and_refuses_dev_null() {
+    let dir = tempfile::tempdir().unwrap();
+    // /dev/null is refused, and stays the device (a rename onto it would replace it with a
+    // file; mcap's writer, seeking in it, panicked).
+    let o = ricochet()
+        .args([
+            "run",
+            "scenarios/shapes.toml",
+            "--frames",
+            "3",
+            "-o",
+            "/dev/null",
+        ])
+        .output()
+        .unwrap();
+    assert_no_panic("run -o /dev/null", &o);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("not a regular file"), "{stderr}");
+    use std::os::unix::fs::FileTypeExt;
+    assert!(
+        std::fs::metadata("/dev/null")
+            .unwrap()
+            .file_type()
+            .is_char_device()
+    );
+    // A link to a log: the log it points to is replaced, the link stays a link.
+    let real = dir.path().join("real.mcap");
+    std::fs::write(&real, b"old").unwrap();
+    let link = dir.path().join("link.mcap");
+    std::os::unix::fs::symlink(&real, &link).unwrap();
+    record("scenarios/shapes.toml", 3, &link);
+    assert!(
+        std::fs::symlink_metadata(&link)
+            .unwrap()
+            .file_type()
+            .is_symlink()
+    );
+    assert!(read_log_file(&real).is_ok());
+    assert!(temp_files(dir.path()).is_empty());
+}

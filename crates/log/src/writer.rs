@@ -33,12 +33,16 @@ pub struct ChannelId(u16);
 /// leaves a truncated log there. Call `finish` also after an interrupted run:
 /// a log finished early is complete and indexed, it just holds fewer messages.
 /// A writer dropped without `finish` removes its temporary file (a process
-/// killed outright, by `SIGKILL` for example, leaves it behind).
+/// killed outright, by `SIGKILL` for example, leaves it behind). A symbolic
+/// link at `path` is followed (the file it names is replaced); an existing
+/// `path` that is not a regular file (`/dev/null`, a FIFO) is refused.
 pub struct LogWriter {
     path: PathBuf,
     mcap: mcap::Writer<BufWriter<File>>,
     /// The temporary file being written; deleted when dropped unless renamed.
     temp: tempfile::TempPath,
+    /// Where the temporary file is renamed to: `path`, or the file it links to.
+    target: PathBuf,
     /// Next sequence number of each channel.
     sequences: BTreeMap<ChannelId, u32>,
 }
@@ -63,7 +67,21 @@ impl LogWriter {
                 "is a directory",
             )));
         }
-        let name = path
+        // An existing output that is not a regular file (`/dev/null`, a FIFO, a terminal)
+        // can't take a renamed file (it would replace the device), nor an MCAP log written
+        // in place (the writer seeks back to finish it).
+        if std::fs::metadata(path).is_ok_and(|m| !m.is_file()) {
+            return Err(create_error(std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                "is not a regular file; a log is written to a file",
+            )));
+        }
+        // An existing symbolic link is followed: the log replaces the file it points to.
+        let target = match std::fs::symlink_metadata(path) {
+            Ok(m) if m.file_type().is_symlink() => path.canonicalize().map_err(create_error)?,
+            _ => path.to_path_buf(),
+        };
+        let name = target
             .file_name()
             .ok_or_else(|| {
                 create_error(std::io::Error::new(
@@ -73,7 +91,7 @@ impl LogWriter {
             })?
             .to_string_lossy()
             .into_owned();
-        let dir = match path.parent() {
+        let dir = match target.parent() {
             Some(d) if !d.as_os_str().is_empty() => d,
             _ => Path::new("."),
         };
@@ -87,6 +105,7 @@ impl LogWriter {
             builder.permissions(std::fs::Permissions::from_mode(0o666));
         }
         let (file, temp) = builder.tempfile_in(dir).map_err(create_error)?.into_parts();
+        let path = path.to_path_buf();
         let options = mcap::WriteOptions::new()
             .library(library)
             .profile("")
@@ -98,13 +117,14 @@ impl LogWriter {
         let mcap = options
             .create(BufWriter::new(file))
             .map_err(|source| LogError::Write {
-                path: path.to_path_buf(),
+                path: path.clone(),
                 source,
             })?;
         Ok(Self {
-            path: path.to_path_buf(),
+            path,
             mcap,
             temp,
+            target,
             sequences: BTreeMap::new(),
         })
     }
@@ -179,7 +199,11 @@ impl LogWriter {
             .finish()
             .map_err(|source| self.write_error(source))?;
         let Self {
-            path, mcap, temp, ..
+            path,
+            mcap,
+            temp,
+            target,
+            ..
         } = self;
         let io_error = |path: &Path, error: std::io::Error| LogError::Write {
             path: path.to_path_buf(),
@@ -192,7 +216,8 @@ impl LogWriter {
         file.flush().map_err(|e| io_error(&path, e))?;
         file.sync_all().map_err(|e| io_error(&path, e))?;
         drop(file);
-        temp.persist(&path).map_err(|e| io_error(&path, e.error))?;
+        temp.persist(&target)
+            .map_err(|e| io_error(&path, e.error))?;
         Ok(())
     }
 
