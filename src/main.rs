@@ -52,7 +52,7 @@ enum Command {
     /// it when complete, so an existing OUT.mcap is replaced whole or not at all.
     ///
     /// Exit code: 0 success, 1 the run failed, 2 bad input (scenario or output path; the
-    /// output can't be the scenario itself, nor `-`).
+    /// output can't be the scenario itself, `-`, or a device such as /dev/null).
     ///
     /// Example: ricochet run scenarios/platformer.toml -o platformer.mcap --frames 1200
     Run {

@@ -666,3 +666,37 @@ fn run_writes_through_a_link_and_refuses_dev_null() {
     assert!(read_log_file(&real).is_ok());
     assert!(temp_files(dir.path()).is_empty());
 }
+
+#[test]
+fn diff_reads_a_log_from_a_pipe() {
+    // `ricochet diff <(zcat a.mcap.gz) b.mcap`: a pipe is read once, into a temporary copy.
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = two_logs(dir.path());
+    for (piped, code) in [(std::fs::read(&a).unwrap(), 1), (b"not a log".to_vec(), 2)] {
+        let mut child = ricochet()
+            .args(["diff", "/dev/stdin", s(&b)])
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let mut stdin = child.stdin.take().unwrap();
+        let feeder = std::thread::spawn(move || {
+            use std::io::Write;
+            let _ = stdin.write_all(&piped);
+        });
+        let o = child.wait_with_output().unwrap();
+        feeder.join().unwrap();
+        assert_no_panic("diff /dev/stdin", &o);
+        let stdout = String::from_utf8_lossy(&o.stdout);
+        assert_eq!(
+            o.status.code(),
+            Some(code),
+            "{stdout}{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        if code == 1 {
+            assert!(stdout.contains("590 / 601, 11"), "{stdout}");
+        }
+    }
+}

@@ -197,7 +197,10 @@ pub struct ChannelInfo {
 /// grow with the log's length.
 #[derive(Debug)]
 pub struct LogFile {
+    /// The path it was opened by, for messages.
     path: std::path::PathBuf,
+    /// What its messages are read from.
+    source: Source,
     library: String,
     /// By channel id.
     channels: BTreeMap<u16, ChannelInfo>,
@@ -219,7 +222,19 @@ impl LogFile {
             source,
         };
         let mut file = File::open(path).map_err(read_error)?;
-        let len = file.metadata().map_err(read_error)?.len();
+        let meta = file.metadata().map_err(read_error)?;
+        if !meta.is_file() {
+            // A pipe (`<(zcat log.mcap.gz)`) can be read once only: copied to a temporary
+            // file first, which is then streamed as many times as needed.
+            let mut copy = tempfile::NamedTempFile::new().map_err(read_error)?;
+            std::io::copy(&mut file, &mut copy).map_err(read_error)?;
+            let copy = copy.into_temp_path();
+            let mut log = Self::open_inner(&copy)?;
+            log.path = path.to_path_buf();
+            log.source = Source::Copy(copy);
+            return Ok(log);
+        }
+        let len = meta.len();
         let magic = mcap::MAGIC.len() as u64;
         // The first bytes and the last ones, as `check_magic` wants them.
         if len < 2 * magic {
@@ -235,9 +250,17 @@ impl LogFile {
         file.seek(SeekFrom::Start(len - tail_len))
             .map_err(read_error)?;
         file.read_exact(&mut tail).map_err(read_error)?;
-        let mut ends = head.clone();
-        ends.extend_from_slice(&tail[tail.len() - magic as usize..]);
-        check_magic(&ends)?;
+        if head != mcap::MAGIC {
+            return Err(corrupt(
+                "does not start with the MCAP magic: not an MCAP file",
+            ));
+        }
+        if tail[tail.len() - magic as usize..] != *mcap::MAGIC {
+            return Err(truncated(&format!(
+                "{len} bytes that do not end with the MCAP magic: the file was cut short, \
+                 or its writer stopped before finishing it"
+            )));
+        }
         if tail.len() < magic as usize + FOOTER_LEN {
             return Err(corrupt("too short to hold a footer"));
         }
@@ -298,6 +321,7 @@ impl LogFile {
         let library = read_library(&mut file, len)?;
         Ok(LogFile {
             path: path.to_path_buf(),
+            source: Source::File(path.to_path_buf()),
             library,
             channels,
             total: stats.message_count,
@@ -331,7 +355,11 @@ impl LogFile {
     }
 
     fn stream(&self, topic: Option<String>) -> Result<Messages, LogError> {
-        let file = File::open(&self.path).map_err(|source| LogError::Read {
+        let from: &Path = match &self.source {
+            Source::File(p) => p,
+            Source::Copy(t) => t,
+        };
+        let file = File::open(from).map_err(|source| LogError::Read {
             path: self.path.clone(),
             source,
         })?;
@@ -355,6 +383,15 @@ impl LogFile {
             done: false,
         })
     }
+}
+
+/// Where a [`LogFile`]'s messages are read from.
+#[derive(Debug)]
+enum Source {
+    /// The file itself.
+    File(std::path::PathBuf),
+    /// A copy of what a pipe held, deleted with the `LogFile`.
+    Copy(tempfile::TempPath),
 }
 
 /// The messages of a [`LogFile`], read and decoded one at a time. Chunk CRCs
