@@ -11,16 +11,17 @@ pub fn check(path: &Path) -> anyhow::Result<ExitCode> {
         Ok(s) => s,
         Err(code) => return Ok(code),
     };
-    println!(
-        "{}: ok: \"{}\", {} bodies, {} templates, {} script events, {} layers, dt {} s, {} frames",
+    // A closed pipe or a failed write is the caller's (`main`) to report.
+    crate::out::print(&format!(
+        "{}: ok: \"{}\", {} bodies, {} templates, {} script events, {} layers, dt {} s, {} frames\n",
         path.display(),
-        s.name,
+        crate::out::escape_controls(&s.name),
         s.bodies.len(),
         s.templates.len(),
         s.script.len(),
         s.world.layers.names().len(),
         s.world.dt,
         s.frames
-    );
+    ))?;
     Ok(ExitCode::SUCCESS)
 }

@@ -8,6 +8,8 @@ use anyhow::Context;
 use ricochet_geom::{contact, parse_case_file};
 use serde::Serialize;
 
+use crate::out::{self, Stream, WriteError};
+
 /// One output line; fields in this order.
 #[derive(Serialize)]
 struct Line<'a> {
@@ -18,7 +20,8 @@ struct Line<'a> {
     point: [f64; 2],
 }
 
-/// Reads `file` (`-` is stdin), prints a JSON line per case, returns the exit code.
+/// Reads `file` (`-` is stdin), prints a JSON line per case, returns the exit code. A closed
+/// pipe (`| head -1`) stops it quietly; any other failed write is an error.
 pub fn run(file: &Path) -> anyhow::Result<ExitCode> {
     let text = if file == Path::new("-") {
         let mut s = String::new();
@@ -30,7 +33,7 @@ pub fn run(file: &Path) -> anyhow::Result<ExitCode> {
         match std::fs::read_to_string(file) {
             Ok(s) => s,
             Err(e) => {
-                eprintln!("error: {}: {e}", file.display());
+                out::error(&format!("error: {}: {e}", file.display()));
                 return Ok(ExitCode::from(2));
             }
         }
@@ -43,34 +46,40 @@ pub fn run(file: &Path) -> anyhow::Result<ExitCode> {
             } else {
                 file.display().to_string()
             };
+            let mut report = String::new();
             for e in &errors {
-                eprintln!("error: {name}: {e}");
+                report += &format!("error: {name}: {e}\n");
             }
-            eprintln!(
+            report += &format!(
                 "{} bad case(s); nothing was collided. See `ricochet collide --help` for the format.",
                 errors.len()
             );
+            out::error(&report);
             return Ok(ExitCode::from(2));
         }
     };
-    let mut out = BufWriter::new(std::io::stdout().lock());
-    for case in &cases {
-        let c = contact(&case.a.shape, &case.a.pose, &case.b.shape, &case.b.pose);
-        let line = Line {
-            id: &case.id,
-            overlap: c.overlaps(),
-            depth: c.depth,
-            normal: [c.normal.x, c.normal.y],
-            point: [c.point.x, c.point.y],
-        };
-        let line = serde_json::to_string(&line).context("encoding a result")?;
-        if writeln!(out, "{line}").is_err() {
-            // The reader went away (`| head`): not an error of ours.
-            return Ok(ExitCode::SUCCESS);
+    let mut stdout = BufWriter::new(std::io::stdout().lock());
+    let mut write = || -> std::io::Result<()> {
+        for case in &cases {
+            let c = contact(&case.a.shape, &case.a.pose, &case.b.shape, &case.b.pose);
+            let line = Line {
+                id: &case.id,
+                overlap: c.overlaps(),
+                depth: c.depth,
+                normal: [c.normal.x, c.normal.y],
+                point: [c.point.x, c.point.y],
+            };
+            serde_json::to_writer(&mut stdout, &line)?;
+            stdout.write_all(b"\n")?;
         }
+        stdout.flush()
+    };
+    match write() {
+        Ok(()) => Ok(ExitCode::SUCCESS),
+        Err(source) => Err(WriteError {
+            stream: Stream::Stdout,
+            source,
+        }
+        .into()),
     }
-    if out.flush().is_err() {
-        return Ok(ExitCode::SUCCESS);
-    }
-    Ok(ExitCode::SUCCESS)
 }

@@ -1,12 +1,15 @@
 //! `ricochet diff A.mcap B.mcap`: compare two logs message by message, decoded, so chunking
 //! and compression never matter. Reports the first divergent frame, topic, body and field
-//! with both values, then how many messages differ per topic.
+//! with both values, then how many messages differ per topic. Both logs are streamed, one
+//! topic at a time and one message at a time: memory does not grow with their length.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 use std::process::ExitCode;
 
-use ricochet_log::{LogMessage, read_log_file};
+use ricochet_log::{LogError, LogFile, LogMessage};
+
+use crate::out;
 use serde::Serialize;
 use serde_json::Value;
 
@@ -107,7 +110,8 @@ fn compare(
     }
 }
 
-/// A body's id in a log: its `id` and, in logs that have one, its `generation`.
+/// A body's id in a log: its `id` and, in logs that have one, its `generation` (a slot
+/// reused by a later body has the next generation, so id and generation name one body).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 struct BodyId {
     id: u64,
@@ -115,7 +119,7 @@ struct BodyId {
 }
 
 impl std::fmt::Display for BodyId {
-    /// `id:generation`, as the logs write a body, or `id` for a log without generations.
+    /// `id:generation` as the logs write a body, or `id` in a log without generations.
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self.generation {
             Some(g) => write!(f, "{}:{g}", self.id),
@@ -124,8 +128,7 @@ impl std::fmt::Display for BodyId {
     }
 }
 
-/// The id of the body named by field `id` (and `<id>_generation`, or `generation` next to
-/// `id`) of an object.
+/// The body named by field `id` (with its generation in field `generation`) of an object.
 fn body_id(v: &Value, id: &str, generation: &str) -> Option<BodyId> {
     Some(BodyId {
         id: v.get(id).and_then(Value::as_u64)?,
@@ -133,8 +136,7 @@ fn body_id(v: &Value, id: &str, generation: &str) -> Option<BodyId> {
     })
 }
 
-/// The id of a list element that is an object with one (bodies in `/bodies`): bodies are
-/// matched by id and generation, so a reused slot is another body.
+/// The id of a list element that is an object with one (bodies in `/bodies`).
 fn id_of(v: &Value) -> Option<BodyId> {
     body_id(v, "id", "generation")
 }
@@ -145,7 +147,7 @@ fn label(v: &Value) -> String {
         body_id(v, "b", "b_generation"),
     );
     match (id_of(v), v.get("name").and_then(Value::as_str), pair) {
-        (Some(id), Some(name), _) => format!("{id} ({name})"),
+        (Some(id), Some(name), _) => format!("{id} ({})", out::escape_controls(name)),
         (Some(id), None, _) => id.to_string(),
         (None, _, (Some(a), Some(b))) => format!("pair {a}/{b}"),
         _ => String::new(),
@@ -159,8 +161,8 @@ fn compare_arrays(
     path: &mut String,
     body: &mut Option<String>,
 ) -> Option<(String, String, String)> {
-    // Lists of bodies are matched by id, so one extra body is reported as that body, not as
-    // every later element shifted by one.
+    // Lists of bodies are matched by id (and generation), so one extra body is reported as
+    // that body, not as every later element shifted by one.
     let by_id = x.iter().chain(y).all(|v| id_of(v).is_some()) && !x.is_empty() && !y.is_empty();
     if by_id {
         let ys: BTreeMap<BodyId, &Value> =
@@ -179,7 +181,7 @@ fn compare_arrays(
             }
             path.truncate(len);
         }
-        let xs: Vec<BodyId> = x.iter().filter_map(id_of).collect();
+        let xs: BTreeSet<BodyId> = x.iter().filter_map(id_of).collect();
         return y
             .iter()
             .find(|v| id_of(v).is_some_and(|i| !xs.contains(&i)))
@@ -239,14 +241,6 @@ fn first_in_message(topic: &str, a: &LogMessage, b: &LogMessage, tol: f64) -> Op
     })
 }
 
-fn by_topic(log: &[LogMessage]) -> BTreeMap<&str, Vec<&LogMessage>> {
-    let mut map: BTreeMap<&str, Vec<&LogMessage>> = BTreeMap::new();
-    for m in log {
-        map.entry(m.topic.as_str()).or_default().push(m);
-    }
-    map
-}
-
 fn rank(topic: &str) -> usize {
     TOPIC_ORDER
         .iter()
@@ -254,47 +248,155 @@ fn rank(topic: &str) -> usize {
         .unwrap_or(TOPIC_ORDER.len())
 }
 
-/// Compares two decoded logs.
-pub fn diff_logs(a: &[LogMessage], b: &[LogMessage], tol: f64, only: Option<&str>) -> Report {
-    let (ta, tb) = (by_topic(a), by_topic(b));
+/// Why two logs could not be compared: exit code 2.
+#[derive(Debug)]
+pub enum DiffError {
+    /// A log is unreadable, cut short or damaged.
+    Log(LogError),
+    /// A log is an MCAP file, but not one Ricochet wrote.
+    Foreign(String),
+    /// `--topic` names a topic neither log has.
+    UnknownTopic(String),
+}
+
+impl std::fmt::Display for DiffError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            DiffError::Log(e) => write!(f, "{e}"),
+            DiffError::Foreign(s) | DiffError::UnknownTopic(s) => f.write_str(s),
+        }
+    }
+}
+
+impl From<LogError> for DiffError {
+    fn from(e: LogError) -> Self {
+        DiffError::Log(e)
+    }
+}
+
+/// Opens a log and checks that Ricochet wrote it: its header names `ricochet` as the library
+/// and every channel is JSON (what the comparison decodes).
+fn open(path: &Path) -> Result<LogFile, DiffError> {
+    let log = LogFile::open(path)?;
+    let name = path.display();
+    let library = log.library();
+    if !library.starts_with("ricochet ") {
+        return Err(DiffError::Foreign(format!(
+            "{name}: not a Ricochet log: it was written by {library:?}, not by `ricochet run`"
+        )));
+    }
+    if let Some(c) = log
+        .channels()
+        .find(|c| c.message_encoding != "json" || c.schema_encoding != "jsonschema")
+    {
+        return Err(DiffError::Foreign(format!(
+            "{name}: not a Ricochet log: channel {} has {:?} messages and a {:?} schema, \
+             where Ricochet writes json with a jsonschema",
+            c.topic, c.message_encoding, c.schema_encoding
+        )));
+    }
+    Ok(log)
+}
+
+/// Compares one topic of two logs, message by message by position: reads both logs' messages
+/// on `topic` in log-time order, one at a time, keeping only the count and the first
+/// divergence.
+fn diff_topic(
+    a: &LogFile,
+    b: &LogFile,
+    topic: &str,
+    tol: f64,
+) -> Result<(TopicCount, Option<Divergence>), LogError> {
+    let (mut ma, mut mb) = (a.topic_messages(topic)?, b.topic_messages(topic)?);
+    let mut count = TopicCount::default();
+    let mut first = None;
+    loop {
+        match (ma.next().transpose()?, mb.next().transpose()?) {
+            (Some(x), Some(y)) => {
+                count.messages_a += 1;
+                count.messages_b += 1;
+                if let Some(d) = first_in_message(topic, &x, &y, tol) {
+                    count.differing += 1;
+                    first.get_or_insert(d);
+                }
+            }
+            (None, None) => break,
+            // One log has more messages on the topic: the first extra one is the divergence
+            // when nothing differed before it, then the rest are counted (and checked).
+            (extra, rest) => {
+                let (mine, other, in_a) = match (extra, rest) {
+                    (Some(m), None) => (m, &mut ma, true),
+                    (None, Some(m)) => (m, &mut mb, false),
+                    _ => unreachable!("both None and both Some are matched above"),
+                };
+                let mut n = 1;
+                while other.next().transpose()?.is_some() {
+                    n += 1;
+                }
+                if in_a {
+                    count.messages_a += n;
+                } else {
+                    count.messages_b += n;
+                }
+                count.differing += n;
+                first.get_or_insert(Divergence {
+                    topic: topic.to_owned(),
+                    time_ns: mine.log_time,
+                    frame: mine.data.get("frame").and_then(Value::as_u64),
+                    body: None,
+                    field: "message count".to_owned(),
+                    a: count.messages_a.to_string(),
+                    b: count.messages_b.to_string(),
+                });
+                break;
+            }
+        }
+    }
+    Ok((count, first))
+}
+
+/// Compares two logs, streaming them topic by topic: memory does not grow with their length.
+pub fn diff_files(
+    a: &LogFile,
+    b: &LogFile,
+    tol: f64,
+    only: Option<&str>,
+) -> Result<Report, DiffError> {
+    let present: BTreeSet<&str> = a
+        .channels()
+        .chain(b.channels())
+        .map(|c| c.topic.as_str())
+        .collect();
+    if let Some(t) = only
+        && !present.contains(t)
+    {
+        let list: Vec<&str> = present.iter().copied().collect();
+        let slashed = format!("/{t}");
+        let hint = if present.contains(slashed.as_str()) {
+            format!(" (did you mean {slashed}?)")
+        } else {
+            String::new()
+        };
+        return Err(DiffError::UnknownTopic(format!(
+            "--topic {}: neither log has that topic{hint}; they have: {}",
+            out::escape_controls(t),
+            list.join(", ")
+        )));
+    }
+    // The topics with messages in either log, as a table of counts lists them.
+    let with_messages: BTreeSet<&str> = a
+        .channels()
+        .chain(b.channels())
+        .filter(|c| c.messages > 0 || only == Some(c.topic.as_str()))
+        .map(|c| c.topic.as_str())
+        .collect();
     let mut topics = BTreeMap::new();
     let mut first: Option<Divergence> = None;
-    let names: std::collections::BTreeSet<&str> = ta.keys().chain(tb.keys()).copied().collect();
-    for topic in names {
+    for topic in with_messages {
         if only.is_some_and(|t| t != topic) {
             continue;
         }
-        let (ma, mb) = (
-            ta.get(topic).cloned().unwrap_or_default(),
-            tb.get(topic).cloned().unwrap_or_default(),
-        );
-        let mut count = TopicCount {
-            messages_a: ma.len(),
-            messages_b: mb.len(),
-            differing: ma.len().abs_diff(mb.len()),
-        };
-        let mut topic_first = None;
-        for (x, y) in ma.iter().zip(&mb) {
-            if let Some(d) = first_in_message(topic, x, y, tol) {
-                count.differing += 1;
-                if topic_first.is_none() {
-                    topic_first = Some(d);
-                }
-            }
-        }
-        if topic_first.is_none() && ma.len() != mb.len() {
-            let n = ma.len().min(mb.len());
-            let extra = ma.get(n).or(mb.get(n));
-            topic_first = extra.map(|m| Divergence {
-                topic: topic.to_owned(),
-                time_ns: m.log_time,
-                frame: m.data.get("frame").and_then(Value::as_u64),
-                body: None,
-                field: "message count".to_owned(),
-                a: ma.len().to_string(),
-                b: mb.len().to_string(),
-            });
-        }
+        let (count, topic_first) = diff_topic(a, b, topic, tol)?;
         if let Some(d) = topic_first {
             let earlier = first
                 .as_ref()
@@ -305,15 +407,16 @@ pub fn diff_logs(a: &[LogMessage], b: &[LogMessage], tol: f64, only: Option<&str
         }
         topics.insert(topic.to_owned(), count);
     }
-    Report {
+    Ok(Report {
         equal: first.is_none(),
         tolerance: tol,
         first,
         topics,
-    }
+    })
 }
 
-/// `ricochet diff`.
+/// `ricochet diff`: exit code 0 equal, 1 they differ, 2 a log can't be compared (unreadable,
+/// cut short, damaged, not a Ricochet log, an unknown `--topic`, a bad `--tolerance`).
 pub fn run(
     a: &Path,
     b: &Path,
@@ -321,31 +424,38 @@ pub fn run(
     topic: Option<&str>,
     json: bool,
 ) -> anyhow::Result<ExitCode> {
-    let read = |p: &Path| {
-        read_log_file(p).map_err(|e| {
-            eprintln!("error: {}: {e}", p.display());
-            ExitCode::from(2)
-        })
-    };
-    let (la, lb) = match (read(a), read(b)) {
-        (Ok(x), Ok(y)) => (x, y),
-        (Err(code), _) | (_, Err(code)) => return Ok(code),
-    };
     if !(tolerance.is_finite() && tolerance >= 0.0) {
-        eprintln!("error: --tolerance must be a finite number >= 0, got {tolerance}");
+        out::error(&format!(
+            "error: --tolerance must be a finite number >= 0, got {tolerance}"
+        ));
         return Ok(ExitCode::from(2));
     }
-    let report = diff_logs(&la, &lb, tolerance, topic);
-    if json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
-    } else {
-        print!("{}", render(&report, a, b));
-    }
-    Ok(if report.equal {
+    let report = open(a)
+        .and_then(|la| open(b).map(|lb| (la, lb)))
+        .and_then(|(la, lb)| diff_files(&la, &lb, tolerance, topic));
+    let report = match report {
+        Ok(r) => r,
+        Err(e) => {
+            out::error(&format!("error: {e}"));
+            return Ok(ExitCode::from(2));
+        }
+    };
+    let code = if report.equal {
         ExitCode::SUCCESS
     } else {
         ExitCode::from(1)
-    })
+    };
+    let text = if json {
+        serde_json::to_string_pretty(&report)? + "\n"
+    } else {
+        render(&report, a, b)
+    };
+    match out::print(&text) {
+        // The reader went away (`| head`): the verdict is still the exit code.
+        Err(e) if e.is_closed() => Ok(code),
+        Err(e) => Err(e.into()),
+        Ok(()) => Ok(code),
+    }
 }
 
 /// The human-readable report.

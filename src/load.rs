@@ -18,13 +18,13 @@ pub fn load(path: Option<&Path>) -> Result<Scenario, ExitCode> {
         Some(p) => match std::fs::read_to_string(p) {
             Ok(t) => (t, p.display().to_string()),
             Err(e) => {
-                eprintln!("error: {}: {e}", p.display());
+                crate::out::error(&format!("error: {}: {e}", p.display()));
                 return Err(ExitCode::from(2));
             }
         },
     };
     load_scenario(&text, &name).map_err(|e| {
-        eprintln!("error: {e}");
+        crate::out::error(&format!("error: {e}"));
         ExitCode::from(2)
     })
 }

@@ -1,8 +1,11 @@
 //! `ricochet`: the command line of the Ricochet 2D game-physics simulation server.
 //!
 //! **Owns:** argument parsing, reading files and stdin, printing results, and exit codes
-//! (0 success, 1 the run failed, 2 bad input). **Never:** holds physics or geometry logic of
-//! its own: every answer comes from the library crates.
+//! (0 success, 1 the run failed, 2 bad input). Every write to stdout and stderr goes through
+//! `out.rs` and is checked: a closed pipe ends a command quietly with its own exit code, any
+//! other failed write is exit 1 (2 for `diff`) with a message if stderr still works.
+//! **Never:** holds physics or geometry logic of its own: every answer comes from the library
+//! crates.
 
 mod accuracy;
 mod bench;
@@ -11,6 +14,7 @@ mod collide;
 mod diff;
 mod events;
 mod load;
+mod out;
 mod record;
 mod run;
 mod scene;
@@ -45,9 +49,12 @@ enum Command {
     /// With no scenario, runs the built-in Asteroids demo (scenarios/asteroids.toml, embedded)
     /// into asteroids.mcap. The log has five channels: /scene (foxglove.SceneUpdate, for the
     /// 3D panel), /bodies, /contacts, /stats (for the Plot panel) and /events (foxglove.Log).
-    /// Ctrl-C stops the run and still leaves a complete, indexed log.
+    /// Ctrl-C (SIGINT), SIGTERM and SIGHUP stop the run and still leave a complete, indexed
+    /// log. The log is written to a hidden temporary file next to OUT.mcap and renamed onto
+    /// it when complete, so an existing OUT.mcap is replaced whole or not at all.
     ///
-    /// Exit code: 0 success, 1 the run failed, 2 bad input (scenario or output path).
+    /// Exit code: 0 success, 1 the run failed, 2 bad input (scenario or output path; the
+    /// output can't be the scenario itself, `-`, or a device such as /dev/null).
     ///
     /// Example: ricochet run scenarios/platformer.toml -o platformer.mcap --frames 1200
     Run {
@@ -86,8 +93,10 @@ enum Command {
     ///
     /// Messages are decoded and compared field by field, so compression and chunking don't
     /// matter. Prints the first divergent frame, topic, body and field with both values, then
-    /// how many messages differ per topic. Exit code: 0 equal (within --tolerance), 1 they
-    /// differ, 2 a file is unreadable or truncated.
+    /// how many messages differ per topic. Both logs are streamed, so memory does not grow
+    /// with their length. Exit code: 0 equal (within --tolerance), 1 they differ, 2 they
+    /// can't be compared: a file is unreadable, truncated or damaged (chunk, data or summary
+    /// CRC), not a Ricochet log, or --topic names a topic neither log has.
     ///
     /// Example: ricochet diff recordings/asteroids.mcap asteroids.mcap --topic /bodies
     Diff {
@@ -98,7 +107,8 @@ enum Command {
         /// Numbers within this absolute difference count as equal (default: exact).
         #[arg(long, default_value_t = 0.0, value_name = "X")]
         tolerance: f64,
-        /// Compare only this topic (/bodies, /contacts, /stats, /events, /scene).
+        /// Compare only this topic (/bodies, /contacts, /stats, /events, /scene); one that
+        /// neither log has is an error (exit code 2) listing those they have.
         #[arg(long, value_name = "T")]
         topic: Option<String>,
         /// Print the report as JSON.
@@ -158,8 +168,8 @@ enum Command {
     ///
     /// Prints {"id", "overlap", "depth", "normal", "point"} per pair. depth > 0 is the
     /// penetration; depth <= 0 is minus the distance. The normal points from a to b: moving
-    /// b by depth * normal separates the pair. Bad input is reported by case id and field,
-    /// with exit code 2, and nothing is printed to stdout.
+    /// b by depth * normal separates the pair. Bad input, an unknown key included, is
+    /// reported by case id and field, with exit code 2, and nothing is printed to stdout.
     ///
     /// Example: ricochet collide tests/data/collision-cases.json | head -3
     Collide {
@@ -176,6 +186,13 @@ fn main() -> ExitCode {
         frames: None,
         validate: false,
     });
+    // An error that ends a command is exit code 1 ("the run failed"), except for `diff`, whose
+    // 1 means "the logs differ": there it is 2, like an unreadable file.
+    let failed = if matches!(command, Command::Diff { .. }) {
+        2
+    } else {
+        1
+    };
     let result = match command {
         Command::Collide { file } => collide::run(&file),
         Command::Run {
@@ -202,9 +219,16 @@ fn main() -> ExitCode {
     };
     match result {
         Ok(code) => code,
+        // The reader of our output went away (`| head`): nothing more to say.
+        Err(e)
+            if e.downcast_ref::<out::WriteError>()
+                .is_some_and(out::WriteError::is_closed) =>
+        {
+            ExitCode::SUCCESS
+        }
         Err(e) => {
-            eprintln!("error: {e:#}");
-            ExitCode::from(1)
+            out::error(&format!("error: {e:#}"));
+            ExitCode::from(failed)
         }
     }
 }

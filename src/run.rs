@@ -1,4 +1,4 @@
-//! `ricochet run`: a scenario stepped to the end (or to Ctrl-C) and recorded.
+//! `ricochet run`: a scenario stepped to the end (or to Ctrl-C, SIGTERM or SIGHUP) and recorded.
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -11,6 +11,7 @@ use anyhow::Context;
 use ricochet_sim::Simulation;
 
 use crate::load::{DEFAULT_NAME, load};
+use crate::out;
 use crate::record::Recorder;
 
 /// Runs of at least this many frames get a progress bar (on a terminal only).
@@ -32,21 +33,42 @@ pub fn run(
         .file_stem()
         .map_or_else(|| "run".to_owned(), |s| s.to_string_lossy().into_owned());
     let output = output.unwrap_or_else(|| PathBuf::from(format!("{stem}.mcap")));
-    let frames = frames.unwrap_or(scenario.frames);
-    // Created before the first step: an unwritable path fails now, not after the run.
-    let mut recorder = match Recorder::create(&output, scenario.world.dt) {
-        Ok(r) => r,
-        Err(e) => {
-            eprintln!("error: cannot write the log: {e}");
-            return Ok(ExitCode::from(2));
-        }
-    };
+    if output == Path::new("-") {
+        out::error(
+            "error: -o -: a log can't be written to standard output (an MCAP log is indexed \
+             at the end, in a file); give a file name",
+        );
+        return Ok(ExitCode::from(2));
+    }
+    if let Some(input) = path
+        && same_file(input, &output)
+    {
+        out::error(&format!(
+            "error: -o {}: that is the scenario being run; choose another output file",
+            output.display()
+        ));
+        return Ok(ExitCode::from(2));
+    }
     let interrupted = Arc::new(AtomicBool::new(false));
     {
         let flag = Arc::clone(&interrupted);
-        // If a handler can't be installed (one already is), Ctrl-C just ends the process.
+        // SIGINT, SIGTERM and SIGHUP (ctrlc's `termination` feature) all stop the run at the
+        // next frame and finish the log. Installed before the log is created, so that no such
+        // signal leaves its temporary file behind. If a handler can't be installed (one
+        // already is), the signal just ends the process, and an old output file stays whole.
         let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
     }
+    let frames = frames.unwrap_or(scenario.frames);
+    // Created before the first step: an unwritable path fails now, not after the run. The
+    // log goes to a temporary file renamed onto `output` when it is complete, so an existing
+    // file there stays whole until then, whatever stops the run.
+    let mut recorder = match Recorder::create(&output, scenario.world.dt) {
+        Ok(r) => r,
+        Err(e) => {
+            out::error(&format!("error: cannot write the log: {e}"));
+            return Ok(ExitCode::from(2));
+        }
+    };
     let progress = (std::io::stderr().is_terminal() && frames >= PROGRESS_FROM).then(|| {
         let bar = indicatif::ProgressBar::new(frames + 1);
         bar.set_style(
@@ -59,10 +81,10 @@ pub fn run(
     });
     if validate && (scenario.world.active_region.is_some() || scenario.world.sleep_after.is_some())
     {
-        eprintln!(
+        out::note(
             "warning: frozen and sleeping bodies are not tested, so /validation may list \
-             their pairs as differences; `ricochet validate` turns both off"
-        );
+             their pairs as differences; `ricochet validate` turns both off",
+        )?;
     }
     let mut validation = if validate {
         recorder
@@ -112,18 +134,36 @@ pub fn run(
     } else {
         ""
     };
-    eprintln!(
+    out::note(&format!(
         "{}: {stepped} frames, {} bodies at the end ({peak_bodies} at most), {contacts} contacts, {:.3} s wall, {:.0} frames/s -> {}{note}",
-        scenario.name,
+        out::escape_controls(&scenario.name),
         sim.world().len(),
         wall,
         ran as f64 / wall.max(1e-9),
         output.display()
-    );
+    ))?;
     if let Some(v) = validation
-        && !v.finish(&scenario, stepped)
+        && !v.finish(&scenario, stepped)?
     {
         return Ok(ExitCode::from(1));
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Whether `output` is the file `input` (the same path, a link to it, another name of it).
+/// An output that does not exist yet is not.
+fn same_file(input: &Path, output: &Path) -> bool {
+    match (input.canonicalize(), output.canonicalize()) {
+        (Ok(a), Ok(b)) if a == b => return true,
+        (Ok(_), Ok(_)) => {}
+        _ => return false,
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        if let (Ok(a), Ok(b)) = (std::fs::metadata(input), std::fs::metadata(output)) {
+            return a.dev() == b.dev() && a.ino() == b.ino();
+        }
+    }
+    false
 }

@@ -12,6 +12,8 @@ use std::process::ExitCode;
 use ricochet_oracle::{FrameReport, Referee, Tolerances, compare_motion, summary_table};
 use ricochet_sim::{FrameOutput, Scenario, Simulation};
 
+use crate::out::WriteError;
+
 /// Test-only hook: when this environment variable is set, every contact's depth is scaled by
 /// 1.01 before the referee sees it, as a broken narrow phase would report it. The tests use
 /// it to prove that `validate` fails on a wrong narrow phase.
@@ -51,11 +53,15 @@ impl Validation {
         r
     }
 
-    /// Adds free flight over `frames`, prints the table, and returns whether it passed.
-    pub fn finish(mut self, scenario: &Scenario, frames: u64) -> bool {
+    /// Adds free flight over `frames`, prints the table, and returns whether it passed. A
+    /// closed pipe on stdout is not an error (the verdict is still the exit code); another
+    /// failed write is.
+    pub fn finish(mut self, scenario: &Scenario, frames: u64) -> Result<bool, WriteError> {
         self.summary.motion = Some(compare_motion(scenario, frames));
-        print!("{}", summary_table(&self.summary));
-        self.summary.passed()
+        match crate::out::print(&summary_table(&self.summary)) {
+            Err(e) if !e.is_closed() => Err(e),
+            _ => Ok(self.summary.passed()),
+        }
     }
 }
 
@@ -67,10 +73,10 @@ pub fn run(path: &Path, frames: Option<u64>) -> anyhow::Result<ExitCode> {
     };
     if scenario.world.active_region.is_some() || scenario.world.sleep_after.is_some() {
         // Frozen and sleeping bodies are not tested on purpose; rapier tests every pair.
-        eprintln!(
+        crate::out::note(
             "validate: active_region and sleep_after are turned off for the referee, which \
-             compares every pair (they are tested to change nothing they do not freeze)"
-        );
+             compares every pair (they are tested to change nothing they do not freeze)",
+        )?;
         scenario.world.active_region = None;
         scenario.world.sleep_after = None;
     }
@@ -82,7 +88,7 @@ pub fn run(path: &Path, frames: Option<u64>) -> anyhow::Result<ExitCode> {
         let out = sim.step();
         v.frame(&sim, &out);
     }
-    Ok(if v.finish(&scenario, frames) {
+    Ok(if v.finish(&scenario, frames)? {
         ExitCode::SUCCESS
     } else {
         ExitCode::from(1)

@@ -120,3 +120,42 @@ fn collide_reports_a_missing_file_with_exit_2() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("no/such/file.json"));
 }
+
+#[test]
+fn collide_rejects_unknown_keys_by_case_and_field() {
+    // A stray key at the top of a case, a misspelt `angle` in a body, a misspelt `center` in
+    // a shape: each is named by case id and field, never silently ignored.
+    let err = rejected(
+        r#"{"id": 5, "tolerance": 1e-3, "a": {"shape": {"kind": "circle", "radius": 1}, "position": [0, 0]}, "b": {"shape": {"kind": "circle", "radius": 1}, "position": [3, 4]}}
+{"id": "six", "a": {"shape": {"kind": "circle", "radius": 1}, "position": [0, 0], "angel": 0.5}, "b": {"shape": {"kind": "circle", "radius": 1}, "position": [3, 4]}}
+{"id": 7, "a": {"shape": {"kind": "circle", "radius": 1}, "position": [0, 0]}, "b": {"shape": {"kind": "circle", "radius": 1, "centre": [1, 0]}, "position": [3, 4]}}"#,
+    );
+    assert!(
+        err.contains("case 5 (line 1): tolerance: unknown field `tolerance`"),
+        "{err}"
+    );
+    assert!(
+        err.contains("case \"six\" (line 2): a.angel: unknown field `angel`"),
+        "{err}"
+    );
+    // Inside a shape (tagged by `kind`) the path stops at the shape; the message names the key.
+    assert!(
+        err.contains("case 7 (line 3): b.shape: unknown field `centre`"),
+        "{err}"
+    );
+    assert!(err.contains("3 bad case(s)"), "{err}");
+}
+
+#[test]
+fn collide_still_accepts_the_shared_files_extra_keys() {
+    // `pair`, `scenario` and `truth` come with the shared ground-truth cases.
+    let out = ricochet(
+        &["collide", "-"],
+        br#"{"id": 1, "pair": "circle-circle", "scenario": "random", "truth": {"depth": 1}, "a": {"id": 0, "shape": {"kind": "circle", "radius": 1}, "position": [0, 0]}, "b": {"shape": {"kind": "circle", "radius": 1}, "position": [1, 0]}}"#,
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}

@@ -89,3 +89,33 @@ fn scenario_corpus_gives_errors_or_results() {
 fn collide_corpus_gives_errors_or_results() {
     replay("collide", checks::collide);
 }
+
+/// Like [`replay`], for a target that reads bytes (logs); its inputs are hand-made seeds and
+/// whatever the fuzzer kept, if it ran.
+fn replay_bytes(target: &str, check: fn(&[u8])) {
+    let (files, _) = inputs(target);
+    assert!(
+        !files.is_empty(),
+        "fuzz/seeds/{target}/ holds the committed seeds: run it from a checkout"
+    );
+    let mut failures = Vec::new();
+    for path in &files {
+        let bytes = std::fs::read(path).expect("a fuzz input can be read");
+        if let Err(payload) = std::panic::catch_unwind(|| check(&bytes)) {
+            let name = path.strip_prefix(root()).unwrap_or(path);
+            failures.push(format!("{}: {}", name.display(), message(&*payload)));
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "{} of {} fuzz inputs panicked:\n{}",
+        failures.len(),
+        files.len(),
+        failures.join("\n")
+    );
+}
+
+#[test]
+fn log_seeds_give_errors_or_messages() {
+    replay_bytes("log", checks::log);
+}

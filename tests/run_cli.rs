@@ -330,11 +330,17 @@ fn ctrl_c_still_leaves_a_complete_indexed_log() {
         .stderr(std::process::Stdio::piped())
         .spawn()
         .unwrap();
-    // Wait until frames are being written, then interrupt as a terminal's Ctrl-C would.
+    // Wait until frames are being written (to the temporary file, renamed onto `out` when
+    // the log is complete), then interrupt as a terminal's Ctrl-C would.
     for _ in 0..200 {
-        if std::fs::metadata(&out).is_ok_and(|m| m.len() > 200_000) {
+        let written = std::fs::read_dir(dir.path())
+            .unwrap()
+            .filter_map(|e| e.ok()?.metadata().ok())
+            .any(|m| m.len() > 200_000);
+        if written {
             break;
         }
+        assert!(!out.exists(), "the log appears only when it is complete");
         std::thread::sleep(std::time::Duration::from_millis(50));
     }
     let kill = std::process::Command::new("kill")

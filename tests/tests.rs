@@ -8,6 +8,7 @@ mod collide_cli;
 mod collision_cases;
 mod fuzz_corpus;
 mod golden;
+mod hostile;
 mod large_scenario;
 mod run_cli;
 mod stress;

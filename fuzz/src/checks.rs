@@ -3,9 +3,11 @@
 //! This file is compiled twice: by the fuzz crate (`fuzz/`, for `cargo fuzz`), and by the
 //! integration tests (`tests/fuzz_corpus.rs` includes it with `#[path]`), which replay the
 //! committed corpus through the same functions. So it may use nothing but `std`,
-//! `ricochet_geom` and `ricochet_sim`, and each function panics only when the library is wrong.
+//! `ricochet_geom`, `ricochet_sim` and `ricochet_log`, and each function panics only when the
+//! library is wrong.
 
 use ricochet_geom::{Case, Primitive, contact, overlaps, parse_case_file};
+use ricochet_log::{LogError, LogFile, read_log};
 use ricochet_sim::{Scenario, Simulation, load_scenario};
 
 /// The file name passed to the scenario loader (it only appears in error messages).
@@ -85,6 +87,10 @@ pub fn collide(text: &str) {
             );
             for e in &errors {
                 let _ = e.to_string();
+                // An unknown key is named by its path (`tolerance`, `a.angel`, `b.shape`).
+                if e.problem.starts_with("unknown field") {
+                    assert!(!e.field.is_empty(), "an unknown key names its field: {e}");
+                }
             }
         }
     }
@@ -155,4 +161,34 @@ fn moderate_scale(case: &Case) -> Option<f64> {
     let moderate = |x: &f64| *x == 0.0 || (TINY..=HUGE).contains(&x.abs());
     (numbers.iter().all(moderate) && angles.iter().all(moderate))
         .then(|| numbers.iter().fold(0.0, |m: f64, x| m.max(x.abs())))
+}
+
+/// Reads `bytes` as a log, as `ricochet diff` does: from memory ([`read_log`]) and streamed
+/// from a file ([`LogFile`], checking the summary's CRC on open), which must give messages or
+/// a truncated or corrupt error, never a panic; when both read it, they read the same messages.
+pub fn log(bytes: &[u8]) {
+    let in_memory = read_log(bytes);
+    if let Err(e) = &in_memory {
+        assert!(
+            matches!(e, LogError::Truncated { .. } | LogError::Corrupt { .. }),
+            "{e:?}"
+        );
+    }
+    let path = std::env::temp_dir().join(format!("ricochet-fuzz-log-{}.mcap", std::process::id()));
+    if std::fs::write(&path, bytes).is_err() {
+        return;
+    }
+    let streamed = LogFile::open(&path).and_then(|log| {
+        let _ = (log.library(), log.channels().count(), log.message_count());
+        log.messages()?.collect::<Result<Vec<_>, _>>()
+    });
+    let _ = std::fs::remove_file(&path);
+    match (&in_memory, &streamed) {
+        (Ok(a), Ok(b)) => assert_eq!(a, b, "the two readers read different messages"),
+        (_, Err(e)) => assert!(
+            matches!(e, LogError::Truncated { .. } | LogError::Corrupt { .. }),
+            "{e:?}"
+        ),
+        (Err(_), Ok(_)) => {}
+    }
 }

@@ -71,10 +71,20 @@ struct BodyDef {
     angle: f64,
 }
 
-// Case files carry extra fields (`pair`, `scenario`, `truth`): unknown keys are allowed here,
-// never inside a body or a shape.
+// Case files carry extra fields (`pair`, `scenario`, `truth`, from the shared ground-truth
+// set): those are allowed and ignored; any other key is an error (a misspelt `angle` or a
+// stray `tolerance` must not be silently dropped), here as inside a body or a shape.
 #[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
 struct CaseDef {
+    #[serde(default, rename = "id")]
+    _id: Option<serde::de::IgnoredAny>,
+    #[serde(default, rename = "pair")]
+    _pair: Option<serde::de::IgnoredAny>,
+    #[serde(default, rename = "scenario")]
+    _scenario: Option<serde::de::IgnoredAny>,
+    #[serde(default, rename = "truth")]
+    _truth: Option<serde::de::IgnoredAny>,
     a: BodyDef,
     b: BodyDef,
 }
@@ -116,8 +126,13 @@ fn case(value: serde_json::Value, line: Option<usize>) -> Result<Case, CaseError
         field,
         problem,
     };
+    // An unknown key's path ends with the key itself (`a.angel`); an empty key at the top
+    // has an empty path, written `""`.
     let def: CaseDef = serde_path_to_error::deserialize(&value).map_err(|e| {
-        let field = e.path().to_string();
+        let field = match e.path().to_string() {
+            p if p.is_empty() => "\"\"".to_owned(),
+            p => p,
+        };
         fail(field, e.into_inner().to_string())
     })?;
     let Some(id) = id.clone() else {

@@ -1,8 +1,10 @@
 //! MCAP logs of a Ricochet simulation run, ready for Foxglove.
 //!
 //! This crate owns:
-//! - writing MCAP logs ([`LogWriter`]) and reading them back ([`read_log`]),
-//!   refusing files that are cut short or damaged;
+//! - writing MCAP logs ([`LogWriter`]), into a temporary file renamed into
+//!   place when complete, and reading them back ([`read_log`], or streamed
+//!   message by message from a file with [`LogFile`]), refusing files that are
+//!   cut short or damaged;
 //! - the Foxglove message types ([`foxglove`]), serialized as JSON exactly as
 //!   the Foxglove schemas require;
 //! - the vendored Foxglove JSON Schemas (`schemas/`, from
@@ -24,5 +26,5 @@ mod reader;
 mod writer;
 
 pub use error::LogError;
-pub use reader::{LogMessage, read_log, read_log_file};
+pub use reader::{ChannelInfo, LogFile, LogMessage, Messages, read_log, read_log_file};
 pub use writer::{ChannelId, LogWriter};

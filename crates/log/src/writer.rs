@@ -2,7 +2,7 @@
 
 use std::collections::BTreeMap;
 use std::fs::File;
-use std::io::BufWriter;
+use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use mcap::records::MessageHeader;
@@ -26,28 +26,86 @@ pub struct ChannelId(u16);
 /// thread (multithreaded zstd output differs from single-threaded output), and
 /// the summary lists schemas and channels in id order.
 ///
-/// Call [`finish`](Self::finish) to write the summary and index, also after an
-/// interrupted run: a log finished early is complete and indexed, it just
-/// holds fewer messages. A writer dropped without `finish` still tries to
-/// finish the file, but any error is lost.
+/// The log is written to a temporary file next to `path` (`.NAME.XXXXXX.tmp`,
+/// in the same directory) and renamed onto `path` only by
+/// [`finish`](Self::finish), once it is complete: until then an existing file
+/// at `path` is untouched, and an interrupted, killed or failed write never
+/// leaves a truncated log there. Call `finish` also after an interrupted run:
+/// a log finished early is complete and indexed, it just holds fewer messages.
+/// A writer dropped without `finish` removes its temporary file (a process
+/// killed outright, by `SIGKILL` for example, leaves it behind). A symbolic
+/// link at `path` is followed (the file it names is replaced); an existing
+/// `path` that is not a regular file (`/dev/null`, a FIFO) is refused.
 pub struct LogWriter {
     path: PathBuf,
     mcap: mcap::Writer<BufWriter<File>>,
+    /// The temporary file being written; deleted when dropped unless renamed.
+    temp: tempfile::TempPath,
+    /// Where the temporary file is renamed to: `path`, or the file it links to.
+    target: PathBuf,
     /// Next sequence number of each channel.
     sequences: BTreeMap<ChannelId, u32>,
 }
 
 impl LogWriter {
-    /// Creates (or truncates) the log file at `path` and writes the MCAP
-    /// header, naming `library` (e.g. `"ricochet 0.1.0"`) as the writer.
+    /// Starts the log that [`finish`](Self::finish) will put at `path`, and
+    /// writes the MCAP header, naming `library` (e.g. `"ricochet 0.1.0"`) as
+    /// the writer.
     ///
-    /// The file is created now, so an unwritable path fails before any
-    /// simulation runs.
+    /// The temporary file is created now, in `path`'s directory, so an
+    /// unwritable directory fails before any simulation runs; so does a `path`
+    /// that is a directory. A file already at `path` is left as it is until
+    /// `finish` replaces it.
     pub fn create(path: &Path, library: &str) -> Result<Self, LogError> {
-        let file = File::create(path).map_err(|source| LogError::Create {
+        let create_error = |source| LogError::Create {
             path: path.to_path_buf(),
             source,
-        })?;
+        };
+        if path.is_dir() {
+            return Err(create_error(std::io::Error::new(
+                std::io::ErrorKind::IsADirectory,
+                "is a directory",
+            )));
+        }
+        // An existing output that is not a regular file (`/dev/null`, a FIFO, a terminal)
+        // can't take a renamed file (it would replace the device), nor an MCAP log written
+        // in place (the writer seeks back to finish it).
+        if std::fs::metadata(path).is_ok_and(|m| !m.is_file()) {
+            return Err(create_error(std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                "is not a regular file; a log is written to a file",
+            )));
+        }
+        // An existing symbolic link is followed: the log replaces the file it points to.
+        let target = match std::fs::symlink_metadata(path) {
+            Ok(m) if m.file_type().is_symlink() => path.canonicalize().map_err(create_error)?,
+            _ => path.to_path_buf(),
+        };
+        let name = target
+            .file_name()
+            .ok_or_else(|| {
+                create_error(std::io::Error::new(
+                    std::io::ErrorKind::InvalidInput,
+                    "names no file",
+                ))
+            })?
+            .to_string_lossy()
+            .into_owned();
+        let dir = match target.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => Path::new("."),
+        };
+        let prefix = format!(".{name}.");
+        let mut builder = tempfile::Builder::new();
+        builder.prefix(&prefix).suffix(".tmp");
+        #[cfg(unix)]
+        {
+            // Read and write for all, less the umask: what `File::create` gives.
+            use std::os::unix::fs::PermissionsExt;
+            builder.permissions(std::fs::Permissions::from_mode(0o666));
+        }
+        let (file, temp) = builder.tempfile_in(dir).map_err(create_error)?.into_parts();
+        let path = path.to_path_buf();
         let options = mcap::WriteOptions::new()
             .library(library)
             .profile("")
@@ -59,12 +117,14 @@ impl LogWriter {
         let mcap = options
             .create(BufWriter::new(file))
             .map_err(|source| LogError::Write {
-                path: path.to_path_buf(),
+                path: path.clone(),
                 source,
             })?;
         Ok(Self {
-            path: path.to_path_buf(),
+            path,
             mcap,
+            temp,
+            target,
             sequences: BTreeMap::new(),
         })
     }
@@ -131,19 +191,33 @@ impl LogWriter {
     }
 
     /// Ends the last chunk, writes the summary (schemas, channels,
-    /// statistics, chunk indexes), the footer and the closing magic, and
-    /// flushes the file.
+    /// statistics, chunk indexes), the footer and the closing magic, flushes
+    /// and syncs the file, and renames it onto the path given to
+    /// [`create`](Self::create), replacing any file there.
     pub fn finish(mut self) -> Result<(), LogError> {
         self.mcap
             .finish()
             .map_err(|source| self.write_error(source))?;
-        let Self { path, mcap, .. } = self;
-        mcap.into_inner()
+        let Self {
+            path,
+            mcap,
+            temp,
+            target,
+            ..
+        } = self;
+        let io_error = |path: &Path, error: std::io::Error| LogError::Write {
+            path: path.to_path_buf(),
+            source: mcap::McapError::Io(error),
+        };
+        let mut file = mcap
             .into_inner()
-            .map_err(|error| LogError::Write {
-                path,
-                source: mcap::McapError::Io(error.into_error()),
-            })?;
+            .into_inner()
+            .map_err(|error| io_error(&path, error.into_error()))?;
+        file.flush().map_err(|e| io_error(&path, e))?;
+        file.sync_all().map_err(|e| io_error(&path, e))?;
+        drop(file);
+        temp.persist(&target)
+            .map_err(|e| io_error(&path, e.error))?;
         Ok(())
     }
 

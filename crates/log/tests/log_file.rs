@@ -6,7 +6,7 @@ mod common;
 use std::path::Path;
 
 use common::{STEP_NS, STEPS, deletion_scene, full_scene, log_line, write_sample_log};
-use ricochet_log::{LogError, LogWriter, read_log, read_log_file};
+use ricochet_log::{LogError, LogFile, LogWriter, read_log, read_log_file};
 
 fn sample_bytes(dir: &Path) -> Vec<u8> {
     let path = dir.join("run.mcap");
@@ -160,4 +160,129 @@ fn create_in_missing_directory_is_an_error() {
     }
     let missing = read_log_file(&path).unwrap_err();
     assert!(matches!(missing, LogError::Read { .. }), "{missing:?}");
+}
+
+/// Every byte the summary CRC covers: from the summary's start to the footer's CRC field.
+fn summary_range(bytes: &[u8]) -> std::ops::Range<usize> {
+    let footer = bytes.len() - 8 - 29;
+    let start = u64::from_le_bytes(bytes[footer + 9..footer + 17].try_into().unwrap());
+    start as usize..bytes.len() - 8 - 4
+}
+
+#[test]
+fn damaged_summary_is_reported_corrupt() {
+    // The summary lists the channels, schemas, statistics and chunk indexes: a flipped byte
+    // there once read as a good log (or a different one). Its CRC is checked now.
+    let dir = tempfile::tempdir().unwrap();
+    let bytes = sample_bytes(dir.path());
+    let range = summary_range(&bytes);
+    assert!(range.len() > 100, "{range:?}");
+    let damaged = dir.path().join("damaged.mcap");
+    // About 40 bytes spread over the whole summary, its first and last included.
+    let step = (range.len() / 40).max(1);
+    for i in range.clone().step_by(step).chain([range.end - 1]) {
+        let mut copy = bytes.clone();
+        copy[i] ^= 0x01;
+        assert_refused(&copy, &format!("byte {i} of the summary flipped"));
+        std::fs::write(&damaged, &copy).unwrap();
+        match LogFile::open(&damaged) {
+            Err(LogError::Corrupt { detail }) => {
+                assert!(detail.contains("damaged.mcap"), "{detail}")
+            }
+            other => panic!("byte {i} of the summary flipped: opened as {other:?}"),
+        }
+    }
+}
+
+#[test]
+fn a_log_file_streams_the_messages_read_log_reads() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("run.mcap");
+    write_sample_log(&path);
+    let all = read_log(&std::fs::read(&path).unwrap()).unwrap();
+    let log = LogFile::open(&path).unwrap();
+    assert_eq!(log.library(), "ricochet-log tests");
+    assert_eq!(log.message_count(), all.len() as u64);
+    let streamed: Vec<_> = log.messages().unwrap().map(Result::unwrap).collect();
+    assert_eq!(streamed, all);
+    let topics: Vec<&str> = log.channels().map(|c| c.topic.as_str()).collect();
+    assert_eq!(topics, ["/scene", "/log"]);
+    let scene: Vec<_> = log
+        .topic_messages("/scene")
+        .unwrap()
+        .map(Result::unwrap)
+        .collect();
+    let expected: Vec<_> = all
+        .iter()
+        .filter(|m| m.topic == "/scene")
+        .cloned()
+        .collect();
+    assert_eq!(scene, expected);
+    assert_eq!(
+        log.channels().next().unwrap().messages,
+        expected.len() as u64
+    );
+}
+
+#[test]
+fn a_log_file_refuses_prefixes_and_damaged_chunks() {
+    let dir = tempfile::tempdir().unwrap();
+    let bytes = sample_bytes(dir.path());
+    let path = dir.path().join("cut.mcap");
+    let read = |bytes: &[u8]| {
+        std::fs::write(&path, bytes).unwrap();
+        LogFile::open(&path).and_then(|l| l.messages()?.collect::<Result<Vec<_>, _>>())
+    };
+    for len in (0..bytes.len()).step_by(7).chain([bytes.len() - 1]) {
+        match read(&bytes[..len]) {
+            Err(LogError::Truncated { .. } | LogError::Corrupt { .. }) => {}
+            other => panic!("prefix of {len} bytes: {other:?}"),
+        }
+    }
+    let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
+    let chunk = &summary.chunk_indexes[0];
+    let mut damaged = bytes.clone();
+    damaged[(chunk.chunk_start_offset + chunk.chunk_length / 2) as usize] ^= 0x55;
+    assert!(matches!(read(&damaged), Err(LogError::Corrupt { .. })));
+    assert!(read(&bytes).is_ok());
+}
+
+/// The files in `dir`, sorted.
+fn listing(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+#[test]
+fn an_existing_log_is_replaced_only_by_a_finished_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("run.mcap");
+    std::fs::write(&path, b"the old log").unwrap();
+    // Written, not finished, dropped: the old file is untouched and no temporary file is left.
+    let mut writer = LogWriter::create(&path, "ricochet-log tests").unwrap();
+    let channel = writer.add_log_channel("/log").unwrap();
+    writer.write(channel, 0, &log_line(0)).unwrap();
+    assert_eq!(std::fs::read(&path).unwrap(), b"the old log");
+    let during = listing(dir.path());
+    assert_eq!(during.len(), 2, "{during:?}");
+    assert!(
+        during[0].starts_with(".run.mcap.") && during[0].ends_with(".tmp"),
+        "{during:?}"
+    );
+    drop(writer);
+    assert_eq!(std::fs::read(&path).unwrap(), b"the old log");
+    assert_eq!(listing(dir.path()), ["run.mcap"]);
+    // Finished: the new log replaces it, whole.
+    write_sample_log(&path);
+    assert_eq!(listing(dir.path()), ["run.mcap"]);
+    assert!(read_log_file(&path).is_ok());
+    // A directory is not a log file.
+    assert!(matches!(
+        LogWriter::create(dir.path(), "ricochet-log tests"),
+        Err(LogError::Create { .. })
+    ));
 }

@@ -1,0 +1,702 @@
+//! The binary against a hostile environment: standard output and error on `/dev/full`,
+//! pipes closed early, signals in the middle of a run, output files that already exist or are
+//! the input, memory caps, damaged and foreign logs, names with terminal escapes. Every test
+//! checks the exit code, the message, that nothing panicked, and what is left on disk.
+
+use std::fs::File;
+use std::io::{BufRead, BufReader, Read};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+use ricochet_log::{LogWriter, read_log_file};
+use serde_json::json;
+
+use crate::util::{data, root};
+
+/// The binary, run from the project root.
+fn ricochet() -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_ricochet"));
+    c.current_dir(root()).stdin(Stdio::null());
+    c
+}
+
+/// `/dev/full`: every write fails with "No space left on device".
+fn full() -> Stdio {
+    File::options()
+        .write(true)
+        .open("/dev/full")
+        .expect("/dev/full exists")
+        .into()
+}
+
+/// Exit code 101 is a Rust panic; the message says so when stderr works.
+fn assert_no_panic(what: &str, o: &Output) {
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_ne!(o.status.code(), Some(101), "{what} panicked: {stderr}");
+    assert!(!stderr.contains("panicked"), "{what} panicked: {stderr}");
+}
+
+/// Records `scenario` for `frames` frames into `out` (must succeed).
+fn record(scenario: &str, frames: u64, out: &Path) {
+    let o = ricochet()
+        .args(["run", scenario, "--frames", &frames.to_string(), "-o"])
+        .arg(out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+/// Two short logs that differ (600 and 10 frames), made once per test.
+fn two_logs(dir: &Path) -> (PathBuf, PathBuf) {
+    let (a, b) = (dir.join("a.mcap"), dir.join("b.mcap"));
+    record("scenarios/asteroids.toml", 600, &a);
+    record("scenarios/asteroids.toml", 10, &b);
+    (a, b)
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+#[test]
+fn a_full_stdout_is_an_error_with_a_message_for_every_subcommand() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = two_logs(dir.path());
+    let cases_file = data("collision-cases.json");
+    let cases: [(&[&str], i32); 6] = [
+        (&["check", "scenarios/asteroids.toml"], 1),
+        (&["diff", s(&a), s(&b)], 2),
+        (&["diff", "--json", s(&a), s(&b)], 2),
+        (&["diff", s(&a), s(&a)], 2),
+        (&["collide", s(&cases_file)], 1),
+        (&["validate", "scenarios/shapes.toml", "--frames", "5"], 1),
+    ];
+    for (args, code) in cases {
+        let o = ricochet().args(args).stdout(full()).output().unwrap();
+        assert_no_panic(&format!("{args:?}"), &o);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(code), "{args:?}: {stderr}");
+        assert!(
+            stderr.contains("cannot write to standard output: No space left on device"),
+            "{args:?}: {stderr}"
+        );
+    }
+}
+
+#[test]
+fn a_full_stderr_is_an_exit_code_not_a_panic() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, _) = two_logs(dir.path());
+    let out = dir.path().join("run.mcap");
+    let bad = data("bad-scenarios/clockwise-polygon.toml");
+    // (arguments, exit code): error paths keep their code; a lost run summary is exit 1, but
+    // the log itself is complete.
+    let cases: [(&[&str], i32); 7] = [
+        (
+            &[
+                "run",
+                "scenarios/asteroids.toml",
+                "--frames",
+                "20",
+                "-o",
+                s(&out),
+            ],
+            1,
+        ),
+        (&["check", "no/such/scenario.toml"], 2),
+        (&["check", s(&bad)], 2),
+        (&["collide", "no/such/cases.json"], 2),
+        (&["collide", "-"], 2),
+        (&["diff", s(&a), "no/such/log.mcap"], 2),
+        (&["run", "no/such/scenario.toml", "-o", s(&out)], 2),
+    ];
+    for (args, code) in cases {
+        let o = ricochet()
+            .args(args)
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(full())
+            .spawn()
+            .and_then(|mut c| {
+                // `collide -` reads a bad case from stdin.
+                use std::io::Write;
+                let mut stdin = c.stdin.take().unwrap();
+                let _ = stdin.write_all(b"{\"id\": 1}\n");
+                drop(stdin);
+                c.wait_with_output()
+            })
+            .unwrap();
+        assert_no_panic(&format!("{args:?}"), &o);
+        assert_eq!(o.status.code(), Some(code), "{args:?}");
+        assert!(o.stdout.is_empty(), "{args:?}");
+    }
+    let log = read_log_file(&out).expect("the run's log is complete even without a summary");
+    assert_eq!(log.iter().filter(|m| m.topic == "/stats").count(), 21);
+}
+
+/// Spawns `args` with stdout piped, reads `lines` lines, closes the pipe, and waits.
+fn close_after(args: &[&str], lines: usize) -> (Output, Vec<String>) {
+    let mut child = ricochet()
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut read = Vec::new();
+    {
+        let mut stdout = BufReader::new(child.stdout.take().unwrap());
+        for _ in 0..lines {
+            let mut line = String::new();
+            stdout.read_line(&mut line).unwrap();
+            read.push(line);
+        }
+        // Dropped here: the read end is closed, as `| head -N` does.
+    }
+    (child.wait_with_output().unwrap(), read)
+}
+
+#[test]
+fn a_closed_pipe_ends_quietly_with_the_commands_own_exit_code() {
+    let cases = data("collision-cases.json");
+    // 3000 lines are far more than a pipe holds: collide meets the closed pipe mid-way.
+    let (o, lines) = close_after(&["collide", s(&cases)], 1);
+    assert_no_panic("collide | head -1", &o);
+    assert_eq!(o.status.code(), Some(0));
+    assert!(
+        o.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(lines[0].starts_with("{\"id\":0,"), "{lines:?}");
+
+    // Closed before the first write: the verdict of `diff` is still its exit code.
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = two_logs(dir.path());
+    for (args, code) in [
+        (vec!["diff", s(&a), s(&b)], 1),
+        (vec!["diff", "--json", s(&a), s(&a)], 0),
+        (vec!["check", "scenarios/asteroids.toml"], 0),
+        (
+            vec!["validate", "scenarios/shapes.toml", "--frames", "5"],
+            0,
+        ),
+    ] {
+        let (o, _) = close_after(&args, 0);
+        assert_no_panic(&format!("{args:?}"), &o);
+        assert_eq!(o.status.code(), Some(code), "{args:?}");
+        assert!(
+            o.stderr.is_empty(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    }
+}
+
+/// The hidden temporary files a run leaves in `dir` (`.NAME.XXXXXX.tmp`).
+fn temp_files(dir: &Path) -> Vec<PathBuf> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "tmp"))
+        .collect()
+}
+
+/// Waits for `child`, at most `limit`; kills it and fails past that.
+fn wait_bounded(mut child: Child, limit: Duration) -> Output {
+    let start = Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed() > limit {
+            let _ = child.kill();
+            panic!("ricochet did not stop within {limit:?}");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    child.wait_with_output().unwrap()
+}
+
+/// Starts a long run into `out` and waits until its temporary file holds `bytes` bytes.
+fn start_long_run(out: &Path, bytes: u64) -> Child {
+    let child = ricochet()
+        .args([
+            "run",
+            "scenarios/asteroids.toml",
+            "--frames",
+            "1000000",
+            "-o",
+        ])
+        .arg(out)
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    let dir = out.parent().unwrap();
+    while start.elapsed() < Duration::from_secs(60) {
+        let size = temp_files(dir)
+            .iter()
+            .filter_map(|p| std::fs::metadata(p).ok())
+            .map(|m| m.len())
+            .max()
+            .unwrap_or(0);
+        if size >= bytes {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    child
+}
+
+fn kill(child: &Child, signal: &str) {
+    let status = Command::new("kill")
+        .args([&format!("-{signal}"), &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+}
+
+#[test]
+fn sigint_sigterm_and_sighup_at_random_frames_finish_the_log() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("long.mcap");
+    // An old, good log is there first: it must be replaced by a complete one, never cut.
+    record("scenarios/asteroids.toml", 30, &out);
+    let old = std::fs::read(&out).unwrap();
+    // Pseudo-random sizes (hence frames) at which to stop, different for each signal.
+    let mut x: u64 = 0x9E37_79B9_7F4A_7C15;
+    for signal in ["INT", "TERM", "HUP", "INT", "TERM", "HUP"] {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        let bytes = 1_000 + x % 400_000;
+        let child = start_long_run(&out, bytes);
+        kill(&child, signal);
+        let o = wait_bounded(child, Duration::from_secs(60));
+        assert_no_panic(signal, &o);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(0), "SIG{signal}: {stderr}");
+        assert!(stderr.contains("interrupted"), "SIG{signal}: {stderr}");
+        let log =
+            read_log_file(&out).unwrap_or_else(|e| panic!("SIG{signal} after {bytes} bytes: {e}"));
+        assert!(
+            log.iter().any(|m| m.topic == "/stats"),
+            "SIG{signal}: frames were written"
+        );
+        assert_ne!(std::fs::read(&out).unwrap(), old, "SIG{signal}");
+        assert!(temp_files(dir.path()).is_empty(), "SIG{signal}");
+        // And `ricochet diff` reads it.
+        let d = ricochet()
+            .args(["diff", s(&out), s(&out)])
+            .output()
+            .unwrap();
+        assert_eq!(
+            d.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&d.stderr)
+        );
+    }
+}
+
+#[test]
+fn a_killed_or_size_limited_run_leaves_the_old_log_intact() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("keep.mcap");
+    record("scenarios/asteroids.toml", 30, &out);
+    let old = std::fs::read(&out).unwrap();
+
+    // SIGKILL can't be caught: the old log stays, the temporary file is left behind.
+    let child = start_long_run(&out, 100_000);
+    kill(&child, "KILL");
+    let o = wait_bounded(child, Duration::from_secs(30));
+    assert_eq!(o.status.code(), None, "killed by a signal");
+    assert_eq!(
+        std::fs::read(&out).unwrap(),
+        old,
+        "SIGKILL: the old log is intact"
+    );
+    for t in temp_files(dir.path()) {
+        std::fs::remove_file(t).unwrap();
+    }
+
+    // A file size limit (`ulimit -f`, 64 KiB) stops the run: SIGXFSZ, or a write error.
+    let o = Command::new("sh")
+        .arg("-c")
+        .arg(format!(
+            "ulimit -f 128; exec '{}' run scenarios/asteroids.toml --frames 100000 -o '{}'",
+            env!("CARGO_BIN_EXE_ricochet"),
+            s(&out)
+        ))
+        .current_dir(root())
+        .output()
+        .unwrap();
+    assert_no_panic("ulimit -f", &o);
+    assert_ne!(o.status.code(), Some(0));
+    assert_eq!(
+        std::fs::read(&out).unwrap(),
+        old,
+        "ulimit -f: the old log is intact"
+    );
+    assert!(read_log_file(&out).is_ok());
+}
+
+#[test]
+fn run_refuses_to_write_its_log_over_its_scenario_or_to_a_file_named_dash() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = dir.path().join("x.toml");
+    std::fs::copy(root().join("scenarios/asteroids.toml"), &scenario).unwrap();
+    let text = std::fs::read(&scenario).unwrap();
+    let link = dir.path().join("link.mcap");
+    std::os::unix::fs::symlink(&scenario, &link).unwrap();
+    let cwd_name = dir.path().join(".").join("x.toml");
+    for output in [&scenario, &link, &cwd_name] {
+        let o = ricochet()
+            .args(["run", s(&scenario), "-o", s(output)])
+            .output()
+            .unwrap();
+        assert_no_panic("run x.toml -o x.toml", &o);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{stderr}");
+        assert!(
+            stderr.contains("that is the scenario being run"),
+            "{stderr}"
+        );
+        assert_eq!(
+            std::fs::read(&scenario).unwrap(),
+            text,
+            "the scenario is intact"
+        );
+    }
+    let o = ricochet()
+        .args(["run", s(&scenario), "-o", "-"])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert_no_panic("run -o -", &o);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("standard output"));
+    assert!(o.stdout.is_empty());
+    assert!(!dir.path().join("-").exists(), "no file named -");
+}
+
+#[test]
+fn diff_of_an_unknown_topic_is_an_error_naming_the_topics_there_are() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = two_logs(dir.path());
+    for topic in ["/bodys", "bodies"] {
+        let o = ricochet()
+            .args(["diff", "--topic", topic, s(&a), s(&b)])
+            .output()
+            .unwrap();
+        assert_no_panic(topic, &o);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{topic}: {stderr}");
+        assert!(o.stdout.is_empty());
+        assert!(
+            stderr.contains("/bodies, /contacts, /events, /scene, /stats"),
+            "{stderr}"
+        );
+    }
+    let o = ricochet()
+        .args(["diff", "--topic", "bodies", s(&a), s(&b)])
+        .output()
+        .unwrap();
+    assert!(String::from_utf8_lossy(&o.stderr).contains("did you mean /bodies?"));
+    // A topic that is there still compares.
+    let o = ricochet()
+        .args(["diff", "--topic", "/bodies", s(&a), s(&b)])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("590 / 601, 11"));
+}
+
+#[test]
+fn diff_of_a_log_with_a_damaged_summary_is_exit_2() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, _) = two_logs(dir.path());
+    let bytes = std::fs::read(&a).unwrap();
+    let footer = bytes.len() - 8 - 29;
+    let start = u64::from_le_bytes(bytes[footer + 9..footer + 17].try_into().unwrap()) as usize;
+    let damaged = dir.path().join("damaged.mcap");
+    for i in [start, start + 40, (start + footer) / 2, footer - 1] {
+        let mut copy = bytes.clone();
+        copy[i] ^= 0x20;
+        std::fs::write(&damaged, &copy).unwrap();
+        let o = ricochet()
+            .args(["diff", s(&a), s(&damaged)])
+            .output()
+            .unwrap();
+        assert_no_panic("diff damaged", &o);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "byte {i}: {stderr}");
+        assert!(
+            stderr.contains("damaged.mcap") && stderr.contains("summary"),
+            "{stderr}"
+        );
+    }
+}
+
+#[test]
+fn diff_of_a_foreign_mcap_is_exit_2_not_a_ricochet_log() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, _) = two_logs(dir.path());
+    // JSON on other topics, from another writer.
+    let other = dir.path().join("other.mcap");
+    let mut w = LogWriter::create(&other, "some other tool 1.0").unwrap();
+    let ch = w.add_json_channel("/bodies", "x.Bodies", "{}").unwrap();
+    w.write(ch, 0, &json!({"frame": 0})).unwrap();
+    w.finish().unwrap();
+    // Ricochet's name, but messages in another encoding.
+    let proto = dir.path().join("proto.mcap");
+    {
+        let mut w = mcap::WriteOptions::new()
+            .library("ricochet 0.1.0")
+            .create(std::io::BufWriter::new(File::create(&proto).unwrap()))
+            .unwrap();
+        let schema = w.add_schema("x.Pose", "protobuf", b"\x0a\x00").unwrap();
+        let ch = w
+            .add_channel(schema, "/bodies", "protobuf", &Default::default())
+            .unwrap();
+        let header = mcap::records::MessageHeader {
+            channel_id: ch,
+            sequence: 0,
+            log_time: 0,
+            publish_time: 0,
+        };
+        w.write_to_known_channel(&header, b"\x08\x01").unwrap();
+        w.finish().unwrap();
+    }
+    for (file, why) in [(&other, "some other tool"), (&proto, "protobuf")] {
+        for args in [[s(&a), s(file)], [s(file), s(&a)]] {
+            let o = ricochet().arg("diff").args(args).output().unwrap();
+            assert_no_panic("diff foreign", &o);
+            let stderr = String::from_utf8_lossy(&o.stderr);
+            assert_eq!(o.status.code(), Some(2), "{args:?}: {stderr}");
+            assert!(
+                stderr.contains("not a Ricochet log") && stderr.contains(why),
+                "{stderr}"
+            );
+        }
+    }
+}
+
+#[test]
+fn diff_memory_does_not_grow_with_the_log() {
+    // 3000 frames of asteroids is a 1.8 MB log. Decoded whole, as diff once did, two copies
+    // took 575 MB; streamed, diff needs about 15 MB whatever the length. Under a 160 MB cap
+    // on address space, the old diff aborts; this one finishes.
+    let dir = tempfile::tempdir().unwrap();
+    let long = dir.path().join("long.mcap");
+    record("scenarios/asteroids.toml", 3000, &long);
+    let copy = dir.path().join("copy.mcap");
+    std::fs::copy(&long, &copy).unwrap();
+    let o = Command::new("sh")
+        .arg("-c")
+        .arg(format!(
+            "ulimit -v 160000; exec '{}' diff '{}' '{}'",
+            env!("CARGO_BIN_EXE_ricochet"),
+            s(&long),
+            s(&copy)
+        ))
+        .output()
+        .unwrap();
+    assert_no_panic("diff under a memory cap", &o);
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{stdout}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(stdout.contains("0 / 3001, 3001"), "{stdout}");
+}
+
+/// A log of one `/bodies` message per list, written by "ricochet" (the diff reads it as ours).
+fn bodies_log(path: &Path, frames: &[serde_json::Value]) {
+    let mut w = LogWriter::create(path, "ricochet test").unwrap();
+    let ch = w
+        .add_json_channel("/bodies", "ricochet.Bodies", "{}")
+        .unwrap();
+    for (i, bodies) in frames.iter().enumerate() {
+        let msg = json!({"frame": i, "bodies": bodies});
+        w.write(ch, i as u64 * 1000, &msg).unwrap();
+    }
+    w.finish().unwrap();
+}
+
+#[test]
+fn diff_matches_bodies_by_id_and_generation() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (dir.path().join("a.mcap"), dir.path().join("b.mcap"));
+    // Slot 5 holds rock_a (generation 0) in A, and a later body, rock_b (generation 1), in
+    // B: they are two bodies, not one that moved.
+    let rock = |generation: u64, name: &str| json!({"id": 5, "generation": generation, "name": name, "position": [1.0, 2.0]});
+    let ship = json!({"id": 0, "generation": 0, "name": "ship", "position": [0.0, 0.0]});
+    bodies_log(&a, &[json!([ship.clone(), rock(0, "rock_a")])]);
+    bodies_log(&b, &[json!([ship.clone(), rock(1, "rock_b")])]);
+    let o = ricochet().args(["diff", s(&a), s(&b)]).output().unwrap();
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(o.status.code(), Some(1), "{stdout}");
+    assert!(stdout.contains("body 5:0 (rock_a)"), "{stdout}");
+    assert!(stdout.contains("field bodies[id=5:0]"), "{stdout}");
+    assert!(stdout.contains("B: missing"), "{stdout}");
+    // Without generations (older logs), bodies are matched by id alone.
+    let old = |x: f64| json!([{"id": 5, "name": "rock", "position": [x, 2.0]}]);
+    bodies_log(&a, &[old(1.0)]);
+    bodies_log(&b, &[old(1.5)]);
+    let o = ricochet().args(["diff", s(&a), s(&b)]).output().unwrap();
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        stdout.contains("body 5 (rock)") && stdout.contains("bodies[id=5].position[0]"),
+        "{stdout}"
+    );
+}
+
+#[test]
+fn names_with_terminal_escapes_are_printed_escaped() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(root().join("scenarios/asteroids.toml")).unwrap();
+    let name_line = text
+        .lines()
+        .find(|l| l.starts_with("name"))
+        .expect("the scenario has a name");
+    let evil = text.replacen(
+        name_line,
+        r#"name = "evil\u001b[2J\u001b]0;pwned\u0007\nok""#,
+        1,
+    );
+    let path = dir.path().join("evil.toml");
+    std::fs::write(&path, evil).unwrap();
+    let o = ricochet().args(["check", s(&path)]).output().unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let stdout = String::from_utf8(o.stdout).unwrap();
+    assert!(
+        !stdout.contains('\u{1b}') && !stdout.contains('\u{7}'),
+        "{stdout:?}"
+    );
+    assert!(
+        stdout.contains(r#""evil\u{1b}[2J\u{1b}]0;pwned\u{7}\nok""#),
+        "{stdout:?}"
+    );
+    assert_eq!(stdout.lines().count(), 1, "{stdout:?}");
+    let out = dir.path().join("evil.mcap");
+    let o = ricochet()
+        .args(["run", s(&path), "--frames", "2", "-o", s(&out)])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8(o.stderr).unwrap();
+    assert_eq!(o.status.code(), Some(0), "{stderr}");
+    assert!(stderr.starts_with(r"evil\u{1b}[2J"), "{stderr:?}");
+    assert!(!stderr.contains('\u{1b}'), "{stderr:?}");
+}
+
+#[test]
+fn help_and_version_into_a_full_or_closed_stdout_do_not_panic() {
+    for args in [&["--help"][..], &["--version"], &["run", "--help"]] {
+        let o = ricochet().args(args).stdout(full()).output().unwrap();
+        assert_no_panic(&format!("{args:?}"), &o);
+        let (o, _) = close_after(args, 0);
+        assert_no_panic(&format!("{args:?}"), &o);
+    }
+    // Reading stdin that is closed at once is fine too.
+    let mut child = ricochet()
+        .args(["collide", "-"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdin.take());
+    let mut stdout = String::new();
+    child
+        .stdout
+        .take()
+        .unwrap()
+        .read_to_string(&mut stdout)
+        .unwrap();
+    let o = child.wait_with_output().unwrap();
+    assert_no_panic("collide - < /dev/null", &o);
+    assert_eq!(o.status.code(), Some(0));
+}
+
+#[test]
+fn run_writes_through_a_link_and_refuses_dev_null() {
+    let dir = tempfile::tempdir().unwrap();
+    // /dev/null is refused, and stays the device (a rename onto it would replace it with a
+    // file; mcap's writer, seeking in it, panicked).
+    let o = ricochet()
+        .args([
+            "run",
+            "scenarios/shapes.toml",
+            "--frames",
+            "3",
+            "-o",
+            "/dev/null",
+        ])
+        .output()
+        .unwrap();
+    assert_no_panic("run -o /dev/null", &o);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("not a regular file"), "{stderr}");
+    use std::os::unix::fs::FileTypeExt;
+    assert!(
+        std::fs::metadata("/dev/null")
+            .unwrap()
+            .file_type()
+            .is_char_device()
+    );
+    // A link to a log: the log it points to is replaced, the link stays a link.
+    let real = dir.path().join("real.mcap");
+    std::fs::write(&real, b"old").unwrap();
+    let link = dir.path().join("link.mcap");
+    std::os::unix::fs::symlink(&real, &link).unwrap();
+    record("scenarios/shapes.toml", 3, &link);
+    assert!(
+        std::fs::symlink_metadata(&link)
+            .unwrap()
+            .file_type()
+            .is_symlink()
+    );
+    assert!(read_log_file(&real).is_ok());
+    assert!(temp_files(dir.path()).is_empty());
+}
+
+#[test]
+fn diff_reads_a_log_from_a_pipe() {
+    // `ricochet diff <(zcat a.mcap.gz) b.mcap`: a pipe is read once, into a temporary copy.
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = two_logs(dir.path());
+    for (piped, code) in [(std::fs::read(&a).unwrap(), 1), (b"not a log".to_vec(), 2)] {
+        let mut child = ricochet()
+            .args(["diff", "/dev/stdin", s(&b)])
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let mut stdin = child.stdin.take().unwrap();
+        let feeder = std::thread::spawn(move || {
+            use std::io::Write;
+            let _ = stdin.write_all(&piped);
+        });
+        let o = child.wait_with_output().unwrap();
+        feeder.join().unwrap();
+        assert_no_panic("diff /dev/stdin", &o);
+        let stdout = String::from_utf8_lossy(&o.stdout);
+        assert_eq!(
+            o.status.code(),
+            Some(code),
+            "{stdout}{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        if code == 1 {
+            assert!(stdout.contains("590 / 601, 11"), "{stdout}");
+        }
+    }
+}
