@@ -11,6 +11,8 @@ use std::path::Path;
 use std::process::ExitCode;
 
 use anyhow::{Context, bail};
+
+use crate::{files, out};
 use ricochet_scenes::bench::{DEFAULT_SCENES, Scene};
 use ricochet_study::bench::{Row, report, run_scene};
 
@@ -57,25 +59,31 @@ pub fn run(scenes: &[String], frames: u64, csv: Option<&Path>) -> anyhow::Result
         match Scene::parse(name) {
             Ok(kind) => parsed.push((name.clone(), kind)),
             Err(e) => {
-                eprintln!("error: {e:#}");
+                out::error(&format!("error: {e:#}"));
                 return Ok(ExitCode::from(2));
             }
         }
     }
     if frames == 0 {
-        eprintln!("error: --frames must be at least 1");
+        out::error("error: --frames must be at least 1");
         return Ok(ExitCode::from(2));
+    }
+    if let Some(path) = csv {
+        files::check_writable(path)?;
     }
     let in_process = std::env::var_os(CHILD_ENV).is_some();
     let mut rows = Vec::new();
     for (name, kind) in &parsed {
         if in_process {
-            let row = run_scene(name, *kind, frames, |note| eprintln!("bench: {note}"))?;
-            println!("{ROW_PREFIX}{}", serde_json::to_string(&row)?);
+            let row = run_scene(name, *kind, frames, |note| {
+                // Progress only: a lost line must not stop the measurement.
+                let _ = out::note(&format!("bench: {note}"));
+            })?;
+            out::print(&format!("{ROW_PREFIX}{}\n", serde_json::to_string(&row)?))?;
             rows.push(row);
         } else {
             let row = run_child(name, frames)?;
-            eprint!("{}", report::scene_summary(&row));
+            out::eprint(&report::scene_summary(&row))?;
             rows.push(row);
         }
     }
@@ -83,11 +91,9 @@ pub fn run(scenes: &[String], frames: u64, csv: Option<&Path>) -> anyhow::Result
     if in_process {
         return Ok(ExitCode::from(if agree { 0 } else { 1 }));
     }
-    print!("{}", report::table(&rows));
-    println!("{}", report::NOTES);
+    out::print(&format!("{}{}\n", report::table(&rows), report::NOTES))?;
     if let Some(path) = csv {
-        std::fs::write(path, report::csv_text(&rows))
-            .with_context(|| format!("writing {}", path.display()))?;
+        files::write(path, report::csv_text(&rows).as_bytes())?;
     }
     Ok(ExitCode::from(if agree { 0 } else { 1 }))
 }

@@ -13,6 +13,7 @@ mod check;
 mod collide;
 mod diff;
 mod events;
+mod files;
 mod load;
 mod out;
 mod record;

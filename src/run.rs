@@ -59,6 +59,11 @@ pub fn run(
         let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
     }
     let frames = frames.unwrap_or(scenario.frames);
+    // Every frame's log time must be a whole number of nanoseconds that fits in a u64.
+    if let Err(e) = scenario.world.last_time_ns(frames) {
+        out::error(&format!("error: --frames {frames}: {e}"));
+        return Ok(ExitCode::from(2));
+    }
     // Created before the first step: an unwritable path fails now, not after the run. The
     // log goes to a temporary file renamed onto `output` when it is complete, so an existing
     // file there stays whole until then, whatever stops the run.
@@ -100,11 +105,17 @@ pub fn run(
     let mut contacts = 0u64;
     let mut peak_bodies = 0usize;
     let mut ran = 0u64;
+    let mut overflow = None;
     for _ in 0..=frames {
         if interrupted.load(Ordering::SeqCst) {
             break;
         }
         let out = sim.step();
+        if let Some(bad) = sim.first_non_finite() {
+            // Nothing after an overflow can be trusted: the log ends with the last good frame.
+            overflow = Some((out.frame, bad));
+            break;
+        }
         contacts += out.contacts.len() as u64;
         peak_bodies = peak_bodies.max(sim.world().len());
         recorder
@@ -127,6 +138,15 @@ pub fn run(
     recorder
         .finish()
         .with_context(|| format!("finishing {}", output.display()))?;
+    if let Some((frame, bad)) = overflow {
+        out::error(&format!(
+            "error: frame {frame}: {}; the simulation overflowed. {} holds frames 0 to {}",
+            crate::validate::describe(&sim, &bad),
+            output.display(),
+            frame.saturating_sub(1)
+        ));
+        return Ok(ExitCode::from(1));
+    }
     let wall = started.elapsed().as_secs_f64();
     let stepped = ran.saturating_sub(1);
     let note = if interrupted.load(Ordering::SeqCst) {

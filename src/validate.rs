@@ -10,7 +10,7 @@ use std::path::Path;
 use std::process::ExitCode;
 
 use ricochet_oracle::{FrameReport, Referee, Tolerances, compare_motion, summary_table};
-use ricochet_sim::{FrameOutput, Scenario, Simulation};
+use ricochet_sim::{FrameOutput, NonFinite, Scenario, Simulation};
 
 use crate::out::WriteError;
 
@@ -65,6 +65,20 @@ impl Validation {
     }
 }
 
+/// A non-finite body for people: `body NAME #id:generation has a non-finite FIELD [x, y]`.
+pub fn describe(sim: &Simulation, bad: &NonFinite) -> String {
+    let w = sim.world();
+    let name = w.index_of(bad.body).map_or("?", |i| w.name[i].as_str());
+    format!(
+        "body {} #{} has a non-finite {} [{}, {}]",
+        crate::out::escape_controls(name),
+        bad.body,
+        bad.field,
+        bad.value[0],
+        bad.value[1]
+    )
+}
+
 /// `ricochet validate SCENARIO`: simulate without writing a log, referee every frame.
 pub fn run(path: &Path, frames: Option<u64>) -> anyhow::Result<ExitCode> {
     let mut scenario = match crate::load::load(Some(path)) {
@@ -81,11 +95,25 @@ pub fn run(path: &Path, frames: Option<u64>) -> anyhow::Result<ExitCode> {
         scenario.world.sleep_after = None;
     }
     let frames = frames.unwrap_or(scenario.frames);
+    if let Err(e) = scenario.world.last_time_ns(frames) {
+        crate::out::error(&format!("error: --frames {frames}: {e}"));
+        return Ok(ExitCode::from(2));
+    }
     let mut sim = Simulation::new(&scenario);
     sim.capture_detect_poses = true;
     let mut v = Validation::new(&scenario);
     for _ in 0..=frames {
         let out = sim.step();
+        if let Some(bad) = sim.first_non_finite() {
+            // No comparison with a NaN or an infinity can pass: say so and fail.
+            crate::out::error(&format!(
+                "error: frame {}: {}; the simulation overflowed, nothing after it can be \
+                 compared",
+                out.frame,
+                describe(&sim, &bad)
+            ));
+            return Ok(ExitCode::from(1));
+        }
         v.frame(&sim, &out);
     }
     Ok(if v.finish(&scenario, frames)? {

@@ -700,3 +700,113 @@ fn diff_reads_a_log_from_a_pipe() {
         }
     }
 }
+
+/// Issue 11, item 2: gravity 1e308 times a scale of 1e308 overflows in the first step. The
+/// run stops with an error naming the frame, the body and the field; the log it leaves is
+/// complete and holds the frames before (frame 0 only); validate fails instead of passing.
+#[test]
+fn an_overflowing_body_stops_the_run_with_its_frame_body_and_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = dir.path().join("overflow.toml");
+    std::fs::write(
+        &scenario,
+        "layers = [\"a\"]\nframes = 5\nworld.gravity = [0, -1e308]\n[[bodies]]\nname = \
+         \"rock\"\nlayer = \"a\"\nshape = { kind = \"circle\", radius = 1 }\ngravity_scale = \
+         1e308\n",
+    )
+    .unwrap();
+    let log = dir.path().join("overflow.mcap");
+    let o = ricochet()
+        .args(["run", s(&scenario), "-o", s(&log)])
+        .output()
+        .unwrap();
+    assert_no_panic("run", &o);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{stderr}");
+    for part in [
+        "frame 1",
+        "rock #0:0",
+        "non-finite position",
+        "-inf",
+        "frames 0 to 0",
+    ] {
+        assert!(stderr.contains(part), "{part:?} in {stderr}");
+    }
+    let messages = read_log_file(&log).expect("the log is complete");
+    let bodies: Vec<_> = messages.iter().filter(|m| m.topic == "/bodies").collect();
+    assert_eq!(bodies.len(), 1, "frame 0 only");
+    assert!(
+        !serde_json::to_string(&bodies[0].data)
+            .unwrap()
+            .contains("null")
+    );
+    let o = ricochet()
+        .args(["validate", s(&scenario)])
+        .output()
+        .unwrap();
+    assert_no_panic("validate", &o);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("non-finite position"), "{stderr}");
+    assert!(!String::from_utf8_lossy(&o.stdout).contains("PASS"));
+}
+
+/// Issue 11, item 9: `--frames` obeys the file's limit (100,000,000) and the log's time
+/// limit (the last frame within 2^64 ns); nothing is written.
+#[test]
+fn frames_beyond_the_limits_are_refused_before_anything_is_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let slow = dir.path().join("slow.toml");
+    // 2e9 s a step: 5 frames fit (1e19 ns), 10 do not (2e19 > 2^64).
+    std::fs::write(&slow, "dt = 2e9\nframes = 5\nlayers = [\"a\"]\n").unwrap();
+    let cases = [
+        (
+            "scenarios/asteroids.toml",
+            "200000000",
+            "must be 0 to 100000000",
+        ),
+        (s(&slow), "10", "2^64 ns"),
+    ];
+    for (scenario, frames, says) in cases {
+        let log = dir.path().join("never.mcap");
+        let o = ricochet()
+            .args(["run", scenario, "--frames", frames, "-o", s(&log)])
+            .output()
+            .unwrap();
+        assert_no_panic(scenario, &o);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{stderr}");
+        assert!(stderr.contains(says), "{stderr}");
+        assert!(!log.exists());
+        assert!(temp_files(dir.path()).is_empty());
+    }
+    let ok = dir.path().join("slow.mcap");
+    let o = ricochet()
+        .args(["run", s(&slow), "-o", s(&ok)])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let last = read_log_file(&ok).unwrap().last().unwrap().log_time;
+    assert_eq!(last, 5 * 2_000_000_000_000_000_000);
+}
+
+/// Issue 11, item 10: an output path that can't be written fails before the work (the
+/// accuracy study takes seconds), with nothing printed to stdout.
+#[test]
+fn an_unwritable_output_fails_before_the_work() {
+    for args in [
+        ["accuracy", "--csv", "no/such/dir/a.csv"],
+        ["bench", "--csv", "no/such/dir/b.csv"],
+    ] {
+        let o = ricochet().args(args).output().unwrap();
+        assert_no_panic(args[0], &o);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{stderr}");
+        assert!(stderr.contains("no/such/dir"), "{stderr}");
+        assert!(o.stdout.is_empty(), "nothing was measured");
+        assert!(
+            !stderr.contains("accuracy: ") && !stderr.contains("bench: "),
+            "{stderr}"
+        );
+    }
+}
