@@ -36,6 +36,7 @@ mod convert;
 mod motion;
 mod pairs;
 mod referee;
+mod seam;
 mod summary;
 mod swept;
 

@@ -13,6 +13,7 @@ use ricochet_sim::{
 
 use crate::convert::{ReferenceContact, overlap_along, pairing, place, reference_contact, size};
 use crate::pairs::{LayerFilter, penetration};
+use crate::seam::{Seam, moved};
 use crate::{OracleError, Tolerances, rules};
 
 /// What one frame's check found.
@@ -155,6 +156,8 @@ pub(crate) fn recheck(
 pub struct Referee {
     pub(crate) layers: Layers,
     pub(crate) tol: Tolerances,
+    /// The translations a pair is tested at (through the wrap seam).
+    pub(crate) seam: Seam,
     /// Every body's position at the end of the last frame checked, and that frame: where a
     /// body removed during the next frame started it.
     pub(crate) previous: Option<(u64, BTreeMap<Entity, Vec2>)>,
@@ -167,6 +170,7 @@ impl Referee {
         Referee {
             layers: scenario.world.layers.clone(),
             tol,
+            seam: Seam::new(scenario),
             previous: None,
         }
     }
@@ -381,20 +385,24 @@ impl Referee {
             let moved = pa != detect[&ea] || pb != detect[&eb];
             let in_rapier = found.contains(&(ea, eb));
             let logged_here = logged.get(&(ea, eb)).copied();
-            if let Some(c) = logged_here
-                && (c.pose_a != pa || c.pose_b != pb)
-            {
-                report.mismatch(format!(
-                    "{who}: logged at poses {:?} {:?}, the replayed pass says {pa:?} {pb:?}",
-                    c.pose_a, c.pose_b
-                ));
+            if let Some(c) = logged_here {
+                match self.seam.offset_to(&pb, &c.pose_b) {
+                    Some(offset) if c.pose_a == pa => {
+                        self.check_seam_rule(&a, &b, (&pa, &pb), offset, tol, &who, report);
+                    }
+                    _ => report.mismatch(format!(
+                        "{who}: logged at poses {:?} {:?}, the replayed pass says {pa:?} {pb:?}",
+                        c.pose_a, c.pose_b
+                    )),
+                }
             }
             if in_rapier && logged_here.is_some() {
                 report.pairs_confirmed += 1;
             } else {
-                // A difference: parry's depth where Ricochet tested the pair decides.
-                let d = match depth(a.shape, &pa, b.shape, &pb, tol) {
-                    Ok(d) => d,
+                // A difference: parry's depth where Ricochet tested the pair decides (the
+                // deepest translation through the seam).
+                let d = match self.seam.deepest(a.shape, &pa, b.shape, &pb, tol) {
+                    Ok((d, _)) => d,
                     Err(e) => {
                         report.mismatch(format!("{who}: {e}"));
                         continue;
@@ -441,8 +449,38 @@ impl Referee {
         current
     }
 
+    /// A logged `all` contact through the seam at `offset` (of `b`'s pose): no other
+    /// translation may be deeper by parry (beyond the tolerance).
+    #[expect(clippy::too_many_arguments, reason = "the pair as the caller holds it")]
+    fn check_seam_rule(
+        &self,
+        a: &Body<'_>,
+        b: &Body<'_>,
+        (pa, pb): (&Pose, &Pose),
+        offset: Vec2,
+        tol: f64,
+        who: &str,
+        report: &mut FrameReport,
+    ) {
+        if !self.seam.wraps() {
+            return;
+        }
+        let logged = depth(a.shape, pa, b.shape, &moved(pb, offset), tol);
+        let best = self.seam.deepest(a.shape, pa, b.shape, pb, tol);
+        match (logged, best) {
+            (Ok(d), Ok((best, o))) if best > d + tol => report.mismatch(format!(
+                "{who}: logged with b translated by {offset} (parry depth {d:e}); by {o} it \
+                 is deeper ({best:e}): the seam rule takes the deepest"
+            )),
+            (Err(e), _) | (_, Err(e)) => report.mismatch(format!("{who}: {e}")),
+            _ => {}
+        }
+    }
+
     /// The pairs rapier's broad and narrow phase find penetrating (`dist < 0`) with every
-    /// body's collider at its detect pose, layers filtering as Ricochet's matrix does.
+    /// body's collider at its detect pose, layers filtering as Ricochet's matrix does. In a
+    /// wrapping world every body also has a collider at each of its images, and a pair of a
+    /// body and another's image counts as the pair.
     fn rapier_pairs(
         &self,
         sim: &Simulation,
@@ -452,15 +490,19 @@ impl Referee {
         let mut world = PhysicsWorld::new();
         world.integration_parameters.normalized_prediction_distance = 0.0;
         let filter = LayerFilter::new(&self.layers);
+        let offsets = self.seam.offsets();
+        let n = offsets.len();
         for (k, (e, pose)) in poses.iter().enumerate() {
             let b = body(sim, out, *e).ok_or(OracleError::Conversion("unknown body"))?;
-            let (p, shape) = place(b.shape, pose, Vec2::ZERO)?;
-            let builder = ColliderBuilder::new(shape)
-                .position(p)
-                .active_collision_types(ActiveCollisionTypes::all());
-            world
-                .colliders
-                .insert(filter.collider(builder, b.layer, k).build());
+            for (m, &o) in offsets.iter().enumerate() {
+                let (p, shape) = place(b.shape, &moved(pose, o), Vec2::ZERO)?;
+                let builder = ColliderBuilder::new(shape)
+                    .position(p)
+                    .active_collision_types(ActiveCollisionTypes::all());
+                world
+                    .colliders
+                    .insert(filter.collider(builder, b.layer, k * n + m).build());
+            }
         }
         world.detect_collisions(&filter, &());
         let mut pairs = BTreeSet::new();
@@ -472,6 +514,12 @@ impl Referee {
             let (Some(i), Some(j)) = (index(pair.collider1), index(pair.collider2)) else {
                 continue;
             };
+            // A body and another's image (index 0 is the body itself); two images moved
+            // alike are the real pair, and a body never meets its own image.
+            let ((i, mi), (j, mj)) = ((i / n, i % n), (j / n, j % n));
+            if (mi != 0 && mj != 0) || i == j {
+                continue;
+            }
             let (ea, eb) = (poses[i].0, poses[j].0);
             pairs.insert((ea.min(eb), ea.max(eb)));
         }

@@ -10,14 +10,19 @@ use ricochet_sim::{
 
 use crate::convert::{first_touch, size};
 use crate::referee::{Body, FrameReport, Referee, body, depth};
+use crate::seam::{moved, widened};
 use crate::{OracleError, rules};
 
 /// One swept-eligible pair, with parry's answer.
 struct Pair<'a> {
     a: Body<'a>,
     b: Body<'a>,
-    /// Start poses: start positions, end angles (rotation is not swept).
+    /// Start poses: start positions, end angles (rotation is not swept); `b`'s translated
+    /// by `offset`.
     start: (Pose, Pose),
+    /// The translation of `b` through the wrap seam (zero for the direct pair): the one
+    /// whose first touch is earliest.
+    offset: Vec2,
     /// Displacements over the frame.
     motion: (Vec2, Vec2),
     /// Parry's first touch in `[0, 1]`.
@@ -215,7 +220,8 @@ impl Referee {
                             })
                     });
                     if spent {
-                        let d = depth(p.a.shape, &end[&ea], p.b.shape, &end[&eb], tol)
+                        let end_b = moved(&end[&eb], p.offset);
+                        let d = depth(p.a.shape, &end[&ea], p.b.shape, &end_b, tol)
                             .unwrap_or(f64::NEG_INFINITY);
                         report.explain(rules::FIRST_HIT, d);
                         continue;
@@ -303,6 +309,50 @@ impl Referee {
         Ok(None)
     }
 
+    /// The translation of `b` (through the wrap seam) whose first touch along the motion is
+    /// earliest, the first in the seam's order on a tie, and that touch. When none touches,
+    /// the earliest within the stopping gap (a graze), else the direct one.
+    fn earliest_touch(
+        &self,
+        a: &Body<'_>,
+        b: &Body<'_>,
+        start: (Pose, Pose),
+        motion: (Vec2, Vec2),
+    ) -> Result<(Vec2, Option<f64>), OracleError> {
+        let gap = self.tol.toi_gap * size(a.shape).min(size(b.shape));
+        let swept = |s: &ricochet_geom::Shape, p: &Pose, d: Vec2| {
+            s.bounds(p)
+                .union(s.bounds(&Pose::new(p.position + d, p.angle)))
+        };
+        let path_a = widened(swept(a.shape, &start.0, motion.0), 2.0 * gap);
+        let mut touch: Option<(f64, Vec2)> = None;
+        let mut graze: Option<(f64, Vec2)> = None;
+        for &o in self.seam.offsets() {
+            let sb = moved(&start.1, o);
+            if o != Vec2::ZERO && !path_a.overlaps(&swept(b.shape, &sb, motion.1)) {
+                continue;
+            }
+            let cast =
+                |target| first_touch(a.shape, &start.0, motion.0, b.shape, &sb, motion.1, target);
+            if let Some(t) = cast(0.0)?
+                && touch.is_none_or(|(best, _)| t < best)
+            {
+                touch = Some((t, o));
+            }
+            if touch.is_none()
+                && let Some(t) = cast(gap)?
+                && graze.is_none_or(|(best, _)| t < best)
+            {
+                graze = Some((t, o));
+            }
+        }
+        Ok(match (touch, graze) {
+            (Some((t, o)), _) => (o, Some(t)),
+            (None, Some((_, o))) => (o, None),
+            (None, None) => (Vec2::ZERO, None),
+        })
+    }
+
     /// Every pair Ricochet tests by time of impact this frame, with parry's first touch.
     fn swept_pairs<'a>(
         &self,
@@ -334,9 +384,8 @@ impl Referee {
                     Pose::new(start_b, detect_b.angle),
                 );
                 let motion = (end_a - start_a, end_b - start_b);
-                let toi = first_touch(
-                    a.shape, &start.0, motion.0, b.shape, &start.1, motion.1, 0.0,
-                )?;
+                let (offset, toi) = self.earliest_touch(&a, &b, start, motion)?;
+                let start = (start.0, moved(&start.1, offset));
                 let mover = if motion.1.length() > motion.0.length() {
                     *eb
                 } else {
@@ -349,6 +398,7 @@ impl Referee {
                         a,
                         b,
                         start,
+                        offset,
                         motion,
                         toi,
                         mover,

@@ -311,6 +311,35 @@ pub struct WorldBounds {
     pub wrap: bool,
 }
 
+impl WorldBounds {
+    /// The world's size, `max - min`.
+    #[must_use]
+    pub fn size(&self) -> Vec2 {
+        self.max - self.min
+    }
+
+    /// Where a body's images may be in a wrapping world: the translations by whole world
+    /// sizes `(sx * width, sy * height)`, `sx` and `sy` in `-1, 0, 1`, in the fixed order
+    /// of the wrap-seam rule. The direct one (`sx = sy = 0`) comes first, then `sx`, then
+    /// `sy` ascending. Of the translations of `b` that overlap `a`, `detect` takes the
+    /// deepest (the earliest touch for a swept pair), the first in this order on a tie.
+    #[must_use]
+    pub fn image_offsets(&self) -> [Vec2; 9] {
+        let size = self.size();
+        let mut out = [Vec2::ZERO; 9];
+        let mut k = 1;
+        for sx in [-1.0, 0.0, 1.0] {
+            for sy in [-1.0, 0.0, 1.0] {
+                if sx != 0.0 || sy != 0.0 {
+                    out[k] = Vec2::new(sx * size.x, sy * size.y);
+                    k += 1;
+                }
+            }
+        }
+        out
+    }
+}
+
 /// World-wide settings.
 #[derive(Clone, Debug, PartialEq)]
 pub struct WorldDef {

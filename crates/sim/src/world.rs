@@ -445,10 +445,19 @@ impl World {
     /// [`World::bounds`], widened over the frame's motion for a body of a layer in
     /// `sweeping` (a bullet that went right through something is still paired with it), and
     /// a frozen body handed over as kinematic (it keeps its place in the dense order; the
-    /// caller drops its pairs).
-    pub(crate) fn mover_entries(&mut self, sweeping: &[bool], out: &mut Vec<BodyEntry>) {
+    /// caller drops its pairs). Returns the bounds of them all (`None` without moving
+    /// bodies): how far they reach, for the wrap seam.
+    pub(crate) fn mover_entries(
+        &mut self,
+        sweeping: &[bool],
+        out: &mut Vec<BodyEntry>,
+    ) -> Option<Bounds> {
         out.clear();
         out.reserve(self.movers.len());
+        let mut all = Bounds {
+            min: Vec2::INFINITY,
+            max: Vec2::NEG_INFINITY,
+        };
         for &i in &self.movers {
             let i = i as usize;
             let p = self.position[i];
@@ -458,6 +467,7 @@ impl World {
             if sweeping[usize::from(layer)] && moved != Vec2::ZERO {
                 bounds = bounds.union(bounds.translated(moved));
             }
+            all = all.union(bounds);
             out.push(BodyEntry {
                 key: self.key(i),
                 bounds,
@@ -469,6 +479,7 @@ impl World {
                 },
             });
         }
+        (!out.is_empty()).then_some(all)
     }
 
     /// The pose of body `i`.

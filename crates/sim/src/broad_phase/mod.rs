@@ -166,7 +166,7 @@ struct Member {
 }
 
 /// Marks a handle as a static body's index (in the [`StaticSet`]).
-const STATIC_BIT: u32 = 1 << 31;
+pub(crate) const STATIC_BIT: u32 = 1 << 31;
 /// Layer ids are `u8`.
 const LAYERS: usize = 256;
 
@@ -237,7 +237,7 @@ impl BroadPhase {
             st.load(bodies.iter().filter(|b| b.kind == BodyKind::Static), None);
         }
         self.group_movers(bodies, |b| b.kind != BodyKind::Static);
-        self.run(bodies, true, interactions, out)
+        self.run(bodies, (true, true), interactions, out)
     }
 
     /// Like [`BroadPhase::pairs`], with the static bodies apart: `statics` is read only when
@@ -254,6 +254,34 @@ impl BroadPhase {
         static_generation: u64,
         movers: &[BodyEntry],
         interactions: &Interactions,
+        out: &mut Vec<(u32, u32)>,
+    ) -> BroadPhaseStats {
+        self.split(statics, static_generation, movers, interactions, true, out)
+    }
+
+    /// Like [`BroadPhase::pairs_split`], but each pair is left as the two handles the
+    /// algorithm met it by, in no particular order: an index into `movers`, or
+    /// [`STATIC_BIT`] with an index into `statics`. For a caller that maps its entries back
+    /// to bodies itself (the wrap seam's images).
+    pub(crate) fn pairs_split_handles(
+        &mut self,
+        statics: &[BodyEntry],
+        static_generation: u64,
+        movers: &[BodyEntry],
+        interactions: &Interactions,
+        out: &mut Vec<(u32, u32)>,
+    ) -> BroadPhaseStats {
+        self.split(statics, static_generation, movers, interactions, false, out)
+    }
+
+    /// [`BroadPhase::pairs_split`], resolved to dense indices or not.
+    fn split(
+        &mut self,
+        statics: &[BodyEntry],
+        static_generation: u64,
+        movers: &[BodyEntry],
+        interactions: &Interactions,
+        dense: bool,
         out: &mut Vec<(u32, u32)>,
     ) -> BroadPhaseStats {
         debug_assert!(
@@ -277,7 +305,7 @@ impl BroadPhase {
         }
         tally.flush();
         self.group_movers(movers, |_| true);
-        self.run(movers, false, interactions, out)
+        self.run(movers, (false, dense), interactions, out)
     }
 
     /// This call's moving bodies of `layer`, in key order.
@@ -286,11 +314,12 @@ impl BroadPhase {
         &self.movers[self.layer_start[l] as usize..self.layer_start[l + 1] as usize]
     }
 
-    /// Chooses the algorithm, finds the pairs and resolves them.
+    /// Chooses the algorithm, finds the pairs and, with `dense`, resolves them (`all_given`:
+    /// whether `bodies` holds the static bodies too).
     fn run(
         &mut self,
         bodies: &[BodyEntry],
-        all_given: bool,
+        (all_given, dense): (bool, bool),
         interactions: &Interactions,
         out: &mut Vec<(u32, u32)>,
     ) -> BroadPhaseStats {
@@ -316,7 +345,9 @@ impl BroadPhase {
         } else {
             self.by_layers(kind, bodies, interactions, out, &mut stats);
         }
-        self.resolve(bodies, all_given, out);
+        if dense {
+            self.resolve(bodies, all_given, out);
+        }
         stats.pairs = out.len() as u64;
         stats.static_rebuilds = self.static_rebuilds;
         stats

@@ -22,6 +22,11 @@
 //! of impact instead: each moving body's hits are taken in time order and it stops at the
 //! first that destroys it, so a bullet never passes through a rock, and hits the first one
 //! on its path. Rotation during the frame is not swept (the end angles are used).
+//!
+//! In a wrapping world, pairs also meet through the seam (`wrap.rs`): a pair with an image
+//! is tested directly and with `b` translated by whole world sizes next to `a`; the deepest
+//! contact (the earliest touch) wins, the direct one on a tie, and is logged with `b`'s
+//! image as `pose_b`. Responses are the same (a push moves the real bodies).
 
 use ricochet_geom::{Contact, Pose, Sweep, Vec2, contact, time_of_impact};
 
@@ -33,6 +38,7 @@ use crate::output::{ContactRecord, Phase};
 use crate::stages::push::separate_along_normal;
 use crate::stages::remove::remove;
 use crate::stages::separate::is_box;
+use crate::stages::wrap::Seam;
 use crate::stages::{SLOP, StageCtx};
 use crate::world::World;
 
@@ -58,6 +64,8 @@ pub(crate) struct DetectState {
     statics: Vec<BodyEntry>,
     movers: Vec<BodyEntry>,
     pairs: Vec<(u32, u32)>,
+    /// The wrap seam's images (a wrapping world only).
+    seam: Seam,
     /// Narrow-phase tests per layer pair this frame, `[a * n + b]`.
     tests: Vec<u64>,
 }
@@ -78,6 +86,7 @@ impl DetectState {
             statics: Vec::new(),
             movers: Vec::new(),
             pairs: Vec::new(),
+            seam: Seam::new(kind),
             tests: vec![0; n * n],
         }
     }
@@ -95,6 +104,7 @@ fn interactions(layers: &Layers, box_only: &[bool]) -> Interactions {
 /// Fills the broad phase's inputs and finds the candidate pairs (dense indices, sorted).
 fn candidate_pairs(ctx: &mut StageCtx, st: &mut DetectState) -> Vec<(u32, u32)> {
     let w = &mut *ctx.world;
+    let wrap = ctx.def.bounds.filter(|b| b.wrap);
     let changed = (0..st.box_only.len()).any(|l| st.box_only[l] != w.only_boxes(l as u8));
     if changed {
         for (l, b) in st.box_only.iter_mut().enumerate() {
@@ -115,8 +125,11 @@ fn candidate_pairs(ctx: &mut StageCtx, st: &mut DetectState) -> Vec<(u32, u32)> 
                 });
             }
         }
+        if let Some(b) = wrap {
+            st.seam.statics_changed(&b, &st.statics);
+        }
     }
-    w.mover_entries(&st.sweeping, &mut st.movers);
+    let all = w.mover_entries(&st.sweeping, &mut st.movers);
     let generation = w.static_generation();
     let mut pairs = std::mem::take(&mut st.pairs);
     let bp = st.broad_phase.pairs_split(
@@ -127,6 +140,16 @@ fn candidate_pairs(ctx: &mut StageCtx, st: &mut DetectState) -> Vec<(u32, u32)> 
         &mut pairs,
     );
     st.static_generation = Some(generation);
+    if let Some(b) = wrap {
+        st.seam.add_pairs(
+            &b,
+            w,
+            (&st.statics, generation),
+            (&st.movers, all),
+            &st.interactions,
+            &mut pairs,
+        );
+    }
     ctx.out.stats.broad_phase = Some(bp.kind);
     ctx.out.stats.layer_pairs_skipped += bp.layer_pairs_skipped;
     pairs
@@ -168,8 +191,17 @@ pub(crate) fn run(ctx: &mut StageCtx, st: &mut DetectState, capture_poses: bool)
             continue;
         }
         ctx.out.stats.narrow_tests += 1;
-        let (pose_a, pose_b) = (w.pose(i), w.pose(j));
-        let c = contact(&w.shape[i], &pose_a, &w.shape[j], &pose_b);
+        let (pose_a, mut pose_b) = (w.pose(i), w.pose(j));
+        let mut c = contact(&w.shape[i], &pose_a, &w.shape[j], &pose_b);
+        // Through the seam: `b`'s images next to `a`, the deepest (the first on a tie).
+        for offset in st.seam.offsets(i, j) {
+            ctx.out.stats.narrow_tests += 1;
+            let image = Pose::new(w.position[j] + offset, w.angle[j]);
+            let d = contact(&w.shape[i], &pose_a, &w.shape[j], &image);
+            if d.depth > c.depth {
+                (c, pose_b) = (d, image);
+            }
+        }
         let threshold = if response == Response::Separate {
             SLOP
         } else {
@@ -198,7 +230,7 @@ pub(crate) fn run(ctx: &mut StageCtx, st: &mut DetectState, capture_poses: bool)
         }
     }
     st.tests = per_layer_pair;
-    run_swept(ctx, &mut doomed, &swept, layers, &mut woken);
+    run_swept(ctx, &mut doomed, &swept, &st.seam, &mut woken);
     for i in woken {
         ctx.world.wake(i);
     }
@@ -217,9 +249,10 @@ fn run_swept(
     ctx: &mut StageCtx,
     doomed: &mut Vec<(Entity, Entity)>,
     swept: &[(usize, usize)],
-    layers: &Layers,
+    seam: &Seam,
     woken: &mut Vec<usize>,
 ) {
+    let layers = &ctx.def.layers;
     struct Hit {
         mover: Entity,
         toi: f64,
@@ -237,7 +270,23 @@ fn run_swept(
             end: w.position[k],
             angle: w.angle[k],
         };
-        if let Some(impact) = time_of_impact(&w.shape[i], &sweep(i), &w.shape[j], &sweep(j)) {
+        let mut first = time_of_impact(&w.shape[i], &sweep(i), &w.shape[j], &sweep(j));
+        // Through the seam: `b`'s images next to `a`, the earliest (the first on a tie).
+        for offset in seam.offsets(i, j) {
+            ctx.out.stats.narrow_tests += 1;
+            let image = Sweep {
+                start: w.start_position[j] + offset,
+                end: w.position[j] + offset,
+                angle: w.angle[j],
+            };
+            let hit = time_of_impact(&w.shape[i], &sweep(i), &w.shape[j], &image);
+            if let Some(h) = hit
+                && first.as_ref().is_none_or(|f| h.t < f.t)
+            {
+                first = Some(h);
+            }
+        }
+        if let Some(impact) = first {
             // The mover is the body that went further: a bullet against a drifting rock.
             let travel = |k: usize| (w.position[k] - w.start_position[k]).length();
             let mover = if travel(j) > travel(i) {

@@ -19,6 +19,7 @@ pub(crate) mod remove;
 pub(crate) mod script;
 pub(crate) mod separate;
 pub(crate) mod sleep;
+pub(crate) mod wrap;
 
 /// How far two solid bodies may still overlap after `separate` has pushed them apart, in
 /// world units: positions are set exactly flush, so what remains is rounding.

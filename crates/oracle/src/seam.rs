@@ -1,0 +1,97 @@
+//! The wrap seam as the referee sees it: in a world with `bounds` and `wrap = true`, a pair
+//! also meets through the edges, `b` translated by whole world sizes
+//! ([`WorldBounds::image_offsets`]) next to `a`. Ricochet logs such a contact with `b`'s
+//! image as `pose_b`, and takes the deepest translation (the earliest touch for a swept
+//! pair), the first in the offsets' order (the direct one first) on a tie. The referee
+//! gives rapier a collider for each image, and checks the choice with parry.
+
+use ricochet_geom::{Bounds, Pose, Shape, Vec2};
+use ricochet_sim::{Scenario, WorldBounds};
+
+use crate::OracleError;
+use crate::referee::depth;
+
+/// The translations of `b` a pair is tested at: the direct one alone in a world that does
+/// not wrap, else [`WorldBounds::image_offsets`] (direct first).
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct Seam {
+    offsets: Vec<Vec2>,
+}
+
+impl Seam {
+    /// The seam of `scenario`'s world.
+    pub(crate) fn new(scenario: &Scenario) -> Seam {
+        let offsets = match scenario.world.bounds {
+            Some(b @ WorldBounds { wrap: true, .. }) => b.image_offsets().to_vec(),
+            _ => vec![Vec2::ZERO],
+        };
+        Seam { offsets }
+    }
+
+    /// The translations, direct first.
+    pub(crate) fn offsets(&self) -> &[Vec2] {
+        &self.offsets
+    }
+
+    /// Whether the world wraps.
+    pub(crate) fn wraps(&self) -> bool {
+        self.offsets.len() > 1
+    }
+
+    /// The offset that takes `pose` exactly (the same addition as Ricochet's) to `image`.
+    pub(crate) fn offset_to(&self, pose: &Pose, image: &Pose) -> Option<Vec2> {
+        self.offsets
+            .iter()
+            .copied()
+            .find(|&o| moved(pose, o) == *image)
+    }
+
+    /// Parry's depth of `a` and `b` at each translation of `b`: the deepest, and its
+    /// offset (the first on a tie; `-inf` at the direct one when all are further apart
+    /// than `prediction`).
+    pub(crate) fn deepest(
+        &self,
+        a: &Shape,
+        pa: &Pose,
+        b: &Shape,
+        pb: &Pose,
+        prediction: f64,
+    ) -> Result<(f64, Vec2), OracleError> {
+        let mut best = (f64::NEG_INFINITY, Vec2::ZERO);
+        for &o in &self.offsets {
+            if o != Vec2::ZERO && !near(a, pa, b, &moved(pb, o), prediction) {
+                continue;
+            }
+            let d = depth(a, pa, b, &moved(pb, o), prediction)?;
+            if d > best.0 {
+                best = (d, o);
+            }
+        }
+        Ok(best)
+    }
+}
+
+/// `pose` translated by `offset` (the pose itself for the direct one), as Ricochet
+/// translates it.
+pub(crate) fn moved(pose: &Pose, offset: Vec2) -> Pose {
+    if offset == Vec2::ZERO {
+        *pose
+    } else {
+        Pose::new(pose.position + offset, pose.angle)
+    }
+}
+
+/// Whether the two shapes' bounds, widened by `margin`, overlap: a translation that fails
+/// this is not worth a parry query.
+pub(crate) fn near(a: &Shape, pa: &Pose, b: &Shape, pb: &Pose, margin: f64) -> bool {
+    widened(a.bounds(pa), margin).overlaps(&b.bounds(pb))
+}
+
+/// `b` grown by `margin` (plus a relative rounding margin) on every side.
+pub(crate) fn widened(b: Bounds, margin: f64) -> Bounds {
+    let m = margin.max(0.0) + 1e-9 * (1.0 + b.min.abs().max(b.max.abs()).max_element());
+    Bounds {
+        min: b.min - Vec2::splat(m),
+        max: b.max + Vec2::splat(m),
+    }
+}

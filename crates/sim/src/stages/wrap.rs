@@ -1,0 +1,232 @@
+//! The wrap seam: in a world with `bounds` and `wrap = true`, bodies collide through the
+//! edges. A body near an edge also collides, through its **images** (the body translated
+//! by whole world sizes, [`WorldBounds::image_offsets`]), with bodies near the opposite
+//! edge, or the opposite corner.
+//!
+//! **Broad phase.** Only moving bodies get images, and only those near an edge. "Near" is
+//! within the world's *reach* of the edge: how far any body's bounds stick out of the world
+//! on that axis (static bodies measured when they change, moving ones every frame), plus a
+//! rounding margin. That is enough: if `b` translated by `+width` overlaps `a`, then
+//! `a.max.x >= b.min.x + width >= max.x - reach` and
+//! `b.min.x <= a.max.x - width <= min.x + reach`, so *both* bodies are near the edges the
+//! offset crosses (on both axes for a corner), and the moving one of the two has the image.
+//! The images go to a broad phase of their own, with the near moving bodies and the static
+//! bodies (whose structures it builds only when they change), never to the main one, whose
+//! sorted lists stay as they were; the pairs it finds with an image are mapped back to the
+//! real bodies and merged into the main pairs (sorted `(i, j)`, `i < j`, each once). When
+//! nothing sticks out of the world the reach is zero and only bodies touching an edge get an
+//! image: a frame without any costs one pass over the moving bodies' bounds.
+//!
+//! **Narrow phase.** A pair with an image is tested directly and at every offset either
+//! body's images suggest, with `b` translated next to `a`; the deepest contact wins, the
+//! first in [`WorldBounds::image_offsets`] order (the direct one first) on a tie. The
+//! contact, and its logged `pose_b`, are in `a`'s coordinates: `pose_b` is `b`'s image.
+//! Swept pairs take the earliest touch the same way.
+//!
+//! Offsets are whole world sizes `-1, 0, 1` on each axis: a body further than a world size
+//! out of the bounds (only a static body, or a body placed there, can be) meets no image
+//! beyond those.
+
+use ricochet_geom::{Bounds, Vec2};
+
+use crate::broad_phase::{BodyEntry, BroadPhase, BroadPhaseKind, Interactions, STATIC_BIT};
+use crate::def::WorldBounds;
+use crate::entity::Entity;
+use crate::world::World;
+
+/// Keys of image entries: above every real key (an entity's index is below `2^31`).
+const IMAGE_KEY: u64 = 1 << 63;
+
+/// The rounding margin of "near an edge" and of an image's bounds, relative to the world's
+/// size: `2^-40`, far above the rounding of `x + width`, far below any shape.
+const SLACK: f64 = 1.0 / (1u64 << 40) as f64;
+
+/// The wrap seam's state (see the module docs).
+#[derive(Debug)]
+pub(crate) struct Seam {
+    /// The images' own broad phase.
+    broad_phase: BroadPhase,
+    /// [`WorldBounds::image_offsets`] of the world.
+    offsets: [Vec2; 9],
+    /// This frame's broad-phase entries: the near moving bodies, then their images.
+    entries: Vec<BodyEntry>,
+    /// World index of each entry: a near moving body's, or the body an image is of.
+    bodies: Vec<u32>,
+    /// Entries from here on are images.
+    first_image: usize,
+    /// Per world index, the offsets of the body's images (bit `k`: `offsets[k]`); empty
+    /// when no body has one this frame.
+    masks: Vec<u16>,
+    /// How far the static bodies' bounds reach out of the world on each axis (`>= 0`).
+    static_reach: Vec2,
+    found: Vec<(u32, u32)>,
+}
+
+/// How far `b` sticks out of the world on each axis (`>= 0`).
+fn reach(world: &WorldBounds, b: &Bounds) -> Vec2 {
+    (world.min - b.min).max(b.max - world.max).max(Vec2::ZERO)
+}
+
+/// The offset index `k` of `-offsets[k]` ([`WorldBounds::image_offsets`] lists them so).
+fn negated(k: usize) -> usize {
+    if k == 0 { 0 } else { 9 - k }
+}
+
+/// Which offsets (bit `k`: [`WorldBounds::image_offsets`]`[k]`) a body with bounds `b`
+/// has images at, given the edges moved in by the reach (`lo`, `hi`).
+fn image_mask(b: &Bounds, lo: Vec2, hi: Vec2) -> u16 {
+    // Near the upper edge: an image one size below; near the lower: one above.
+    let steps = |axis: usize| [b.max[axis] >= hi[axis], true, b.min[axis] <= lo[axis]];
+    let (xs, ys) = (steps(0), steps(1));
+    let mut mask = 0u16;
+    for (gx, &okx) in xs.iter().enumerate() {
+        for (gy, &oky) in ys.iter().enumerate() {
+            let g = 3 * gx + gy;
+            if okx && oky && g != 4 {
+                mask |= 1 << if g < 4 { g + 1 } else { g };
+            }
+        }
+    }
+    mask
+}
+
+impl Seam {
+    /// The seam of a world whose broad phase is `kind`.
+    pub(crate) fn new(kind: BroadPhaseKind) -> Seam {
+        Seam {
+            broad_phase: BroadPhase::new(kind),
+            offsets: [Vec2::ZERO; 9],
+            entries: Vec::new(),
+            bodies: Vec::new(),
+            first_image: 0,
+            masks: Vec::new(),
+            static_reach: Vec2::ZERO,
+            found: Vec::new(),
+        }
+    }
+
+    /// Measures how far the static bodies reach out of the world: call it whenever the
+    /// static bodies change.
+    pub(crate) fn statics_changed(&mut self, world: &WorldBounds, statics: &[BodyEntry]) {
+        self.static_reach = statics
+            .iter()
+            .fold(Vec2::ZERO, |r, s| r.max(reach(world, &s.bounds)));
+    }
+
+    /// Adds to `pairs` (the main broad phase's: dense indices, sorted) the pairs that meet
+    /// through the seam: the images of the moving bodies near an edge (`movers`, whose world
+    /// indices are [`World::movers`], and `all`, the bounds of them all) against the near moving bodies and the static bodies
+    /// (`statics`, read only when `static_generation` changes).
+    pub(crate) fn add_pairs(
+        &mut self,
+        world: &WorldBounds,
+        w: &World,
+        (statics, static_generation): (&[BodyEntry], u64),
+        (movers, all): (&[BodyEntry], Option<Bounds>),
+        interactions: &Interactions,
+        pairs: &mut Vec<(u32, u32)>,
+    ) {
+        self.offsets = world.image_offsets();
+        self.masks.clear();
+        self.entries.clear();
+        self.bodies.clear();
+        let slack = world.size() * SLACK;
+        let r = all.map_or(self.static_reach, |b| {
+            self.static_reach.max(reach(world, &b))
+        });
+        let (lo, hi) = (world.min + r + slack, world.max - r - slack);
+        let indices = w.movers();
+        for (m, entry) in movers.iter().enumerate() {
+            let b = &entry.bounds;
+            if b.min.x > lo.x && b.max.x < hi.x && b.min.y > lo.y && b.max.y < hi.y {
+                continue;
+            }
+            if self.masks.is_empty() {
+                self.masks.resize(w.len(), 0);
+            }
+            self.masks[indices[m] as usize] = image_mask(b, lo, hi);
+            self.entries.push(*entry);
+            self.bodies.push(indices[m]);
+        }
+        if self.entries.is_empty() {
+            return;
+        }
+        self.first_image = self.entries.len();
+        for n in 0..self.first_image {
+            let (entry, i) = (self.entries[n], self.bodies[n]);
+            let mask = self.masks[i as usize];
+            for k in (1..9).filter(|k| mask & (1 << k) != 0) {
+                let moved = entry.bounds.translated(self.offsets[k]);
+                self.entries.push(BodyEntry {
+                    key: IMAGE_KEY | ((n as u64) << 4) | k as u64,
+                    bounds: Bounds {
+                        min: moved.min - slack,
+                        max: moved.max + slack,
+                    },
+                    ..entry
+                });
+                self.bodies.push(i);
+            }
+        }
+        let mut found = std::mem::take(&mut self.found);
+        self.broad_phase.pairs_split_handles(
+            statics,
+            static_generation,
+            &self.entries,
+            interactions,
+            &mut found,
+        );
+        let before = pairs.len();
+        let world_index = |h: u32| -> u32 {
+            if h & STATIC_BIT != 0 {
+                let key = statics[(h & !STATIC_BIT) as usize].key;
+                let e = Entity {
+                    index: (key >> 32) as u32,
+                    generation: key as u32,
+                };
+                w.index_of(e).map_or(u32::MAX, |i| i as u32)
+            } else {
+                self.bodies[h as usize]
+            }
+        };
+        let image = |h: u32| h & STATIC_BIT == 0 && h as usize >= self.first_image;
+        for &(p, q) in &found {
+            // Exactly one image: two images moved alike are a real pair, found already.
+            if image(p) == image(q) {
+                continue;
+            }
+            let (i, j) = (world_index(p), world_index(q));
+            debug_assert!(i != u32::MAX && j != u32::MAX, "statics are this frame's");
+            if i != j && i != u32::MAX && j != u32::MAX {
+                pairs.push((i.min(j), i.max(j)));
+            }
+        }
+        self.found = found;
+        if pairs.len() > before {
+            pairs.sort_unstable_by_key(|&(i, j)| (u64::from(i) << 32) | u64::from(j));
+            pairs.dedup();
+        }
+    }
+
+    /// The offsets, besides the direct test, at which the pair `(i, j)` (world indices)
+    /// may overlap through the seam: each a translation of `j` next to `i`, in
+    /// [`WorldBounds::image_offsets`] order. Empty for a pair of bodies without images.
+    pub(crate) fn offsets(&self, i: usize, j: usize) -> impl Iterator<Item = Vec2> + '_ {
+        let mask = match self.masks.get(i).zip(self.masks.get(j)) {
+            Some((&mi, &mj)) => {
+                // `j + o` near `i`: `j`'s own images, and `i`'s images negated.
+                let mut m = mj;
+                for k in 1..9 {
+                    if mi & (1 << k) != 0 {
+                        m |= 1 << negated(k);
+                    }
+                }
+                m
+            }
+            None => 0,
+        };
+        (1..9)
+            .filter(move |k| mask & (1 << k) != 0)
+            .map(|k| self.offsets[k])
+    }
+}
