@@ -445,19 +445,16 @@ impl World {
     /// [`World::bounds`], widened over the frame's motion for a body of a layer in
     /// `sweeping` (a bullet that went right through something is still paired with it), and
     /// a frozen body handed over as kinematic (it keeps its place in the dense order; the
-    /// caller drops its pairs). Returns the bounds of them all (`None` without moving
-    /// bodies): how far they reach, for the wrap seam.
+    /// caller drops its pairs). `visit` sees each entry's place in `out` and its bounds as
+    /// they are made (the wrap seam looks for bodies near an edge without another pass).
     pub(crate) fn mover_entries(
         &mut self,
         sweeping: &[bool],
         out: &mut Vec<BodyEntry>,
-    ) -> Option<Bounds> {
+        mut visit: impl FnMut(usize, &Bounds),
+    ) {
         out.clear();
         out.reserve(self.movers.len());
-        let mut all = Bounds {
-            min: Vec2::INFINITY,
-            max: Vec2::NEG_INFINITY,
-        };
         for &i in &self.movers {
             let i = i as usize;
             let p = self.position[i];
@@ -467,7 +464,7 @@ impl World {
             if sweeping[usize::from(layer)] && moved != Vec2::ZERO {
                 bounds = bounds.union(bounds.translated(moved));
             }
-            all = all.union(bounds);
+            visit(out.len(), &bounds);
             out.push(BodyEntry {
                 key: self.key(i),
                 bounds,
@@ -479,7 +476,6 @@ impl World {
                 },
             });
         }
-        (!out.is_empty()).then_some(all)
     }
 
     /// The pose of body `i`.

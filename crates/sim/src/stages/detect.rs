@@ -129,7 +129,14 @@ fn candidate_pairs(ctx: &mut StageCtx, st: &mut DetectState) -> Vec<(u32, u32)> 
             st.seam.statics_changed(&b, &st.statics);
         }
     }
-    let all = w.mover_entries(&st.sweeping, &mut st.movers);
+    match wrap {
+        Some(b) => {
+            let seam = &mut st.seam;
+            seam.begin(&b);
+            w.mover_entries(&st.sweeping, &mut st.movers, |m, b| seam.visit(m, b));
+        }
+        None => w.mover_entries(&st.sweeping, &mut st.movers, |_, _| {}),
+    }
     let generation = w.static_generation();
     let mut pairs = std::mem::take(&mut st.pairs);
     let bp = st.broad_phase.pairs_split(
@@ -145,7 +152,7 @@ fn candidate_pairs(ctx: &mut StageCtx, st: &mut DetectState) -> Vec<(u32, u32)> 
             &b,
             w,
             (&st.statics, generation),
-            (&st.movers, all),
+            &st.movers,
             &st.interactions,
             &mut pairs,
         );

@@ -15,7 +15,9 @@
 //! sorted lists stay as they were; the pairs it finds with an image are mapped back to the
 //! real bodies and merged into the main pairs (sorted `(i, j)`, `i < j`, each once). When
 //! nothing sticks out of the world the reach is zero and only bodies touching an edge get an
-//! image: a frame without any costs one pass over the moving bodies' bounds.
+//! image. A frame without any costs four comparisons per moving body, made as its broad-phase
+//! entry is built (against the edges moved in by a guessed reach: a quarter more than the
+//! last frame's; a frame whose reach outgrew the guess looks at the moving bodies again).
 //!
 //! **Narrow phase.** A pair with an image is tested directly and at every offset either
 //! body's images suggest, with `b` translated next to `a`; the deepest contact wins, the
@@ -59,6 +61,13 @@ pub(crate) struct Seam {
     masks: Vec<u16>,
     /// How far the static bodies' bounds reach out of the world on each axis (`>= 0`).
     static_reach: Vec2,
+    /// The reach guessed for this frame (from the last one's), and the world's edges moved
+    /// in by it (plus the slack): a body inside them neither sticks out nor can be near.
+    guess: Vec2,
+    guess_lo: Vec2,
+    guess_hi: Vec2,
+    /// Moving bodies (places in the entries) outside the guessed edges.
+    candidates: Vec<u32>,
     found: Vec<(u32, u32)>,
 }
 
@@ -101,6 +110,10 @@ impl Seam {
             first_image: 0,
             masks: Vec::new(),
             static_reach: Vec2::ZERO,
+            guess: Vec2::ZERO,
+            guess_lo: Vec2::ZERO,
+            guess_hi: Vec2::ZERO,
+            candidates: Vec::new(),
             found: Vec::new(),
         }
     }
@@ -113,16 +126,40 @@ impl Seam {
             .fold(Vec2::ZERO, |r, s| r.max(reach(world, &s.bounds)));
     }
 
+    /// Starts a frame: [`Seam::visit`] then sees every moving body's entry.
+    pub(crate) fn begin(&mut self, world: &WorldBounds) {
+        let slack = world.size() * SLACK;
+        let r = self.guess.max(self.static_reach);
+        self.guess_lo = world.min + r + slack;
+        self.guess_hi = world.max - r - slack;
+        self.candidates.clear();
+    }
+
+    /// Notes the moving body at place `m` of the entries if its bounds `b` are outside the
+    /// guessed edges (one pass, as the entries are made).
+    pub(crate) fn visit(&mut self, m: usize, b: &Bounds) {
+        let (lo, hi) = (self.guess_lo, self.guess_hi);
+        if !(b.min.x > lo.x && b.max.x < hi.x && b.min.y > lo.y && b.max.y < hi.y) {
+            self.candidates.push(m as u32);
+        }
+    }
+
     /// Adds to `pairs` (the main broad phase's: dense indices, sorted) the pairs that meet
     /// through the seam: the images of the moving bodies near an edge (`movers`, whose world
-    /// indices are [`World::movers`], and `all`, the bounds of them all) against the near moving bodies and the static bodies
-    /// (`statics`, read only when `static_generation` changes).
+    /// indices are [`World::movers`], each seen by [`Seam::visit`]) against the near moving
+    /// bodies and the static bodies (`statics`, read only when `static_generation`
+    /// changes).
+    ///
+    /// Only bodies outside the guessed edges can stick out of the world, so the reach is
+    /// measured on them; if it is within the guess, they hold every near body, else (the
+    /// reach grew) every moving body is looked at again. The next frame guesses a quarter
+    /// more than this one's reach.
     pub(crate) fn add_pairs(
         &mut self,
         world: &WorldBounds,
         w: &World,
         (statics, static_generation): (&[BodyEntry], u64),
-        (movers, all): (&[BodyEntry], Option<Bounds>),
+        movers: &[BodyEntry],
         interactions: &Interactions,
         pairs: &mut Vec<(u32, u32)>,
     ) {
@@ -131,12 +168,20 @@ impl Seam {
         self.entries.clear();
         self.bodies.clear();
         let slack = world.size() * SLACK;
-        let r = all.map_or(self.static_reach, |b| {
-            self.static_reach.max(reach(world, &b))
+        let r = self.candidates.iter().fold(self.static_reach, |r, &m| {
+            r.max(reach(world, &movers[m as usize].bounds))
         });
         let (lo, hi) = (world.min + r + slack, world.max - r - slack);
+        // Inside the guessed edges is inside these: the candidates hold every near body.
+        let within_guess = self.guess_lo.cmpge(lo).all() && self.guess_hi.cmple(hi).all();
+        self.guess = r * 1.25;
+        if !within_guess {
+            self.candidates.clear();
+            self.candidates.extend(0..movers.len() as u32);
+        }
         let indices = w.movers();
-        for (m, entry) in movers.iter().enumerate() {
+        for &m in &self.candidates {
+            let (m, entry) = (m as usize, &movers[m as usize]);
             let b = &entry.bounds;
             if b.min.x > lo.x && b.max.x < hi.x && b.min.y > lo.y && b.max.y < hi.y {
                 continue;
