@@ -4,7 +4,8 @@
 //! **Owns:** the only link to rapier and parry in the workspace; the conversion of Ricochet
 //! shapes to parry shapes placed exactly as `ricochet_geom` places them; the per-frame
 //! [`Referee`] (every logged contact recomputed by parry; the `all` pass's set of pairs
-//! compared with rapier's broad and narrow phase at the detect poses; every swept pair cast
+//! compared with rapier's broad and narrow phase at the detect poses, with a collider at
+//! every image through the wrap seam (`seam.rs`); every swept pair cast
 //! by parry along the frame's motion; each difference explained by a named rule of
 //! [`rules`]); the free-flight comparison [`compare_motion`];
 //! the [`ValidationSummary`] with its printable [`summary_table`]; the rapier side of
