@@ -14,3 +14,4 @@ mod run_cli;
 mod stress;
 mod util;
 mod validate_cli;
+mod viewer_schemas;
