@@ -73,7 +73,9 @@ fn filled(outline: &[Point3], color: Color) -> TriangleListPrimitive {
         points: outline.to_vec(),
         color,
         colors: Vec::new(),
-        indices: (1..n.saturating_sub(1)).flat_map(|k| [0, k, k + 1]).collect(),
+        indices: (1..n.saturating_sub(1))
+            .flat_map(|k| [0, k, k + 1])
+            .collect(),
     }
 }
 

@@ -6,6 +6,7 @@ mod bad_scenarios;
 mod bench_cli;
 mod collide_cli;
 mod collision_cases;
+mod dump_cli;
 mod fuzz_corpus;
 mod golden;
 mod hostile;
