@@ -379,3 +379,33 @@ fn a_lift_pushes_a_box_along_its_motion_and_crushes_it_against_a_wall() {
     assert_eq!(crushed, Some(85));
     assert!(s.contains(rider), "the engine removes nothing");
 }
+
+#[test]
+fn a_rider_carried_into_a_wall_stops_at_it_and_the_lift_slides_on() {
+    // The lift (top at 0.25) passes under a wall whose bottom is at 0.5: the box on it (0.8
+    // high) is stopped flush at the wall's left face (x = 3), not crushed, and falls once the
+    // lift has slid from under it.
+    let mut s = Simulation::new(
+        &lift_and_box([0.0, 0.0])
+            .tile("wall", [0.5, 2.0], [3.5, 2.5])
+            .scenario(),
+    );
+    let (lift, rider) = (entity(&s, "lift"), entity(&s, "box"));
+    s.step();
+    s.step();
+    s.apply(lift, Action::SetVelocity(Vec2::new(3.0, 0.0)))
+        .unwrap();
+    let mut stopped = false;
+    for frame in 0..120 {
+        let out = s.step();
+        assert!(crushes(&out).is_empty(), "frame {frame}: {:?}", out.events);
+        let b = bounds(&s, rider, [0.4, 0.4]);
+        assert!(b.max.x <= 3.0 + SLOP, "frame {frame}: {b:?} in the wall");
+        stopped |= (b.max.x - 3.0).abs() <= 1e-12;
+    }
+    assert!(stopped, "it reached the wall");
+    let (b, l) = (bounds(&s, rider, [0.4, 0.4]), bounds(&s, lift, LIFT));
+    assert!(l.min.x > b.max.x, "the lift slid on: {l:?}, {b:?}");
+    assert!(b.max.y < l.max.y, "and the box fell: {b:?}");
+    assert_eq!(s.world().carrier[1], None);
+}
