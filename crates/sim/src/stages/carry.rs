@@ -4,7 +4,9 @@
 //! - **Who rides what.** `resolve_y` records each dynamic box's *carrier*
 //!   ([`World::carrier`]): the kinematic or dynamic box that pushed it up last in the pass,
 //!   or, when nothing pushed it up, the carrier it still rests on flush ([`still_rides`]).
-//!   A static body carries nothing (it never moves), so standing on one records `None`.
+//!   A static body carries nothing (it never moves), so standing on one records `None`. A
+//!   box frozen by the active region, put to sleep or teleported rides nothing until a
+//!   `resolve_y` finds what it stands on again.
 //! - **Carried.** In the next frame's `move_x` and `move_y`, before its own `v * dt`, a rider
 //!   moves by its carrier's displacement along the axis ([`displacement`]): the same
 //!   `v * dt` the kinematic carrier adds to its own position in that stage, so a rider keeps
