@@ -409,3 +409,28 @@ fn a_rider_carried_into_a_wall_stops_at_it_and_the_lift_slides_on() {
     assert!(b.max.y < l.max.y, "and the box fell: {b:?}");
     assert_eq!(s.world().carrier[1], None);
 }
+
+#[test]
+fn a_rider_moved_by_the_game_rides_nothing_until_it_lands_again() {
+    // Taken off a moving lift with `set_position`, the box is not carried by the lift it left:
+    // it falls straight down (x unchanged) until it lands on the floor below.
+    let mut s = Simulation::new(
+        &lift_and_box([0.0, 3.0])
+            .tile("floor", [10.0, 0.5], [0.0, -0.5])
+            .scenario(),
+    );
+    let (lift, rider) = (entity(&s, "lift"), entity(&s, "box"));
+    s.step();
+    s.step();
+    s.apply(lift, Action::SetVelocity(Vec2::new(3.0, 0.0)))
+        .unwrap();
+    s.step();
+    assert_eq!(s.world().carrier[1], Some(lift));
+    s.set_position(rider, Vec2::new(-5.0, 2.0)).unwrap();
+    assert_eq!(s.world().carrier[1], None);
+    for frame in 0..60 {
+        s.step();
+        assert_eq!(s.position(rider).unwrap().x, -5.0, "frame {frame}");
+    }
+    assert_eq!(s.grounded(rider), Some(true), "on the floor");
+}
