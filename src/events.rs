@@ -12,7 +12,8 @@ use ricochet_sim::{
 
 /// One event as a log line.
 pub struct EventLine {
-    /// `input`, `spawn`, `destroy`, `expire`, `missed`, `contact`, `hit`, `hit_x` or `hit_y`.
+    /// `input`, `spawn`, `destroy`, `expire`, `missed`, `contact`, `hit`, `hit_x`, `hit_y` or
+    /// `crush`.
     pub kind: &'static str,
     /// Warnings for bodies lost and events that missed, info for inputs and spawns, debug for
     /// collisions.
@@ -51,6 +52,7 @@ fn kind(event: &GameEvent) -> &'static str {
         GameEvent::PushedApart { .. } => "hit",
         GameEvent::PushedOut { axis: 0, .. } => "hit_x",
         GameEvent::PushedOut { .. } => "hit_y",
+        GameEvent::Crushed { .. } => "crush",
     }
 }
 
@@ -112,6 +114,12 @@ fn message(event: &GameEvent, world: &World, out: &FrameOutput) -> String {
             if *axis == 0 { "x" } else { "y" },
             body(*obstacle)
         ),
+        GameEvent::Crushed { body: e, by, axis } => format!(
+            "{} crushed by {}: no room to be pushed out along {}",
+            body(*e),
+            body(*by),
+            if *axis == 0 { "x" } else { "y" },
+        ),
     }
 }
 
@@ -119,7 +127,7 @@ fn message(event: &GameEvent, world: &World, out: &FrameOutput) -> String {
 pub fn line(event: &GameEvent, world: &World, out: &FrameOutput) -> EventLine {
     let kind = kind(event);
     let level = match kind {
-        "destroy" | "expire" | "missed" => LogLevel::Warning,
+        "destroy" | "expire" | "missed" | "crush" => LogLevel::Warning,
         "input" | "spawn" => LogLevel::Info,
         _ => LogLevel::Debug,
     };
@@ -175,6 +183,50 @@ shape = { kind = "circle", radius = 0.5 }
                     "set_velocity: no body named old is alive".to_owned()
                 ),
             ]
+        );
+    }
+
+    /// A lift climbing into a ceiling with a box on it: the crush is a warning naming the box
+    /// and the lift, and the pass it was found in.
+    #[test]
+    fn a_crush_is_a_warning_naming_the_box_and_what_crushed_it() {
+        let text = r#"
+layers = ["solid", "box"]
+collide = [{ a = "box", b = "solid", response = "separate" }]
+world.gravity = [0, -20]
+[[bodies]]
+name = "lift"
+layer = "solid"
+kind = "kinematic"
+shape = { kind = "aabb", half_extents = [1.5, 0.25] }
+velocity = [0, 3]
+[[bodies]]
+name = "ceiling"
+layer = "solid"
+kind = "static"
+shape = { kind = "aabb", half_extents = [4, 0.5] }
+position = [0, 2.025]
+[[bodies]]
+name = "box"
+layer = "box"
+shape = { kind = "aabb", half_extents = [0.4, 0.4] }
+position = [0.3, 0.65]
+"#;
+        let scenario = load_scenario(text, "crush.toml").unwrap();
+        let mut sim = Simulation::new(&scenario);
+        let crush = (0..30).find_map(|_| {
+            let out = sim.step();
+            out.events
+                .iter()
+                .find(|e| matches!(e, GameEvent::Crushed { .. }))
+                .map(|e| line(e, sim.world(), &out))
+        });
+        let crush = crush.expect("the box is crushed");
+        assert_eq!(crush.kind, "crush");
+        assert_eq!(crush.level, LogLevel::Warning);
+        assert_eq!(
+            crush.message,
+            "box #2:0 crushed by lift #0:0: no room to be pushed out along y"
         );
     }
 }

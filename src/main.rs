@@ -9,9 +9,11 @@
 
 mod accuracy;
 mod bench;
+mod channels;
 mod check;
 mod collide;
 mod diff;
+mod dump;
 mod events;
 mod files;
 mod load;
@@ -71,6 +73,28 @@ enum Command {
         /// summary table; exit code 1 on any unexplained difference.
         #[arg(long)]
         validate: bool,
+        /// Record only these channels (comma-separated: scene, bodies, contacts, stats,
+        /// events). Default: all five. Without /scene, Foxglove's 3D panel is empty but plots
+        /// and the log panel work; `ricochet diff` needs /bodies to name a divergent body.
+        #[arg(long, value_name = "LIST")]
+        channels: Option<String>,
+    },
+    /// Print a log as JSON lines, one message a line, for scripts and grep.
+    ///
+    /// Each line is {"topic", "sequence", "log_time", "publish_time", "data"}, like
+    /// `mcap cat --json`; `data` is the message as recorded. Memory does not grow with the
+    /// log. Exit code 2 when the log is unreadable, damaged, or has no such topic.
+    ///
+    /// Example: ricochet dump recordings/asteroids.mcap --topic /contacts --frames 40..60
+    Dump {
+        /// The log (MCAP written by `ricochet run`).
+        log: PathBuf,
+        /// Only this topic (/bodies, /contacts, /stats, /events, /scene).
+        #[arg(long, value_name = "T")]
+        topic: Option<String>,
+        /// Only these frames: `A..B` (inclusive), `A..`, `..B` or `N`.
+        #[arg(long, value_name = "A..B")]
+        frames: Option<String>,
     },
     /// Referee a scenario with rapier2d: same shapes, same poses, same motion.
     ///
@@ -186,10 +210,11 @@ fn main() -> ExitCode {
         output: None,
         frames: None,
         validate: false,
+        channels: None,
     });
     // An error that ends a command is exit code 1 ("the run failed"), except for `diff`, whose
     // 1 means "the logs differ": there it is 2, like an unreadable file.
-    let failed = if matches!(command, Command::Diff { .. }) {
+    let failed = if matches!(command, Command::Diff { .. } | Command::Dump { .. }) {
         2
     } else {
         1
@@ -201,7 +226,17 @@ fn main() -> ExitCode {
             output,
             frames,
             validate,
-        } => run::run(scenario.as_deref(), output, frames, validate),
+            channels,
+        } => run::run(
+            scenario.as_deref(),
+            output,
+            frames,
+            validate,
+            channels.as_deref(),
+        ),
+        Command::Dump { log, topic, frames } => {
+            dump::run(&log, topic.as_deref(), frames.as_deref())
+        }
         Command::Validate { scenario, frames } => validate::run(&scenario, frames),
         Command::Check { scenario } => check::check(&scenario),
         Command::Bench {

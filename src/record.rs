@@ -20,6 +20,8 @@ use ricochet_log::{ChannelId, LogError, LogWriter};
 use ricochet_sim::{BodyKind, FrameOutput, Layers, RemovedBody, Simulation};
 use serde::Serialize;
 
+use crate::channels::Channels;
+
 /// The `library` field of every log's header.
 pub const LIBRARY: &str = concat!("ricochet ", env!("CARGO_PKG_VERSION"));
 
@@ -116,25 +118,39 @@ fn removed_msg<'a>(r: &'a RemovedBody, layers: &'a Layers) -> BodyMsg<'a> {
 pub struct Recorder {
     writer: LogWriter,
     dt_ns: u64,
-    scene: ChannelId,
-    bodies: ChannelId,
-    contacts: ChannelId,
-    stats: ChannelId,
-    events: ChannelId,
+    scene: Option<ChannelId>,
+    bodies: Option<ChannelId>,
+    contacts: Option<ChannelId>,
+    stats: Option<ChannelId>,
+    events: Option<ChannelId>,
     validation: Option<ChannelId>,
 }
 
 impl Recorder {
     /// Creates the file now (so a bad path fails before the simulation starts) and adds the
-    /// five channels.
-    pub fn create(path: &Path, dt: f64) -> Result<Recorder, LogError> {
+    /// chosen channels (all five by default).
+    pub fn create(path: &Path, dt: f64, channels: Channels) -> Result<Recorder, LogError> {
         let mut writer = LogWriter::create(path, LIBRARY)?;
-        let scene = writer.add_scene_channel("/scene")?;
-        let bodies = writer.add_json_channel("/bodies", "ricochet.Bodies", BODIES_SCHEMA)?;
-        let contacts =
-            writer.add_json_channel("/contacts", "ricochet.Contacts", CONTACTS_SCHEMA)?;
-        let stats = writer.add_json_channel("/stats", "ricochet.Stats", STATS_SCHEMA)?;
-        let events = writer.add_log_channel("/events")?;
+        let mut add = |on: bool,
+                       make: &mut dyn FnMut(&mut LogWriter) -> Result<ChannelId, LogError>|
+         -> Result<Option<ChannelId>, LogError> {
+            if on {
+                make(&mut writer).map(Some)
+            } else {
+                Ok(None)
+            }
+        };
+        let scene = add(channels.scene, &mut |w| w.add_scene_channel("/scene"))?;
+        let bodies = add(channels.bodies, &mut |w| {
+            w.add_json_channel("/bodies", "ricochet.Bodies", BODIES_SCHEMA)
+        })?;
+        let contacts = add(channels.contacts, &mut |w| {
+            w.add_json_channel("/contacts", "ricochet.Contacts", CONTACTS_SCHEMA)
+        })?;
+        let stats = add(channels.stats, &mut |w| {
+            w.add_json_channel("/stats", "ricochet.Stats", STATS_SCHEMA)
+        })?;
+        let events = add(channels.events, &mut |w| w.add_log_channel("/events"))?;
         Ok(Recorder {
             writer,
             // Whole nanoseconds per step; `f64 as u64` saturates and the scenario checks
@@ -175,8 +191,39 @@ impl Recorder {
         let ts = Timestamp::from_nanos(t);
         let w = sim.world();
         let layers = &sim.scenario().world.layers;
-        self.writer
-            .write(self.scene, t, &crate::scene::scene_update(w, out, ts))?;
+        if let Some(ch) = self.scene {
+            self.writer
+                .write(ch, t, &crate::scene::scene_update(w, out, ts))?;
+        }
+        if let Some(ch) = self.bodies {
+            self.write_bodies(ch, sim, out)?;
+        }
+        if let Some(ch) = self.contacts {
+            write_contacts(&mut self.writer, ch, t, out)?;
+        }
+        if let Some(ch) = self.stats {
+            write_stats(&mut self.writer, ch, t, out, layers)?;
+        }
+        if let Some(ch) = self.events {
+            for e in &out.events {
+                let line = crate::events::line(e, w, out);
+                let log = Log::new(ts, line.level, line.kind, line.message);
+                self.writer.write(ch, t, &log)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// `/bodies`: every body at the end of the frame, and the removed ones.
+    fn write_bodies(
+        &mut self,
+        ch: ChannelId,
+        sim: &Simulation,
+        out: &FrameOutput,
+    ) -> Result<(), LogError> {
+        let t = out.frame * self.dt_ns;
+        let w = sim.world();
+        let layers = &sim.scenario().world.layers;
         let bodies = (0..w.len())
             .map(|i| BodyMsg {
                 id: w.entity[i].index,
@@ -197,65 +244,78 @@ impl Recorder {
             bodies,
             removed,
         };
-        self.writer.write(self.bodies, t, &msg)?;
-        let contacts = out
-            .contacts
-            .iter()
-            .map(|c| ContactMsg {
-                a: c.a.index,
-                a_generation: c.a.generation,
-                b: c.b.index,
-                b_generation: c.b.generation,
-                phase: c.phase.name(),
-                normal: xy(c.normal),
-                depth: c.depth,
-                point: xy(c.point),
-                pose_a: pose3(&c.pose_a),
-                pose_b: pose3(&c.pose_b),
-                response: c.response.name(),
-                resolved: xy(c.resolved),
-            })
-            .collect();
-        self.writer.write(
-            self.contacts,
-            t,
-            &ContactsMsg {
-                frame: out.frame,
-                contacts,
-            },
-        )?;
-        let s = &out.stats;
-        let stats = StatsMsg {
-            frame: out.frame,
-            bodies: s.bodies,
-            broad_phase: s.broad_phase.map_or("", |k| k.name()),
-            broad_pairs: s.broad_pairs,
-            narrow_tests: s.narrow_tests,
-            contacts: s.contacts,
-            layer_pairs_skipped: s.layer_pairs_skipped,
-            frozen: s.frozen,
-            asleep: s.asleep,
-            stages_run: s.stages_run.len(),
-            stages_skipped: s.stages_skipped.len(),
-            skipped: s.stages_skipped.iter().map(|st| st.name()).collect(),
-            tests_by_layer_pair: s
-                .tests_by_layer_pair
-                .iter()
-                .map(|&((a, b), n)| (format!("{}/{}", layers.name(a), layers.name(b)), n))
-                .collect(),
-            kinetic_energy: s.kinetic_energy,
-        };
-        self.writer.write(self.stats, t, &stats)?;
-        for e in &out.events {
-            let line = crate::events::line(e, w, out);
-            let log = Log::new(ts, line.level, line.kind, line.message);
-            self.writer.write(self.events, t, &log)?;
-        }
-        Ok(())
+        self.writer.write(ch, t, &msg)
     }
 
     /// Writes the summary and index. Called after an interrupted run too.
     pub fn finish(self) -> Result<(), LogError> {
         self.writer.finish()
     }
+}
+
+/// `/contacts`: every contact of the frame with the poses it was found at.
+fn write_contacts(
+    writer: &mut LogWriter,
+    ch: ChannelId,
+    t: u64,
+    out: &FrameOutput,
+) -> Result<(), LogError> {
+    let contacts = out
+        .contacts
+        .iter()
+        .map(|c| ContactMsg {
+            a: c.a.index,
+            a_generation: c.a.generation,
+            b: c.b.index,
+            b_generation: c.b.generation,
+            phase: c.phase.name(),
+            normal: xy(c.normal),
+            depth: c.depth,
+            point: xy(c.point),
+            pose_a: pose3(&c.pose_a),
+            pose_b: pose3(&c.pose_b),
+            response: c.response.name(),
+            resolved: xy(c.resolved),
+        })
+        .collect();
+    writer.write(
+        ch,
+        t,
+        &ContactsMsg {
+            frame: out.frame,
+            contacts,
+        },
+    )
+}
+
+/// `/stats`: the frame's counters, layer pairs and stages named.
+fn write_stats(
+    writer: &mut LogWriter,
+    ch: ChannelId,
+    t: u64,
+    out: &FrameOutput,
+    layers: &Layers,
+) -> Result<(), LogError> {
+    let s = &out.stats;
+    let stats = StatsMsg {
+        frame: out.frame,
+        bodies: s.bodies,
+        broad_phase: s.broad_phase.map_or("", |k| k.name()),
+        broad_pairs: s.broad_pairs,
+        narrow_tests: s.narrow_tests,
+        contacts: s.contacts,
+        layer_pairs_skipped: s.layer_pairs_skipped,
+        frozen: s.frozen,
+        asleep: s.asleep,
+        stages_run: s.stages_run.len(),
+        stages_skipped: s.stages_skipped.len(),
+        skipped: s.stages_skipped.iter().map(|st| st.name()).collect(),
+        tests_by_layer_pair: s
+            .tests_by_layer_pair
+            .iter()
+            .map(|&((a, b), n)| (format!("{}/{}", layers.name(a), layers.name(b)), n))
+            .collect(),
+        kinetic_energy: s.kinetic_energy,
+    };
+    writer.write(ch, t, &stats)
 }

@@ -10,6 +10,7 @@ use std::time::Instant;
 use anyhow::Context;
 use ricochet_sim::Simulation;
 
+use crate::channels::Channels;
 use crate::load::{DEFAULT_NAME, load};
 use crate::out;
 use crate::record::Recorder;
@@ -23,7 +24,15 @@ pub fn run(
     output: Option<PathBuf>,
     frames: Option<u64>,
     validate: bool,
+    channels: Option<&str>,
 ) -> anyhow::Result<ExitCode> {
+    let channels = match channels.map(Channels::parse).transpose() {
+        Ok(c) => c.unwrap_or_default(),
+        Err(e) => {
+            out::error(&format!("error: {e}"));
+            return Ok(ExitCode::from(2));
+        }
+    };
     let scenario = match load(path) {
         Ok(s) => s,
         Err(code) => return Ok(code),
@@ -67,7 +76,7 @@ pub fn run(
     // Created before the first step: an unwritable path fails now, not after the run. The
     // log goes to a temporary file renamed onto `output` when it is complete, so an existing
     // file there stays whole until then, whatever stops the run.
-    let mut recorder = match Recorder::create(&output, scenario.world.dt) {
+    let mut recorder = match Recorder::create(&output, scenario.world.dt, channels) {
         Ok(r) => r,
         Err(e) => {
             out::error(&format!("error: cannot write the log: {e}"));

@@ -1,11 +1,11 @@
-//! Drawing a frame as a `foxglove.SceneUpdate`: every body in the XY plane (cubes for boxes,
-//! cylinders for circles, line loops for polygons and capsule outlines), contact normals as
+//! Drawing a frame as a `foxglove.SceneUpdate`: every body in the XY plane, filled (cubes for
+//! boxes, cylinders for circles, triangle fans for polygons and capsules), contact normals as
 //! arrows, and deletions for the bodies removed this frame.
 
 use ricochet_geom::{Primitive, Rot, Shape, Vec2};
 use ricochet_log::foxglove::{
-    ArrowPrimitive, Color, CubePrimitive, CylinderPrimitive, LinePrimitive, LineType, Point3, Pose,
-    Quaternion, SceneEntity, SceneEntityDeletion, SceneUpdate, Timestamp, Vector3,
+    ArrowPrimitive, Color, CubePrimitive, CylinderPrimitive, Point3, Pose, Quaternion, SceneEntity,
+    SceneEntityDeletion, SceneUpdate, Timestamp, TriangleListPrimitive, Vector3,
 };
 use ricochet_sim::{BodyKind, Entity, FrameOutput, World};
 
@@ -64,16 +64,18 @@ fn capsule_outline(a: Vec2, b: Vec2, r: f64) -> Vec<Point3> {
     pts
 }
 
-fn line_loop(points: Vec<Point3>, color: Color) -> LinePrimitive {
-    LinePrimitive {
-        line_type: LineType::LineLoop,
+/// A convex outline, filled: a fan of triangles from its first point (filled like the
+/// circles and boxes, where a thin outline was a faint one-pixel line at the layout's zoom).
+fn filled(outline: &[Point3], color: Color) -> TriangleListPrimitive {
+    let n = outline.len() as u32;
+    TriangleListPrimitive {
         pose: Pose::planar(0.0, 0.0, 0.0),
-        thickness: DEPTH,
-        scale_invariant: false,
-        points,
+        points: outline.to_vec(),
         color,
         colors: Vec::new(),
-        indices: Vec::new(),
+        indices: (1..n.saturating_sub(1))
+            .flat_map(|k| [0, k, k + 1])
+            .collect(),
     }
 }
 
@@ -116,17 +118,18 @@ fn draw(
         }
         Primitive::Capsule(c) => {
             let (a, b) = (position + rot.apply(c.a), position + rot.apply(c.b));
+            // A capsule is convex: its outline fans into triangles like a polygon's.
             entity
-                .lines
-                .push(line_loop(capsule_outline(a, b, c.radius), color));
+                .triangles
+                .push(filled(&capsule_outline(a, b, c.radius), color));
         }
         Primitive::Polygon(p) => {
-            let pts = p
+            let pts: Vec<Point3> = p
                 .vertices()
                 .iter()
                 .map(|v| p3(position + rot.apply(*v)))
                 .collect();
-            entity.lines.push(line_loop(pts, color));
+            entity.triangles.push(filled(&pts, color));
         }
     }
 }
@@ -166,7 +169,8 @@ pub fn scene_update(world: &World, out: &FrameOutput, ts: Timestamp) -> SceneUpd
         entities.push(e);
     }
     // Contact normals: an arrow from the contact point along the normal, as long as the depth
-    // (at least 0.2 units, so shallow contacts stay visible). Replaced every frame.
+    // but at least 0.8 units (about 8 px at the layout's zoom; shallow contacts stay visible).
+    // Replaced every frame.
     let mut contacts = SceneEntity::new("contacts", FRAME_ID, ts);
     for c in &out.contacts {
         contacts.arrows.push(ArrowPrimitive {
@@ -174,10 +178,10 @@ pub fn scene_update(world: &World, out: &FrameOutput, ts: Timestamp) -> SceneUpd
                 Vector3::new(c.point.x, c.point.y, DEPTH),
                 Quaternion::from_yaw(libm::atan2(c.normal.y, c.normal.x)),
             ),
-            shaft_length: c.depth.max(0.2),
-            shaft_diameter: 0.04,
-            head_length: 0.12,
-            head_diameter: 0.12,
+            shaft_length: c.depth.max(0.8),
+            shaft_diameter: 0.12,
+            head_length: 0.35,
+            head_diameter: 0.3,
             color: Color::rgba(1.0, 0.2, 0.2, 1.0),
         });
     }

@@ -249,6 +249,35 @@ fn hostile_scenarios_are_named_with_their_location() {
     );
 }
 
+/// A field the body's kind ignores is rejected: whoever wrote it expected it to do
+/// something (a static lift given a velocity meant `kinematic`).
+#[test]
+fn a_field_the_kind_ignores_is_named_with_what_to_write() {
+    case(
+        "static-with-velocity",
+        "8:1",
+        &[
+            "bodies[0].velocity",
+            "static body never moves",
+            "kind = \"kinematic\"",
+        ],
+    );
+    case(
+        "kinematic-with-template-gravity",
+        "6:1",
+        &[
+            "bodies[0].gravity_scale",
+            "kinematic body",
+            "set by template \"crate\"",
+        ],
+    );
+    case(
+        "spawn-static-with-velocity",
+        "12:1",
+        &["script[0].velocity", "\"wall\" is static", "kinematic"],
+    );
+}
+
 #[test]
 fn every_bad_scenario_file_has_a_case() {
     let mut files: Vec<String> = std::fs::read_dir(crate::util::data("bad-scenarios"))

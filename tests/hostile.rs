@@ -64,8 +64,9 @@ fn a_full_stdout_is_an_error_with_a_message_for_every_subcommand() {
     let dir = tempfile::tempdir().unwrap();
     let (a, b) = two_logs(dir.path());
     let cases_file = data("collision-cases.json");
-    let cases: [(&[&str], i32); 6] = [
+    let cases: [(&[&str], i32); 7] = [
         (&["check", "scenarios/asteroids.toml"], 1),
+        (&["dump", s(&a)], 2),
         (&["diff", s(&a), s(&b)], 2),
         (&["diff", "--json", s(&a), s(&b)], 2),
         (&["diff", s(&a), s(&a)], 2),

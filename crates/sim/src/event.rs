@@ -91,6 +91,19 @@ pub enum GameEvent {
         /// The box it was pushed out of.
         obstacle: Entity,
     },
+    /// A box that a kinematic body pushed or carried this frame still overlaps a static or
+    /// kinematic box after its per-axis pass: it was pushed into a wall (or ceiling, or
+    /// floor) with no room to go. The engine leaves it where the pushes put it, overlapping;
+    /// the game decides (remove it, take a life, stop the lift).
+    Crushed {
+        /// The box.
+        body: Entity,
+        /// The kinematic body that pushed it, or the one it rode (at the bottom of its chain
+        /// of carriers).
+        by: Entity,
+        /// The pass that found it: `0` for `resolve_x`, `1` for `resolve_y`.
+        axis: u8,
+    },
 }
 
 /// What a script event did to a body it found.

@@ -11,10 +11,10 @@
 //! | `unground` | clear `grounded`: it is set again below by whatever holds a body up |
 //! | `controls` | controllers turn inputs into angular velocity (ship) or x velocity (runner, walker) |
 //! | `forces` | semi-implicit Euler, velocity half: `a = sum(f) / m`, `v += a * dt` |
-//! | `move_x` | `x += vx * dt` for every moving body |
-//! | `resolve_x` | per-axis separation along x (boxes in `separate` layer pairs) |
-//! | `move_y` | `y += vy * dt` |
-//! | `resolve_y` | per-axis separation along y; a push upwards sets `grounded` |
+//! | `move_x` | a rider first moves by its carrier's `vx * dt`; then `x += vx * dt` for every moving body |
+//! | `resolve_x` | per-axis separation along x (boxes in `separate` layer pairs); `crushed` when a kinematic body left a box no room |
+//! | `move_y` | a rider first moves by its carrier's `vy * dt`; then `y += vy * dt` |
+//! | `resolve_y` | per-axis separation along y; a push upwards sets `grounded` and the carrier a box rides next frame; `crushed` as along x |
 //! | `turn` | `angle += angular_velocity * dt` |
 //! | `detect` | broad phase, exact narrow phase, `report`/`destroy`/`separate` responses |
 //! | `lifetimes` | count down lifetimes; remove expired bodies |
@@ -23,6 +23,11 @@
 //!
 //! The motion stages visit only the *active* bodies ([`World::active`]): moving, not frozen,
 //! not asleep. Static bodies are never visited after they are indexed.
+//!
+//! Riders (`stages/carry.rs`): a dynamic box that a kinematic box (or a box riding one)
+//! held up in the last `resolve_y` is carried by that kinematic body's `v * dt` in `move_x`
+//! and `move_y`, before its own motion, so it keeps its place on a moving platform; a
+//! kinematic box moving into a dynamic one pushes it in the per-axis passes.
 
 use crate::action::{Action, Event};
 use crate::entity::Entity;

@@ -14,11 +14,11 @@ pub enum Stage {
     Controls,
     /// `v += a dt`.
     Forces,
-    /// `x += vx dt`.
+    /// Riders carried by their carrier's `vx dt`, then `x += vx dt`.
     MoveX,
     /// Per-axis separation along x.
     ResolveX,
-    /// `y += vy dt`.
+    /// Riders carried by their carrier's `vy dt`, then `y += vy dt`.
     MoveY,
     /// Per-axis separation along y.
     ResolveY,

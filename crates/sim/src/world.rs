@@ -63,6 +63,11 @@ pub struct World {
     pub grounded: Vec<bool>,
     /// Standing on a static body: pushed up by one this frame (what sleeping needs).
     pub on_static: Vec<bool>,
+    /// What a box stands on and rides (`stages/carry.rs`): the kinematic or dynamic box that
+    /// last pushed it up in the last `resolve_y` (or that it still rests on, flush), `None`
+    /// on a static body or in the air. `move_x` and `move_y` move it by that carrier's
+    /// displacement before its own motion.
+    pub carrier: Vec<Option<Entity>>,
     /// Ended the last frame where it started it, with zero velocity (a box resting on a
     /// sleeper does not wake it).
     pub still: Vec<bool>,
@@ -172,6 +177,7 @@ impl World {
         self.inputs.reserve_exact(additional);
         self.grounded.reserve_exact(additional);
         self.on_static.reserve_exact(additional);
+        self.carrier.reserve_exact(additional);
         self.still.reserve_exact(additional);
         self.split.reserve_exact(additional);
         self.frozen.reserve_exact(additional);
@@ -229,6 +235,7 @@ impl World {
         self.inputs.insert(i, Inputs::default());
         self.grounded.insert(i, false);
         self.on_static.insert(i, false);
+        self.carrier.insert(i, None);
         self.still.insert(i, false);
         self.split.insert(i, def.split.clone());
         self.frozen.insert(i, false);
@@ -286,6 +293,7 @@ impl World {
         self.inputs.remove(i);
         self.grounded.remove(i);
         self.on_static.remove(i);
+        self.carrier.remove(i);
         self.still.remove(i);
         self.split.remove(i);
         self.frozen.remove(i);
@@ -317,10 +325,12 @@ impl World {
     /// Moves body `i` to `position` at `angle` now, keeping the caches right: a static body
     /// bumps [`World::static_generation`] (the broad phase and the per-axis stages re-index
     /// the static bodies) and wakes every sleeper (what it rested on may have moved); a
-    /// moving body wakes. The frame's swept tests start from the new position.
+    /// moving body wakes and no longer rides what it stood on. The frame's swept tests start
+    /// from the new position.
     pub fn teleport(&mut self, i: usize, position: Vec2, angle: f64) {
         self.position[i] = position;
         self.start_position[i] = position;
+        self.carrier[i] = None;
         if self.kind[i] == BodyKind::Static {
             self.angle[i] = angle;
             self.local_bounds[i] = LocalBounds::new(&self.shape[i], angle);
@@ -377,12 +387,14 @@ impl World {
         self.rest_frames[i] = 0;
     }
 
-    /// Puts body `i` to sleep (from the next [`World::refresh_active`] on).
+    /// Puts body `i` to sleep (from the next [`World::refresh_active`] on). A sleeper rides
+    /// nothing: when it wakes, the next `resolve_y` finds what it stands on.
     pub fn put_to_sleep(&mut self, i: usize) {
         if !self.asleep[i] {
             self.sleeping += 1;
         }
         self.asleep[i] = true;
+        self.carrier[i] = None;
     }
 
     /// How many bodies are asleep.

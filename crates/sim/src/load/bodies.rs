@@ -276,6 +276,78 @@ pub(crate) fn body_def(
     })
 }
 
+/// The fields a body file may set that some kind of body ignores, and whether `b` sets each.
+fn kind_sensitive(b: &BodyFile) -> [(&'static str, bool); 6] {
+    [
+        ("velocity", b.velocity.is_some()),
+        ("angular_velocity", b.angular_velocity.is_some()),
+        ("force", b.force.is_some()),
+        ("gravity_scale", b.gravity_scale.is_some()),
+        ("mass", b.mass.is_some()),
+        (
+            "controller",
+            matches!(
+                b.controller,
+                Some(ControllerFile::Runner { .. } | ControllerFile::Walker { .. })
+            ),
+        ),
+    ]
+}
+
+/// Why a body of `kind` ignores `field` (one of [`kind_sensitive`]'s), if it does. What the
+/// stages really do: a static body's velocity and angular velocity are set to zero when it
+/// is created, and it is never integrated, so no controller that sets a velocity (runner,
+/// walker) moves it (a static ship still fires; its turn and thrust do nothing); `forces`
+/// and impulses act on dynamic bodies only, so static and kinematic bodies ignore `force`,
+/// `gravity_scale` and `mass` (a kinematic body keeps its velocity, angular velocity and
+/// controller: it moves, turns, runs or walks, whatever touches it).
+fn ignored_because(kind: BodyKind, field: &str) -> Option<&'static str> {
+    match (kind, field) {
+        (BodyKind::Static, "velocity") => Some(
+            "a static body never moves, so this velocity would be dropped: for a body that \
+             moves at its velocity whatever it touches, write `kind = \"kinematic\"`",
+        ),
+        (BodyKind::Static, "angular_velocity") => Some(
+            "a static body never turns, so this angular velocity would be dropped: for a body \
+             that turns whatever it touches, write `kind = \"kinematic\"`",
+        ),
+        (BodyKind::Static, "controller") => Some(
+            "a static body never moves, so a runner or walker controller would do nothing: \
+             make it dynamic (or kinematic), or remove the controller",
+        ),
+        (BodyKind::Static, _) => Some(
+            "a static body is moved by nothing, so this would be ignored: make it dynamic, \
+             or remove the field",
+        ),
+        (BodyKind::Kinematic, "force" | "gravity_scale" | "mass") => Some(
+            "a kinematic body moves at its velocity whatever acts on it, so this would be \
+             ignored: make it dynamic, or remove the field",
+        ),
+        _ => None,
+    }
+}
+
+/// The first field `merged` (a body over its template, or a template) sets that a body of
+/// `kind` ignores, with the problem: whoever wrote it expected it to do something. `own`
+/// is what the body itself wrote: a field set only by its template says so.
+pub(crate) fn ignored_field(
+    kind: BodyKind,
+    merged: &BodyFile,
+    own: &BodyFile,
+) -> Option<(&'static str, String)> {
+    kind_sensitive(merged)
+        .iter()
+        .zip(kind_sensitive(own))
+        .find_map(|(&(field, set), (_, set_here))| {
+            let why = ignored_because(kind, field).filter(|_| set)?;
+            let problem = match (&own.template, set_here) {
+                (Some(t), false) => format!("{why} (set by template \"{t}\")"),
+                _ => why.to_owned(),
+            };
+            Some((field, problem))
+        })
+}
+
 /// The problem when more than one body of `bodies` has the name `name` that something
 /// addresses (`purpose`: what must name one body), `None` otherwise. `sorted` holds every
 /// body's `(name, index)`, sorted.

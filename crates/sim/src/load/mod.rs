@@ -13,8 +13,8 @@ use std::collections::BTreeMap;
 
 use crate::scenario::Scenario;
 use bodies::{
-    MAX_SPLIT_BODIES, SplitProblem, body_def, merge, names_sorted, references, shared_name,
-    split_problem,
+    MAX_SPLIT_BODIES, SplitProblem, body_def, ignored_field, merge, names_sorted, references,
+    shared_name, split_problem,
 };
 use chunks::split_bodies;
 pub use context::ScenarioError;
@@ -88,6 +88,9 @@ fn load(text: &str, file: &str, chunked: bool) -> Result<Scenario, ScenarioError
             ));
         }
         let def = body_def(&ctx, &world.layers, t.get_ref(), t.span(), &field, name)?;
+        if let Some((f, problem)) = ignored_field(def.kind, t.get_ref(), t.get_ref()) {
+            return Err(ctx.err(t.span(), format!("{field}.{f}"), problem));
+        }
         templates.insert(name.clone(), def);
     }
     // Checks that need every template: bullets and splits must name one.
@@ -146,14 +149,18 @@ fn load(text: &str, file: &str, chunked: bool) -> Result<Scenario, ScenarioError
             .clone()
             .unwrap_or_else(|| "body".to_owned());
         references(&ctx, &templates, &merged, b.span(), &field)?;
-        bodies.push(body_def(
+        let def = body_def(
             &ctx,
             &world.layers,
             &merged,
             b.span(),
             &field,
             &default_name,
-        )?);
+        )?;
+        if let Some((f, problem)) = ignored_field(def.kind, &merged, b.get_ref()) {
+            return Err(ctx.err(b.span(), format!("{field}.{f}"), problem));
+        }
+        bodies.push(def);
     }
     if let Some(r) = &raw.world.active_region {
         let focus = r.focus.get_ref();

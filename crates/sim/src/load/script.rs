@@ -3,7 +3,7 @@
 use std::collections::BTreeMap;
 
 use crate::action::{Action, Event, ScriptAction};
-use crate::def::BodyDef;
+use crate::def::{BodyDef, BodyKind};
 use crate::load::bodies::{names_sorted, shared_name};
 use crate::load::context::{Ctx, ScenarioError, finite, unknown, vec2, within_world};
 use crate::load::file::{ActionFile, EventFile, ScenarioFile};
@@ -106,6 +106,17 @@ pub(crate) fn script(
                 }
                 def.position = within_world(fail, v("position", *position)?)?;
                 if let Some(vel) = velocity {
+                    if def.kind == BodyKind::Static {
+                        return Err(fail(
+                            "velocity",
+                            format!(
+                                "template \"{template}\" is static: a static body never \
+                                 moves, so this velocity would be dropped: for a body that \
+                                 moves at its velocity, give the template \
+                                 `kind = \"kinematic\"`"
+                            ),
+                        ));
+                    }
                     def.velocity = v("velocity", *vel)?;
                 }
                 if let Some(a) = angle {

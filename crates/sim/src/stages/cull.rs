@@ -37,6 +37,10 @@ pub(crate) fn run(ctx: &mut StageCtx, focus: &mut Option<Entity>) {
         let i = w.movers()[k] as usize;
         let outside = area.is_some_and(|a| Some(i) != found && !w.bounds(i).overlaps(&a));
         w.frozen[i] = outside;
+        if outside {
+            // Thawed, it finds what it stands on again: the lift it rode has moved on.
+            w.carrier[i] = None;
+        }
         frozen += usize::from(outside);
     }
     w.refresh_active();

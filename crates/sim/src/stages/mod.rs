@@ -10,6 +10,7 @@ use crate::output::FrameOutput;
 use crate::world::World;
 
 pub(crate) mod bounds;
+pub(crate) mod carry;
 pub(crate) mod cull;
 pub(crate) mod detect;
 pub(crate) mod lifetimes;

@@ -1,8 +1,10 @@
-//! Controls, forces and motion: semi-implicit Euler, exactly `v += a*dt; x += v*dt`.
+//! Controls, forces and motion: semi-implicit Euler, exactly `v += a*dt; x += v*dt`, a rider
+//! first carried by what it stands on (`stages/carry.rs`).
 
 use ricochet_geom::Vec2;
 
 use crate::def::{BodyKind, Controller, WorldDef};
+use crate::stages::carry;
 use crate::world::World;
 
 /// Whether an active body is grounded.
@@ -104,20 +106,28 @@ pub(crate) fn has_motion(w: &World) -> bool {
         .any(|&i| w.velocity[i as usize] != Vec2::ZERO)
 }
 
-/// `position[axis] += velocity[axis] * dt` for every active body.
+/// `position[axis] += velocity[axis] * dt` for every active body, a rider first carried by
+/// its carrier's displacement along the axis (`stages/carry.rs`).
 fn move_axis(w: &mut World, dt: f64, axis: usize) {
     for k in 0..w.active().len() {
         let i = w.active()[k] as usize;
+        if w.carrier[i].is_some() {
+            let d = carry::displacement(w, i, axis, dt);
+            // Nothing is added for no motion: `-0.0 + 0.0` would change a zero's sign.
+            if d != 0.0 {
+                w.position[i][axis] += d;
+            }
+        }
         w.position[i][axis] += w.velocity[i][axis] * dt;
     }
 }
 
-/// `x += vx * dt`.
+/// A rider's `x += carrier's vx * dt`, then everyone's `x += vx * dt`.
 pub(crate) fn move_x(w: &mut World, dt: f64) {
     move_axis(w, dt, 0);
 }
 
-/// `y += vy * dt`.
+/// A rider's `y += carrier's vy * dt`, then everyone's `y += vy * dt`.
 pub(crate) fn move_y(w: &mut World, dt: f64) {
     move_axis(w, dt, 1);
 }

@@ -4,10 +4,13 @@
 //! checked against the other boxes it may not overlap. Where two overlap by more than
 //! [`SLOP`] on both axes, the dynamic one is pushed out along the moved axis by the smaller of
 //! the two overlaps on that axis, its velocity into the obstacle on that axis is zeroed, and a
-//! `hit_x`/`hit_y` event is raised. A push upwards sets `grounded`. Dynamic boxes settle
-//! lowest (leftmost) first, and a settled box is solid to the rest, so stacks resolve
-//! bottom-up in one pass. Only boxes (a single AABB) are resolved per axis; every other shape in
-//! a `separate` pair is pushed along the contact normal by the `detect` stage.
+//! `hit_x`/`hit_y` event is raised. A push upwards sets `grounded`, and records the kinematic
+//! or dynamic box that pushed it as the carrier the box rides next frame; a box that a
+//! kinematic body pushed or carried and that is left overlapping a wall raises `crush`
+//! (riders: `stages/carry.rs`). Dynamic boxes settle lowest (leftmost) first, and a settled
+//! box is solid to the rest, so stacks resolve bottom-up in one pass. Only boxes (a single
+//! AABB) are resolved per axis; every other shape in a `separate` pair is pushed along the
+//! contact normal by the `detect` stage.
 
 //!
 //! Finding the obstacles: static boxes sit in a grid built once (rebuilt only when the static
@@ -24,7 +27,7 @@ use crate::def::{BodyKind, Controller, LayerId, Layers, Response};
 use crate::entity::Entity;
 use crate::event::GameEvent;
 use crate::output::{ContactRecord, Phase};
-use crate::stages::{SLOP, StageCtx};
+use crate::stages::{SLOP, StageCtx, carry};
 use crate::world::World;
 
 /// Whether a shape is resolved per axis: a single axis-aligned box.
@@ -237,6 +240,13 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
         // After pushes that took it further, it looks again.
         let mut region: Option<Bounds> = None;
         let mut next = 0;
+        // What it rode into the frame, and the first kinematic box that pushes it (riders:
+        // `stages/carry.rs`). `resolve_y` records what holds it up now.
+        let old_carrier = ctx.world.carrier[i];
+        if axis == 1 {
+            ctx.world.carrier[i] = None;
+        }
+        let mut pushed_by = None;
         'look: loop {
             let bi = box_bounds(ctx.world, i);
             if !region.is_some_and(|r| contains(&r, &bi)) {
@@ -274,11 +284,16 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
                 if w.asleep[j] && !w.still[i] {
                     woken.push(j);
                 }
-                let on_static = w.kind[j] == BodyKind::Static;
+                let kind = w.kind[j];
+                if kind == BodyKind::Kinematic && pushed_by.is_none() {
+                    pushed_by = Some(j);
+                }
                 let w = &mut *ctx.world;
                 apply_push(w, i, axis, moved[axis]);
-                if axis == 1 && moved[axis] > 0.0 && on_static {
-                    w.on_static[i] = true;
+                if axis == 1 && moved[axis] > 0.0 {
+                    // Held up: by a static body (it may sleep), or by a carrier it rides.
+                    w.on_static[i] |= kind == BodyKind::Static;
+                    w.carrier[i] = (kind != BodyKind::Static).then(|| w.entity[j]);
                 }
                 out.contacts.push(ContactRecord {
                     a: w.entity[a],
@@ -302,6 +317,10 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
                 continue 'look;
             }
             break;
+        }
+        let riding = (old_carrier, pushed_by);
+        if let Some(event) = rider(ctx.world, layers, st, &mut found, (i, axis), riding) {
+            out.events.push(event);
         }
         st.movers.insert(&box_bounds(ctx.world, i), i as u32);
     }
@@ -333,4 +352,47 @@ fn apply_push(w: &mut crate::World, i: usize, axis: usize, push: f64) {
     {
         *speed = -*speed;
     }
+}
+
+/// After box `i`'s pass along `axis` (riders: `stages/carry.rs`). In `resolve_y`, a box that
+/// nothing pushed up keeps `old_carrier` if it still rests on it flush. Then, if a kinematic
+/// box moved it this frame (`pushed_by`, the first that pushed it in this pass, or the
+/// kinematic carrier it rode into the frame), and it still overlaps a static or kinematic
+/// box by more than [`SLOP`] on both axes, it had no room: the [`GameEvent::Crushed`] to
+/// raise. It is left where the pushes put it; the game decides.
+fn rider(
+    w: &mut World,
+    layers: &Layers,
+    st: &mut SeparateState,
+    found: &mut Vec<Obstacle>,
+    (i, axis): (usize, usize),
+    (old_carrier, pushed_by): (Option<Entity>, Option<usize>),
+) -> Option<GameEvent> {
+    if old_carrier.is_none() && pushed_by.is_none() {
+        // Rode nothing, pushed by no kinematic body: the usual case, nothing to do.
+        return None;
+    }
+    let bi = box_bounds(w, i);
+    if axis == 1
+        && w.carrier[i].is_none()
+        && let Some(c) = old_carrier.and_then(|e| w.index_of(e))
+        && carry::still_rides(&bi, &box_bounds(w, c))
+    {
+        w.carrier[i] = old_carrier;
+    }
+    let by = pushed_by.or_else(|| carry::kinematic_root(w, old_carrier))?;
+    obstacles(st, w, &bi, 0, found);
+    let no_room = found.iter().any(|o| {
+        let j = o.index as usize;
+        j != i
+            && w.kind[j] != BodyKind::Dynamic
+            && layers.response(w.layer[i], o.layer) == Response::Separate
+            && overlap(&bi, &o.bounds, 0) > SLOP
+            && overlap(&bi, &o.bounds, 1) > SLOP
+    });
+    no_room.then(|| GameEvent::Crushed {
+        body: w.entity[i],
+        by: w.entity[by],
+        axis: axis as u8,
+    })
 }
