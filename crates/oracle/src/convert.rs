@@ -287,3 +287,14 @@ pub(crate) fn first_touch(
     }
     Ok(best)
 }
+
+/// Parry's depth of the pair at these poses (`-inf` when further apart than `prediction`).
+pub(crate) fn depth(
+    a: &Shape,
+    pa: &Pose,
+    b: &Shape,
+    pb: &Pose,
+    prediction: f64,
+) -> Result<f64, OracleError> {
+    Ok(reference_contact(a, pa, b, pb, prediction)?.map_or(f64::NEG_INFINITY, |r| r.depth))
+}

@@ -11,7 +11,9 @@ use ricochet_sim::{
     Simulation, Stage,
 };
 
-use crate::convert::{ReferenceContact, overlap_along, pairing, place, reference_contact, size};
+use crate::convert::{
+    ReferenceContact, depth, overlap_along, pairing, place, reference_contact, size,
+};
 use crate::pairs::{LayerFilter, penetration};
 use crate::seam::{Seam, moved};
 use crate::{OracleError, Tolerances, rules};
@@ -99,17 +101,6 @@ fn angle_between(a: Vec2, b: Vec2) -> f64 {
 /// Whether the shape is resolved per axis by Ricochet: a single AABB.
 fn is_box(s: &Shape) -> bool {
     matches!(s, Shape::Primitive(Primitive::Aabb(_)))
-}
-
-/// Parry's depth of the pair at these poses (`-inf` when further apart than `prediction`).
-pub(crate) fn depth(
-    a: &Shape,
-    pa: &Pose,
-    b: &Shape,
-    pb: &Pose,
-    prediction: f64,
-) -> Result<f64, OracleError> {
-    Ok(reference_contact(a, pa, b, pb, prediction)?.map_or(f64::NEG_INFINITY, |r| r.depth))
 }
 
 /// The depth at which a response starts: `SLOP` for `separate`, 0 otherwise.

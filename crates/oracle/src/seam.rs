@@ -9,7 +9,7 @@ use ricochet_geom::{Bounds, Pose, Shape, Vec2};
 use ricochet_sim::{Scenario, WorldBounds};
 
 use crate::OracleError;
-use crate::referee::depth;
+use crate::convert::depth;
 
 /// The translations of `b` a pair is tested at: the direct one alone in a world that does
 /// not wrap, else [`WorldBounds::image_offsets`] (direct first).

@@ -8,8 +8,9 @@ use ricochet_sim::{
     BodyKind, ContactRecord, Doomed, Entity, FrameOutput, Phase, Response, Simulation,
 };
 
+use crate::convert::depth;
 use crate::convert::{first_touch, size};
-use crate::referee::{Body, FrameReport, Referee, body, depth};
+use crate::referee::{Body, FrameReport, Referee, body};
 use crate::seam::{moved, widened};
 use crate::{OracleError, rules};
 

@@ -8,7 +8,8 @@ use super::MAX_AGREEMENT_DETAILS;
 #[cfg(doc)]
 use super::{CONTACT_TOLERANCE, RapierScene};
 use crate::OracleError;
-use crate::referee::{Recheck, body, depth, recheck, threshold};
+use crate::convert::depth;
+use crate::referee::{Recheck, body, recheck, threshold};
 
 /// How one frame's (or a whole run's) contact sets compare. Every compared item either
 /// agrees or is counted as a disagreement with a sentence in `details`. Serialisable: the
