@@ -1,0 +1,145 @@
+//! Swept `separate`: a moving body never passes through static geometry it `separate`s from,
+//! whatever its speed. Boxes by the per-axis swept move (`stages/sweep_axis.rs`), every
+//! other shape by time of impact in `detect`. Each case is checked every frame: once the
+//! body's lowest point was above the floor's top, it is never below the floor's bottom.
+
+use ricochet_geom::{Shape, Vec2};
+use ricochet_scenes::{layers, scenario};
+use ricochet_sim::{BodyDef, BodyKind, Response, SLOP, Simulation, WorldDef};
+
+const THING: u8 = 0;
+const FLOOR: u8 = 1;
+
+/// A static floor `thickness` thick, 40 wide, top at y = 0; one dynamic body of `shape`
+/// at `(0.1, height)` (off the floor's centre) moving at `vy`, under gravity `g`.
+fn drop(shape: Shape, height: f64, vy: f64, g: f64, thickness: f64) -> Simulation {
+    let world = WorldDef {
+        layers: layers(&["thing", "floor"], &[(THING, FLOOR, Response::Separate)]),
+        gravity: Vec2::new(0.0, g),
+        ..WorldDef::default()
+    };
+    let floor = BodyDef {
+        name: "floor".to_owned(),
+        layer: FLOOR,
+        kind: BodyKind::Static,
+        shape: Shape::aabb(Vec2::new(20.0, thickness / 2.0)).unwrap(),
+        position: Vec2::new(0.0, -thickness / 2.0),
+        ..BodyDef::default()
+    };
+    let thing = BodyDef {
+        name: "thing".to_owned(),
+        layer: THING,
+        shape,
+        position: Vec2::new(0.1, height),
+        velocity: Vec2::new(0.0, vy),
+        ..BodyDef::default()
+    };
+    Simulation::new(&scenario("drop", world, vec![floor, thing], 10_000))
+}
+
+/// Runs `frames` frames and checks every one: the body's lowest point, once above the
+/// floor's top (y = 0), never goes below its bottom (y = -thickness). Returns the body's
+/// lowest point and y at the end.
+fn run(sim: &mut Simulation, frames: u32, thickness: f64, what: &str) -> (f64, f64) {
+    let lowest = |sim: &mut Simulation| {
+        let i = sim.world().find("thing").unwrap();
+        let w = sim.world();
+        (w.shape[i].bounds(&w.pose(i)).min.y, w.position[i].y)
+    };
+    let mut above = lowest(sim).0 >= 0.0;
+    for frame in 1..=frames {
+        sim.step();
+        let (low, y) = lowest(sim);
+        assert!(
+            !above || low >= -thickness,
+            "{what}: frame {frame}: lowest point {low} below the floor's bottom (y = {y})"
+        );
+        above |= low >= 0.0;
+    }
+    lowest(sim)
+}
+
+/// A 0.8 × 0.8 crate.
+fn crate_box() -> Shape {
+    Shape::aabb(Vec2::splat(0.4)).unwrap()
+}
+
+#[test]
+fn the_issue_s_crate_dropped_from_200_rests_on_the_half_unit_ledge() {
+    // 0.8 × 0.8 from y = 200 under gravity -30: about 1.8 units a frame at the ledge.
+    let mut sim = drop(crate_box(), 200.0, 0.0, -30.0, 0.5);
+    let (_, y) = run(&mut sim, 400, 0.5, "crate");
+    assert!((y - 0.4).abs() <= SLOP, "the crate ended at y = {y}");
+}
+
+#[test]
+fn crates_dropped_or_thrown_onto_a_thin_floor_land_flush() {
+    for (height, vy) in [
+        (10.0, 0.0),
+        (100.0, 0.0),
+        (1_000.0, 0.0),
+        (10_000.0, 0.0),
+        (50.0, -1_000.0),
+        (50.0, -10_000.0),
+        (10_000.0, -10_000.0),
+    ] {
+        for half in [0.4, 0.01, 3.0] {
+            let what = format!("box {half} from {height} at {vy}");
+            let shape = Shape::aabb(Vec2::splat(half)).unwrap();
+            let mut sim = drop(shape, height, vy, -30.0, 0.05);
+            let mut landed = false;
+            // At most ~26 s of fall from 10,000 units: 1600 frames.
+            for _ in 0..40 {
+                let (_, y) = run(&mut sim, 50, 0.05, &what);
+                if y <= half + 1.0 {
+                    landed = true;
+                    break;
+                }
+            }
+            assert!(landed, "{what}: never landed");
+            let (_, y) = run(&mut sim, 5, 0.05, &what);
+            assert!((y - half).abs() <= SLOP, "{what}: rests at y = {y}");
+        }
+    }
+}
+
+#[test]
+fn the_landing_frame_puts_a_fast_crate_exactly_flush() {
+    // 10,000 units/s: 166.7 units a frame; the frame it meets the floor, it stops on it.
+    let mut sim = drop(crate_box(), 100.0, -10_000.0, 0.0, 0.05);
+    sim.step(); // frame 0: the initial state
+    sim.step();
+    let i = sim.world().find("thing").unwrap();
+    assert_eq!(sim.world().position[i].y, 0.4);
+    assert_eq!(sim.world().velocity[i].y, 0.0);
+    assert!(sim.world().grounded[i]);
+}
+
+#[test]
+fn a_fast_crate_thrown_sideways_stops_flush_against_a_thin_wall() {
+    let world = WorldDef {
+        layers: layers(&["thing", "floor"], &[(THING, FLOOR, Response::Separate)]),
+        ..WorldDef::default()
+    };
+    let wall = BodyDef {
+        name: "wall".to_owned(),
+        layer: FLOOR,
+        kind: BodyKind::Static,
+        shape: Shape::aabb(Vec2::new(0.025, 5.0)).unwrap(),
+        position: Vec2::new(10.025, 0.0),
+        ..BodyDef::default()
+    };
+    let thing = BodyDef {
+        name: "thing".to_owned(),
+        layer: THING,
+        shape: crate_box(),
+        velocity: Vec2::new(10_000.0, 0.0),
+        ..BodyDef::default()
+    };
+    let mut sim = Simulation::new(&scenario("wall", world, vec![wall, thing], 10));
+    sim.step(); // frame 0: the initial state
+    sim.step();
+    let i = sim.world().find("thing").unwrap();
+    assert_eq!(sim.world().position[i].x, 9.6);
+    assert_eq!(sim.world().velocity[i].x, 0.0);
+}
