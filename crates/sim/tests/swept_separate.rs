@@ -143,3 +143,81 @@ fn a_fast_crate_thrown_sideways_stops_flush_against_a_thin_wall() {
     assert_eq!(sim.world().position[i].x, 9.6);
     assert_eq!(sim.world().velocity[i].x, 0.0);
 }
+
+#[test]
+fn the_issue_s_ball_thrown_down_at_120_rests_on_the_half_unit_ledge() {
+    // A 0.3-radius ball thrown down at 120 units/s (2 units a frame): from a few heights,
+    // so the frames fall differently against the ledge.
+    for k in 0..8 {
+        let height = 10.0 + 0.25 * f64::from(k);
+        let mut sim = drop(Shape::circle(0.3).unwrap(), height, -120.0, -30.0, 0.5);
+        let (low, _) = run(&mut sim, 200, 0.5, &format!("ball from {height}"));
+        assert!(
+            low.abs() <= 1e-6,
+            "from {height}: rests with its bottom at {low}"
+        );
+    }
+}
+
+/// A shape of every kind that is not resolved per axis, about 0.6 across.
+fn shapes() -> Vec<(&'static str, Shape)> {
+    let v = |x, y| Vec2::new(x, y);
+    vec![
+        ("ball", Shape::circle(0.3).unwrap()),
+        ("small ball", Shape::circle(0.01).unwrap()),
+        (
+            "capsule",
+            Shape::capsule(v(-0.3, 0.0), v(0.3, 0.0), 0.1).unwrap(),
+        ),
+        (
+            "upright capsule",
+            Shape::capsule(v(0.0, -0.3), v(0.0, 0.3), 0.05).unwrap(),
+        ),
+        (
+            "polygon",
+            Shape::polygon(&[
+                v(-0.3, -0.2),
+                v(0.3, -0.3),
+                v(0.35, 0.2),
+                v(0.0, 0.4),
+                v(-0.3, 0.2),
+            ])
+            .unwrap(),
+        ),
+        (
+            "triangle",
+            Shape::polygon(&[v(-0.3, -0.2), v(0.3, -0.2), v(0.0, 0.3)]).unwrap(),
+        ),
+    ]
+}
+
+#[test]
+fn balls_capsules_and_polygons_dropped_or_thrown_onto_a_thin_floor_rest_on_it() {
+    for (name, shape) in shapes() {
+        for (height, vy) in [
+            (10.0, 0.0),
+            (1_000.0, 0.0),
+            (10_000.0, 0.0),
+            (50.0, -1_000.0),
+            (50.0, -10_000.0),
+            (10_000.0, -10_000.0),
+        ] {
+            let what = format!("{name} from {height} at {vy}");
+            let mut sim = drop(shape.clone(), height, vy, -30.0, 0.05);
+            let mut landed = false;
+            for _ in 0..40 {
+                let (low, _) = run(&mut sim, 50, 0.05, &what);
+                if low <= 1.0 {
+                    landed = true;
+                    break;
+                }
+            }
+            assert!(landed, "{what}: never landed");
+            let (low, _) = run(&mut sim, 30, 0.05, &what);
+            assert!(
+                low.abs() <= 1e-6,
+                "{what}: rests with its lowest point at {low}"
+            );
+        }
+    }
+}
