@@ -257,9 +257,16 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
         }
         let mut pushed_by = None;
         // Where the box started along the axis, relative to where it is now: the first
-        // lookup covers the whole swept interval, and the sweep runs once on it.
+        // lookup covers the whole swept interval, and the sweep runs once on it. A box that
+        // moved at most half its size cannot get past a static box's middle (it goes in by
+        // at most that, less than half the pair's size), so today's push is right for it
+        // and the sweep is skipped (`sweep_axis.rs`).
         let back = ctx.world.start_position[i][axis] - ctx.world.position[i][axis];
-        let mut swept = back == 0.0;
+        let size = {
+            let b = box_bounds(ctx.world, i);
+            b.max[axis] - b.min[axis]
+        };
+        let mut swept = 2.0 * back.abs() <= size;
         'look: loop {
             let bi = box_bounds(ctx.world, i);
             if !region.is_some_and(|r| contains(&r, &bi)) {

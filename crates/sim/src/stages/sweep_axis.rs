@@ -14,7 +14,11 @@
 //! when the box still overlaps that first obstacle along the axis and the push out by the
 //! smaller overlap takes it back towards where it came from, the pass goes on as it always
 //! did ([`first_hit`] answers `None`). Only a box that went right through (no overlap left)
-//! or deep enough to be pushed out of the far side is stopped by the sweep.
+//! or deep enough to be pushed out of the far side is stopped by the sweep. A box that moved
+//! at most half its own size along the axis is not swept at all: from outside a static box
+//! it goes in by at most that, less than half the two boxes' size, so the push is always
+//! right (against a kinematic or settled box moving towards it, the push by the smaller
+//! overlap decides, as before).
 
 use ricochet_geom::Bounds;
 
