@@ -221,3 +221,43 @@ fn balls_capsules_and_polygons_dropped_or_thrown_onto_a_thin_floor_rest_on_it() 
         }
     }
 }
+
+#[test]
+fn a_fast_ball_rolling_over_a_tiled_floor_is_not_stopped_at_the_seams() {
+    // 30 units/s along x (half a unit a frame, more than the 0.1 radius): every frame it
+    // touches the next tile on the way; it must not stop there.
+    for g in [-30.0, 0.0] {
+        let world = WorldDef {
+            layers: layers(&["thing", "floor"], &[(THING, FLOOR, Response::Separate)]),
+            gravity: Vec2::new(0.0, g),
+            ..WorldDef::default()
+        };
+        let mut bodies: Vec<BodyDef> = (0..60)
+            .map(|k| BodyDef {
+                name: format!("tile{k}"),
+                layer: FLOOR,
+                kind: BodyKind::Static,
+                shape: Shape::aabb(Vec2::new(0.5, 0.5)).unwrap(),
+                position: Vec2::new(f64::from(k), -0.5),
+                ..BodyDef::default()
+            })
+            .collect();
+        bodies.push(BodyDef {
+            name: "thing".to_owned(),
+            layer: THING,
+            shape: Shape::circle(0.1).unwrap(),
+            position: Vec2::new(0.0, 0.1),
+            velocity: Vec2::new(30.0, 0.0),
+            ..BodyDef::default()
+        });
+        let mut sim = Simulation::new(&scenario("roll", world, bodies, 100));
+        for _ in 0..=60 {
+            sim.step();
+        }
+        let i = sim.world().find("thing").unwrap();
+        let (p, v) = (sim.world().position[i], sim.world().velocity[i]);
+        assert_eq!(v.x, 30.0, "gravity {g}: the ball slowed to {v}");
+        assert!((p.x - 30.0).abs() < 1e-9, "gravity {g}: the ball is at {p}");
+        assert!((p.y - 0.1).abs() <= 1e-6, "gravity {g}: the ball is at {p}");
+    }
+}

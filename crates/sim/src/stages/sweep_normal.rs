@@ -7,9 +7,10 @@
 //! that moved less than that from outside the other cannot get past its middle, so the
 //! end-pose test pushes it back the way it came, and nothing changes for it. Above it, the
 //! pair is also tested by [`time_of_impact`] from the frame's start to its end (straight
-//! lines, end angles). When the bodies touched on the way (not already at the start) and the
-//! end pose either no longer overlaps or would be pushed out along a normal that opposes the
-//! normal at the touch (out of the far side), the dynamic body is put back at its pose at
+//! lines, end angles). When the bodies touched on the way (not overlapping at the start) and the
+//! contact normal at the end pose (overlapping or not) opposes the normal at the touch (the
+//! body went through, or deep enough to be pushed out of the far side), the dynamic body
+//! is put back at its pose at
 //! the time of impact and pushed there like any `separate` pair: its velocity into the
 //! surface removed, `grounded` set on landing. The contact is logged with phase `swept` at
 //! the touching poses.
@@ -49,12 +50,15 @@ pub(crate) fn stop(
         angle: w.angle[k],
     };
     let impact = time_of_impact(&w.shape[i], &sweep(i), &w.shape[j], &sweep(j))?;
-    if impact.t <= 0.0 {
-        // Touching or overlapping when the frame began: the push decides, as before.
+    if impact.t <= 0.0 && impact.contact.depth > SLOP {
+        // Overlapping when the frame began: the push decides, as before. (Touching then is
+        // swept like any other touch: a body flush on a floor that falls through it stays.)
         return None;
     }
-    if end.depth > SLOP && end.normal.dot(impact.contact.normal) > 0.0 {
-        // The push at the end poses goes back the way the body came.
+    if end.normal.dot(impact.contact.normal) > 0.0 {
+        // At the end poses the obstacle is still on the side the body touched it from:
+        // the push there (if any) goes back the way the body came, and a body that slid
+        // along a surface onto the next tile (touching both) is not stopped at the seam.
         return None;
     }
     Some(impact)
