@@ -261,3 +261,51 @@ fn a_fast_ball_rolling_over_a_tiled_floor_is_not_stopped_at_the_seams() {
         assert!((p.y - 0.1).abs() <= 1e-6, "gravity {g}: the ball is at {p}");
     }
 }
+
+#[test]
+fn fast_bodies_land_on_a_thin_rising_kinematic_platform() {
+    // The platform rises at 3 units/s; a crate and a ball fall onto it at 2,000 units/s.
+    for (name, shape, half) in [
+        ("crate", crate_box(), 0.4),
+        ("ball", Shape::circle(0.3).unwrap(), 0.3),
+    ] {
+        let world = WorldDef {
+            layers: layers(&["thing", "floor"], &[(THING, FLOOR, Response::Separate)]),
+            gravity: Vec2::new(0.0, -30.0),
+            ..WorldDef::default()
+        };
+        let lift = BodyDef {
+            name: "lift".to_owned(),
+            layer: FLOOR,
+            kind: BodyKind::Kinematic,
+            shape: Shape::aabb(Vec2::new(5.0, 0.025)).unwrap(),
+            position: Vec2::new(0.0, -0.025),
+            velocity: Vec2::new(0.0, 3.0),
+            ..BodyDef::default()
+        };
+        let thing = BodyDef {
+            name: "thing".to_owned(),
+            layer: THING,
+            shape,
+            position: Vec2::new(0.1, 100.0),
+            velocity: Vec2::new(0.0, -2_000.0),
+            ..BodyDef::default()
+        };
+        let mut sim = Simulation::new(&scenario("lift", world, vec![lift, thing], 100));
+        for frame in 0..=30 {
+            sim.step();
+            let w = sim.world();
+            let (l, t) = (w.find("lift").unwrap(), w.find("thing").unwrap());
+            let top = w.position[l].y + 0.025;
+            let low = w.position[t].y - half;
+            assert!(
+                low >= top - 0.05 - 1e-9,
+                "{name}: frame {frame}: lowest point {low} below the lift's bottom ({top} top)"
+            );
+        }
+        let w = sim.world();
+        let (l, t) = (w.find("lift").unwrap(), w.find("thing").unwrap());
+        let gap = (w.position[t].y - half) - (w.position[l].y + 0.025);
+        assert!(gap.abs() <= 1e-6, "{name}: rests {gap} above the lift");
+    }
+}
