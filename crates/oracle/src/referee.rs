@@ -393,14 +393,9 @@ impl Referee {
                 b.shape_name()
             );
             if let Some(c) = stops.get(&(ea, eb)) {
-                // The stop replaces the end-pose test: what rapier sees there is the
-                // tunnelled pose (explained), the record is checked as a first touch.
-                let tol = self.depth_tol(a.shape, b.shape);
-                let d = depth(a.shape, &pa, b.shape, &pb, tol).unwrap_or(f64::NEG_INFINITY);
-                report.explain(rules::SWEPT_SEPARATE, d);
-                let (ka, kb) = (a.kind, b.kind);
+                // The stop replaces the end-pose test (`swept.rs`).
+                apply_push(&mut current, c, a.kind, b.kind);
                 self.check_swept_separate(sim, out, (a, b), c, (pa, pb), &who, report);
-                apply_push(&mut current, c, ka, kb);
                 continue;
             }
             let response = self.layers.response(a.layer, b.layer);
@@ -560,7 +555,12 @@ impl Body<'_> {
 /// Applies the push a logged `separate` contact made, exactly as Ricochet's `detect` did:
 /// `resolved` is the push of the body that moved (`b`'s when both did, `a`'s being its
 /// negation).
-fn apply_push(current: &mut BTreeMap<Entity, Pose>, c: &ContactRecord, ka: BodyKind, kb: BodyKind) {
+pub(crate) fn apply_push(
+    current: &mut BTreeMap<Entity, Pose>,
+    c: &ContactRecord,
+    ka: BodyKind,
+    kb: BodyKind,
+) {
     if c.response != Response::Separate || c.resolved == Vec2::ZERO {
         return;
     }

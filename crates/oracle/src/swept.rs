@@ -243,7 +243,8 @@ impl Referee {
     /// A swept `separate` record (`sweep_normal.rs` in the simulation), met in the replayed
     /// `all` pass at the poses `(pa, pb)` the pass had reached: Ricochet swept the pair from
     /// the frame's start positions to those poses. The record must be parry's first touch
-    /// along that path, as for a `swept` hit (or within the stopping gap of one: `touching`).
+    /// along that path, as for a `swept` hit (or within the stopping gap of one: `touching`);
+    /// what rapier sees at those poses (the tunnelled end pose) is rule `swept-separate`.
     #[expect(clippy::too_many_arguments, reason = "the pair as the replay holds it")]
     pub(crate) fn check_swept_separate(
         &self,
@@ -255,6 +256,10 @@ impl Referee {
         who: &str,
         report: &mut FrameReport,
     ) {
+        // What rapier sees at these poses is the tunnelled end pose: explained.
+        let tol = self.depth_tol(a.shape, b.shape);
+        let d = depth(a.shape, &pa, b.shape, &pb, tol).unwrap_or(f64::NEG_INFINITY);
+        report.explain(rules::SWEPT_SEPARATE, d);
         let (Some(start_a), Some(start_b)) = (
             self.start_of(sim, out, c.a, &pa),
             self.start_of(sim, out, c.b, &pb),
@@ -264,7 +269,6 @@ impl Referee {
         };
         let start = (Pose::new(start_a, pa.angle), Pose::new(start_b, pb.angle));
         let motion = (pa.position - start_a, pb.position - start_b);
-        let tol = self.depth_tol(a.shape, b.shape);
         let small = size(a.shape).min(size(b.shape));
         let gap = self.tol.toi_gap * small;
         let speed = (motion.1 - motion.0).length();
