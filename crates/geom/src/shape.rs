@@ -429,4 +429,35 @@ impl Shape {
             Shape::Compound(c) => c.parts(),
         }
     }
+
+    /// A lower bound on the shape's width in every direction (at any angle): the diameter of
+    /// a circle or a capsule, the smaller side of a box, the smallest extent of a polygon
+    /// across its edge normals (exact for a convex polygon); for a compound, its narrowest
+    /// part. A body moving less than half of it in a frame, from outside an obstacle, cannot
+    /// get past the obstacle's middle.
+    #[must_use]
+    pub fn min_width(&self) -> f64 {
+        self.primitives()
+            .iter()
+            .map(|p| match p {
+                Primitive::Circle(c) => 2.0 * c.radius,
+                Primitive::Capsule(c) => 2.0 * c.radius,
+                Primitive::Aabb(b) => 2.0 * b.half_extents.min_element(),
+                Primitive::Obb(b) => 2.0 * b.half_extents.min_element(),
+                Primitive::Polygon(g) => g
+                    .normals()
+                    .iter()
+                    .map(|n| {
+                        let (lo, hi) = g
+                            .vertices()
+                            .iter()
+                            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                                (lo.min(v.dot(*n)), hi.max(v.dot(*n)))
+                            });
+                        hi - lo
+                    })
+                    .fold(f64::INFINITY, f64::min),
+            })
+            .fold(f64::INFINITY, f64::min)
+    }
 }

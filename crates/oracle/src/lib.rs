@@ -117,8 +117,14 @@ pub mod rules {
     /// fell back to the end-of-frame overlap.
     pub const TOI_FALLBACK: &str = "toi-fallback";
 
+    /// A `separate` pair Ricochet stopped by time of impact in `detect` (a fast body
+    /// against static or kinematic geometry): rapier's test at the detect poses sees the
+    /// tunnelled end pose; the `swept` record is checked as a first touch instead, and its
+    /// move replayed like a push.
+    pub const SWEPT_SEPARATE: &str = "swept-separate";
+
     /// Every rule, in the order they are tried, with a one-line meaning.
-    pub const ALL: [(&str, &str); 7] = [
+    pub const ALL: [(&str, &str); 8] = [
         (
             STATIC_STATIC,
             "neither body dynamic: Ricochet never tests the pair",
@@ -135,6 +141,10 @@ pub mod rules {
         (
             TIED_NORMAL,
             "normals differ but both are minimum translations (a tie)",
+        ),
+        (
+            SWEPT_SEPARATE,
+            "a separate pair stopped by time of impact: checked as a first touch",
         ),
         (
             FIRST_HIT,

@@ -346,10 +346,23 @@ impl Referee {
             .filter(|c| c.phase == Phase::All)
             .map(|c| ((c.a, c.b), c))
             .collect();
+        // Swept `separate` stops (time of impact in the pass, then the push): checked where
+        // the replay meets them, and their moves replayed like pushes.
+        let stops: BTreeMap<(Entity, Entity), &ContactRecord> = out
+            .contacts
+            .iter()
+            .filter(|c| c.phase == Phase::Swept && c.response == Response::Separate)
+            .map(|c| ((c.a, c.b), c))
+            .collect();
         // Poses as the pass saw them: the detect poses, moved by each `separate` push in
         // pair order (replayed from the records, so the same floating-point additions).
         let mut current = detect.clone();
-        let keys: BTreeSet<(Entity, Entity)> = found.iter().chain(logged.keys()).copied().collect();
+        let keys: BTreeSet<(Entity, Entity)> = found
+            .iter()
+            .chain(logged.keys())
+            .chain(stops.keys())
+            .copied()
+            .collect();
         for (ea, eb) in keys {
             let (Some(a), Some(b)) = (body(sim, out, ea), body(sim, out, eb)) else {
                 report.mismatch(format!(
@@ -370,6 +383,12 @@ impl Referee {
                 b.name,
                 b.shape_name()
             );
+            if let Some(c) = stops.get(&(ea, eb)) {
+                // The stop replaces the end-pose test (`swept.rs`).
+                apply_push(&mut current, c, a.kind, b.kind);
+                self.check_swept_separate(sim, out, (a, b), c, (pa, pb), &who, report);
+                continue;
+            }
             let response = self.layers.response(a.layer, b.layer);
             let tol = self.depth_tol(a.shape, b.shape);
             let thr = threshold(response);
@@ -527,7 +546,12 @@ impl Body<'_> {
 /// Applies the push a logged `separate` contact made, exactly as Ricochet's `detect` did:
 /// `resolved` is the push of the body that moved (`b`'s when both did, `a`'s being its
 /// negation).
-fn apply_push(current: &mut BTreeMap<Entity, Pose>, c: &ContactRecord, ka: BodyKind, kb: BodyKind) {
+pub(crate) fn apply_push(
+    current: &mut BTreeMap<Entity, Pose>,
+    c: &ContactRecord,
+    ka: BodyKind,
+    kb: BodyKind,
+) {
     if c.response != Response::Separate || c.resolved == Vec2::ZERO {
         return;
     }

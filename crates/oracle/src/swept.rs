@@ -120,7 +120,7 @@ impl Referee {
         let logged: BTreeMap<(Entity, Entity), &ContactRecord> = out
             .contacts
             .iter()
-            .filter(|c| c.phase == Phase::Swept)
+            .filter(|c| c.phase == Phase::Swept && c.response != Response::Separate)
             .map(|c| ((c.a, c.b), c))
             .collect();
         let n = self.layers.names().len();
@@ -238,6 +238,77 @@ impl Referee {
                 }
                 (None, None) => {}
             }
+        }
+    }
+
+    /// A swept `separate` record (`sweep_normal.rs` in the simulation), met in the replayed
+    /// `all` pass at the poses `(pa, pb)` the pass had reached: Ricochet swept the pair from
+    /// the frame's start positions to those poses. The record must be parry's first touch
+    /// along that path, as for a `swept` hit (or within the stopping gap of one: `touching`);
+    /// what rapier sees at those poses (the tunnelled end pose) is rule `swept-separate`.
+    #[expect(clippy::too_many_arguments, reason = "the pair as the replay holds it")]
+    pub(crate) fn check_swept_separate(
+        &self,
+        sim: &Simulation,
+        out: &FrameOutput,
+        (a, b): (Body<'_>, Body<'_>),
+        c: &ContactRecord,
+        (pa, pb): (Pose, Pose),
+        who: &str,
+        report: &mut FrameReport,
+    ) {
+        // What rapier sees at these poses is the tunnelled end pose: explained.
+        let tol = self.depth_tol(a.shape, b.shape);
+        let d = depth(a.shape, &pa, b.shape, &pb, tol).unwrap_or(f64::NEG_INFINITY);
+        report.explain(rules::SWEPT_SEPARATE, d);
+        let (Some(start_a), Some(start_b)) = (
+            self.start_of(sim, out, c.a, &pa),
+            self.start_of(sim, out, c.b, &pb),
+        ) else {
+            report.mismatch(format!("{who}: a swept separate body has no start pose"));
+            return;
+        };
+        let start = (Pose::new(start_a, pa.angle), Pose::new(start_b, pb.angle));
+        let motion = (pa.position - start_a, pb.position - start_b);
+        let small = size(a.shape).min(size(b.shape));
+        let gap = self.tol.toi_gap * small;
+        let speed = (motion.1 - motion.0).length();
+        let slack = if speed > 0.0 {
+            self.tol.toi * small / speed
+        } else {
+            0.0
+        };
+        let toi = first_touch(
+            a.shape, &start.0, motion.0, b.shape, &start.1, motion.1, 0.0,
+        );
+        // Only the first-touch check reads the pair: no seam, and the mover is not used.
+        let p = Pair {
+            a,
+            b,
+            start,
+            offset: Vec2::ZERO,
+            motion,
+            toi: None,
+            mover: c.a,
+        };
+        match toi {
+            Ok(Some(t_r)) => match self.check_first_touch(&p, c, t_r, tol, gap, slack) {
+                Ok(None) => report.swept_confirmed += 1,
+                Ok(Some(Ok((rule, d)))) => report.explain(rule, d),
+                Ok(Some(Err(why))) => report.mismatch(format!("{who}: {why}")),
+                Err(e) => report.mismatch(format!("{who}: {e}")),
+            },
+            Ok(None) => match first_touch(
+                p.a.shape, &start.0, motion.0, p.b.shape, &start.1, motion.1, gap,
+            ) {
+                Ok(Some(_)) => report.explain(rules::TOUCHING, c.depth),
+                Ok(None) => report.mismatch(format!(
+                    "{who}: Ricochet logged a swept separate stop; parry's shape cast finds \
+                     no touch on the path"
+                )),
+                Err(e) => report.mismatch(format!("{who}: {e}")),
+            },
+            Err(e) => report.mismatch(format!("{who}: {e}")),
         }
     }
 

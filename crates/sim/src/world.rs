@@ -455,13 +455,16 @@ impl World {
 
     /// The broad phase's view of every moving body, in [`World::movers`] order, into `out`:
     /// [`World::bounds`], widened over the frame's motion for a body of a layer in
-    /// `sweeping` (a bullet that went right through something is still paired with it), and
+    /// `sweeping` (a bullet that went right through something is still paired with it), or of
+    /// a layer in `separate_swept` that moved more than half its [`Shape::min_width`] (a
+    /// `separate` pair that time of impact may have to stop), and
     /// a frozen body handed over as kinematic (it keeps its place in the dense order; the
     /// caller drops its pairs). `visit` sees each entry's place in `out` and its bounds as
     /// they are made (the wrap seam looks for bodies near an edge without another pass).
     pub(crate) fn mover_entries(
         &mut self,
         sweeping: &[bool],
+        separate_swept: &[bool],
         out: &mut Vec<BodyEntry>,
         mut visit: impl FnMut(usize, &Bounds),
     ) {
@@ -473,7 +476,11 @@ impl World {
             let mut bounds = self.local_bounds[i].at(&self.shape[i], self.angle[i], p);
             let layer = self.layer[i];
             let moved = self.start_position[i] - p;
-            if sweeping[usize::from(layer)] && moved != Vec2::ZERO {
+            if moved != Vec2::ZERO
+                && (sweeping[usize::from(layer)]
+                    || (separate_swept[usize::from(layer)]
+                        && moved.length() > 0.5 * self.shape[i].min_width()))
+            {
                 bounds = bounds.union(bounds.translated(moved));
             }
             visit(out.len(), &bounds);

@@ -17,6 +17,10 @@
 //!
 //! A sleeping body that touches an awake one wakes up (from the next frame on).
 //!
+//! A `separate` pair of a fast dynamic body and a static or kinematic one is also tested by
+//! time of impact (`sweep_normal.rs`): when the end pose tunnelled, the body is stopped
+//! where it touched and pushed there.
+//!
 //! Swept pairs (a layer in `fast_layers`, or `sweep = true` on the `[[collide]]` entry;
 //! `report` and `destroy` only) are bounded over the whole frame's motion and tested by time
 //! of impact instead: each moving body's hits are taken in time order and it stops at the
@@ -38,6 +42,7 @@ use crate::output::{ContactRecord, Phase};
 use crate::stages::push::separate_along_normal;
 use crate::stages::remove::remove;
 use crate::stages::separate::is_box;
+use crate::stages::sweep_normal;
 use crate::stages::wrap::Seam;
 use crate::stages::{SLOP, StageCtx};
 use crate::world::World;
@@ -59,6 +64,9 @@ pub(crate) struct DetectState {
     box_only: Vec<bool>,
     /// Layers with a swept pair.
     sweeping: Vec<bool>,
+    /// Layers with a `separate` pair `detect` tests (not two layers of boxes only): a fast
+    /// body of one is bounded over its motion (`sweep_normal.rs`).
+    separate_swept: Vec<bool>,
     /// The static generation `statics` was built at.
     static_generation: Option<u64>,
     statics: Vec<BodyEntry>,
@@ -78,6 +86,7 @@ impl DetectState {
         DetectState {
             broad_phase: BroadPhase::new(kind),
             interactions: interactions(layers, &box_only),
+            separate_swept: separate_swept(layers, &box_only),
             box_only,
             sweeping: (0..n)
                 .map(|l| (0..n).any(|m| layers.sweeps(l as u8, m as u8)))
@@ -101,6 +110,19 @@ fn interactions(layers: &Layers, box_only: &[bool]) -> Interactions {
     })
 }
 
+/// The layers with a `separate` pair `detect` tests, given which layers hold only boxes.
+fn separate_swept(layers: &Layers, box_only: &[bool]) -> Vec<bool> {
+    let n = box_only.len();
+    (0..n)
+        .map(|a| {
+            (0..n).any(|b| {
+                layers.response(a as u8, b as u8) == Response::Separate
+                    && !(box_only[a] && box_only[b])
+            })
+        })
+        .collect()
+}
+
 /// Fills the broad phase's inputs and finds the candidate pairs (dense indices, sorted).
 fn candidate_pairs(ctx: &mut StageCtx, st: &mut DetectState) -> Vec<(u32, u32)> {
     let w = &mut *ctx.world;
@@ -111,6 +133,7 @@ fn candidate_pairs(ctx: &mut StageCtx, st: &mut DetectState) -> Vec<(u32, u32)> 
             *b = w.only_boxes(l as u8);
         }
         st.interactions = interactions(&ctx.def.layers, &st.box_only);
+        st.separate_swept = separate_swept(&ctx.def.layers, &st.box_only);
     }
     if st.static_generation != Some(w.static_generation()) {
         st.statics.clear();
@@ -133,9 +156,12 @@ fn candidate_pairs(ctx: &mut StageCtx, st: &mut DetectState) -> Vec<(u32, u32)> 
         Some(b) => {
             let seam = &mut st.seam;
             seam.begin(&b);
-            w.mover_entries(&st.sweeping, &mut st.movers, |m, b| seam.visit(m, b));
+            let separate = &st.separate_swept;
+            w.mover_entries(&st.sweeping, separate, &mut st.movers, |m, b| {
+                seam.visit(m, b);
+            });
         }
-        None => w.mover_entries(&st.sweeping, &mut st.movers, |_, _| {}),
+        None => w.mover_entries(&st.sweeping, &st.separate_swept, &mut st.movers, |_, _| {}),
     }
     let generation = w.static_generation();
     let mut pairs = std::mem::take(&mut st.pairs);
@@ -200,6 +226,15 @@ pub(crate) fn run(ctx: &mut StageCtx, st: &mut DetectState, capture_poses: bool)
         ctx.out.stats.narrow_tests += 1;
         let (pose_a, mut pose_b) = (w.pose(i), w.pose(j));
         let mut c = contact(&w.shape[i], &pose_a, &w.shape[j], &pose_b);
+        // A fast body against static or kinematic geometry: time of impact, then the push
+        // (`sweep_normal.rs`; not through the wrap seam).
+        if response == Response::Separate
+            && st.seam.offsets(i, j).next().is_none()
+            && let Some(hit) = sweep_normal::stop(w, (i, j), &c, &mut ctx.out.stats.narrow_tests)
+        {
+            sweep_normal::apply(ctx, (i, j), &hit);
+            continue;
+        }
         // Through the seam: `b`'s images next to `a`, the deepest (the first on a tie).
         for offset in st.seam.offsets(i, j) {
             ctx.out.stats.narrow_tests += 1;

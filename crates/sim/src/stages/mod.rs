@@ -20,6 +20,8 @@ pub(crate) mod remove;
 pub(crate) mod script;
 pub(crate) mod separate;
 pub(crate) mod sleep;
+pub(crate) mod sweep_axis;
+pub(crate) mod sweep_normal;
 pub(crate) mod wrap;
 
 /// How far two solid bodies may still overlap after `separate` has pushed them apart, in

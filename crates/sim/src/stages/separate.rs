@@ -11,6 +11,10 @@
 //! box is solid to the rest, so stacks resolve bottom-up in one pass. Only boxes (a single
 //! AABB) are resolved per axis; every other shape in a `separate` pair is pushed along the
 //! contact normal by the `detect` stage.
+//!
+//! Before the pushes, a box that moved along the axis is swept (`sweep_axis.rs`): it stops
+//! flush against the first box it would have crossed, so no speed takes it through a tile.
+//! The first lookup covers the box's start and end along the axis.
 
 //!
 //! Finding the obstacles: static boxes sit in a grid built once (rebuilt only when the static
@@ -27,6 +31,7 @@ use crate::def::{BodyKind, Controller, LayerId, Layers, Response};
 use crate::entity::Entity;
 use crate::event::GameEvent;
 use crate::output::{ContactRecord, Phase};
+use crate::stages::sweep_axis::{self, Swept};
 use crate::stages::{SLOP, StageCtx, carry};
 use crate::world::World;
 
@@ -83,6 +88,8 @@ struct Obstacle {
     index: u32,
     bounds: Bounds,
     layer: LayerId,
+    /// Whether it may have moved this frame (from the mover grid, not the static one).
+    moving: bool,
 }
 
 impl SeparateState {
@@ -176,6 +183,7 @@ fn obstacles(st: &mut SeparateState, w: &World, q: &Bounds, from: u32, found: &m
                 index,
                 bounds: *bounds,
                 layer,
+                moving: false,
             });
         }
     });
@@ -185,6 +193,7 @@ fn obstacles(st: &mut SeparateState, w: &World, q: &Bounds, from: u32, found: &m
                 index: i,
                 bounds: box_bounds(w, i as usize),
                 layer: w.layer[i as usize],
+                moving: true,
             });
         }
     });
@@ -247,6 +256,17 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
             ctx.world.carrier[i] = None;
         }
         let mut pushed_by = None;
+        // Where the box started along the axis, relative to where it is now: the first
+        // lookup covers the whole swept interval, and the sweep runs once on it. A box that
+        // moved at most half its size cannot get past a static box's middle (it goes in by
+        // at most that, less than half the pair's size), so today's push is right for it
+        // and the sweep is skipped (`sweep_axis.rs`).
+        let back = ctx.world.start_position[i][axis] - ctx.world.position[i][axis];
+        let size = {
+            let b = box_bounds(ctx.world, i);
+            b.max[axis] - b.min[axis]
+        };
+        let mut swept = 2.0 * back.abs() <= size;
         'look: loop {
             let bi = box_bounds(ctx.world, i);
             if !region.is_some_and(|r| contains(&r, &bi)) {
@@ -254,6 +274,12 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
                 let reach = bi.max[axis] - bi.min[axis];
                 r.min[axis] -= reach;
                 r.max[axis] += reach;
+                if !swept {
+                    let mut start = bi;
+                    start.min[axis] += back;
+                    start.max[axis] += back;
+                    r = r.union(start);
+                }
                 // After a push at `found[next - 1]`, the obstacles after it.
                 let from = if next > 0 {
                     found[next - 1].index + 1
@@ -264,7 +290,33 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
                 region = Some(r);
                 next = 0;
             }
-            while next < found.len() {
+            // The obstacle, the new coordinate, the push, and whether it is a swept stop.
+            let mut push: Option<(usize, f64, f64, bool)> = None;
+            if !swept {
+                // The swept move (`sweep_axis.rs`): stop flush at the first obstacle crossed.
+                swept = true;
+                let w = &*ctx.world;
+                let solid = |o: &&Obstacle| {
+                    o.index as usize != i
+                        && layers.response(w.layer[i], o.layer) == Response::Separate
+                };
+                let candidates = found.iter().filter(solid).map(|o| Swept {
+                    bounds: o.bounds,
+                    back: if o.moving {
+                        let j = o.index as usize;
+                        w.start_position[j][axis] - w.position[j][axis]
+                    } else {
+                        0.0
+                    },
+                });
+                if let Some(stop) = sweep_axis::first_hit(&bi, back, axis, candidates) {
+                    let o = found.iter().filter(solid).nth(stop.at).copied();
+                    let o = o.expect("the stop is one of the candidates");
+                    let to = flush(w, i, &bi, axis, stop);
+                    push = Some((o.index as usize, to, to - w.position[i][axis], true));
+                }
+            }
+            while push.is_none() && next < found.len() {
                 let o = found[next];
                 let (j, bj) = (o.index as usize, o.bounds);
                 next += 1;
@@ -275,48 +327,61 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
                 if overlap(&bi, &bj, 0) <= SLOP || overlap(&bi, &bj, 1) <= SLOP {
                     continue;
                 }
-                let (a, b) = if i < j { (i, j) } else { (j, i) };
+                let by = push_out(&bi, &bj, axis);
+                push = Some((j, w.position[i][axis] + by, by, false));
+            }
+            let Some((j, to, by, after)) = push else {
+                break;
+            };
+            let w = &*ctx.world;
+            let (a, b) = if i < j { (i, j) } else { (j, i) };
+            // A box that was still already (resting on the sleeper) does not wake it.
+            if w.asleep[j] && !w.still[i] {
+                woken.push(j);
+            }
+            let kind = w.kind[j];
+            if kind == BodyKind::Kinematic && pushed_by.is_none() {
+                pushed_by = Some(j);
+            }
+            // A push's contact is logged where the pair overlapped; a swept stop's where it
+            // touches.
+            let pair_contact = |w: &World| {
                 let (pose_a, pose_b) = (w.pose(a), w.pose(b));
                 let c = contact(&w.shape[a], &pose_a, &w.shape[b], &pose_b);
-                let mut moved = Vec2::ZERO;
-                moved[axis] = push_out(&bi, &bj, axis);
-                // A box that was still already (resting on the sleeper) does not wake it.
-                if w.asleep[j] && !w.still[i] {
-                    woken.push(j);
-                }
-                let kind = w.kind[j];
-                if kind == BodyKind::Kinematic && pushed_by.is_none() {
-                    pushed_by = Some(j);
-                }
-                let w = &mut *ctx.world;
-                apply_push(w, i, axis, moved[axis]);
-                if axis == 1 && moved[axis] > 0.0 {
-                    // Held up: by a static body (it may sleep), or by a carrier it rides.
-                    w.on_static[i] |= kind == BodyKind::Static;
-                    w.carrier[i] = (kind != BodyKind::Static).then(|| w.entity[j]);
-                }
-                out.contacts.push(ContactRecord {
-                    a: w.entity[a],
-                    b: w.entity[b],
-                    phase,
-                    normal: c.normal,
-                    depth: c.depth,
-                    point: c.point,
-                    pose_a,
-                    pose_b,
-                    response: Response::Separate,
-                    resolved: moved,
-                });
-                out.events.push(GameEvent::PushedOut {
-                    body: w.entity[i],
-                    axis: axis as u8,
-                    by: moved[axis],
-                    obstacle: w.entity[j],
-                });
-                // The box moved: go on from the next obstacle, at its new place.
-                continue 'look;
+                (c, pose_a, pose_b)
+            };
+            let before = (!after).then(|| pair_contact(w));
+            let mut moved = Vec2::ZERO;
+            moved[axis] = by;
+            let w = &mut *ctx.world;
+            apply_push(w, i, axis, to, by);
+            let (c, pose_a, pose_b) = before.unwrap_or_else(|| pair_contact(w));
+            if axis == 1 && moved[axis] > 0.0 {
+                // Held up: by a static body (it may sleep), or by a carrier it rides.
+                w.on_static[i] |= kind == BodyKind::Static;
+                w.carrier[i] = (kind != BodyKind::Static).then(|| w.entity[j]);
             }
-            break;
+            out.contacts.push(ContactRecord {
+                a: w.entity[a],
+                b: w.entity[b],
+                phase,
+                normal: c.normal,
+                depth: c.depth,
+                point: c.point,
+                pose_a,
+                pose_b,
+                response: Response::Separate,
+                resolved: moved,
+            });
+            out.events.push(GameEvent::PushedOut {
+                body: w.entity[i],
+                axis: axis as u8,
+                by: moved[axis],
+                obstacle: w.entity[j],
+            });
+            // The box moved: go on from the next obstacle, at its new place (after a swept
+            // stop, from the first: it stands where the pass may start again).
+            continue 'look;
         }
         let riding = (old_carrier, pushed_by);
         if let Some(event) = rider(ctx.world, layers, st, &mut found, (i, axis), riding) {
@@ -335,10 +400,27 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
     out.contacts[first..].sort_by_key(|c| (c.a, c.b));
 }
 
-/// Moves body `i` by `push` along `axis`, stops its motion into the obstacle, and notes
+/// The coordinate along `axis` that puts box `i` (bounds `bi`) flush against the sweep's
+/// `stop`: exactly `face ∓ half extent` for a box on the body origin.
+fn flush(w: &World, i: usize, bi: &Bounds, axis: usize, stop: sweep_axis::Stop) -> f64 {
+    let p = w.position[i][axis];
+    match &w.shape[i] {
+        Shape::Primitive(Primitive::Aabb(b)) if b.center == Vec2::ZERO => {
+            if stop.towards_max {
+                stop.face - b.half_extents[axis]
+            } else {
+                stop.face + b.half_extents[axis]
+            }
+        }
+        _ if stop.towards_max => p + (stop.face - bi.max[axis]),
+        _ => p + (stop.face - bi.min[axis]),
+    }
+}
+
+/// Moves body `i` to `to` along `axis` (a push by `push`), stops its motion into the obstacle, and notes
 /// landing (pushed up) and walkers turning round (pushed along x).
-fn apply_push(w: &mut crate::World, i: usize, axis: usize, push: f64) {
-    w.position[i][axis] += push;
+fn apply_push(w: &mut crate::World, i: usize, axis: usize, to: f64, push: f64) {
+    w.position[i][axis] = to;
     let v = &mut w.velocity[i][axis];
     if (push < 0.0 && *v > 0.0) || (push > 0.0 && *v < 0.0) {
         *v = 0.0;
