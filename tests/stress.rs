@@ -5,8 +5,7 @@
 use ricochet_geom::{Shape, Vec2, contact};
 use ricochet_scenes::{layers, scenario};
 use ricochet_sim::{
-    BodyDef, BodyKind, FrameOutput, Phase, Response, SLOP, Simulation, World, WorldDef,
-    load_scenario,
+    BodyKind, FrameOutput, Phase, Response, SLOP, Simulation, World, WorldDef, load_scenario,
 };
 
 use crate::util::root;
@@ -52,17 +51,7 @@ fn worst_solid_overlap(s: &Simulation) -> f64 {
     worst
 }
 
-/// A body of `layer` and `shape` at `at`, moving at `velocity`.
-fn body(name: &str, layer: u8, shape: Shape, at: Vec2, velocity: Vec2) -> BodyDef {
-    BodyDef {
-        name: name.to_owned(),
-        layer,
-        shape,
-        position: at,
-        velocity,
-        ..BodyDef::default()
-    }
-}
+use ricochet_scenes::moving_body as body;
 
 /// The stress version of the shapes scene, moved by `offset`.
 fn shifted_scene(offset: f64) -> Simulation {

@@ -26,6 +26,7 @@ pub mod tiles;
 
 pub use rng::Rng;
 
+use ricochet_geom::{Shape, Vec2};
 use ricochet_sim::{BodyDef, LayerId, Layers, Response, Scenario, WorldDef};
 
 /// Layers with names and the listed responses; every other pair ignored.
@@ -48,5 +49,19 @@ pub fn scenario(name: &str, world: WorldDef, bodies: Vec<BodyDef>, frames: u64) 
         templates: std::collections::BTreeMap::new(),
         bodies,
         script: Vec::new(),
+    }
+}
+
+/// A dynamic body named `name` of `layer` and `shape` at `at`, moving at `velocity`: the
+/// body most hand-built test scenes are made of.
+#[must_use]
+pub fn moving_body(name: &str, layer: LayerId, shape: Shape, at: Vec2, velocity: Vec2) -> BodyDef {
+    BodyDef {
+        name: name.to_owned(),
+        layer,
+        shape,
+        position: at,
+        velocity,
+        ..BodyDef::default()
     }
 }

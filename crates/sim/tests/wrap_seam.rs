@@ -38,16 +38,7 @@ fn world(size: Vec2) -> WorldDef {
     }
 }
 
-fn body(name: &str, layer: u8, shape: Shape, at: Vec2, velocity: Vec2) -> BodyDef {
-    BodyDef {
-        name: name.to_owned(),
-        layer,
-        shape,
-        position: at,
-        velocity,
-        ..BodyDef::default()
-    }
-}
+use ricochet_scenes::moving_body as body;
 
 fn circle(r: f64) -> Shape {
     Shape::circle(r).unwrap()
