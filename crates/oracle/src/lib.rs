@@ -34,6 +34,7 @@
 
 pub mod bench;
 mod convert;
+mod frame_report;
 mod motion;
 mod pairs;
 mod referee;
