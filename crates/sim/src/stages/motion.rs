@@ -108,10 +108,12 @@ pub(crate) fn has_motion(w: &World) -> bool {
 
 /// `position[axis] += velocity[axis] * dt` for every active body, a rider first carried by
 /// its carrier's displacement along the axis (`stages/carry.rs`).
-fn move_axis(w: &mut World, dt: f64, axis: usize) {
+/// Without per-axis layer pairs (`carries` false) no body has a carrier, and the loop reads
+/// no carrier column.
+fn move_axis(w: &mut World, dt: f64, axis: usize, carries: bool) {
     for k in 0..w.active().len() {
         let i = w.active()[k] as usize;
-        if w.carrier[i].is_some() {
+        if carries && w.carrier[i].is_some() {
             let d = carry::displacement(w, i, axis, dt);
             // Nothing is added for no motion: `-0.0 + 0.0` would change a zero's sign.
             if d != 0.0 {
@@ -123,13 +125,13 @@ fn move_axis(w: &mut World, dt: f64, axis: usize) {
 }
 
 /// A rider's `x += carrier's vx * dt`, then everyone's `x += vx * dt`.
-pub(crate) fn move_x(w: &mut World, dt: f64) {
-    move_axis(w, dt, 0);
+pub(crate) fn move_x(w: &mut World, dt: f64, carries: bool) {
+    move_axis(w, dt, 0, carries);
 }
 
 /// A rider's `y += carrier's vy * dt`, then everyone's `y += vy * dt`.
-pub(crate) fn move_y(w: &mut World, dt: f64) {
-    move_axis(w, dt, 1);
+pub(crate) fn move_y(w: &mut World, dt: f64, carries: bool) {
+    move_axis(w, dt, 1, carries);
 }
 
 /// Whether an active body has an angular velocity.

@@ -93,6 +93,12 @@ struct Obstacle {
 }
 
 impl SeparateState {
+    /// Whether any layer pair is resolved per axis: only then can a box stand on a carrier
+    /// (`resolve_y` is the only place a carrier is recorded).
+    pub(crate) fn carries(&self) -> bool {
+        self.any_layer
+    }
+
     /// The state for a scene with these layers.
     pub(crate) fn new(layers: &Layers) -> SeparateState {
         let n = layers.names().len();
