@@ -15,7 +15,15 @@ use serde_json::Value;
 
 /// Topics in the order a report names them when several differ at the same time: the
 /// plain state first, the drawing last.
-const TOPIC_ORDER: [&str; 5] = ["/bodies", "/contacts", "/stats", "/events", "/scene"];
+const TOPIC_ORDER: [&str; 7] = [
+    "/bodies",
+    "/contacts",
+    "/stats",
+    "/events",
+    "/tf",
+    "/scene",
+    "/scene/contacts",
+];
 
 /// The first difference found.
 #[derive(Serialize, Debug)]
@@ -275,7 +283,8 @@ impl From<LogError> for DiffError {
 }
 
 /// Opens a log and checks that Ricochet wrote it: its header names `ricochet` as the library
-/// and every channel is JSON (what the comparison decodes).
+/// and every channel is protobuf with a protobuf schema, or JSON with a JSON Schema (what the
+/// comparison decodes).
 fn open(path: &Path) -> Result<LogFile, DiffError> {
     let log = LogFile::open(path)?;
     let name = path.display();
@@ -287,11 +296,16 @@ fn open(path: &Path) -> Result<LogFile, DiffError> {
     }
     if let Some(c) = log
         .channels()
-        .find(|c| c.message_encoding != "json" || c.schema_encoding != "jsonschema")
+        .find(|c| {
+            !matches!(
+                (c.message_encoding.as_str(), c.schema_encoding.as_str()),
+                ("protobuf", "protobuf") | ("json", "jsonschema")
+            )
+        })
     {
         return Err(DiffError::Foreign(format!(
             "{name}: not a Ricochet log: channel {} has {:?} messages and a {:?} schema, \
-             where Ricochet writes json with a jsonschema",
+             where Ricochet writes protobuf with a protobuf schema",
             c.topic, c.message_encoding, c.schema_encoding
         )));
     }

@@ -5,7 +5,7 @@
 //! `/contacts` and `/scene` give it. Names are looked up at the end of the frame: in the world
 //! for a body still alive, in the frame's removed bodies for one removed during it.
 
-use ricochet_log::foxglove::LogLevel;
+use crate::record::Level as LogLevel;
 use ricochet_sim::{
     Entity, FireOutcome, FrameOutput, GameEvent, JumpOutcome, Removal, ScriptInput, World,
 };

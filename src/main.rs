@@ -20,9 +20,7 @@ mod load;
 mod out;
 mod record;
 mod run;
-mod scene;
 mod validate;
-mod validation_channel;
 
 use std::path::PathBuf;
 use std::process::ExitCode;

@@ -445,7 +445,7 @@ fn diff_of_a_foreign_mcap_is_exit_2_not_a_ricochet_log() {
     let other = dir.path().join("other.mcap");
     let mut w = LogWriter::create(&other, "some other tool 1.0").unwrap();
     let ch = w.add_json_channel("/bodies", "x.Bodies", "{}").unwrap();
-    w.write(ch, 0, &json!({"frame": 0})).unwrap();
+    w.write_json(ch, 0, &json!({"frame": 0})).unwrap();
     w.finish().unwrap();
     // Ricochet's name, but messages in another encoding.
     let proto = dir.path().join("proto.mcap");
@@ -520,7 +520,7 @@ fn bodies_log(path: &Path, frames: &[serde_json::Value]) {
         .unwrap();
     for (i, bodies) in frames.iter().enumerate() {
         let msg = json!({"frame": i, "bodies": bodies});
-        w.write(ch, i as u64 * 1000, &msg).unwrap();
+        w.write_json(ch, i as u64 * 1000, &msg).unwrap();
     }
     w.finish().unwrap();
 }

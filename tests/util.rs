@@ -58,3 +58,62 @@ pub fn record(scenario: &std::path::Path, out: &std::path::Path) {
     );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
+
+/// The `/bodies` messages of a decoded log, each rebuilt in full (every live body with every
+/// field) from the keyframes and deltas: what `/bodies` meant before it sent only changes.
+pub fn full_bodies(log: &[ricochet_log::LogMessage]) -> Vec<serde_json::Value> {
+    let mut states = ricochet_log::BodyStates::default();
+    log.iter()
+        .filter(|m| m.topic == "/bodies")
+        .map(|m| states.apply(&m.data))
+        .collect()
+}
+
+/// A `/bodies` shape (`{"circle": {"radius": 1, "center": [0, 0]}}`, as `ricochet.Shape`
+/// decodes) as the scenario's `ShapeDef`.
+pub fn shape_def(v: &serde_json::Value) -> ricochet_geom::ShapeDef {
+    use ricochet_geom::ShapeDef;
+    let pair = |v: &serde_json::Value| -> [f64; 2] {
+        let a = v.as_array().expect("a point");
+        [a[0].as_f64().unwrap(), a[1].as_f64().unwrap()]
+    };
+    let num = |v: &serde_json::Value| v.as_f64().unwrap();
+    let (kind, s) = v
+        .as_object()
+        .and_then(|o| o.iter().next())
+        .expect("one kind of shape");
+    match kind.as_str() {
+        "circle" => ShapeDef::Circle {
+            radius: num(&s["radius"]),
+            center: pair(&s["center"]),
+        },
+        "aabb" => ShapeDef::Aabb {
+            half_extents: pair(&s["half_extents"]),
+            center: pair(&s["center"]),
+        },
+        "obb" => ShapeDef::Obb {
+            half_extents: pair(&s["half_extents"]),
+            center: pair(&s["center"]),
+            angle: num(&s["angle"]),
+        },
+        "capsule" => ShapeDef::Capsule {
+            a: pair(&s["a"]),
+            b: pair(&s["b"]),
+            radius: num(&s["radius"]),
+            center: [0.0, 0.0],
+        },
+        "polygon" => ShapeDef::Polygon {
+            vertices: s["vertices"]
+                .as_array()
+                .unwrap()
+                .chunks(2)
+                .map(|p| [p[0].as_f64().unwrap(), p[1].as_f64().unwrap()])
+                .collect(),
+            center: [0.0, 0.0],
+        },
+        "compound" => ShapeDef::Compound {
+            parts: s["parts"].as_array().unwrap().iter().map(shape_def).collect(),
+        },
+        other => panic!("unknown shape kind {other}"),
+    }
+}

@@ -10,8 +10,10 @@ use mcap::read::{MessageStream, Options, Summary};
 use mcap::sans_io::{LinearReaderOptions, SummaryReadEvent, SummaryReader, SummaryReaderOptions};
 
 use crate::LogError;
+use crate::decode::Decoder;
 
-/// One message of a log, with its JSON payload parsed.
+/// One message of a log, with its payload decoded to JSON (protobuf through the schema the
+/// log embeds, with the `.proto` field names).
 #[derive(Debug, Clone, PartialEq)]
 pub struct LogMessage {
     /// Topic of the message's channel.
@@ -25,8 +27,30 @@ pub struct LogMessage {
     pub publish_time: u64,
     /// Sequence number within the channel.
     pub sequence: u32,
-    /// The JSON payload.
+    /// The payload, decoded to JSON.
     pub data: serde_json::Value,
+}
+
+/// One message of a log, not yet decoded: what [`Messages::next_raw`] yields.
+pub struct RawMessage {
+    inner: mcap::Message<'static>,
+}
+
+impl RawMessage {
+    /// Topic of the message's channel.
+    pub fn topic(&self) -> &str {
+        &self.inner.channel.topic
+    }
+
+    /// Log time, nanoseconds of simulation time.
+    pub fn log_time(&self) -> u64 {
+        self.inner.log_time
+    }
+
+    /// The encoded payload.
+    pub fn bytes(&self) -> &[u8] {
+        &self.inner.data
+    }
 }
 
 /// Reads every message of an MCAP log, in file order (which, for logs written
@@ -79,13 +103,14 @@ pub fn read_log(bytes: &[u8]) -> Result<Vec<LogMessage>, LogError> {
             stats.message_count,
         )));
     }
-    raw.into_iter().map(decode).collect()
+    let mut decoder = Decoder::default();
+    raw.into_iter().map(|m| decode(&mut decoder, m)).collect()
 }
 
-fn decode(message: mcap::Message<'_>) -> Result<LogMessage, LogError> {
-    let data = serde_json::from_slice(&message.data).map_err(|error| {
+fn decode(decoder: &mut Decoder, message: mcap::Message<'_>) -> Result<LogMessage, LogError> {
+    let data = decoder.decode(&message).map_err(|error| {
         corrupt(&format!(
-            "message {} on {} is not JSON: {error}",
+            "message {} on {}: {error}",
             message.sequence, message.channel.topic
         ))
     })?;
@@ -381,6 +406,7 @@ impl LogFile {
                 .collect(),
             counts: BTreeMap::new(),
             done: false,
+            decoder: Decoder::default(),
         })
     }
 }
@@ -405,19 +431,18 @@ pub struct Messages {
     expected: BTreeMap<u16, u64>,
     counts: BTreeMap<u16, u64>,
     done: bool,
+    decoder: Decoder,
 }
 
 impl Messages {
-    fn fail(&mut self, error: LogError) -> Option<Result<LogMessage, LogError>> {
+    fn fail<T>(&mut self, error: LogError) -> Option<Result<T, LogError>> {
         self.done = true;
         Some(Err(at(&self.path)(error)))
     }
-}
 
-impl Iterator for Messages {
-    type Item = Result<LogMessage, LogError>;
-
-    fn next(&mut self) -> Option<Self::Item> {
+    /// The message [`next`](Iterator::next) would yield, with the same checks, but not
+    /// decoded: to compare payloads byte for byte before decoding them.
+    pub fn next_raw(&mut self) -> Option<Result<RawMessage, LogError>> {
         while !self.done {
             let Some(message) = self.reader.next() else {
                 self.done = true;
@@ -440,13 +465,29 @@ impl Iterator for Messages {
                 .as_ref()
                 .is_none_or(|t| *t == message.channel.topic)
             {
-                return Some(decode(message).map_err(|e| {
-                    self.done = true;
-                    at(&self.path)(e)
-                }));
+                return Some(Ok(RawMessage { inner: message }));
             }
         }
         None
+    }
+
+    /// Decodes a message [`next_raw`](Self::next_raw) yielded.
+    pub fn decode(&mut self, raw: RawMessage) -> Result<LogMessage, LogError> {
+        decode(&mut self.decoder, raw.inner).map_err(|e| {
+            self.done = true;
+            at(&self.path)(e)
+        })
+    }
+}
+
+impl Iterator for Messages {
+    type Item = Result<LogMessage, LogError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        Some(match self.next_raw()? {
+            Ok(raw) => self.decode(raw),
+            Err(e) => Err(e),
+        })
     }
 }
 

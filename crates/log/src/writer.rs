@@ -1,30 +1,142 @@
-//! Writing a deterministic, chunked, indexed MCAP log.
+//! Writing a deterministic, chunked, indexed MCAP log, encoding and compressing on a
+//! writer thread.
 
 use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
+use std::sync::mpsc;
+use std::thread::JoinHandle;
 
 use mcap::records::MessageHeader;
 use serde::Serialize;
 
 use crate::LogError;
-use crate::foxglove::{LOG_SCHEMA, LOG_SCHEMA_NAME, SCENE_UPDATE_SCHEMA, SCENE_UPDATE_SCHEMA_NAME};
+use crate::messages::Schema;
 
 /// Target uncompressed size of one chunk: 1 MiB, mcap's default. Foxglove
 /// loads a log chunk by chunk, so this bounds what it reads to seek.
 const CHUNK_SIZE: u64 = 1024 * 1024;
 
+/// Messages queued for the writer thread before [`LogWriter::write`] waits: bounds the
+/// memory a fast simulation can fill while the thread compresses.
+const QUEUE: usize = 256;
+
 /// A channel of a [`LogWriter`], returned when the channel is added.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct ChannelId(u16);
 
-/// Writes an MCAP log of JSON messages that Foxglove can open.
+/// Where a [`LogWriter`] encodes and compresses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Threading {
+    /// On a writer thread of its own (the default): the caller only builds messages.
+    #[default]
+    Thread,
+    /// On the calling thread. The file is byte-identical to [`Threading::Thread`]'s.
+    Inline,
+}
+
+/// A message to encode: already bytes (JSON), or a protobuf message encoded where the
+/// MCAP writer runs.
+enum Payload {
+    Bytes(Vec<u8>),
+    Proto(Box<dyn Encodable>),
+}
+
+/// A protobuf message that can be sent to the writer thread.
+trait Encodable: Send {
+    fn encode_into(&self, buf: &mut Vec<u8>);
+}
+
+impl<M: prost::Message + Send> Encodable for M {
+    fn encode_into(&self, buf: &mut Vec<u8>) {
+        // A Vec grows as needed: encoding into one never runs out of room.
+        self.encode_raw(buf);
+    }
+}
+
+/// One call on the MCAP writer, in the order the [`LogWriter`] received it.
+enum Job {
+    Channel {
+        topic: String,
+        schema: Schema,
+        message_encoding: &'static str,
+        reply: mpsc::Sender<Result<u16, mcap::McapError>>,
+    },
+    Message {
+        header: MessageHeader,
+        payload: Payload,
+    },
+}
+
+/// The MCAP writer and its encode buffer: runs the jobs, on whichever thread owns it.
+struct Sink {
+    mcap: mcap::Writer<BufWriter<File>>,
+    buf: Vec<u8>,
+}
+
+impl Sink {
+    fn run(&mut self, job: Job) -> Result<(), mcap::McapError> {
+        match job {
+            Job::Channel {
+                topic,
+                schema,
+                message_encoding,
+                reply,
+            } => {
+                let id = self.add_channel(&topic, &schema, message_encoding);
+                // The caller waits on the reply (and reports an error); it is gone only if
+                // it gave up.
+                let _ = reply.send(id);
+                Ok(())
+            }
+            Job::Message { header, payload } => {
+                let data = match &payload {
+                    Payload::Bytes(b) => b.as_slice(),
+                    Payload::Proto(m) => {
+                        self.buf.clear();
+                        m.encode_into(&mut self.buf);
+                        self.buf.as_slice()
+                    }
+                };
+                self.mcap.write_to_known_channel(&header, data)
+            }
+        }
+    }
+
+    fn add_channel(
+        &mut self,
+        topic: &str,
+        schema: &Schema,
+        message_encoding: &str,
+    ) -> Result<u16, mcap::McapError> {
+        let schema_id = self
+            .mcap
+            .add_schema(&schema.name, &schema.encoding, &schema.data)?;
+        self.mcap
+            .add_channel(schema_id, topic, message_encoding, &BTreeMap::new())
+    }
+}
+
+/// The sink, on this thread or on the writer thread.
+enum Engine {
+    Inline(Box<Sink>),
+    Thread {
+        jobs: mpsc::SyncSender<Job>,
+        thread: JoinHandle<Result<Sink, mcap::McapError>>,
+    },
+    /// Between a failure and the error's report.
+    Failed,
+}
+
+/// Writes an MCAP log of protobuf (or JSON) messages that Foxglove can open.
 ///
 /// The file is a pure function of the calls made: no wall-clock time, host
-/// name or thread count reaches it. Chunks are zstd-compressed on the calling
-/// thread (multithreaded zstd output differs from single-threaded output), and
-/// the summary lists schemas and channels in id order.
+/// name or thread count reaches it. Messages are encoded and chunks
+/// zstd-compressed on one writer thread (or inline, see [`Threading`]), in the
+/// order the calls were made, so the bytes are the same either way; zstd
+/// itself runs single-threaded (multithreaded zstd output differs). The
+/// summary lists schemas and channels in id order.
 ///
 /// The log is written to a temporary file next to `path` (`.NAME.XXXXXX.tmp`,
 /// in the same directory) and renamed onto `path` only by
@@ -38,7 +150,7 @@ pub struct ChannelId(u16);
 /// `path` that is not a regular file (`/dev/null`, a FIFO) is refused.
 pub struct LogWriter {
     path: PathBuf,
-    mcap: mcap::Writer<BufWriter<File>>,
+    engine: Engine,
     /// The temporary file being written; deleted when dropped unless renamed.
     temp: tempfile::TempPath,
     /// Where the temporary file is renamed to: `path`, or the file it links to.
@@ -50,13 +162,18 @@ pub struct LogWriter {
 impl LogWriter {
     /// Starts the log that [`finish`](Self::finish) will put at `path`, and
     /// writes the MCAP header, naming `library` (e.g. `"ricochet 0.1.0"`) as
-    /// the writer.
+    /// the writer. Encodes on a writer thread; see [`create_with`](Self::create_with).
     ///
     /// The temporary file is created now, in `path`'s directory, so an
     /// unwritable directory fails before any simulation runs; so does a `path`
     /// that is a directory. A file already at `path` is left as it is until
     /// `finish` replaces it.
     pub fn create(path: &Path, library: &str) -> Result<Self, LogError> {
+        Self::create_with(path, library, Threading::Thread)
+    }
+
+    /// [`create`](Self::create), encoding and compressing where `threading` says.
+    pub fn create_with(path: &Path, library: &str, threading: Threading) -> Result<Self, LogError> {
         let create_error = |source| LogError::Create {
             path: path.to_path_buf(),
             source,
@@ -120,62 +237,112 @@ impl LogWriter {
                 path: path.clone(),
                 source,
             })?;
+        let sink = Sink {
+            mcap,
+            buf: Vec::new(),
+        };
+        let engine = match threading {
+            Threading::Inline => Engine::Inline(Box::new(sink)),
+            Threading::Thread => {
+                let (jobs, queue) = mpsc::sync_channel::<Job>(QUEUE);
+                let thread = std::thread::Builder::new()
+                    .name("log-writer".into())
+                    .spawn(move || {
+                        let mut sink = sink;
+                        for job in queue {
+                            sink.run(job)?;
+                        }
+                        Ok(sink)
+                    })
+                    .map_err(|e| LogError::Write {
+                        path: path.clone(),
+                        source: mcap::McapError::Io(e),
+                    })?;
+                Engine::Thread { jobs, thread }
+            }
+        };
         Ok(Self {
             path,
-            mcap,
+            engine,
             temp,
             target,
             sequences: BTreeMap::new(),
         })
     }
 
+    /// Adds a channel on `topic` whose messages are encoded as `message_encoding`
+    /// (`protobuf` or `json`) and described by `schema`. Adding the same topic and schema
+    /// again returns the same channel.
+    pub fn add_channel(
+        &mut self,
+        topic: &str,
+        schema: Schema,
+        message_encoding: &'static str,
+    ) -> Result<ChannelId, LogError> {
+        let (reply, answer) = mpsc::channel();
+        self.submit(Job::Channel {
+            topic: topic.to_owned(),
+            schema,
+            message_encoding,
+            reply,
+        })?;
+        match answer.recv() {
+            Ok(Ok(id)) => Ok(ChannelId(id)),
+            Ok(Err(source)) => Err(self.write_error(source)),
+            // The writer thread stopped: its error says why.
+            Err(_) => Err(self.fail()),
+        }
+    }
+
+    /// Adds a channel on `topic` for protobuf messages of type `schema.name`, whose
+    /// `schema.data` is a FileDescriptorSet that defines it (MCAP's protobuf profile).
+    pub fn add_protobuf_channel(&mut self, topic: &str, schema: Schema) -> Result<ChannelId, LogError> {
+        self.add_channel(topic, schema, "protobuf")
+    }
+
     /// Adds a channel on `topic` whose messages are JSON (message encoding
     /// `json`) described by the JSON Schema `schema_json` named
     /// `schema_name` (schema encoding `jsonschema`).
-    ///
-    /// Adding the same topic and schema again returns the same channel.
     pub fn add_json_channel(
         &mut self,
         topic: &str,
         schema_name: &str,
         schema_json: &str,
     ) -> Result<ChannelId, LogError> {
-        let schema_id = self
-            .mcap
-            .add_schema(schema_name, "jsonschema", schema_json.as_bytes())
-            .map_err(|source| self.write_error(source))?;
-        let channel_id = self
-            .mcap
-            .add_channel(schema_id, topic, "json", &BTreeMap::new())
-            .map_err(|source| self.write_error(source))?;
-        Ok(ChannelId(channel_id))
+        let schema = Schema {
+            name: schema_name.to_owned(),
+            encoding: "jsonschema".to_owned(),
+            data: schema_json.as_bytes().to_vec(),
+        };
+        self.add_channel(topic, schema, "json")
     }
 
-    /// Adds a `foxglove.SceneUpdate` channel on `topic`, for
-    /// [`SceneUpdate`](crate::foxglove::SceneUpdate) messages.
-    pub fn add_scene_channel(&mut self, topic: &str) -> Result<ChannelId, LogError> {
-        self.add_json_channel(topic, SCENE_UPDATE_SCHEMA_NAME, SCENE_UPDATE_SCHEMA)
+    /// Writes the protobuf `message` on `channel` at simulation time `time_ns` (both the
+    /// log and publish time). Its sequence number is the count of messages written on
+    /// `channel` before it. The message is encoded on the writer thread.
+    pub fn write<M: prost::Message + Send + 'static>(
+        &mut self,
+        channel: ChannelId,
+        time_ns: u64,
+        message: M,
+    ) -> Result<(), LogError> {
+        self.write_payload(channel, time_ns, Payload::Proto(Box::new(message)))
     }
 
-    /// Adds a `foxglove.Log` channel on `topic`, for
-    /// [`Log`](crate::foxglove::Log) messages.
-    pub fn add_log_channel(&mut self, topic: &str) -> Result<ChannelId, LogError> {
-        self.add_json_channel(topic, LOG_SCHEMA_NAME, LOG_SCHEMA)
-    }
-
-    /// Writes `message` as compact JSON on `channel` at simulation time
-    /// `time_ns` (both the log and publish time). Its sequence number is the
-    /// count of messages written on `channel` before it.
-    ///
-    /// Floating-point fields of `message` must be finite: `serde_json`
-    /// writes NaN and the infinities as `null`.
-    pub fn write<T: Serialize>(
+    /// Writes `message` as compact JSON on `channel` (a JSON channel), like
+    /// [`write`](Self::write). Floating-point fields of `message` must be finite:
+    /// `serde_json` writes NaN and the infinities as `null`.
+    pub fn write_json<T: Serialize>(
         &mut self,
         channel: ChannelId,
         time_ns: u64,
         message: &T,
     ) -> Result<(), LogError> {
         let data = serde_json::to_vec(message)?;
+        self.write_payload(channel, time_ns, Payload::Bytes(data))
+    }
+
+    fn write_payload(&mut self, channel: ChannelId, time_ns: u64, payload: Payload) -> Result<(), LogError> {
         let sequence = self.sequences.get(&channel).copied().unwrap_or(0);
         let header = MessageHeader {
             channel_id: channel.0,
@@ -183,11 +350,52 @@ impl LogWriter {
             log_time: time_ns,
             publish_time: time_ns,
         };
-        self.mcap
-            .write_to_known_channel(&header, &data)
-            .map_err(|source| self.write_error(source))?;
+        self.submit(Job::Message { header, payload })?;
         self.sequences.insert(channel, sequence.wrapping_add(1));
         Ok(())
+    }
+
+    /// Runs `job` inline, or queues it for the writer thread (waiting while the queue is
+    /// full). A failure of the thread is reported by the next call.
+    fn submit(&mut self, job: Job) -> Result<(), LogError> {
+        match &mut self.engine {
+            Engine::Inline(sink) => sink.run(job).map_err(|source| self.write_error(source)),
+            Engine::Thread { jobs, .. } => match jobs.send(job) {
+                Ok(()) => Ok(()),
+                Err(_) => Err(self.fail()),
+            },
+            Engine::Failed => Err(self.write_error(mcap::McapError::Io(std::io::Error::other(
+                "the log writer failed before",
+            )))),
+        }
+    }
+
+    /// Stops the writer thread and returns its error.
+    fn fail(&mut self) -> LogError {
+        match self.take_sink() {
+            Ok(_) => self.write_error(mcap::McapError::Io(std::io::Error::other(
+                "the log writer thread stopped",
+            ))),
+            Err(e) => e,
+        }
+    }
+
+    /// The sink, back from the writer thread once it has run every queued job.
+    fn take_sink(&mut self) -> Result<Sink, LogError> {
+        match std::mem::replace(&mut self.engine, Engine::Failed) {
+            Engine::Inline(sink) => Ok(*sink),
+            Engine::Thread { jobs, thread } => {
+                drop(jobs);
+                match thread.join() {
+                    Ok(Ok(sink)) => Ok(sink),
+                    Ok(Err(source)) => Err(self.write_error(source)),
+                    Err(panic) => std::panic::resume_unwind(panic),
+                }
+            }
+            Engine::Failed => Err(self.write_error(mcap::McapError::Io(std::io::Error::other(
+                "the log writer failed before",
+            )))),
+        }
     }
 
     /// Ends the last chunk, writes the summary (schemas, channels,
@@ -195,21 +403,19 @@ impl LogWriter {
     /// and syncs the file, and renames it onto the path given to
     /// [`create`](Self::create), replacing any file there.
     pub fn finish(mut self) -> Result<(), LogError> {
-        self.mcap
+        let mut sink = self.take_sink()?;
+        sink.mcap
             .finish()
             .map_err(|source| self.write_error(source))?;
         let Self {
-            path,
-            mcap,
-            temp,
-            target,
-            ..
+            path, temp, target, ..
         } = self;
         let io_error = |path: &Path, error: std::io::Error| LogError::Write {
             path: path.to_path_buf(),
             source: mcap::McapError::Io(error),
         };
-        let mut file = mcap
+        let mut file = sink
+            .mcap
             .into_inner()
             .into_inner()
             .map_err(|error| io_error(&path, error.into_error()))?;

@@ -1,0 +1,267 @@
+//! Recording a run as an MCAP log of protobuf messages (MCAP's protobuf profile: every
+//! channel's schema is a FileDescriptorSet, so any protobuf reader decodes it).
+//!
+//! | topic | schema | content |
+//! |---|---|---|
+//! | `/scene` | `foxglove.SceneUpdate` | every body, drawn in its own frame; sent whole when the set of bodies changes |
+//! | `/tf` | `foxglove.FrameTransforms` | each body's frame: sent when the body appears or moves |
+//! | `/scene/contacts` | `foxglove.SceneUpdate` | the frame's contact normals as arrows |
+//! | `/bodies` | `ricochet.Bodies` | exact body states: every body at keyframes, what changed between |
+//! | `/contacts` | `ricochet.Contacts` | every contact, with the poses it was detected at |
+//! | `/stats` | `ricochet.Stats` | deterministic counters, for Foxglove's Plot panel |
+//! | `/events` | `foxglove.Log` | inputs, spawns, destructions and collision events |
+//!
+//! `log_time = publish_time = frame * dt_ns`, with `dt_ns` the step rounded to whole
+//! nanoseconds: nothing from the wall clock reaches the file. Messages are built here and
+//! encoded and compressed on the log's writer thread.
+
+mod bodies;
+pub mod scene;
+
+use std::path::Path;
+
+use ricochet_log::messages::fox::{FrameTransforms, Log, SceneUpdate, log};
+use ricochet_log::messages::{Schema, ricochet as pb, timestamp};
+use ricochet_log::{ChannelId, LogError, LogWriter, Threading};
+use ricochet_sim::{FrameOutput, Layers, Simulation};
+
+use crate::channels::Channels;
+use bodies::Tracker;
+
+
+/// The `library` field of every log's header.
+pub const LIBRARY: &str = concat!("ricochet ", env!("CARGO_PKG_VERSION"));
+
+/// Setting this environment variable to `1` encodes on the calling thread instead of the
+/// writer thread (the log is byte-identical; tests check it).
+pub const INLINE_ENV: &str = "RICOCHET_INLINE_WRITER";
+
+fn xy(v: ricochet_geom::Vec2) -> Vec<f64> {
+    vec![v.x, v.y]
+}
+
+fn pose3(p: &ricochet_geom::Pose) -> Vec<f64> {
+    vec![p.position.x, p.position.y, p.angle]
+}
+
+/// The channels of a log, those recorded.
+#[derive(Default)]
+struct Topics {
+    scene: Option<ChannelId>,
+    tf: Option<ChannelId>,
+    arrows: Option<ChannelId>,
+    bodies: Option<ChannelId>,
+    contacts: Option<ChannelId>,
+    stats: Option<ChannelId>,
+    events: Option<ChannelId>,
+    validation: Option<ChannelId>,
+}
+
+/// Writes a run's frames to an MCAP file.
+pub struct Recorder {
+    writer: LogWriter,
+    dt_ns: u64,
+    dt: f64,
+    topics: Topics,
+    tracker: Tracker,
+    /// The previous frame had contact arrows (so this one sends an empty set if it has none).
+    arrows_shown: bool,
+}
+
+impl Recorder {
+    /// Creates the file now (so a bad path fails before the simulation starts) and adds the
+    /// chosen channels (all by default).
+    pub fn create(path: &Path, dt: f64, channels: Channels) -> Result<Recorder, LogError> {
+        let threading = if std::env::var_os(INLINE_ENV).is_some_and(|v| v == "1") {
+            Threading::Inline
+        } else {
+            Threading::Thread
+        };
+        let mut w = LogWriter::create_with(path, LIBRARY, threading)?;
+        let mut t = Topics::default();
+        if channels.scene {
+            t.scene = Some(w.add_protobuf_channel("/scene", Schema::foxglove::<SceneUpdate>())?);
+            t.tf = Some(w.add_protobuf_channel("/tf", Schema::foxglove::<FrameTransforms>())?);
+            t.arrows = Some(
+                w.add_protobuf_channel("/scene/contacts", Schema::foxglove::<SceneUpdate>())?,
+            );
+        }
+        if channels.bodies {
+            t.bodies = Some(w.add_protobuf_channel("/bodies", Schema::ricochet("ricochet.Bodies"))?);
+        }
+        if channels.contacts {
+            t.contacts =
+                Some(w.add_protobuf_channel("/contacts", Schema::ricochet("ricochet.Contacts"))?);
+        }
+        if channels.stats {
+            t.stats = Some(w.add_protobuf_channel("/stats", Schema::ricochet("ricochet.Stats"))?);
+        }
+        if channels.events {
+            t.events = Some(w.add_protobuf_channel("/events", Schema::foxglove::<Log>())?);
+        }
+        Ok(Recorder {
+            writer: w,
+            // Whole nanoseconds per step; `f64 as u64` saturates and the scenario checks
+            // dt > 0 and finite.
+            dt_ns: (dt * 1e9).round() as u64,
+            dt,
+            topics: t,
+            tracker: Tracker::default(),
+            arrows_shown: false,
+        })
+    }
+
+    /// Adds the `/validation` channel (`ricochet run --validate`).
+    pub fn add_validation_channel(&mut self) -> Result<(), LogError> {
+        let id = self
+            .writer
+            .add_protobuf_channel("/validation", Schema::ricochet("ricochet.Validation"))?;
+        self.topics.validation = Some(id);
+        Ok(())
+    }
+
+    /// Writes the referee's verdict on a frame to `/validation`.
+    pub fn record_validation(&mut self, r: &ricochet_oracle::FrameReport) -> Result<(), LogError> {
+        if let Some(ch) = self.topics.validation {
+            let msg = pb::Validation {
+                frame: r.frame,
+                contacts_compared: r.contacts_compared,
+                mismatches: r.mismatches,
+                worst_depth_error: r.worst_depth_error,
+                worst_normal_error: r.worst_normal_error,
+                pairs_confirmed: r.pairs_confirmed,
+                swept_confirmed: r.swept_confirmed,
+                explained: r
+                    .explained
+                    .iter()
+                    .map(|(k, v)| ((*k).to_owned(), *v))
+                    .collect(),
+                details: r.details.clone(),
+            };
+            self.writer.write(ch, r.frame * self.dt_ns, msg)?;
+        }
+        Ok(())
+    }
+
+    /// Writes one frame on every channel.
+    pub fn record(&mut self, sim: &Simulation, out: &FrameOutput) -> Result<(), LogError> {
+        let t = out.frame * self.dt_ns;
+        let ts = timestamp(t);
+        let w = sim.world();
+        let layers = &sim.scenario().world.layers;
+        let want_bodies = self.topics.bodies.is_some();
+        if self.topics.scene.is_some() || want_bodies {
+            let mut changes = self.tracker.frame(w, out, layers, self.dt_ns, want_bodies);
+            if let (Some(ch), true) = (self.topics.scene, changes.scene_changed) {
+                let drawings = (0..w.len()).map(|i| scene::BodyDrawing {
+                    entity: w.entity[i],
+                    name: &w.name[i],
+                    shape: &w.shape[i],
+                    angle: w.angle[i],
+                    layer: w.layer[i],
+                    kind: w.kind[i],
+                });
+                self.writer.write(ch, t, scene::snapshot(drawings, ts))?;
+            }
+            if let (Some(ch), false) = (self.topics.tf, changes.transforms.is_empty()) {
+                let transforms = std::mem::take(&mut changes.transforms);
+                self.writer.write(ch, t, FrameTransforms { transforms })?;
+            }
+            if let Some(ch) = self.topics.arrows
+                && (!out.contacts.is_empty() || self.arrows_shown)
+            {
+                self.writer
+                    .write(ch, t, scene::contact_arrows(&out.contacts, ts))?;
+                self.arrows_shown = !out.contacts.is_empty();
+            }
+            if let Some(ch) = self.topics.bodies {
+                changes.bodies.time = out.frame as f64 * self.dt;
+                self.writer.write(ch, t, changes.bodies)?;
+            }
+        }
+        if let Some(ch) = self.topics.contacts {
+            self.writer.write(ch, t, contacts_message(out))?;
+        }
+        if let Some(ch) = self.topics.stats {
+            self.writer.write(ch, t, stats_message(out, layers))?;
+        }
+        if let Some(ch) = self.topics.events {
+            for e in &out.events {
+                let line = crate::events::line(e, w, out);
+                let msg = Log {
+                    timestamp: Some(ts),
+                    level: line.level as i32,
+                    message: line.message,
+                    name: line.kind.to_owned(),
+                    file: String::new(),
+                    line: 0,
+                };
+                self.writer.write(ch, t, msg)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Writes the summary and index. Called after an interrupted run too.
+    pub fn finish(self) -> Result<(), LogError> {
+        self.writer.finish()
+    }
+}
+
+/// `/contacts`: every contact of the frame with the poses it was found at.
+fn contacts_message(out: &FrameOutput) -> pb::Contacts {
+    let contacts = out
+        .contacts
+        .iter()
+        .map(|c| pb::Contact {
+            a: c.a.index,
+            a_generation: c.a.generation,
+            b: c.b.index,
+            b_generation: c.b.generation,
+            phase: c.phase.name().to_owned(),
+            normal: xy(c.normal),
+            depth: c.depth,
+            point: xy(c.point),
+            pose_a: pose3(&c.pose_a),
+            pose_b: pose3(&c.pose_b),
+            response: c.response.name().to_owned(),
+            resolved: xy(c.resolved),
+        })
+        .collect();
+    pb::Contacts {
+        frame: out.frame,
+        contacts,
+    }
+}
+
+/// `/stats`: the frame's counters, layer pairs and stages named.
+fn stats_message(out: &FrameOutput, layers: &Layers) -> pb::Stats {
+    let s = &out.stats;
+    pb::Stats {
+        frame: out.frame,
+        bodies: s.bodies as u64,
+        broad_phase: s.broad_phase.map_or("", |k| k.name()).to_owned(),
+        broad_pairs: s.broad_pairs,
+        narrow_tests: s.narrow_tests,
+        contacts: s.contacts,
+        layer_pairs_skipped: s.layer_pairs_skipped,
+        frozen: s.frozen as u64,
+        asleep: s.asleep as u64,
+        stages_run: s.stages_run.len() as u64,
+        stages_skipped: s.stages_skipped.len() as u64,
+        skipped: s
+            .stages_skipped
+            .iter()
+            .map(|st| st.name().to_owned())
+            .collect(),
+        tests_by_layer_pair: s
+            .tests_by_layer_pair
+            .iter()
+            .map(|&((a, b), n)| (format!("{}/{}", layers.name(a), layers.name(b)), n))
+            .collect(),
+        kinetic_energy: s.kinetic_energy,
+    }
+}
+
+/// The level of an event line, as `foxglove.Log` numbers it.
+pub type Level = log::Level;
