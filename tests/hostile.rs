@@ -393,7 +393,7 @@ fn diff_of_an_unknown_topic_is_an_error_naming_the_topics_there_are() {
         assert_eq!(o.status.code(), Some(2), "{topic}: {stderr}");
         assert!(o.stdout.is_empty());
         assert!(
-            stderr.contains("/bodies, /contacts, /events, /scene, /stats"),
+            stderr.contains("/bodies, /contacts, /events, /scene, /scene/contacts, /stats, /tf"),
             "{stderr}"
         );
     }
@@ -447,16 +447,16 @@ fn diff_of_a_foreign_mcap_is_exit_2_not_a_ricochet_log() {
     let ch = w.add_json_channel("/bodies", "x.Bodies", "{}").unwrap();
     w.write_json(ch, 0, &json!({"frame": 0})).unwrap();
     w.finish().unwrap();
-    // Ricochet's name, but messages in another encoding.
+    // Ricochet's name, but messages in another encoding (ROS 2 CDR).
     let proto = dir.path().join("proto.mcap");
     {
         let mut w = mcap::WriteOptions::new()
             .library("ricochet 0.1.0")
             .create(std::io::BufWriter::new(File::create(&proto).unwrap()))
             .unwrap();
-        let schema = w.add_schema("x.Pose", "protobuf", b"\x0a\x00").unwrap();
+        let schema = w.add_schema("x/Pose", "ros2msg", b"float64 x").unwrap();
         let ch = w
-            .add_channel(schema, "/bodies", "protobuf", &Default::default())
+            .add_channel(schema, "/bodies", "cdr", &Default::default())
             .unwrap();
         let header = mcap::records::MessageHeader {
             channel_id: ch,
@@ -467,7 +467,7 @@ fn diff_of_a_foreign_mcap_is_exit_2_not_a_ricochet_log() {
         w.write_to_known_channel(&header, b"\x08\x01").unwrap();
         w.finish().unwrap();
     }
-    for (file, why) in [(&other, "some other tool"), (&proto, "protobuf")] {
+    for (file, why) in [(&other, "some other tool"), (&proto, "cdr")] {
         for args in [[s(&a), s(file)], [s(file), s(&a)]] {
             let o = ricochet().arg("diff").args(args).output().unwrap();
             assert_no_panic("diff foreign", &o);

@@ -80,7 +80,11 @@ fn run_with_no_arguments_writes_the_asteroids_demo_with_seven_decodable_channels
     }
     let scenes = topic(&log, "/scene").count();
     assert!(scenes > 1 && scenes < frames, "{scenes} /scene messages");
-    assert_eq!(topic(&log, "/tf").count(), frames, "something moves every frame");
+    assert_eq!(
+        topic(&log, "/tf").count(),
+        frames,
+        "something moves every frame"
+    );
     for (k, m) in topic(&log, "/bodies").enumerate() {
         assert_eq!(m.data["frame"], k as u64);
         assert_eq!(
@@ -99,6 +103,30 @@ fn every_scenario_gives_identical_bytes_twice() {
         let first = run(&s, dir.path(), "first.mcap");
         let second = run(&s, dir.path(), "second.mcap");
         assert!(first == second, "{} is not deterministic", s.display());
+    }
+}
+
+#[test]
+fn the_writer_thread_and_inline_encoding_write_the_same_bytes() {
+    let dir = tempfile::tempdir().unwrap();
+    for name in ["asteroids", "shapes"] {
+        let scenario = root().join(format!("scenarios/{name}.toml"));
+        let threaded = run(&scenario, dir.path(), "threaded.mcap");
+        let inline_out = dir.path().join("inline.mcap");
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_ricochet"))
+            .args(["run", scenario.to_str().unwrap(), "-o"])
+            .arg(&inline_out)
+            .env("RICOCHET_INLINE_WRITER", "1")
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let inline = std::fs::read(&inline_out).unwrap();
+        assert!(
+            threaded.len() > 10_000 && threaded == inline,
+            "{name}: {} bytes threaded, {} inline",
+            threaded.len(),
+            inline.len()
+        );
     }
 }
 

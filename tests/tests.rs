@@ -4,6 +4,7 @@
 mod accuracy;
 mod bad_scenarios;
 mod bench_cli;
+mod channel_schemas;
 mod collide_cli;
 mod collision_cases;
 mod dump_cli;
@@ -15,4 +16,3 @@ mod run_cli;
 mod stress;
 mod util;
 mod validate_cli;
-mod viewer_schemas;

@@ -112,7 +112,12 @@ pub fn shape_def(v: &serde_json::Value) -> ricochet_geom::ShapeDef {
             center: [0.0, 0.0],
         },
         "compound" => ShapeDef::Compound {
-            parts: s["parts"].as_array().unwrap().iter().map(shape_def).collect(),
+            parts: s["parts"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(shape_def)
+                .collect(),
         },
         other => panic!("unknown shape kind {other}"),
     }

@@ -68,7 +68,10 @@ pub fn shape_message(def: &ShapeDef) -> pb::Shape {
             angle: *angle,
         }),
         ShapeDef::Capsule {
-            a, b, radius, center,
+            a,
+            b,
+            radius,
+            center,
         } => Kind::Capsule(pb::Capsule {
             a: vec![a[0] + center[0], a[1] + center[1]],
             b: vec![b[0] + center[0], b[1] + center[1]],
@@ -230,7 +233,10 @@ impl Tracker {
             }
         }
         let removed = if want_bodies {
-            out.removed.iter().map(|r| removed_message(r, layers)).collect()
+            out.removed
+                .iter()
+                .map(|r| removed_message(r, layers))
+                .collect()
         } else {
             Vec::new()
         };

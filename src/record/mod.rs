@@ -28,7 +28,6 @@ use ricochet_sim::{FrameOutput, Layers, Simulation};
 use crate::channels::Channels;
 use bodies::Tracker;
 
-
 /// The `library` field of every log's header.
 pub const LIBRARY: &str = concat!("ricochet ", env!("CARGO_PKG_VERSION"));
 
@@ -82,12 +81,12 @@ impl Recorder {
         if channels.scene {
             t.scene = Some(w.add_protobuf_channel("/scene", Schema::foxglove::<SceneUpdate>())?);
             t.tf = Some(w.add_protobuf_channel("/tf", Schema::foxglove::<FrameTransforms>())?);
-            t.arrows = Some(
-                w.add_protobuf_channel("/scene/contacts", Schema::foxglove::<SceneUpdate>())?,
-            );
+            t.arrows =
+                Some(w.add_protobuf_channel("/scene/contacts", Schema::foxglove::<SceneUpdate>())?);
         }
         if channels.bodies {
-            t.bodies = Some(w.add_protobuf_channel("/bodies", Schema::ricochet("ricochet.Bodies"))?);
+            t.bodies =
+                Some(w.add_protobuf_channel("/bodies", Schema::ricochet("ricochet.Bodies"))?);
         }
         if channels.contacts {
             t.contacts =

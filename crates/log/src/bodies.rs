@@ -94,16 +94,20 @@ mod tests {
             {"id": 1, "generation": 0, "name": "a", "position": [0.0, 0.0], "angle": 0.0, "velocity": [0.0, 0.0]},
         ]}));
         assert_eq!(k["bodies"][0]["name"], "a", "sorted by id");
-        let d = s.apply(&json!({"frame": 1, "keyframe": false, "removed": [], "bodies": [
-            {"id": 2, "generation": 0, "position": [1.5, 2.0], "velocity": []},
-        ]}));
+        let d = s.apply(
+            &json!({"frame": 1, "keyframe": false, "removed": [], "bodies": [
+                {"id": 2, "generation": 0, "position": [1.5, 2.0], "velocity": []},
+            ]}),
+        );
         assert_eq!(
             d["bodies"][1],
             json!({"id": 2, "generation": 0, "name": "b", "position": [1.5, 2.0], "angle": 0.5, "velocity": [3.0, 4.0]})
         );
-        let r = s.apply(&json!({"frame": 2, "keyframe": false, "bodies": [], "removed": [
-            {"id": 1, "generation": 0, "name": "a"},
-        ]}));
+        let r = s.apply(
+            &json!({"frame": 2, "keyframe": false, "bodies": [], "removed": [
+                {"id": 1, "generation": 0, "name": "a"},
+            ]}),
+        );
         assert_eq!(r["bodies"].as_array().unwrap().len(), 1);
         let k = s.apply(&json!({"frame": 3, "keyframe": true, "removed": [], "bodies": []}));
         assert!(k["bodies"].as_array().unwrap().is_empty() && s.is_empty());

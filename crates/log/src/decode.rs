@@ -50,7 +50,9 @@ impl Decoder {
                     .serialize_with_options(serde_json::value::Serializer, &options())
                     .map_err(|e| format!("{}: {e}", schema.name))
             }
-            other => Err(format!("message encoding {other:?} is neither json nor protobuf")),
+            other => Err(format!(
+                "message encoding {other:?} is neither json nor protobuf"
+            )),
         }
     }
 }

@@ -296,8 +296,21 @@ impl LogWriter {
 
     /// Adds a channel on `topic` for protobuf messages of type `schema.name`, whose
     /// `schema.data` is a FileDescriptorSet that defines it (MCAP's protobuf profile).
-    pub fn add_protobuf_channel(&mut self, topic: &str, schema: Schema) -> Result<ChannelId, LogError> {
+    pub fn add_protobuf_channel(
+        &mut self,
+        topic: &str,
+        schema: Schema,
+    ) -> Result<ChannelId, LogError> {
         self.add_channel(topic, schema, "protobuf")
+    }
+
+    /// Adds a channel on `topic` for the official Foxglove message type `T`
+    /// (`SceneUpdate`, `FrameTransforms`, `Log`, ... from [`fox`](crate::messages::fox)).
+    pub fn add_foxglove_channel<T: foxglove::Encode>(
+        &mut self,
+        topic: &str,
+    ) -> Result<ChannelId, LogError> {
+        self.add_protobuf_channel(topic, Schema::foxglove::<T>())
     }
 
     /// Adds a channel on `topic` whose messages are JSON (message encoding
@@ -342,7 +355,12 @@ impl LogWriter {
         self.write_payload(channel, time_ns, Payload::Bytes(data))
     }
 
-    fn write_payload(&mut self, channel: ChannelId, time_ns: u64, payload: Payload) -> Result<(), LogError> {
+    fn write_payload(
+        &mut self,
+        channel: ChannelId,
+        time_ns: u64,
+        payload: Payload,
+    ) -> Result<(), LogError> {
         let sequence = self.sequences.get(&channel).copied().unwrap_or(0);
         let header = MessageHeader {
             channel_id: channel.0,

@@ -32,45 +32,71 @@ fn same_calls_give_byte_identical_files() {
 }
 
 #[test]
+fn the_writer_thread_and_inline_encoding_give_the_same_bytes() {
+    let dir = tempfile::tempdir().unwrap();
+    let (thread, inline) = (dir.path().join("t.mcap"), dir.path().join("i.mcap"));
+    common::write_sample_log_with(&thread, ricochet_log::Threading::Thread);
+    common::write_sample_log_with(&inline, ricochet_log::Threading::Inline);
+    let (t, i) = (
+        std::fs::read(thread).unwrap(),
+        std::fs::read(inline).unwrap(),
+    );
+    assert!(t.len() > 1000 && t == i, "{} vs {} bytes", t.len(), i.len());
+}
+
+#[test]
 fn written_log_reads_back_unchanged() {
+    use prost::Message;
+    use ricochet_log::messages::fox::{Log, SceneUpdate};
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("run.mcap");
     write_sample_log(&path);
-    let messages = read_log_file(&path).unwrap();
-
-    let mut expected = Vec::new();
-    for step in 0..STEPS {
-        let time_ns = step * STEP_NS;
-        let scene = serde_json::to_value(full_scene(time_ns)).unwrap();
-        let log = serde_json::to_value(log_line(time_ns)).unwrap();
-        expected.push((
-            "/scene",
-            "foxglove.SceneUpdate",
-            time_ns,
-            step as u32,
-            scene,
-        ));
-        expected.push(("/log", "foxglove.Log", time_ns, step as u32, log));
+    let log = LogFile::open(&path).unwrap();
+    let mut messages = log.messages().unwrap();
+    let mut expected_scenes = (0..STEPS)
+        .map(|s| full_scene(s * STEP_NS))
+        .collect::<Vec<_>>();
+    expected_scenes.push(deletion_scene(STEPS * STEP_NS));
+    let (mut scenes, mut lines) = (0, 0);
+    while let Some(raw) = messages.next_raw() {
+        let raw = raw.unwrap();
+        // The payload decodes, with prost, to the very message written.
+        match raw.topic() {
+            "/scene" => {
+                let got = SceneUpdate::decode(raw.bytes()).unwrap();
+                assert_eq!(got, expected_scenes[scenes]);
+                assert_eq!(raw.log_time(), scenes as u64 * STEP_NS);
+                scenes += 1;
+            }
+            "/log" => {
+                let got = Log::decode(raw.bytes()).unwrap();
+                assert_eq!(got, log_line(lines as u64 * STEP_NS));
+                lines += 1;
+            }
+            other => panic!("unexpected topic {other}"),
+        }
     }
-    let end_ns = STEPS * STEP_NS;
-    let deletion = serde_json::to_value(deletion_scene(end_ns)).unwrap();
-    expected.push((
-        "/scene",
-        "foxglove.SceneUpdate",
-        end_ns,
-        STEPS as u32,
-        deletion,
-    ));
-
-    assert_eq!(messages.len(), expected.len());
-    for (got, (topic, schema_name, time_ns, sequence, data)) in messages.iter().zip(&expected) {
-        assert_eq!(got.topic, *topic);
-        assert_eq!(got.schema_name, *schema_name);
-        assert_eq!(got.log_time, *time_ns);
-        assert_eq!(got.publish_time, *time_ns);
-        assert_eq!(got.sequence, *sequence);
-        assert_eq!(got.data, *data);
-    }
+    assert_eq!((scenes, lines), (STEPS as usize + 1, STEPS as usize));
+    // And to JSON, from the schema the log embeds: the protobuf JSON mapping, with the
+    // .proto field names and every field.
+    let all = read_log_file(&path).unwrap();
+    let line = all
+        .iter()
+        .find(|m| m.topic == "/log" && m.sequence == 1)
+        .unwrap();
+    assert_eq!(line.schema_name, "foxglove.Log");
+    assert_eq!((line.log_time, line.publish_time), (STEP_NS, STEP_NS));
+    assert_eq!(
+        line.data,
+        serde_json::json!({
+            "timestamp": "1970-01-01T00:00:00.016666667Z",
+            "level": "INFO",
+            "message": "step at 16666667 ns",
+            "name": "ricochet",
+            "file": "src/main.rs",
+            "line": 42
+        })
+    );
 }
 
 #[test]
@@ -79,9 +105,13 @@ fn log_finished_early_is_complete() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("interrupted.mcap");
     let mut writer = LogWriter::create(&path, "ricochet-log tests").unwrap();
-    let scene = writer.add_scene_channel("/scene").unwrap();
-    let _unused = writer.add_log_channel("/log").unwrap();
-    writer.write(scene, 5, &full_scene(5)).unwrap();
+    let scene = writer
+        .add_foxglove_channel::<ricochet_log::messages::fox::SceneUpdate>("/scene")
+        .unwrap();
+    let _unused = writer
+        .add_foxglove_channel::<ricochet_log::messages::fox::Log>("/log")
+        .unwrap();
+    writer.write(scene, 5, full_scene(5)).unwrap();
     writer.finish().unwrap();
     let messages = read_log_file(&path).unwrap();
     assert_eq!(messages.len(), 1);
@@ -264,8 +294,10 @@ fn an_existing_log_is_replaced_only_by_a_finished_one() {
     std::fs::write(&path, b"the old log").unwrap();
     // Written, not finished, dropped: the old file is untouched and no temporary file is left.
     let mut writer = LogWriter::create(&path, "ricochet-log tests").unwrap();
-    let channel = writer.add_log_channel("/log").unwrap();
-    writer.write(channel, 0, &log_line(0)).unwrap();
+    let channel = writer
+        .add_foxglove_channel::<ricochet_log::messages::fox::Log>("/log")
+        .unwrap();
+    writer.write(channel, 0, log_line(0)).unwrap();
     assert_eq!(std::fs::read(&path).unwrap(), b"the old log");
     let during = listing(dir.path());
     assert_eq!(during.len(), 2, "{during:?}");

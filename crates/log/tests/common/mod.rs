@@ -8,86 +8,118 @@
 use std::path::Path;
 
 use ricochet_log::LogWriter;
-use ricochet_log::foxglove::{
-    ArrowPrimitive, Color, CubePrimitive, CylinderPrimitive, KeyValuePair, LinePrimitive, LineType,
-    Log, LogLevel, ModelPrimitive, Point3, Pose, SceneEntity, SceneEntityDeletion, SceneUpdate,
-    SpherePrimitive, TextPrimitive, Timestamp, TriangleListPrimitive, Vector3,
+use ricochet_log::messages::fox::{
+    ArrowPrimitive, Color, CubePrimitive, CylinderPrimitive, KeyValuePair, LinePrimitive, Log,
+    ModelPrimitive, Point3, Pose, Quaternion, SceneEntity, SceneEntityDeletion, SceneUpdate,
+    SpherePrimitive, TextPrimitive, TriangleListPrimitive, Vector3, line_primitive, log,
+    scene_entity_deletion,
 };
+use ricochet_log::messages::timestamp;
+
+fn v3(x: f64, y: f64, z: f64) -> Option<Vector3> {
+    Some(Vector3 { x, y, z })
+}
+
+fn p3(x: f64, y: f64) -> Point3 {
+    Point3 { x, y, z: 0.0 }
+}
 
 /// A scene update with one entity holding one primitive of every kind.
 pub fn full_scene(time_ns: u64) -> SceneUpdate {
-    let timestamp = Timestamp::from_nanos(time_ns);
-    let red = Color::rgba(1.0, 0.0, 0.0, 1.0);
-    let pose = Pose::planar(1.5, -2.25, 0.75);
-    let mut entity = SceneEntity::new("body/7", "world", timestamp);
-    entity.metadata.push(KeyValuePair::new("shape", "ball"));
-    entity.arrows.push(ArrowPrimitive {
-        pose,
-        shaft_length: 1.0,
-        shaft_diameter: 0.05,
-        head_length: 0.2,
-        head_diameter: 0.1,
-        color: red,
+    let red = Some(Color {
+        r: 1.0,
+        g: 0.0,
+        b: 0.0,
+        a: 1.0,
     });
-    entity.cubes.push(CubePrimitive {
-        pose,
-        size: Vector3::new(2.0, 1.0, 0.1),
-        color: red,
+    let pose = Some(Pose {
+        position: v3(1.5, -2.25, 0.0),
+        orientation: Some(Quaternion {
+            x: 0.0,
+            y: 0.0,
+            z: 0.25,
+            w: 0.75,
+        }),
     });
-    entity.spheres.push(SpherePrimitive {
-        pose,
-        size: Vector3::new(0.5, 0.5, 0.5),
-        color: red,
-    });
-    entity.cylinders.push(CylinderPrimitive {
-        pose,
-        size: Vector3::new(1.0, 1.0, 0.1),
-        bottom_scale: 1.0,
-        top_scale: 1.0,
-        color: red,
-    });
-    entity.lines.push(LinePrimitive {
-        line_type: LineType::LineLoop,
-        pose,
-        thickness: 2.0,
-        scale_invariant: true,
-        points: vec![
-            Point3::new(0.0, 0.0, 0.0),
-            Point3::new(1.0, 0.0, 0.0),
-            Point3::new(0.0, 1.0, 0.0),
-        ],
-        color: red,
-        colors: Vec::new(),
-        indices: vec![0, 1, 2],
-    });
-    entity.triangles.push(TriangleListPrimitive {
-        pose,
-        points: vec![
-            Point3::new(0.0, 0.0, 0.0),
-            Point3::new(1.0, 0.0, 0.0),
-            Point3::new(0.0, 1.0, 0.0),
-        ],
-        color: red,
-        colors: vec![red, red, red],
-        indices: Vec::new(),
-    });
-    entity.texts.push(TextPrimitive {
-        pose,
-        billboard: true,
-        font_size: 12.0,
-        scale_invariant: true,
-        color: red,
-        text: "body 7".to_owned(),
-    });
-    entity.models.push(ModelPrimitive {
-        pose,
-        scale: Vector3::new(1.0, 1.0, 1.0),
-        color: red,
-        override_color: false,
-        url: "package://ricochet/ball.glb".to_owned(),
-        media_type: String::new(),
-        data: String::new(),
-    });
+    let triangle = vec![p3(0.0, 0.0), p3(1.0, 0.0), p3(0.0, 1.0)];
+    let entity = SceneEntity {
+        timestamp: Some(timestamp(time_ns)),
+        frame_id: "world".to_owned(),
+        id: "body/7".to_owned(),
+        lifetime: None,
+        frame_locked: true,
+        metadata: vec![KeyValuePair {
+            key: "shape".to_owned(),
+            value: "ball".to_owned(),
+        }],
+        arrows: vec![ArrowPrimitive {
+            pose,
+            shaft_length: 1.0,
+            shaft_diameter: 0.05,
+            head_length: 0.2,
+            head_diameter: 0.1,
+            color: red,
+        }],
+        cubes: vec![CubePrimitive {
+            pose,
+            size: v3(2.0, 1.0, 0.1),
+            color: red,
+        }],
+        spheres: vec![SpherePrimitive {
+            pose,
+            size: v3(0.5, 0.5, 0.5),
+            color: red,
+        }],
+        cylinders: vec![CylinderPrimitive {
+            pose,
+            size: v3(1.0, 1.0, 0.1),
+            bottom_scale: 1.0,
+            top_scale: 1.0,
+            color: red,
+        }],
+        lines: vec![LinePrimitive {
+            r#type: line_primitive::Type::LineLoop as i32,
+            pose,
+            thickness: 2.0,
+            scale_invariant: true,
+            points: triangle.clone(),
+            color: red,
+            colors: Vec::new(),
+            indices: vec![0, 1, 2],
+        }],
+        triangles: vec![TriangleListPrimitive {
+            pose,
+            points: triangle,
+            color: red,
+            colors: vec![
+                Color {
+                    r: 1.0,
+                    g: 0.0,
+                    b: 0.0,
+                    a: 1.0
+                };
+                3
+            ],
+            indices: Vec::new(),
+        }],
+        texts: vec![TextPrimitive {
+            pose,
+            billboard: true,
+            font_size: 12.0,
+            scale_invariant: true,
+            color: red,
+            text: "body 7".to_owned(),
+        }],
+        models: vec![ModelPrimitive {
+            pose,
+            scale: v3(1.0, 1.0, 1.0),
+            color: red,
+            override_color: false,
+            url: "package://ricochet/ball.glb".to_owned(),
+            media_type: String::new(),
+            data: Vec::new().into(),
+        }],
+    };
     SceneUpdate {
         deletions: Vec::new(),
         entities: vec![entity],
@@ -96,11 +128,15 @@ pub fn full_scene(time_ns: u64) -> SceneUpdate {
 
 /// A scene update that only deletes: one entity by id, then everything.
 pub fn deletion_scene(time_ns: u64) -> SceneUpdate {
-    let timestamp = Timestamp::from_nanos(time_ns);
+    let deletion = |kind: scene_entity_deletion::Type, id: &str| SceneEntityDeletion {
+        timestamp: Some(timestamp(time_ns)),
+        r#type: kind as i32,
+        id: id.to_owned(),
+    };
     SceneUpdate {
         deletions: vec![
-            SceneEntityDeletion::matching_id(timestamp, "body/7"),
-            SceneEntityDeletion::all(timestamp),
+            deletion(scene_entity_deletion::Type::MatchingId, "body/7"),
+            deletion(scene_entity_deletion::Type::All, ""),
         ],
         entities: Vec::new(),
     }
@@ -108,15 +144,14 @@ pub fn deletion_scene(time_ns: u64) -> SceneUpdate {
 
 /// A log line.
 pub fn log_line(time_ns: u64) -> Log {
-    let mut log = Log::new(
-        Timestamp::from_nanos(time_ns),
-        LogLevel::Info,
-        "ricochet",
-        format!("step at {time_ns} ns"),
-    );
-    log.file = "src/main.rs".to_owned();
-    log.line = 42;
-    log
+    Log {
+        timestamp: Some(timestamp(time_ns)),
+        level: log::Level::Info as i32,
+        message: format!("step at {time_ns} ns"),
+        name: "ricochet".to_owned(),
+        file: "src/main.rs".to_owned(),
+        line: 42,
+    }
 }
 
 /// Number of steps [`write_sample_log`] writes.
@@ -127,17 +162,22 @@ pub const STEP_NS: u64 = 16_666_667;
 /// Writes a small log: per step a scene update on `/scene` and a line on
 /// `/log`, with a deletion on the last step.
 pub fn write_sample_log(path: &Path) {
-    let mut writer = LogWriter::create(path, "ricochet-log tests").unwrap();
-    let scene = writer.add_scene_channel("/scene").unwrap();
-    let log = writer.add_log_channel("/log").unwrap();
+    write_sample_log_with(path, ricochet_log::Threading::Thread);
+}
+
+/// [`write_sample_log`], encoding where `threading` says.
+pub fn write_sample_log_with(path: &Path, threading: ricochet_log::Threading) {
+    let mut writer = LogWriter::create_with(path, "ricochet-log tests", threading).unwrap();
+    let scene = writer
+        .add_foxglove_channel::<SceneUpdate>("/scene")
+        .unwrap();
+    let log = writer.add_foxglove_channel::<Log>("/log").unwrap();
     for step in 0..STEPS {
         let time_ns = step * STEP_NS;
-        writer.write(scene, time_ns, &full_scene(time_ns)).unwrap();
-        writer.write(log, time_ns, &log_line(time_ns)).unwrap();
+        writer.write(scene, time_ns, full_scene(time_ns)).unwrap();
+        writer.write(log, time_ns, log_line(time_ns)).unwrap();
     }
     let end_ns = STEPS * STEP_NS;
-    writer
-        .write(scene, end_ns, &deletion_scene(end_ns))
-        .unwrap();
+    writer.write(scene, end_ns, deletion_scene(end_ns)).unwrap();
     writer.finish().unwrap();
 }
