@@ -9,6 +9,7 @@
 
 mod accuracy;
 mod bench;
+mod bench_record;
 mod channels;
 mod check;
 mod collide;
@@ -173,6 +174,14 @@ enum Command {
         /// Write the results as CSV here.
         #[arg(long, value_name = "FILE")]
         csv: Option<PathBuf>,
+        /// Measure the log instead: run each scene alone, then recorded with every channel
+        /// as `ricochet run` records it; print frames/s both ways and the log's bytes per
+        /// moving body per frame. Default scene: asteroids-10000.
+        #[arg(long)]
+        record: bool,
+        /// With --record: keep the logs in this directory (NAME.mcap).
+        #[arg(long, value_name = "DIR", requires = "record")]
+        keep: Option<PathBuf>,
     },
     /// Check a scenario file without running it: syntax, units, layers, templates, script.
     ///
@@ -241,6 +250,17 @@ fn main() -> ExitCode {
             scenes,
             frames,
             csv,
+            record: true,
+            keep,
+        } => {
+            let _ = csv;
+            bench_record::run(&scenes, frames, keep.as_deref())
+        }
+        Command::Bench {
+            scenes,
+            frames,
+            csv,
+            ..
         } => bench::run(&scenes, frames, csv.as_deref()),
         Command::Accuracy { csv, svg } => accuracy::run(csv.as_deref(), svg.as_deref()),
         Command::Diff {
