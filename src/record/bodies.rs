@@ -1,10 +1,20 @@
 //! What changed since the previous frame, body by body: the `/bodies` deltas, the `/tf`
 //! transforms to send and whether `/scene` must be sent whole again.
 //!
-//! Values are compared by their bits, so a change of sign of a zero, or any NaN, is a change.
+//! `/bodies` leaves out what the integrator predicts (see `proto/ricochet.proto`): a position
+//! that is `previous + velocity * dt`, an angle that is `previous + angular_velocity * dt`,
+//! velocities that did not change. Values are compared by their bits, so a change of sign of
+//! a zero, or any NaN, is a change.
+//!
+//! `/tf` sends a body's pose only at the ends of the stretches where it moves in a straight
+//! line at a constant rate (and turns at a constant rate, less than a quarter turn):
+//! Foxglove interpolates between a frame's transforms, linearly for the position and
+//! spherically for the rotation, which gives back every frame's pose in between (within
+//! [`LINE_TOLERANCE`], far below what f32 rendering shows). A stretch still open at the end
+//! of the log, or when its body goes, is closed by [`Tracker::close`].
 
 use ricochet_geom::{ShapeDef, Vec2};
-use ricochet_log::messages::fox::{FrameTransform, Timestamp};
+use ricochet_log::messages::fox::FrameTransform;
 use ricochet_log::messages::ricochet as pb;
 use ricochet_sim::{BodyKind, Entity, FrameOutput, Layers, RemovedBody, World};
 
@@ -12,6 +22,48 @@ use super::scene;
 
 /// `/bodies` lists every body in full every this many frames (and at frame 0).
 pub const KEYFRAME_INTERVAL: u64 = 60;
+
+/// How far, relative to the value (or absolutely, below 1), a frame's pose may be from the
+/// straight line of its stretch: 1e-9, some ten thousand times finer than f32 rendering.
+pub const LINE_TOLERANCE: f64 = 1e-9;
+
+/// A pose as `/tf` interpolates it: x, y and angle.
+type Pose3 = [f64; 3];
+
+/// A stretch of straight-line motion: its first frame and pose, and the step per frame
+/// (known from its second frame on).
+struct Stretch {
+    frame: u64,
+    pose: Pose3,
+    step: Option<Pose3>,
+}
+
+impl Stretch {
+    fn start(frame: u64, pose: Pose3) -> Stretch {
+        Stretch {
+            frame,
+            pose,
+            step: None,
+        }
+    }
+
+    /// Whether `pose` at `frame` is on the line (setting the step at its second frame).
+    fn extends_to(&mut self, frame: u64, pose: Pose3) -> bool {
+        let n = (frame - self.frame) as f64;
+        let Some(step) = self.step else {
+            self.step = Some([
+                pose[0] - self.pose[0],
+                pose[1] - self.pose[1],
+                pose[2] - self.pose[2],
+            ]);
+            return (pose[2] - self.pose[2]).abs() < std::f64::consts::FRAC_PI_2;
+        };
+        (0..3).all(|k| {
+            let want = self.pose[k] + step[k] * n;
+            (pose[k] - want).abs() <= LINE_TOLERANCE * pose[k].abs().max(1.0)
+        }) && (pose[2] - self.pose[2]).abs() < std::f64::consts::FRAC_PI_2
+    }
+}
 
 /// What was last recorded of a body alive at the end of the previous frame.
 struct Known {
@@ -22,12 +74,20 @@ struct Known {
     angular_velocity: f64,
     /// Its frame's name, `body/index:generation`.
     frame_id: String,
-    /// The last frame a transform of it was sent in.
-    transform_frame: u64,
+    /// The stretch of straight-line motion it is on.
+    stretch: Stretch,
+    /// The last frame whose pose was sent on `/tf`.
+    sent: u64,
     /// Its drawing turns back by its angle (an AABB part): a turn redraws the scene.
     drawn_with_angle: bool,
     /// The frame it was last seen in the world.
     seen: u64,
+}
+
+impl Known {
+    fn pose(&self) -> Pose3 {
+        [self.position.x, self.position.y, self.angle]
+    }
 }
 
 fn same(a: f64, b: f64) -> bool {
@@ -102,7 +162,8 @@ pub fn removed_message(r: &RemovedBody, layers: &Layers) -> pb::Body {
         position: xy(r.pose.position),
         angle: Some(r.pose.angle),
         velocity: xy(r.velocity),
-        angular_velocity: None,
+        angular_velocity: Some(r.angular_velocity),
+        still: false,
     }
 }
 
@@ -110,7 +171,8 @@ pub fn removed_message(r: &RemovedBody, layers: &Layers) -> pb::Body {
 pub struct Changes {
     /// `/bodies`.
     pub bodies: pb::Bodies,
-    /// `/tf`: the transforms of the bodies that appeared or moved.
+    /// `/tf`: the transforms of the bodies that appeared, or whose stretch of straight-line
+    /// motion ended.
     pub transforms: Vec<FrameTransform>,
     /// `/scene` must be sent whole: a body appeared or went, or an AABB body turned.
     pub scene_changed: bool,
@@ -122,6 +184,13 @@ pub struct Tracker {
     known: Vec<Option<Known>>,
     alive: usize,
     started: bool,
+    /// The last frame seen.
+    frame: u64,
+}
+
+fn transform(k: &Known, frame: u64, dt_ns: u64) -> FrameTransform {
+    let ts = ricochet_log::messages::timestamp(frame * dt_ns);
+    scene::transform(&k.frame_id, ts, k.position, k.angle)
 }
 
 impl Tracker {
@@ -131,15 +200,15 @@ impl Tracker {
         world: &World,
         out: &FrameOutput,
         layers: &Layers,
+        dt: f64,
         dt_ns: u64,
         want_bodies: bool,
     ) -> Changes {
         let frame = out.frame;
-        let ts = ricochet_log::messages::timestamp(frame * dt_ns);
-        let before: Timestamp = ricochet_log::messages::timestamp(frame.saturating_sub(1) * dt_ns);
         let keyframe = !self.started || frame.is_multiple_of(KEYFRAME_INTERVAL);
         let mut scene_changed = !self.started || !out.removed.is_empty();
         self.started = true;
+        self.frame = frame;
         let mut bodies = Vec::new();
         let mut transforms = Vec::new();
         for i in 0..world.len() {
@@ -152,46 +221,64 @@ impl Tracker {
             }
             let fresh = !matches!(&self.known[slot], Some(k) if k.generation == e.generation);
             if fresh {
-                if self.known[slot].is_none() {
-                    self.alive += 1;
+                match &self.known[slot] {
+                    None => self.alive += 1,
+                    // The slot's last body went this frame: close its last stretch.
+                    Some(old) if old.sent < old.seen => {
+                        transforms.push(transform(old, old.seen, dt_ns));
+                    }
+                    Some(_) => {}
                 }
                 scene_changed = true;
-                let frame_id = scene::entity_id(e);
-                transforms.push(scene::transform(&frame_id, ts, position, angle));
-                self.known[slot] = Some(Known {
+                let k = Known {
                     generation: e.generation,
                     position,
                     angle,
                     velocity,
                     angular_velocity,
-                    frame_id,
-                    transform_frame: frame,
+                    frame_id: scene::entity_id(e),
+                    stretch: Stretch::start(frame, [position.x, position.y, angle]),
+                    sent: frame,
                     drawn_with_angle: scene::drawing_depends_on_angle(&world.shape[i]),
                     seen: frame,
-                });
+                };
+                transforms.push(transform(&k, frame, dt_ns));
+                self.known[slot] = Some(k);
             }
             let Some(k) = self.known[slot].as_mut() else {
                 continue;
             };
             k.seen = frame;
-            let moved = !same2(k.position, position);
-            let turned = !same(k.angle, angle);
+            let pose = [position.x, position.y, angle];
+            if !fresh && !k.stretch.extends_to(frame, pose) {
+                // The stretch ended at the previous frame: send its end (unless sent), and
+                // start the next stretch there.
+                if k.sent < frame - 1 {
+                    transforms.push(transform(k, frame - 1, dt_ns));
+                    k.sent = frame - 1;
+                }
+                let mut next = Stretch::start(frame - 1, k.pose());
+                if !next.extends_to(frame, pose) {
+                    // A quarter turn or more in one step: this frame is a stretch's end too.
+                    let ts = ricochet_log::messages::timestamp(frame * dt_ns);
+                    transforms.push(scene::transform(&k.frame_id, ts, position, angle));
+                    k.sent = frame;
+                    next = Stretch::start(frame, pose);
+                }
+                k.stretch = next;
+            }
+            if !fresh && k.drawn_with_angle && !same(angle, k.angle) {
+                scene_changed = true;
+            }
             let sped = !same2(k.velocity, velocity);
             let spun = !same(k.angular_velocity, angular_velocity);
-            if !fresh && (moved || turned) {
-                if k.transform_frame + 1 < frame {
-                    // Foxglove interpolates between a frame's transforms: the pose it had
-                    // since its last transform is sent again just before it changes.
-                    transforms.push(scene::transform(&k.frame_id, before, k.position, k.angle));
-                }
-                transforms.push(scene::transform(&k.frame_id, ts, position, angle));
-                k.transform_frame = frame;
-                if turned && k.drawn_with_angle {
-                    scene_changed = true;
-                }
-            }
+            // What a reader predicts: the integrator's step with this frame's velocities.
+            let moved_as_predicted = same2(position, k.position + velocity * dt);
+            let turned_as_predicted = same(angle, k.angle + angular_velocity * dt);
+            let still = same2(position, k.position) && same(angle, k.angle);
             let full = keyframe || fresh;
-            if want_bodies && (full || moved || turned || sped || spun) {
+            let predicted = moved_as_predicted && turned_as_predicted;
+            if want_bodies && (full || sped || spun || !predicted) {
                 let mut b = pb::Body {
                     id: e.index,
                     generation: e.generation,
@@ -202,12 +289,17 @@ impl Tracker {
                     b.layer = Some(layers.name(world.layer[i]).to_owned());
                     b.shape = Some(shape_message(&ShapeDef::from_shape(&world.shape[i])));
                     b.r#static = Some(world.kind[i] == BodyKind::Static);
-                }
-                if full || moved {
                     b.position = xy(position);
-                }
-                if full || turned {
                     b.angle = Some(angle);
+                } else if still && !predicted {
+                    b.still = true;
+                } else {
+                    if !moved_as_predicted {
+                        b.position = xy(position);
+                    }
+                    if !turned_as_predicted {
+                        b.angle = Some(angle);
+                    }
                 }
                 if full || sped {
                     b.velocity = xy(velocity);
@@ -223,9 +315,15 @@ impl Tracker {
             k.angular_velocity = angular_velocity;
         }
         if self.alive != world.len() {
-            // Some bodies went (removed, or despawned between frames): forget them.
+            // Some bodies went (removed, or despawned between frames): close their last
+            // stretch at the frame they were last seen in, and forget them.
             for slot in &mut self.known {
-                if slot.as_ref().is_some_and(|k| k.seen != frame) {
+                if let Some(k) = slot.as_ref()
+                    && k.seen != frame
+                {
+                    if k.sent < k.seen {
+                        transforms.push(transform(k, k.seen, dt_ns));
+                    }
                     *slot = None;
                     self.alive -= 1;
                     scene_changed = true;
@@ -247,9 +345,25 @@ impl Tracker {
                 keyframe,
                 bodies,
                 removed,
+                dt,
             },
             transforms,
             scene_changed,
         }
+    }
+
+    /// The transforms that close every stretch still open at the last frame seen: called
+    /// when the log ends, so that Foxglove has both ends of every stretch.
+    pub fn close(&mut self, dt_ns: u64) -> Vec<FrameTransform> {
+        let frame = self.frame;
+        self.known
+            .iter_mut()
+            .flatten()
+            .filter(|k| k.sent < frame)
+            .map(|k| {
+                k.sent = frame;
+                transform(k, frame, dt_ns)
+            })
+            .collect()
     }
 }

@@ -4,9 +4,9 @@
 //! | topic | schema | content |
 //! |---|---|---|
 //! | `/scene` | `foxglove.SceneUpdate` | every body, drawn in its own frame; sent whole when the set of bodies changes |
-//! | `/tf` | `foxglove.FrameTransforms` | each body's frame: sent when the body appears or moves |
+//! | `/tf` | `foxglove.FrameTransforms` | each body's frame: sent at the ends of its stretches of straight-line motion (Foxglove interpolates between) |
 //! | `/scene/contacts` | `foxglove.SceneUpdate` | the frame's contact normals as arrows |
-//! | `/bodies` | `ricochet.Bodies` | exact body states: every body at keyframes, what changed between |
+//! | `/bodies` | `ricochet.Bodies` | exact body states: every body at keyframes, between them what the integrator does not predict |
 //! | `/contacts` | `ricochet.Contacts` | every contact, with the poses it was detected at |
 //! | `/stats` | `ricochet.Stats` | deterministic counters, for Foxglove's Plot panel |
 //! | `/events` | `foxglove.Log` | inputs, spawns, destructions and collision events |
@@ -65,6 +65,8 @@ pub struct Recorder {
     tracker: Tracker,
     /// The previous frame had contact arrows (so this one sends an empty set if it has none).
     arrows_shown: bool,
+    /// The last frame recorded.
+    last_frame: Option<u64>,
 }
 
 impl Recorder {
@@ -107,6 +109,7 @@ impl Recorder {
             topics: t,
             tracker: Tracker::default(),
             arrows_shown: false,
+            last_frame: None,
         })
     }
 
@@ -146,11 +149,14 @@ impl Recorder {
     pub fn record(&mut self, sim: &Simulation, out: &FrameOutput) -> Result<(), LogError> {
         let t = out.frame * self.dt_ns;
         let ts = timestamp(t);
+        self.last_frame = Some(out.frame);
         let w = sim.world();
         let layers = &sim.scenario().world.layers;
         let want_bodies = self.topics.bodies.is_some();
         if self.topics.scene.is_some() || want_bodies {
-            let mut changes = self.tracker.frame(w, out, layers, self.dt_ns, want_bodies);
+            let mut changes = self
+                .tracker
+                .frame(w, out, layers, self.dt, self.dt_ns, want_bodies);
             if let (Some(ch), true) = (self.topics.scene, changes.scene_changed) {
                 let drawings = (0..w.len()).map(|i| scene::BodyDrawing {
                     entity: w.entity[i],
@@ -201,8 +207,18 @@ impl Recorder {
         Ok(())
     }
 
-    /// Writes the summary and index. Called after an interrupted run too.
-    pub fn finish(self) -> Result<(), LogError> {
+    /// Closes every body's last stretch on `/tf` (at the last frame recorded), then writes
+    /// the summary and index. Called after an interrupted run too.
+    pub fn finish(mut self) -> Result<(), LogError> {
+        if let Some(ch) = self.topics.tf
+            && let Some(frame) = self.last_frame
+        {
+            let transforms = self.tracker.close(self.dt_ns);
+            if !transforms.is_empty() {
+                self.writer
+                    .write(ch, frame * self.dt_ns, FrameTransforms { transforms })?;
+            }
+        }
         self.writer.finish()
     }
 }

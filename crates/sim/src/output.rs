@@ -76,6 +76,8 @@ pub struct RemovedBody {
     pub pose: Pose,
     /// Velocity.
     pub velocity: Vec2,
+    /// Angular velocity, radians per second.
+    pub angular_velocity: f64,
     /// Kind.
     pub kind: BodyKind,
 }

@@ -20,6 +20,7 @@ pub(crate) fn remove(ctx: &mut StageCtx, entity: Entity, cause: Removal, split: 
         shape: w.shape[i].clone(),
         pose: w.pose(i),
         velocity: w.velocity[i],
+        angular_velocity: w.angular_velocity[i],
         kind: w.kind[i],
     };
     ctx.out.events.push(GameEvent::Removed {
