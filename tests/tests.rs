@@ -13,6 +13,7 @@ mod golden;
 mod hostile;
 mod large_scenario;
 mod run_cli;
+mod seek;
 mod stress;
 mod util;
 mod validate_cli;

@@ -1,0 +1,453 @@
+//! Foxglove's seek, emulated: what the 3D panel shows at any time of a log must be the
+//! bodies of `/bodies` at that frame.
+//!
+//! When Foxglove seeks to a time `t` it does not replay the log: it takes, per topic, the last
+//! message with `log_time <= t`, and for `/tf` it has preloaded every transform of the file.
+//! So the panel shows:
+//! - the entities of the last `/scene` (`foxglove.SceneUpdate`) at or before `t`: its
+//!   deletions applied, then its entities (Ricochet sends a delete-all then every body, so
+//!   that one message is the whole scene);
+//! - each entity in its frame (`frame_locked`), placed by the frame's transform history at
+//!   `t`: the transform stamped `t` if there is one; between two, position lerped and
+//!   rotation slerped; before the first or after the last, that one
+//!   (`CoordinateFrame.findClosestTransforms` and `InterpolateTransform` in Foxglove's 3D
+//!   panel).
+//!
+//! At 50 times drawn by a fixed-seed RNG (every third snapped to a frame), plus the first and
+//! the last, in `asteroids`, `platformer` and `level`, [`Log::check`] compares that with
+//! `/bodies` (rebuilt in full) at frame `floor(t / dt_ns)`:
+//! - the entities shown are the bodies alive, each named as its body;
+//! - each entity's frame, by its latest transform at or before `t`, is at the body's position
+//!   and angle, within f32 rounding;
+//! - Foxglove's interpolation gives that same pose at a frame's time, and between frames `f`
+//!   and `f + 1` the lerp of the body's poses at `f` and `f + 1` (this holds because a body
+//!   that starts moving after standing still has its old pose sent again, stamped `f`: of the
+//!   three, only `level`, whose crates stand still until pushed, has such transforms);
+//! - every primitive, taken to the world through its frame, is where the body's shape placed
+//!   at the body's pose is (`ricochet_geom::place`): centres, sizes, turns, vertices.
+//!
+//! Seeking depends on nothing but `t`: the times are checked in the drawn (random) order, and
+//! a second test seeks back and forth and compares with fresh seeks and with playing from 0.
+
+use std::collections::BTreeMap;
+use std::f64::consts::TAU;
+
+use ricochet_geom::{PlacedPrimitive, Pose, Vec2, place};
+use ricochet_scenes::Rng;
+use serde_json::Value;
+
+use crate::util::{full_bodies, record, root, shape_def};
+
+/// Allowed error, relative to max(1, |value|): a few f32 roundings.
+const TOL: f64 = 4.0 * f32::EPSILON as f64;
+
+fn close(shown: f64, want: f64) -> bool {
+    (shown - want).abs() <= TOL * shown.abs().max(want.abs()).max(1.0)
+}
+
+fn close2(shown: Vec2, want: Vec2) -> bool {
+    close(shown.x, want.x) && close(shown.y, want.y)
+}
+
+/// Angles are compared modulo a turn.
+fn close_angle(shown: f64, want: f64) -> bool {
+    wrap(shown - want).abs() <= TOL * want.abs().max(1.0)
+}
+
+/// `a` in [-π, π].
+fn wrap(a: f64) -> f64 {
+    a - TAU * (a / TAU).round()
+}
+
+fn num(v: &Value, key: &str) -> f64 {
+    let n = v[key].as_f64();
+    n.unwrap_or_else(|| panic!("a number {key} in {v}"))
+}
+
+/// Nanoseconds since the epoch of a decoded `google.protobuf.Timestamp` (RFC 3339, UTC, as in
+/// "1970-01-01T00:00:00.016666667Z"; Ricochet's logs start at the epoch).
+fn ns(ts: &Value) -> u64 {
+    let s = ts.as_str().unwrap_or_else(|| panic!("a timestamp: {ts}"));
+    let (date, time) = s.strip_suffix('Z').and_then(|s| s.split_once('T')).unwrap();
+    let day: u64 = date.strip_prefix("1970-01-").unwrap().parse().unwrap();
+    let (hms, frac) = time.split_once('.').unwrap_or((time, ""));
+    let secs = (hms.split(':')).fold(0, |acc, part| acc * 60 + part.parse::<u64>().unwrap());
+    let nanos: u64 = format!("{frac:0<9}").parse().unwrap();
+    ((day - 1) * 86_400 + secs) * 1_000_000_000 + nanos
+}
+
+/// A pose in the plane: what a `/tf` transform, a primitive's `pose` or a body says.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Planar {
+    at: Vec2,
+    yaw: f64,
+}
+
+impl Planar {
+    fn new(at: Vec2, yaw: f64) -> Planar {
+        Planar { at, yaw }
+    }
+
+    /// From a translation and a rotation about z.
+    fn from_json(position: &Value, q: &Value) -> Planar {
+        let flat = num(q, "x") == 0.0 && num(q, "y") == 0.0 && num(position, "z") == 0.0;
+        assert!(flat, "a pose in the plane: {position} {q}");
+        let at = Vec2::new(num(position, "x"), num(position, "y"));
+        Planar::new(at, 2.0 * libm::atan2(num(q, "z"), num(q, "w")))
+    }
+
+    fn of(pose: &Value) -> Planar {
+        Planar::from_json(&pose["position"], &pose["orientation"])
+    }
+
+    fn of_body(body: &Value) -> Planar {
+        let p = &body["position"];
+        let at = Vec2::new(p[0].as_f64().unwrap(), p[1].as_f64().unwrap());
+        Planar::new(at, num(body, "angle"))
+    }
+
+    fn apply(self, p: Vec2) -> Vec2 {
+        let (s, c) = libm::sincos(self.yaw);
+        self.at + Vec2::new(c * p.x - s * p.y, s * p.x + c * p.y)
+    }
+
+    /// This pose composed with `inner`, a pose in its frame.
+    fn then(self, inner: Planar) -> Planar {
+        Planar::new(self.apply(inner.at), self.yaw + inner.yaw)
+    }
+
+    /// A fraction `f` of the way to `to`, turning the short way round.
+    fn towards(self, to: Planar, f: f64) -> Planar {
+        let yaw = self.yaw + f * wrap(to.yaw - self.yaw);
+        Planar::new(self.at.lerp(to.at, f), yaw)
+    }
+}
+
+/// Foxglove's `Transform.Interpolate` between transforms at `a.0 < t < b.0`: position
+/// lerped, rotation slerped the short way round (gl-matrix `quat.slerp`).
+fn interpolate(a: (u64, Planar), b: (u64, Planar), t: u64) -> Planar {
+    let f = (t - a.0) as f64 / (b.0 - a.0) as f64;
+    let (qa, mut qb) = (libm::sincos(a.1.yaw / 2.0), libm::sincos(b.1.yaw / 2.0));
+    let mut cos = qa.0 * qb.0 + qa.1 * qb.1;
+    if cos < 0.0 {
+        (cos, qb) = (-cos, (-qb.0, -qb.1));
+    }
+    let (s0, s1) = if 1.0 - cos > 1e-6 {
+        let omega = libm::acos(cos);
+        let s = libm::sin(omega);
+        (libm::sin((1.0 - f) * omega) / s, libm::sin(f * omega) / s)
+    } else {
+        (1.0 - f, f)
+    };
+    let yaw = 2.0 * libm::atan2(s0 * qa.0 + s1 * qb.0, s0 * qa.1 + s1 * qb.1);
+    Planar::new(a.1.at.lerp(b.1.at, f), yaw)
+}
+
+/// An entity as the panel shows it: its frame's pose and its primitives in the world.
+#[derive(Debug, PartialEq)]
+struct Shown {
+    name: String,
+    /// The latest transform at or before `t` (none: the frame has none yet).
+    pose: Option<Planar>,
+    /// Foxglove's lookup at `t`, interpolating.
+    interpolated: Option<Planar>,
+    /// Pose and size of each cylinder and of each cube.
+    cylinders: Vec<(Planar, Vec2)>,
+    cubes: Vec<(Planar, Vec2)>,
+    /// The points of each triangle list.
+    triangles: Vec<Vec<Vec2>>,
+}
+
+/// A recorded log, indexed as Foxglove holds it once open.
+struct Log {
+    scenario: &'static str,
+    dt_ns: u64,
+    /// `log_time` of the last message.
+    end: u64,
+    /// `/scene` messages, by `log_time`.
+    scenes: Vec<(u64, Value)>,
+    /// Every transform of `/tf`, preloaded: by child frame, then timestamp.
+    transforms: BTreeMap<String, BTreeMap<u64, Planar>>,
+    /// `/bodies` rebuilt in full, by frame.
+    bodies: Vec<Value>,
+}
+
+impl Log {
+    fn record(scenario: &'static str) -> Log {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join(format!("{scenario}.mcap"));
+        record(&root().join(format!("scenarios/{scenario}.toml")), &path);
+        let log = ricochet_log::read_log_file(&path).unwrap();
+        let bodies = full_bodies(&log);
+        // Frame 1's `/bodies` (checked below: one a frame, from 0) is at `dt_ns`.
+        let frame_1 = log.iter().filter(|m| m.topic == "/bodies").nth(1);
+        let dt_ns = frame_1.unwrap().log_time;
+        let (mut scenes, mut transforms) = (Vec::new(), BTreeMap::<_, BTreeMap<_, _>>::new());
+        for m in &log {
+            match m.topic.as_str() {
+                "/scene" => scenes.push((m.log_time, m.data.clone())),
+                "/tf" => {
+                    for tf in m.data["transforms"].as_array().unwrap() {
+                        assert_eq!(tf["parent_frame_id"], "world", "{tf}");
+                        let frame = tf["child_frame_id"].as_str().unwrap().to_owned();
+                        let pose = Planar::from_json(&tf["translation"], &tf["rotation"]);
+                        // Foxglove keeps one transform per time: a later one replaces it.
+                        let history = transforms.entry(frame).or_default();
+                        history.insert(ns(&tf["timestamp"]), pose);
+                    }
+                }
+                "/bodies" => assert_eq!(m.log_time, m.data["frame"].as_u64().unwrap() * dt_ns),
+                _ => {}
+            }
+        }
+        assert!(scenes.is_sorted_by_key(|s| s.0), "/scene in time order");
+        let numbered = bodies.iter().enumerate().all(|(f, b)| b["frame"] == f);
+        assert!(numbered, "/bodies: frames 0, 1, 2...");
+        let end = log.last().unwrap().log_time;
+        Log {
+            scenario,
+            dt_ns,
+            end,
+            scenes,
+            transforms,
+            bodies,
+        }
+    }
+
+    /// 50 times uniform in [0, end], every third snapped to a frame, then 0 and `end`.
+    fn times(&self, rng: &mut Rng) -> Vec<u64> {
+        let mut times: Vec<u64> = (0..50)
+            .map(|i| {
+                let t = (rng.range(0.0, self.end as f64 + 1.0) as u64).min(self.end);
+                let snap = if i % 3 == 0 { self.dt_ns } else { 1 };
+                t / snap * snap
+            })
+            .collect();
+        times.extend([0, self.end]);
+        assert!(
+            times.iter().any(|t| t % self.dt_ns > 0),
+            "times between frames"
+        );
+        times
+    }
+
+    /// The entities at `t`: after the last `/scene` at or before `t`, as a seek shows them,
+    /// or, `played`, after every `/scene` from the start, as playing from 0 shows them.
+    fn scene(&self, t: u64, played: bool) -> BTreeMap<String, Value> {
+        let upto = self.scenes.partition_point(|s| s.0 <= t);
+        let from = if played { 0 } else { upto.saturating_sub(1) };
+        let mut entities = BTreeMap::new();
+        for (_, update) in &self.scenes[from..upto] {
+            apply(&mut entities, update);
+        }
+        entities
+    }
+
+    /// What the panel shows of `entities` at time `t`.
+    fn show(&self, entities: &BTreeMap<String, Value>, t: u64) -> BTreeMap<String, Shown> {
+        let show = |(id, e): (&String, &Value)| (id.clone(), self.show_entity(e, t));
+        entities.iter().map(show).collect()
+    }
+
+    fn show_entity(&self, e: &Value, t: u64) -> Shown {
+        assert_eq!(e["frame_locked"], true, "{}: follows its frame", e["id"]);
+        let history = &self.transforms.get(e["frame_id"].as_str().unwrap());
+        let pair = |(&k, &p): (&u64, &Planar)| (k, p);
+        let before = history.and_then(|h| h.range(..=t).next_back()).map(pair);
+        let after = history.and_then(|h| h.range(t..).next()).map(pair);
+        let interpolated = match (before, after) {
+            (Some(a), Some(b)) if a.0 < b.0 => Some(interpolate(a, b, t)),
+            (Some((_, p)), _) | (None, Some((_, p))) => Some(p),
+            (None, None) => None,
+        };
+        let pose = before.map(|(_, p)| p);
+        let frame = pose.unwrap_or(Planar::new(Vec2::ZERO, 0.0));
+        let world = |prim: &Value| frame.then(Planar::of(&prim["pose"]));
+        let list = |key: &str| e[key].as_array().unwrap().iter();
+        let size = |prim: &Value| Vec2::new(num(&prim["size"], "x"), num(&prim["size"], "y"));
+        let point = |p: &Value| Vec2::new(num(p, "x"), num(p, "y"));
+        let points = |tl: &Value| {
+            let points = tl["points"].as_array().unwrap().iter();
+            points.map(|p| world(tl).apply(point(p))).collect()
+        };
+        Shown {
+            name: e["metadata"][0]["value"].as_str().unwrap_or("").to_owned(),
+            pose,
+            interpolated,
+            cylinders: list("cylinders").map(|c| (world(c), size(c))).collect(),
+            cubes: list("cubes").map(|c| (world(c), size(c))).collect(),
+            triangles: list("triangles").map(points).collect(),
+        }
+    }
+
+    /// Seeks to `t` and compares what is shown with `/bodies`: one line per difference.
+    fn check(&self, t: u64) -> Vec<String> {
+        let frame = (t / self.dt_ns) as usize;
+        let frac = (t % self.dt_ns) as f64 / self.dt_ns as f64;
+        let scenario = self.scenario;
+        let at = format!("{scenario} at t = {t} ns (frame {frame} + {frac:.3})");
+        let bodies = alive(&self.bodies[frame]);
+        let next = self.bodies.get(frame + 1).map(alive).unwrap_or_default();
+        let shown = self.show(&self.scene(t, false), t);
+        let mut problems = Vec::new();
+        let missing: Vec<_> = bodies
+            .keys()
+            .filter(|id| !shown.contains_key(*id))
+            .collect();
+        let extra: Vec<_> = shown
+            .keys()
+            .filter(|id| !bodies.contains_key(*id))
+            .collect();
+        if !missing.is_empty() || !extra.is_empty() {
+            problems.push(format!(
+                "{at}: alive, not shown {missing:?}; shown, dead {extra:?}"
+            ));
+        }
+        for (id, s) in &shown {
+            let Some(body) = bodies.get(id) else { continue };
+            let mut report = |p: String| problems.push(format!("{at}: {id} \"{}\": {p}", s.name));
+            if s.name != body["name"] {
+                report(format!("named {} in /bodies", body["name"]));
+            }
+            let (Some(pose), Some(interpolated)) = (s.pose, s.interpolated) else {
+                report("no /tf transform at or before t".to_owned());
+                continue;
+            };
+            let want = Planar::of_body(body);
+            // Between frames, Foxglove's interpolation is on its way to the next frame's pose
+            // (or stays put if the body is gone then).
+            let towards = match next.get(id) {
+                Some(b) if frac > 0.0 => want.towards(Planar::of_body(b), frac),
+                _ => want,
+            };
+            for (what, got, want) in [("", pose, want), ("interpolated ", interpolated, towards)] {
+                for (field, got, want, ok) in [
+                    ("x", got.at.x, want.at.x, close as fn(f64, f64) -> bool),
+                    ("y", got.at.y, want.at.y, close),
+                    ("angle", got.yaw, want.yaw, close_angle),
+                ] {
+                    if !ok(got, want) {
+                        report(format!("{what}{field} shown {got}, /bodies {want}"));
+                    }
+                }
+            }
+            compare_shape(s, body, want, &mut report);
+        }
+        problems
+    }
+}
+
+/// Foxglove applying a `SceneUpdate`: its deletions, then its entities (added or replaced).
+fn apply(entities: &mut BTreeMap<String, Value>, update: &Value) {
+    for d in update["deletions"].as_array().unwrap() {
+        match d["type"].as_str().unwrap() {
+            "ALL" => entities.clear(),
+            _ => drop(entities.remove(d["id"].as_str().unwrap())),
+        }
+    }
+    for e in update["entities"].as_array().unwrap() {
+        entities.insert(e["id"].as_str().unwrap().to_owned(), e.clone());
+    }
+}
+
+/// The bodies of a full `/bodies` message, by the name of their frame.
+fn alive(full: &Value) -> BTreeMap<String, Value> {
+    let bodies = full["bodies"].as_array().unwrap().iter();
+    let generation = |b: &Value| b["generation"].as_u64().unwrap_or(0);
+    bodies
+        .map(|b| (format!("body/{}:{}", b["id"], generation(b)), b.clone()))
+        .collect()
+}
+
+/// Compares the shown primitives (in the world, through the body's frame) with the body's
+/// shape placed at its pose `at`, part by part and point by point.
+fn compare_shape(s: &Shown, body: &Value, at: Planar, report: &mut impl FnMut(String)) {
+    let shape = shape_def(&body["shape"]).to_shape().unwrap();
+    let (mut cylinders, mut cubes) = (s.cylinders.iter(), s.cubes.iter());
+    let mut triangles = s.triangles.iter();
+    // A cylinder or cube of `size`, turned `yaw` if it says, at `centre`.
+    let solid = |shown: Option<&(Planar, Vec2)>, size: Vec2, yaw: Option<f64>, centre| {
+        let &(pose, got) = shown.ok_or("not drawn")?;
+        match yaw.filter(|&yaw| !close_angle(pose.yaw, yaw)) {
+            Some(yaw) => Err(format!("turned {} in the world, the shape {yaw}", pose.yaw)),
+            None if !close2(got, size) => Err(format!("of size {got}, the shape {size}")),
+            None => Ok(vec![(pose.at, centre)]),
+        }
+    };
+    for (k, prim) in shape.primitives().iter().enumerate() {
+        // Points shown in the world, each with where the shape puts it.
+        let points = match place(prim, &Pose::new(at.at, at.yaw), Vec2::ZERO) {
+            PlacedPrimitive::Circle(c) => {
+                let d = Vec2::splat(2.0 * c.radius);
+                solid(cylinders.next(), d, None, c.center)
+            }
+            PlacedPrimitive::Aabb(b) => solid(cubes.next(), 2.0 * b.half, Some(0.0), b.center),
+            PlacedPrimitive::Obb(b) => {
+                let yaw = libm::atan2(b.rot.s, b.rot.c);
+                solid(cubes.next(), 2.0 * b.half, Some(yaw), b.center)
+            }
+            PlacedPrimitive::Polygon(p) => match triangles.next() {
+                Some(points) if points.len() == p.count => {
+                    Ok(points.iter().copied().zip(p.vertices).collect())
+                }
+                other => Err(format!("drawn as {other:?}")),
+            },
+            // A capsule's outline: every point at the radius from the core segment.
+            PlacedPrimitive::Capsule(c) => triangles.next().ok_or("not drawn".into()).map(|pts| {
+                let d = c.b - c.a;
+                let on =
+                    |p: Vec2| c.a + d * ((p - c.a).dot(d) / d.dot(d).max(1e-300)).clamp(0.0, 1.0);
+                let outline = |p: Vec2| on(p) + (p - on(p)).normalize_or_zero() * c.radius;
+                pts.iter().map(|&p| (p, outline(p))).collect()
+            }),
+        };
+        let points = points.unwrap_or_else(|e| {
+            report(format!("part {k} ({prim:?}): {e}"));
+            Vec::new()
+        });
+        for (i, (got, want)) in points.into_iter().enumerate() {
+            if !close2(got, want) {
+                report(format!(
+                    "part {k} point {i} at {got} in the world, shape {want}"
+                ));
+            }
+        }
+    }
+    if cylinders.next().is_some() || cubes.next().is_some() || triangles.next().is_some() {
+        report("more primitives drawn than its shape has parts".to_owned());
+    }
+}
+
+#[test]
+fn a_seek_shows_the_bodies_of_that_frame() {
+    for (seed, scenario) in [
+        (0x5eec, "asteroids"),
+        (0xf0c5, "platformer"),
+        (0x1e7e, "level"),
+    ] {
+        let log = Log::record(scenario);
+        let times = log.times(&mut Rng::new(seed));
+        let problems: Vec<String> = times.iter().flat_map(|&t| log.check(t)).collect();
+        let n = problems.len();
+        let first = problems[..n.min(12)].join("\n");
+        assert!(n == 0, "{scenario}: {n} differences, the first:\n{first}");
+    }
+}
+
+#[test]
+fn seeking_back_and_forth_shows_what_a_fresh_seek_and_playing_show() {
+    let (log, fresh) = (Log::record("asteroids"), Log::record("asteroids"));
+    let times = log.times(&mut Rng::new(7));
+    let seek = |log: &Log, t| log.show(&log.scene(t, false), t);
+    let want: BTreeMap<u64, _> = times.iter().map(|&t| (t, seek(&fresh, t))).collect();
+    // The drawn times jump back and forth; each pair is also seen the other way round.
+    for pair in times.windows(2) {
+        for t in [pair[0], pair[1], pair[0]] {
+            assert!(seek(&log, t) == want[&t], "seeking to {t} after {pair:?}");
+        }
+    }
+    for t in times {
+        let played = log.show(&log.scene(t, true), t);
+        assert!(played == want[&t], "played to {t}");
+    }
+}
