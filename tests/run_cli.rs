@@ -73,17 +73,20 @@ fn run_with_no_arguments_writes_the_asteroids_demo_with_seven_decodable_channels
         );
     }
     // One /bodies, /contacts and /stats message per frame, at frame * dt; /scene when the
-    // set of bodies changes (bullets come and go), /tf when a body moves.
+    // set of bodies changes (bullets come and go).
     let frames = topic(&log, "/stats").count();
     for name in ["/bodies", "/contacts"] {
         assert_eq!(topic(&log, name).count(), frames, "{name}");
     }
     let scenes = topic(&log, "/scene").count();
     assert!(scenes > 1 && scenes < frames, "{scenes} /scene messages");
-    assert_eq!(
-        topic(&log, "/tf").count(),
-        frames,
-        "something moves every frame"
+    // /tf: the ends of the bodies' straight stretches, far fewer than frames x bodies.
+    let transforms: usize = topic(&log, "/tf")
+        .map(|m| m.data["transforms"].as_array().unwrap().len())
+        .sum();
+    assert!(
+        transforms > 9 && transforms < frames * 9,
+        "{transforms} transforms"
     );
     for (k, m) in topic(&log, "/bodies").enumerate() {
         assert_eq!(m.data["frame"], k as u64);

@@ -1,13 +1,16 @@
 //! Every body's full state, frame by frame, rebuilt from a log's `/bodies` messages.
 //!
 //! `/bodies` lists every body with every field at a keyframe, and between keyframes only
-//! what changed (see `proto/ricochet.proto`). [`BodyStates`] applies the messages in order
-//! and gives each frame as if it listed every body in full: what `ricochet diff` and any
-//! reader that wants whole frames need. Memory is one state per live body.
+//! what the integrator does not predict (see `proto/ricochet.proto`): an unlisted position is
+//! `previous + velocity * dt`, an unlisted angle `previous + angular_velocity * dt` (IEEE
+//! f64, multiply then add), unlisted velocities are unchanged. [`BodyStates`] applies the
+//! messages in order and gives each frame as if it listed every body in full: what `ricochet
+//! diff`, the tests and any reader that wants whole frames need. Memory is one state per
+//! live body.
 
 use std::collections::BTreeMap;
 
-use serde_json::{Map, Value};
+use serde_json::{Map, Value, json};
 
 /// The bodies alive after the messages applied so far, by `(id, generation)`.
 #[derive(Debug, Default, Clone)]
@@ -27,6 +30,17 @@ fn present(value: &Value) -> bool {
     !matches!(value, Value::Null) && value.as_array().is_none_or(|a| !a.is_empty())
 }
 
+fn number(v: Option<&Value>) -> f64 {
+    v.and_then(Value::as_f64).unwrap_or(0.0)
+}
+
+fn pair(v: Option<&Value>) -> [f64; 2] {
+    [
+        number(v.and_then(|v| v.get(0))),
+        number(v.and_then(|v| v.get(1))),
+    ]
+}
+
 impl BodyStates {
     /// Applies one `/bodies` message (decoded to JSON) and returns the frame in full: the
     /// same message with every live body listed with every field, sorted by id and
@@ -36,6 +50,7 @@ impl BodyStates {
             .get("keyframe")
             .and_then(Value::as_bool)
             .unwrap_or(false);
+        let dt = number(message.get("dt"));
         if keyframe {
             self.bodies.clear();
         }
@@ -45,15 +60,47 @@ impl BodyStates {
                 self.bodies.remove(&k);
             }
         }
-        for body in list("bodies").into_iter().flatten() {
-            let (Some(k), Some(fields)) = (key(body), body.as_object()) else {
+        let listed: BTreeMap<(u64, u64), &Map<String, Value>> = list("bodies")
+            .into_iter()
+            .flatten()
+            .filter_map(|b| Some((key(b)?, b.as_object()?)))
+            .collect();
+        // The bodies known before this frame move as the integrator says, unless listed.
+        for (k, state) in &mut self.bodies {
+            let delta = listed.get(k);
+            let field = |name: &str| delta.and_then(|d| d.get(name)).filter(|v| present(v));
+            if let Some(v) = field("velocity") {
+                state.insert("velocity".to_owned(), v.clone());
+            }
+            if let Some(w) = field("angular_velocity") {
+                state.insert("angular_velocity".to_owned(), w.clone());
+            }
+            if field("still").and_then(Value::as_bool) == Some(true) {
                 continue;
-            };
-            let state = self.bodies.entry(k).or_default();
-            for (name, value) in fields {
-                if present(value) || !state.contains_key(name) {
-                    state.insert(name.clone(), value.clone());
+            }
+            let position = match field("position") {
+                Some(p) => p.clone(),
+                None => {
+                    let (p, v) = (pair(state.get("position")), pair(state.get("velocity")));
+                    json!([p[0] + v[0] * dt, p[1] + v[1] * dt])
                 }
+            };
+            let angle = match field("angle") {
+                Some(a) => a.clone(),
+                None => {
+                    let w = number(state.get("angular_velocity"));
+                    json!(number(state.get("angle")) + w * dt)
+                }
+            };
+            state.insert("position".to_owned(), position);
+            state.insert("angle".to_owned(), angle);
+        }
+        // New bodies come with every field.
+        for (k, fields) in listed {
+            if let std::collections::btree_map::Entry::Vacant(slot) = self.bodies.entry(k) {
+                let mut state = fields.clone();
+                state.remove("still");
+                slot.insert(state);
             }
         }
         let mut full = message.as_object().cloned().unwrap_or_default();
@@ -84,32 +131,43 @@ impl BodyStates {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use serde_json::json;
 
     #[test]
-    fn deltas_keep_what_they_do_not_list_and_keyframes_replace_everything() {
+    fn unlisted_bodies_move_as_the_integrator_says_and_keyframes_replace_everything() {
         let mut s = BodyStates::default();
-        let k = s.apply(&json!({"frame": 0, "keyframe": true, "removed": [], "bodies": [
-            {"id": 2, "generation": 0, "name": "b", "position": [1.0, 2.0], "angle": 0.5, "velocity": [3.0, 4.0]},
-            {"id": 1, "generation": 0, "name": "a", "position": [0.0, 0.0], "angle": 0.0, "velocity": [0.0, 0.0]},
+        let k = s.apply(&json!({"frame": 0, "keyframe": true, "dt": 0.5, "removed": [], "bodies": [
+            {"id": 2, "generation": 0, "name": "b", "position": [1.0, 2.0], "angle": 0.5, "velocity": [3.0, 4.0], "angular_velocity": 1.0},
+            {"id": 1, "generation": 0, "name": "a", "position": [0.0, 0.0], "angle": 0.0, "velocity": [0.0, 0.0], "angular_velocity": 0.0},
         ]}));
         assert_eq!(k["bodies"][0]["name"], "a", "sorted by id");
+        // Body 2 not listed: 1 + 3 * 0.5, 2 + 4 * 0.5, 0.5 + 1 * 0.5.
         let d = s.apply(
-            &json!({"frame": 1, "keyframe": false, "removed": [], "bodies": [
-                {"id": 2, "generation": 0, "position": [1.5, 2.0], "velocity": []},
+            &json!({"frame": 1, "keyframe": false, "dt": 0.5, "removed": [], "bodies": [
+                {"id": 1, "generation": 0, "position": [], "velocity": [2.0, 0.0], "still": false},
             ]}),
         );
         assert_eq!(
             d["bodies"][1],
-            json!({"id": 2, "generation": 0, "name": "b", "position": [1.5, 2.0], "angle": 0.5, "velocity": [3.0, 4.0]})
+            json!({"id": 2, "generation": 0, "name": "b", "position": [2.5, 4.0], "angle": 1.0, "velocity": [3.0, 4.0], "angular_velocity": 1.0})
         );
+        // Body 1's new velocity moves it this frame already (semi-implicit Euler).
+        assert_eq!(d["bodies"][0]["position"], json!([1.0, 0.0]));
+        // Still: neither moves, whatever the velocities.
+        let st = s.apply(
+            &json!({"frame": 2, "keyframe": false, "dt": 0.5, "removed": [], "bodies": [
+                {"id": 2, "generation": 0, "position": [], "velocity": [], "still": true},
+            ]}),
+        );
+        assert_eq!(st["bodies"][1]["position"], json!([2.5, 4.0]));
+        assert_eq!(st["bodies"][1]["angle"], json!(1.0));
         let r = s.apply(
-            &json!({"frame": 2, "keyframe": false, "bodies": [], "removed": [
+            &json!({"frame": 3, "keyframe": false, "dt": 0.5, "bodies": [], "removed": [
                 {"id": 1, "generation": 0, "name": "a"},
             ]}),
         );
         assert_eq!(r["bodies"].as_array().unwrap().len(), 1);
-        let k = s.apply(&json!({"frame": 3, "keyframe": true, "removed": [], "bodies": []}));
+        let k =
+            s.apply(&json!({"frame": 4, "keyframe": true, "dt": 0.5, "removed": [], "bodies": []}));
         assert!(k["bodies"].as_array().unwrap().is_empty() && s.is_empty());
     }
 }
