@@ -1,30 +1,34 @@
 //! Foxglove's seek, emulated: what the 3D panel shows at any time of a log must be the
 //! bodies of `/bodies` at that frame.
 //!
-//! When Foxglove seeks to a time `t` it does not replay the log: it takes, per topic, the last
-//! message with `log_time <= t`, and for `/tf` it has preloaded every transform of the file.
+//! When Foxglove (Lichtblick 1.10.8, the open-source Foxglove Studio) seeks to a time `t` it
+//! does not replay the log: it takes, per topic, the last message with `log_time <= t`; and
+//! for `/tf` it has preloaded the transform messages from the start of the file up to `t`
+//! (never past it: `Renderer.handleAllFramesMessages` reads preloaded messages with
+//! `receiveTime <= currentTime`, and a seek backwards clears the tree and reads them again).
 //! So the panel shows:
 //! - the entities of the last `/scene` (`foxglove.SceneUpdate`) at or before `t`: its
 //!   deletions applied, then its entities (Ricochet sends a delete-all then every body, so
 //!   that one message is the whole scene);
-//! - each entity in its frame (`frame_locked`), placed by the frame's transform history at
-//!   `t`: the transform stamped `t` if there is one; between two, position lerped and
-//!   rotation slerped; before the first or after the last, that one
-//!   (`CoordinateFrame.findClosestTransforms` and `InterpolateTransform` in Foxglove's 3D
-//!   panel).
+//! - each entity in its frame (`frame_locked`), placed by the frame's transforms read by then,
+//!   kept by their own timestamp (a later one with the same timestamp replaces the earlier;
+//!   timestamps may be ahead of `t`: predictions): the transform stamped `t` if there is
+//!   one; between two, position lerped and rotation slerped; after the last, the last
+//!   (`CoordinateFrame.findClosestTransforms` and `InterpolateTransform`).
 //!
-//! At 50 times drawn by a fixed-seed RNG (every third snapped to a frame), plus the first and
-//! the last, in `asteroids`, `platformer` and `level`, [`Log::check`] compares that with
-//! `/bodies` (rebuilt in full) at frame `floor(t / dt_ns)`:
+//! At every frame's time, and at 50 times drawn by a fixed-seed RNG (every third snapped to a
+//! frame), plus the first and the last, in `asteroids`, `platformer` and `level`,
+//! [`Log::check`] compares that with `/bodies` (rebuilt in full) at frame `f = floor(t /
+//! dt_ns)`:
 //! - the entities shown are the bodies alive, each named as its body;
-//! - each entity's frame, as Foxglove's interpolation places it at `t`, is at the body's
-//!   position and angle at a frame's time, within f32 rounding, and between frames `f` and
-//!   `f + 1` at the lerp of the body's poses at `f` and `f + 1`. `/tf` sends a body's pose
-//!   only at the ends of its stretches of straight-line motion at a constant turn rate, so
-//!   this holds only if every stretch's ends are sent (both ends, the last one closed when
-//!   the log ends or the body goes) and no stretch turns half a turn or more;
+//! - at a frame's time, each entity's frame is at the body's position and angle within f32
+//!   rounding;
+//! - between frames `f` and `f + 1` (`/tf` sends a body on a straight line only as a
+//!   prediction ahead, which Foxglove interpolates towards), each entity is either still at
+//!   the body's pose at `f`, or moved along its last step, `pose(f) + frac * (pose(f) -
+//!   pose(f - 1))`, within f32 rounding;
 //! - every primitive, taken to the world through its frame, is where the body's shape placed
-//!   at the body's pose is (`ricochet_geom::place`): centres, sizes, turns, vertices.
+//!   at the pose shown is (`ricochet_geom::place`): centres, sizes, turns, vertices.
 //!
 //! Seeking depends on nothing but `t`: the times are checked in the drawn (random) order, and
 //! a second test seeks back and forth and compares with fresh seeks and with playing from 0.
@@ -115,12 +119,6 @@ impl Planar {
     fn then(self, inner: Planar) -> Planar {
         Planar::new(self.apply(inner.at), self.yaw + inner.yaw)
     }
-
-    /// A fraction `f` of the way to `to`, turning the short way round.
-    fn towards(self, to: Planar, f: f64) -> Planar {
-        let yaw = self.yaw + f * wrap(to.yaw - self.yaw);
-        Planar::new(self.at.lerp(to.at, f), yaw)
-    }
 }
 
 /// Foxglove's `Transform.Interpolate` between transforms at `a.0 < t < b.0`: position
@@ -147,10 +145,8 @@ fn interpolate(a: (u64, Planar), b: (u64, Planar), t: u64) -> Planar {
 #[derive(Debug, PartialEq)]
 struct Shown {
     name: String,
-    /// The latest transform at or before `t` (none: the frame has none yet).
+    /// Foxglove's lookup at `t` (none: the frame has no transform yet).
     pose: Option<Planar>,
-    /// Foxglove's lookup at `t`, interpolating.
-    interpolated: Option<Planar>,
     /// Pose and size of each cylinder and of each cube.
     cylinders: Vec<(Planar, Vec2)>,
     cubes: Vec<(Planar, Vec2)>,
@@ -166,8 +162,8 @@ struct Log {
     end: u64,
     /// `/scene` messages, by `log_time`.
     scenes: Vec<(u64, Value)>,
-    /// Every transform of `/tf`, preloaded: by child frame, then timestamp.
-    transforms: BTreeMap<String, BTreeMap<u64, Planar>>,
+    /// Every transform of `/tf` in file order, by child frame: `(log_time, timestamp, pose)`.
+    transforms: BTreeMap<String, Vec<(u64, u64, Planar)>>,
     /// `/bodies` rebuilt in full, by frame.
     bodies: Vec<Value>,
 }
@@ -182,7 +178,7 @@ impl Log {
         // Frame 1's `/bodies` (checked below: one a frame, from 0) is at `dt_ns`.
         let frame_1 = log.iter().filter(|m| m.topic == "/bodies").nth(1);
         let dt_ns = frame_1.unwrap().log_time;
-        let (mut scenes, mut transforms) = (Vec::new(), BTreeMap::<_, BTreeMap<_, _>>::new());
+        let (mut scenes, mut transforms) = (Vec::new(), BTreeMap::<_, Vec<_>>::new());
         for m in &log {
             match m.topic.as_str() {
                 "/scene" => scenes.push((m.log_time, m.data.clone())),
@@ -191,9 +187,10 @@ impl Log {
                         assert_eq!(tf["parent_frame_id"], "world", "{tf}");
                         let frame = tf["child_frame_id"].as_str().unwrap().to_owned();
                         let pose = Planar::from_json(&tf["translation"], &tf["rotation"]);
-                        // Foxglove keeps one transform per time: a later one replaces it.
+                        let stamp = ns(&tf["timestamp"]);
+                        assert_eq!(stamp % dt_ns, 0, "stamped at a frame's time: {tf}");
                         let history = transforms.entry(frame).or_default();
-                        history.insert(ns(&tf["timestamp"]), pose);
+                        history.push((m.log_time, stamp, pose));
                     }
                 }
                 "/bodies" => assert_eq!(m.log_time, m.data["frame"].as_u64().unwrap() * dt_ns),
@@ -251,17 +248,23 @@ impl Log {
 
     fn show_entity(&self, e: &Value, t: u64) -> Shown {
         assert_eq!(e["frame_locked"], true, "{}: follows its frame", e["id"]);
-        let history = &self.transforms.get(e["frame_id"].as_str().unwrap());
+        // The frame's transforms read by `t`, by timestamp: a later one replaces an earlier.
+        let mut history = BTreeMap::new();
+        let all = self.transforms.get(e["frame_id"].as_str().unwrap());
+        for &(log_time, stamp, pose) in all.into_iter().flatten() {
+            if log_time <= t {
+                history.insert(stamp, pose);
+            }
+        }
         let pair = |(&k, &p): (&u64, &Planar)| (k, p);
-        let before = history.and_then(|h| h.range(..=t).next_back()).map(pair);
-        let after = history.and_then(|h| h.range(t..).next()).map(pair);
-        let interpolated = match (before, after) {
+        let before = history.range(..=t).next_back().map(pair);
+        let after = history.range(t..).next().map(pair);
+        // What Foxglove shows: exact, interpolated, or clamped to the nearest.
+        let pose = match (before, after) {
             (Some(a), Some(b)) if a.0 < b.0 => Some(interpolate(a, b, t)),
             (Some((_, p)), _) | (None, Some((_, p))) => Some(p),
             (None, None) => None,
         };
-        // What Foxglove shows: the interpolated pose.
-        let pose = interpolated;
         let frame = pose.unwrap_or(Planar::new(Vec2::ZERO, 0.0));
         let world = |prim: &Value| frame.then(Planar::of(&prim["pose"]));
         let list = |key: &str| e[key].as_array().unwrap().iter();
@@ -274,7 +277,6 @@ impl Log {
         Shown {
             name: e["metadata"][0]["value"].as_str().unwrap_or("").to_owned(),
             pose,
-            interpolated,
             cylinders: list("cylinders").map(|c| (world(c), size(c))).collect(),
             cubes: list("cubes").map(|c| (world(c), size(c))).collect(),
             triangles: list("triangles").map(points).collect(),
@@ -288,7 +290,10 @@ impl Log {
         let scenario = self.scenario;
         let at = format!("{scenario} at t = {t} ns (frame {frame} + {frac:.3})");
         let bodies = alive(&self.bodies[frame]);
-        let next = self.bodies.get(frame + 1).map(alive).unwrap_or_default();
+        let previous = frame
+            .checked_sub(1)
+            .map(|f| alive(&self.bodies[f]))
+            .unwrap_or_default();
         let shown = self.show(&self.scene(t, false), t);
         let mut problems = Vec::new();
         let missing: Vec<_> = bodies
@@ -315,25 +320,35 @@ impl Log {
                 continue;
             };
             let want = Planar::of_body(body);
-            // Between frames, Foxglove's interpolation is on its way to the next frame's pose
-            // (or stays put if the body is gone then).
-            let towards = match next.get(id) {
-                Some(b) if frac > 0.0 => want.towards(Planar::of_body(b), frac),
+            // Between frames: still at `f`, or moved along the last step.
+            let moved = match previous.get(id) {
+                Some(b) if frac > 0.0 => {
+                    let last = Planar::of_body(b);
+                    let step = Planar::new(want.at - last.at, want.yaw - last.yaw);
+                    Planar::new(want.at + step.at * frac, want.yaw + step.yaw * frac)
+                }
                 _ => want,
             };
-            {
-                let (got, want) = (pose, towards);
-                for (field, got, want, ok) in [
-                    ("x", got.at.x, want.at.x, close as fn(f64, f64) -> bool),
-                    ("y", got.at.y, want.at.y, close),
-                    ("angle", got.yaw, want.yaw, close_angle),
-                ] {
-                    if !ok(got, want) {
-                        report(format!("{field} shown {got}, /bodies {want}"));
+            let same = |a: Planar, b: Planar| {
+                close(a.at.x, b.at.x) && close(a.at.y, b.at.y) && close_angle(a.yaw, b.yaw)
+            };
+            if !same(pose, want) && !same(pose, moved) {
+                report(format!(
+                    "shown at ({}, {}) turned {}, /bodies ({}, {}) turned {}{}",
+                    pose.at.x,
+                    pose.at.y,
+                    pose.yaw,
+                    want.at.x,
+                    want.at.y,
+                    want.yaw,
+                    if frac > 0.0 {
+                        " (or along its last step)"
+                    } else {
+                        ""
                     }
-                }
+                ));
             }
-            compare_shape(s, body, towards, &mut report);
+            compare_shape(s, body, pose, &mut report);
         }
         problems
     }
@@ -428,7 +443,9 @@ fn a_seek_shows_the_bodies_of_that_frame() {
         (0x1e7e, "level"),
     ] {
         let log = Log::record(scenario);
-        let times = log.times(&mut Rng::new(seed));
+        let mut times = log.times(&mut Rng::new(seed));
+        // And every frame's time.
+        times.extend((0..log.bodies.len() as u64).map(|f| f * log.dt_ns));
         let problems: Vec<String> = times.iter().flat_map(|&t| log.check(t)).collect();
         let n = problems.len();
         let first = problems[..n.min(12)].join("\n");

@@ -6,64 +6,18 @@
 //! velocities that did not change. Values are compared by their bits, so a change of sign of
 //! a zero, or any NaN, is a change.
 //!
-//! `/tf` sends a body's pose only at the ends of the stretches where it moves in a straight
-//! line at a constant rate (and turns at a constant rate, less than a quarter turn):
-//! Foxglove interpolates between a frame's transforms, linearly for the position and
-//! spherically for the rotation, which gives back every frame's pose in between (within
-//! [`LINE_TOLERANCE`], far below what f32 rendering shows). A stretch still open at the end
-//! of the log, or when its body goes, is closed by [`Tracker::close`].
+//! `/tf` samples each body's frame as [`motion`](super::motion) decides.
 
 use ricochet_geom::{ShapeDef, Vec2};
 use ricochet_log::messages::fox::FrameTransform;
 use ricochet_log::messages::ricochet as pb;
 use ricochet_sim::{BodyKind, Entity, FrameOutput, Layers, RemovedBody, World};
 
+use super::motion::{Motion, Sample};
 use super::scene;
 
 /// `/bodies` lists every body in full every this many frames (and at frame 0).
 pub const KEYFRAME_INTERVAL: u64 = 60;
-
-/// How far, relative to the value (or absolutely, below 1), a frame's pose may be from the
-/// straight line of its stretch: 1e-9, some ten thousand times finer than f32 rendering.
-pub const LINE_TOLERANCE: f64 = 1e-9;
-
-/// A pose as `/tf` interpolates it: x, y and angle.
-type Pose3 = [f64; 3];
-
-/// A stretch of straight-line motion: its first frame and pose, and the step per frame
-/// (known from its second frame on).
-struct Stretch {
-    frame: u64,
-    pose: Pose3,
-    step: Option<Pose3>,
-}
-
-impl Stretch {
-    fn start(frame: u64, pose: Pose3) -> Stretch {
-        Stretch {
-            frame,
-            pose,
-            step: None,
-        }
-    }
-
-    /// Whether `pose` at `frame` is on the line (setting the step at its second frame).
-    fn extends_to(&mut self, frame: u64, pose: Pose3) -> bool {
-        let n = (frame - self.frame) as f64;
-        let Some(step) = self.step else {
-            self.step = Some([
-                pose[0] - self.pose[0],
-                pose[1] - self.pose[1],
-                pose[2] - self.pose[2],
-            ]);
-            return (pose[2] - self.pose[2]).abs() < std::f64::consts::FRAC_PI_2;
-        };
-        (0..3).all(|k| {
-            let want = self.pose[k] + step[k] * n;
-            (pose[k] - want).abs() <= LINE_TOLERANCE * pose[k].abs().max(1.0)
-        }) && (pose[2] - self.pose[2]).abs() < std::f64::consts::FRAC_PI_2
-    }
-}
 
 /// What was last recorded of a body alive at the end of the previous frame.
 struct Known {
@@ -74,20 +28,12 @@ struct Known {
     angular_velocity: f64,
     /// Its frame's name, `body/index:generation`.
     frame_id: String,
-    /// The stretch of straight-line motion it is on.
-    stretch: Stretch,
-    /// The last frame whose pose was sent on `/tf`.
-    sent: u64,
+    /// Its motion as `/tf` has described it.
+    motion: Motion,
     /// Its drawing turns back by its angle (an AABB part): a turn redraws the scene.
     drawn_with_angle: bool,
     /// The frame it was last seen in the world.
     seen: u64,
-}
-
-impl Known {
-    fn pose(&self) -> Pose3 {
-        [self.position.x, self.position.y, self.angle]
-    }
 }
 
 fn same(a: f64, b: f64) -> bool {
@@ -188,9 +134,11 @@ pub struct Tracker {
     frame: u64,
 }
 
-fn transform(k: &Known, frame: u64, dt_ns: u64) -> FrameTransform {
-    let ts = ricochet_log::messages::timestamp(frame * dt_ns);
-    scene::transform(&k.frame_id, ts, k.position, k.angle)
+fn transforms_of(frame_id: &str, samples: &[Sample], dt_ns: u64, out: &mut Vec<FrameTransform>) {
+    for &(frame, [x, y, angle]) in samples {
+        let ts = ricochet_log::messages::timestamp(frame.saturating_mul(dt_ns));
+        out.push(scene::transform(frame_id, ts, Vec2::new(x, y), angle));
+    }
 }
 
 impl Tracker {
@@ -211,6 +159,7 @@ impl Tracker {
         self.frame = frame;
         let mut bodies = Vec::new();
         let mut transforms = Vec::new();
+        let mut samples = Vec::new();
         for i in 0..world.len() {
             let e: Entity = world.entity[i];
             let (position, angle) = (world.position[i], world.angle[i]);
@@ -220,14 +169,10 @@ impl Tracker {
                 self.known.resize_with(slot + 1, || None);
             }
             let fresh = !matches!(&self.known[slot], Some(k) if k.generation == e.generation);
+            samples.clear();
             if fresh {
-                match &self.known[slot] {
-                    None => self.alive += 1,
-                    // The slot's last body went this frame: close its last stretch.
-                    Some(old) if old.sent < old.seen => {
-                        transforms.push(transform(old, old.seen, dt_ns));
-                    }
-                    Some(_) => {}
+                if self.known[slot].is_none() {
+                    self.alive += 1;
                 }
                 scene_changed = true;
                 let k = Known {
@@ -237,35 +182,20 @@ impl Tracker {
                     velocity,
                     angular_velocity,
                     frame_id: scene::entity_id(e),
-                    stretch: Stretch::start(frame, [position.x, position.y, angle]),
-                    sent: frame,
+                    motion: Motion::appear(frame, position, angle, &mut samples),
                     drawn_with_angle: scene::drawing_depends_on_angle(&world.shape[i]),
                     seen: frame,
                 };
-                transforms.push(transform(&k, frame, dt_ns));
+                transforms_of(&k.frame_id, &samples, dt_ns, &mut transforms);
                 self.known[slot] = Some(k);
             }
             let Some(k) = self.known[slot].as_mut() else {
                 continue;
             };
             k.seen = frame;
-            let pose = [position.x, position.y, angle];
-            if !fresh && !k.stretch.extends_to(frame, pose) {
-                // The stretch ended at the previous frame: send its end (unless sent), and
-                // start the next stretch there.
-                if k.sent < frame - 1 {
-                    transforms.push(transform(k, frame - 1, dt_ns));
-                    k.sent = frame - 1;
-                }
-                let mut next = Stretch::start(frame - 1, k.pose());
-                if !next.extends_to(frame, pose) {
-                    // A quarter turn or more in one step: this frame is a stretch's end too.
-                    let ts = ricochet_log::messages::timestamp(frame * dt_ns);
-                    transforms.push(scene::transform(&k.frame_id, ts, position, angle));
-                    k.sent = frame;
-                    next = Stretch::start(frame, pose);
-                }
-                k.stretch = next;
+            if !fresh {
+                k.motion.frame(frame, position, angle, &mut samples);
+                transforms_of(&k.frame_id, &samples, dt_ns, &mut transforms);
             }
             if !fresh && k.drawn_with_angle && !same(angle, k.angle) {
                 scene_changed = true;
@@ -315,15 +245,9 @@ impl Tracker {
             k.angular_velocity = angular_velocity;
         }
         if self.alive != world.len() {
-            // Some bodies went (removed, or despawned between frames): close their last
-            // stretch at the frame they were last seen in, and forget them.
+            // Some bodies went (removed, or despawned between frames): forget them.
             for slot in &mut self.known {
-                if let Some(k) = slot.as_ref()
-                    && k.seen != frame
-                {
-                    if k.sent < k.seen {
-                        transforms.push(transform(k, k.seen, dt_ns));
-                    }
+                if slot.as_ref().is_some_and(|k| k.seen != frame) {
                     *slot = None;
                     self.alive -= 1;
                     scene_changed = true;
@@ -350,20 +274,5 @@ impl Tracker {
             transforms,
             scene_changed,
         }
-    }
-
-    /// The transforms that close every stretch still open at the last frame seen: called
-    /// when the log ends, so that Foxglove has both ends of every stretch.
-    pub fn close(&mut self, dt_ns: u64) -> Vec<FrameTransform> {
-        let frame = self.frame;
-        self.known
-            .iter_mut()
-            .flatten()
-            .filter(|k| k.sent < frame)
-            .map(|k| {
-                k.sent = frame;
-                transform(k, frame, dt_ns)
-            })
-            .collect()
     }
 }

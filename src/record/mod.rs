@@ -4,7 +4,7 @@
 //! | topic | schema | content |
 //! |---|---|---|
 //! | `/scene` | `foxglove.SceneUpdate` | every body, drawn in its own frame; sent whole when the set of bodies changes |
-//! | `/tf` | `foxglove.FrameTransforms` | each body's frame: sent at the ends of its stretches of straight-line motion (Foxglove interpolates between) |
+//! | `/tf` | `foxglove.FrameTransforms` | each body's frame: every frame while its motion changes, one prediction per second on a straight line (Foxglove interpolates) |
 //! | `/scene/contacts` | `foxglove.SceneUpdate` | the frame's contact normals as arrows |
 //! | `/bodies` | `ricochet.Bodies` | exact body states: every body at keyframes, between them what the integrator does not predict |
 //! | `/contacts` | `ricochet.Contacts` | every contact, with the poses it was detected at |
@@ -16,6 +16,7 @@
 //! encoded and compressed on the log's writer thread.
 
 mod bodies;
+mod motion;
 pub mod scene;
 
 use std::path::Path;
@@ -65,8 +66,6 @@ pub struct Recorder {
     tracker: Tracker,
     /// The previous frame had contact arrows (so this one sends an empty set if it has none).
     arrows_shown: bool,
-    /// The last frame recorded.
-    last_frame: Option<u64>,
 }
 
 impl Recorder {
@@ -109,7 +108,6 @@ impl Recorder {
             topics: t,
             tracker: Tracker::default(),
             arrows_shown: false,
-            last_frame: None,
         })
     }
 
@@ -149,7 +147,6 @@ impl Recorder {
     pub fn record(&mut self, sim: &Simulation, out: &FrameOutput) -> Result<(), LogError> {
         let t = out.frame * self.dt_ns;
         let ts = timestamp(t);
-        self.last_frame = Some(out.frame);
         let w = sim.world();
         let layers = &sim.scenario().world.layers;
         let want_bodies = self.topics.bodies.is_some();
@@ -207,18 +204,8 @@ impl Recorder {
         Ok(())
     }
 
-    /// Closes every body's last stretch on `/tf` (at the last frame recorded), then writes
-    /// the summary and index. Called after an interrupted run too.
-    pub fn finish(mut self) -> Result<(), LogError> {
-        if let Some(ch) = self.topics.tf
-            && let Some(frame) = self.last_frame
-        {
-            let transforms = self.tracker.close(self.dt_ns);
-            if !transforms.is_empty() {
-                self.writer
-                    .write(ch, frame * self.dt_ns, FrameTransforms { transforms })?;
-            }
-        }
+    /// Writes the summary and index. Called after an interrupted run too.
+    pub fn finish(self) -> Result<(), LogError> {
         self.writer.finish()
     }
 }
