@@ -18,16 +18,32 @@ section's, each chunk's, the summary's), and every message is decoded with
 - Times: `log_time == publish_time`, nondecreasing through the file, each a whole frame
   (`frame * dt_ns`); `/bodies`, `/contacts` and `/stats` hold one message per frame, the
   frames consecutive from 0, at `frame * dt_ns` (and `/validation`, when recorded);
-  timestamps inside messages and `/bodies.time` agree.
-- `/bodies`: every body's full state is rebuilt from keyframes and deltas, frame by frame;
-  a body appears with every field, bodies are unique by `(id, generation)` (one per id at
-  a time, a reused id has a later generation, a removed body never returns), no body
-  vanishes without being listed in `removed`, and `/stats.bodies` counts the live bodies.
-- `/tf` against `/bodies`: at every frame, exactly the bodies that appeared, moved or
-  turned have a transform at that frame, its translation equal to the position (the same
-  f64 bits) and its yaw to the angle (within 1e-12); a body still since an older
-  transform also gets one at the previous frame with that previous pose (so Foxglove's
-  interpolation holds it still); every body's frame is `body/ID:GENERATION` in `world`.
+  `/bodies.dt` is the same every frame, `dt_ns` is it rounded to whole nanoseconds,
+  `/bodies.time` is `frame * dt`, and the timestamps inside messages agree.
+- `/bodies`: every body's full state is rebuilt frame by frame exactly as `BodyStates`
+  (crates/log/src/bodies.rs) does: a keyframe replaces every body; between keyframes a body
+  not listed, or listed without `position` / `angle`, moves as `previous + velocity * dt`
+  and `previous + angular_velocity * dt` with this frame's velocities (f64, multiply then
+  add), unless `still`; unlisted velocities are unchanged. A body that appears, and every
+  body of a keyframe, has every field; a removed body has every field (its angular
+  velocity too) and, if it was alive, its name, layer, shape and kind; a delta neither
+  changes what only full listings carry nor sets `still` with a position or an angle.
+  Bodies are unique by `(id, generation)` (one per id at a time, a reused id has a later
+  generation, a removed body never returns), no body vanishes without being listed in
+  `removed`, and `/stats.bodies` counts the live bodies.
+- `/tf` against `/bodies`, as Foxglove shows it: every transform is a body's frame
+  `body/ID:GENERATION` in `world`, planar (z = 0, a unit quaternion about z), stamped at a
+  frame's time (a multiple of `dt_ns`), never after its message's `log_time` nor after the
+  last frame, only at frames its body is alive, at most once per frame and body, the first
+  one at the frame the body appeared, each one's translation the body's `/bodies` position
+  at that frame to the bit. Then, with every transform of the log preloaded, at
+  EVERY frame and for every live body, Foxglove's lookup of its frame at that frame's time
+  (the transform stamped then, else the position lerped and the rotation slerped between
+  the transforms before and after, gl-matrix style; before the first or after the last,
+  that one) is the body's `/bodies` pose: x and y within 1e-9 of max(1, |value|), the
+  angle within 1e-9 rad modulo a turn. `/tf` sends only the ends of each body's straight
+  stretches, so this fails if an end is missing (the last stretch not closed, a body gone
+  without its last pose) or a stretch is not straight or turns too far to slerp.
 - `/scene` draws exactly the live bodies at every frame, each once, in its own frame, with
   its `/bodies` name.
 - `/contacts` and `/stats` agree on the number of contacts.
@@ -36,8 +52,10 @@ Prints one line per log, then `check_mcap: N passed, N failed`; exits 1 on any p
 naming it.
 """
 
+import bisect
 import importlib
 import math
+import re
 import struct
 import sys
 import zlib
@@ -62,7 +80,14 @@ EXPECTED = {
 OPTIONAL = {"/validation": "ricochet.Validation"}
 PER_FRAME = ("/bodies", "/contacts", "/stats")
 WORLD = "world"
-YAW_TOLERANCE = 1e-12
+BODY_FRAME = re.compile(r"body/(\d+):(\d+)")
+# A /tf transform's rotation is a unit quaternion (within f64 rounding of sin² + cos²).
+UNIT_TOLERANCE = 1e-12
+# Foxglove's interpolated pose against /bodies: relative to max(1, |value|) for x and y,
+# absolute (radians, modulo a turn) for the angle.
+POSE_TOLERANCE = 1e-9
+# gl-matrix quat.slerp: below this 1 - cos, a plain lerp.
+SLERP_EPSILON = 1e-6
 
 
 class Problem(Exception):
@@ -167,26 +192,37 @@ def ts_ns(t):
     return t.seconds * 1_000_000_000 + t.nanos
 
 
-def yaw(q):
-    return 2.0 * math.atan2(q.z, q.w)
-
-
 class Bodies:
-    """Every body's full state, rebuilt from `/bodies` keyframes and deltas."""
+    """Every body's full state, rebuilt from `/bodies` keyframes and deltas as `BodyStates`
+    (crates/log/src/bodies.rs) does, and every body's pose at every frame it was alive."""
 
-    FULL = ("name", "layer", "shape", "static", "angle", "angular_velocity")
+    # Carried only when a body is listed in full (it appears, or a keyframe).
+    FIXED = ("name", "layer", "shape", "static")
+    FULL = FIXED + ("angle", "angular_velocity")
 
     def __init__(self):
         self.live = {}  # (id, generation) -> {field: value}
         self.retired = set()
         self.generation = {}  # id -> latest generation seen
+        self.dt = None
+        # (id, generation) -> (first frame alive, [(x, y, angle) at each frame since])
+        self.history = {}
 
     def apply(self, m, frame):
-        """Applies frame `frame`'s message; returns the bodies that appeared, moved or turned."""
+        """Applies frame `frame`'s message."""
         if m.frame != frame:
             raise Problem(f"/bodies frame {m.frame} at frame {frame}")
         if frame == 0 and not m.keyframe:
             raise Problem("/bodies: frame 0 is not a keyframe")
+        dt = m.dt
+        if not (math.isfinite(dt) and dt > 0.0):
+            raise Problem(f"/bodies frame {frame}: dt {dt!r}")
+        if self.dt is None:
+            self.dt = dt
+        elif dt != self.dt:
+            raise Problem(f"/bodies frame {frame}: dt {dt!r}, frame 0 had {self.dt!r}")
+        if m.time != frame * dt:
+            raise Problem(f"/bodies frame {frame}: time {m.time!r}, frame * dt is {frame * dt!r}")
         before = self.live
         removed = set()
         for b in m.removed:
@@ -194,67 +230,165 @@ class Bodies:
             if k in removed:
                 raise Problem(f"/bodies frame {frame}: body {k} removed twice")
             removed.add(k)
-            # Removed with its last state (angular velocity aside: not kept for removed bodies).
-            for f in ("name", "layer", "shape", "static", "angle"):
+            # Removed with its last state, every field.
+            for f in self.FULL:
                 if not b.HasField(f):
                     raise Problem(f"/bodies frame {frame}: removed body {k} lacks {f}")
             if len(b.position) != 2 or len(b.velocity) != 2:
                 raise Problem(f"/bodies frame {frame}: removed body {k} lacks position or velocity")
             if k in self.retired:
                 raise Problem(f"/bodies frame {frame}: body {k} removed again")
-        live = {k: v for k, v in before.items() if k not in removed}
-        listed = set()
+            if k in before:
+                for f in self.FIXED:
+                    if getattr(b, f) != before[k][f]:
+                        raise Problem(f"/bodies frame {frame}: removed body {k} has {f} {getattr(b, f)!r}, alive it had {before[k][f]!r}")
+        listed = {}
         for b in m.bodies:
             k = (b.id, b.generation)
             if k in listed:
                 raise Problem(f"/bodies frame {frame}: body {k} listed twice")
-            listed.add(k)
+            listed[k] = b
             if k in removed or k in self.retired:
                 raise Problem(f"/bodies frame {frame}: body {k} listed after its removal")
-            new = k not in live
-            if new or m.keyframe:
-                missing = [f for f in self.FULL if not b.HasField(f)]
-                if len(b.position) != 2 or len(b.velocity) != 2:
-                    missing.append("position/velocity")
-                if missing:
-                    why = "a new body" if new else "a keyframe body"
-                    raise Problem(f"/bodies frame {frame}: {why} {k} lacks {', '.join(missing)}")
+            for f in ("position", "velocity"):
+                if len(getattr(b, f)) not in (0, 2):
+                    raise Problem(f"/bodies frame {frame}: body {k} {f} {list(getattr(b, f))}")
+        if m.keyframe:
+            gone = sorted(set(before) - removed - set(listed))
+            if gone:
+                raise Problem(f"/bodies keyframe {frame}: bodies {gone[:5]} vanished without being listed in removed")
+        live = {}
+        for k, old in before.items():
+            if k in removed:
+                continue
+            b = listed.get(k)
+            if m.keyframe:
+                continue  # listed in full below
+            state = dict(old)
+            if b is not None:
+                for f in self.FIXED:
+                    if b.HasField(f) and getattr(b, f) != old[f]:
+                        raise Problem(f"/bodies frame {frame}: a delta of body {k} changes {f} (to {getattr(b, f)!r}), which readers take only from full listings")
+                if b.still and (b.position or b.HasField("angle")):
+                    raise Problem(f"/bodies frame {frame}: body {k} is still but lists a position or an angle")
+                if b.velocity:
+                    state["velocity"] = tuple(b.velocity)
+                if b.HasField("angular_velocity"):
+                    state["angular_velocity"] = b.angular_velocity
+                if b.still:
+                    live[k] = state
+                    continue
+            # What the integrator predicts, with this frame's velocities: f64, multiply then add.
+            if b is not None and b.position:
+                state["position"] = tuple(b.position)
+            else:
+                (x, y), (vx, vy) = old["position"], state["velocity"]
+                state["position"] = (x + vx * dt, y + vy * dt)
+            if b is not None and b.HasField("angle"):
+                state["angle"] = b.angle
+            else:
+                state["angle"] = old["angle"] + state["angular_velocity"] * dt
+            live[k] = state
+        for k, b in listed.items():
+            if k in live:
+                continue
+            new = k not in before
+            missing = [f for f in self.FULL if not b.HasField(f)]
+            if len(b.position) != 2 or len(b.velocity) != 2:
+                missing.append("position/velocity")
+            if missing:
+                why = "a new body" if new else "a keyframe body"
+                raise Problem(f"/bodies frame {frame}: {why} {k} lacks {', '.join(missing)}")
+            if b.still:
+                raise Problem(f"/bodies frame {frame}: body {k}, listed in full, is still")
             if new:
                 last = self.generation.get(b.id)
                 if last is not None and b.generation <= last:
                     raise Problem(f"/bodies frame {frame}: id {b.id} reused with generation {b.generation}, after {last}")
                 if (b.id, last) in live:
                     raise Problem(f"/bodies frame {frame}: body {k} appears while {(b.id, last)} is alive")
-                state = {}
-            else:
-                state = dict(live[k])
-            for f in self.FULL:
-                if b.HasField(f):
-                    state[f] = getattr(b, f)
-            if b.position:
-                if len(b.position) != 2:
-                    raise Problem(f"/bodies frame {frame}: body {k} position {list(b.position)}")
-                state["position"] = tuple(b.position)
-            if b.velocity:
-                if len(b.velocity) != 2:
-                    raise Problem(f"/bodies frame {frame}: body {k} velocity {list(b.velocity)}")
-                state["velocity"] = tuple(b.velocity)
+                self.history[k] = (frame, [])
+            elif m.keyframe:
+                for f in self.FIXED:
+                    if getattr(b, f) != before[k][f]:
+                        raise Problem(f"/bodies keyframe {frame}: body {k} has {f} {getattr(b, f)!r}, the frame before {before[k][f]!r}")
+            state = {f: getattr(b, f) for f in self.FULL}
+            state["position"] = tuple(b.position)
+            state["velocity"] = tuple(b.velocity)
             live[k] = state
             self.generation[b.id] = max(self.generation.get(b.id, b.generation), b.generation)
-        if m.keyframe:
-            gone = sorted(set(live) - listed)
-            if gone:
-                raise Problem(f"/bodies keyframe {frame}: bodies {gone[:5]} vanished without being listed in removed")
         for k in removed:
             self.retired.add(k)
             self.generation[k[0]] = max(self.generation.get(k[0], k[1]), k[1])
-        moved = set()
-        for k in listed:  # a body not listed keeps its state
-            s, old = live[k], before.get(k)
-            if old is None or bits(*old["position"], old["angle"]) != bits(*s["position"], s["angle"]):
-                moved.add(k)
+        for k, s in live.items():
+            self.history[k][1].append((*s["position"], s["angle"]))
         self.live = live
-        return before, moved
+
+
+def slerp_yaw(a, b, f):
+    """gl-matrix `quat.slerp(a, b, f)` of two quaternions (x, y, z, w), as a yaw."""
+    cos = sum(p * q for p, q in zip(a, b))
+    if cos < 0.0:
+        cos, b = -cos, tuple(-q for q in b)
+    if 1.0 - cos > SLERP_EPSILON:
+        omega = math.acos(cos)
+        s = math.sin(omega)
+        s0, s1 = math.sin((1.0 - f) * omega) / s, math.sin(f * omega) / s
+    else:
+        s0, s1 = 1.0 - f, f
+    z = s0 * a[2] + s1 * b[2]
+    w = s0 * a[3] + s1 * b[3]
+    return 2.0 * math.atan2(z, w)
+
+
+class Transform:
+    """One `/tf` transform of a body's frame."""
+
+    __slots__ = ("stamp", "log_time", "x", "y", "q")
+
+    def __init__(self, tf, log_time):
+        self.stamp = ts_ns(tf.timestamp)
+        self.log_time = log_time
+        self.x, self.y = tf.translation.x, tf.translation.y
+        r = tf.rotation
+        self.q = (r.x, r.y, r.z, r.w)
+
+    def pose(self):
+        return self.x, self.y, 2.0 * math.atan2(self.q[2], self.q[3])
+
+
+def foxglove_pose(transforms, stamps, t):
+    """The pose Foxglove's 3D panel gives a frame at `t`, all of its transforms loaded
+    (`stamps` their sorted timestamps): the one stamped `t`; between two, the translation
+    lerped and the rotation slerped; before the first or after the last, that one. Also
+    the indices of the transforms used."""
+    i = bisect.bisect_left(stamps, t)
+    if i < len(stamps) and stamps[i] == t:
+        return transforms[i].pose(), (i, i)
+    if i == 0:
+        return transforms[0].pose(), (0, 0)
+    if i == len(stamps):
+        return transforms[-1].pose(), (i - 1, i - 1)
+    a, b = transforms[i - 1], transforms[i]
+    f = (t - a.stamp) / (b.stamp - a.stamp)
+    x = a.x + f * (b.x - a.x)  # gl-matrix vec3.lerp
+    y = a.y + f * (b.y - a.y)
+    return (x, y, slerp_yaw(a.q, b.q, f)), (i - 1, i)
+
+
+def pose_error(got, want):
+    """(x and y error relative to max(1, |value|), angle error modulo a turn); NaN counts
+    as infinitely wrong."""
+    ex = max(abs(g - w) / max(1.0, abs(w)) for g, w in zip(got[:2], want[:2]))
+    ea = abs(math.remainder(got[2] - want[2], math.tau))
+    return tuple(e if e == e else math.inf for e in (ex, ea))
+
+
+def round_ns(seconds):
+    """Rust's `(seconds * 1e9).round() as u64`: half away from zero."""
+    v = seconds * 1e9
+    r = math.floor(v)
+    return int(r) + (1 if v - r >= 0.5 else 0)
 
 
 class Log:
@@ -264,7 +398,8 @@ class Log:
         self.dt_ns = None
         self.frames = 0
         self.bodies = Bodies()
-        self.last_tf = {}  # body -> frame of its last transform
+        self.tf = {}  # child frame -> [Transform], in file order
+        self.tf_summary = ""
         self.scene = None  # the entities of the last /scene, by id
         self.validation = False
         self.validation_mismatches = 0
@@ -323,11 +458,12 @@ class Log:
             for c in summary.channels.values():
                 if stats.channel_message_counts.get(c.id, 0) != self.counts[c.topic]:
                     raise Problem(f"{c.topic}: read {self.counts[c.topic]} messages, the summary says {stats.channel_message_counts.get(c.id, 0)}")
+        self.check_tf()
         total = sum(self.counts.values())
         per_topic = ", ".join(f"{t} {self.counts[t]}" for t in list(EXPECTED) + list(OPTIONAL) if t in EXPECTED or t in self.counts)
         extra = f" ({self.validation_mismatches} mismatches)" if self.validation else ""
         return (f"ok, CRCs checked, {self.frames} frames of {self.dt_ns or 0} ns, {len(self.bodies.live)} bodies at the end, "
-                f"{total} messages: {per_topic}{extra}")
+                f"{total} messages: {per_topic}{extra}; {self.tf_summary}")
 
     def frame(self, t, msgs):
         """Checks the messages logged at time `t`: one frame's."""
@@ -346,10 +482,9 @@ class Log:
         self.frames += 1
         if "/validation" in msgs:
             self.validation_mismatches += msgs["/validation"][0].mismatches
-        b = msgs["/bodies"][0]
-        if abs(b.time * 1e9 - t) > 0.5 * frame + 1e-12 * t + 1e-6:
-            raise Problem(f"/bodies frame {frame}: time {b.time!r} s, log_time {t} ns")
-        before, moved = self.bodies.apply(b, frame)
+        self.bodies.apply(msgs["/bodies"][0], frame)
+        if frame == 1 and round_ns(self.bodies.dt) != dt:
+            raise Problem(f"frames {dt} ns apart, /bodies.dt {self.bodies.dt!r} s rounds to {round_ns(self.bodies.dt)} ns")
         live = self.bodies.live
         names = {f"body/{i}:{g}": (i, g) for i, g in live}
         stats = msgs["/stats"][0]
@@ -358,48 +493,23 @@ class Log:
         contacts = len(msgs["/contacts"][0].contacts)
         if stats.contacts != contacts:
             raise Problem(f"/stats frame {frame}: {stats.contacts} contacts, /contacts lists {contacts}")
-        # /tf: exactly the bodies that appeared, moved or turned, at their exact poses.
-        now, prev = set(), set()
-        for tf in (x for m in msgs.get("/tf", []) for x in m.transforms):
-            stamp = ts_ns(tf.timestamp)
-            name = tf.child_frame_id
-            if tf.parent_frame_id != WORLD:
-                raise Problem(f"/tf frame {frame}: {name} has parent {tf.parent_frame_id!r}, not {WORLD!r}")
-            k = names.get(name)
-            if stamp == t:
-                if k is None:
-                    raise Problem(f"/tf frame {frame}: a transform of {name}, which is not a live body")
-                target, state = now, live[k]
-            elif frame > 0 and stamp == t - dt:
-                if k is None or k not in before:
-                    raise Problem(f"/tf frame {frame}: a transform at the previous frame of {name}, not a body then")
-                target, state = prev, before[k]
-            else:
-                raise Problem(f"/tf frame {frame}: {name} stamped {stamp} ns")
-            if k in target:
-                raise Problem(f"/tf frame {frame}: two transforms of {name} at {stamp} ns")
-            target.add(k)
-            tr, q = tf.translation, tf.rotation
-            x, y = state["position"]
-            if bits(tr.x, tr.y, tr.z) != bits(x, y, 0.0):
-                raise Problem(f"/tf frame {frame}: {name} at ({tr.x!r}, {tr.y!r}, {tr.z!r}) stamped {stamp} ns, /bodies has ({x!r}, {y!r})")
-            if q.x != 0.0 or q.y != 0.0 or abs(q.z * q.z + q.w * q.w - 1.0) > 1e-12:
-                raise Problem(f"/tf frame {frame}: {name} rotation ({q.x}, {q.y}, {q.z}, {q.w}) is not a unit yaw")
-            err = math.remainder(yaw(q) - state["angle"], math.tau)
-            if not abs(err) <= YAW_TOLERANCE:
-                raise Problem(f"/tf frame {frame}: {name} yaw {yaw(q)!r}, /bodies angle {state['angle']!r} (off by {err:.3g})")
-        if now != moved:
-            missing, extra = sorted(moved - now), sorted(now - moved)
-            raise Problem(f"/tf frame {frame}: no transform of {missing[:5]}, which appeared or moved; transforms of {extra[:5]}, which did not")
-        for k in now:
-            held = k in before and self.last_tf[k] + 1 < frame
-            if held != (k in prev):
-                raise Problem(f"/tf frame {frame}: body {k}, last sent at frame {self.last_tf.get(k)}, has {'no' if held else 'a'} transform at the previous frame")
-            self.last_tf[k] = frame
-        if prev - now:
-            raise Problem(f"/tf frame {frame}: transforms at the previous frame of bodies that did not move {sorted(prev - now)[:5]}")
-        for k in [k for k in self.last_tf if k not in live]:
-            del self.last_tf[k]
+        # /tf: kept (preloaded, as Foxglove does) and checked against /bodies at the end.
+        for m in msgs.get("/tf", []):
+            if not m.transforms:
+                raise Problem(f"/tf frame {frame}: an empty message")
+            for tf in m.transforms:
+                name = tf.child_frame_id
+                if tf.parent_frame_id != WORLD:
+                    raise Problem(f"/tf frame {frame}: {name} has parent {tf.parent_frame_id!r}, not {WORLD!r}")
+                if not BODY_FRAME.fullmatch(name):
+                    raise Problem(f"/tf frame {frame}: a transform of {name!r}, not a body's frame body/ID:GENERATION")
+                tr, q = tf.translation, tf.rotation
+                if tr.z != 0.0 or q.x != 0.0 or q.y != 0.0 or not abs(q.z * q.z + q.w * q.w - 1.0) <= UNIT_TOLERANCE:
+                    raise Problem(f"/tf frame {frame}: {name} at ({tr.x!r}, {tr.y!r}, {tr.z!r}) turned ({q.x}, {q.y}, {q.z}, {q.w}): not planar (z = 0, a unit yaw quaternion)")
+                x = Transform(tf, t)
+                if x.stamp > t:
+                    raise Problem(f"/tf frame {frame}: {name} stamped {x.stamp} ns, after its message ({t} ns)")
+                self.tf.setdefault(name, []).append(x)
         # /scene: its last message is the whole scene, every live body in its own frame.
         for s in msgs.get("/scene", []):
             if [d.type for d in s.deletions] != [1] or ts_ns(s.deletions[0].timestamp) != t:
@@ -421,6 +531,75 @@ class Log:
         for e in msgs.get("/events", []):
             if ts_ns(e.timestamp) != t:
                 raise Problem(f"/events frame {frame}: stamped {ts_ns(e.timestamp)} ns at {t} ns")
+
+    def check_tf(self):
+        """Every body's frame, as Foxglove shows it with all of `/tf` loaded, against `/bodies`
+        at every frame the body is alive."""
+        dt_ns = self.dt_ns or 0
+        last = (self.frames - 1) * dt_ns
+        history = self.bodies.history
+        frame_ids = {f"body/{i}:{g}": (i, g) for i, g in history}
+        strays = sorted(set(self.tf) - set(frame_ids))
+        if strays:
+            raise Problem(f"/tf: transforms of {strays[:5]}, never a body in /bodies")
+
+        def at(stamp):
+            return stamp // dt_ns if dt_ns else 0
+
+        worst = [0.0, 0.0]
+        checked = bad = 0
+        off = []  # (frame, body frame, what is wrong): the first of each body
+        for name, k in frame_ids.items():
+            first, poses = history[k]
+            gone = first + len(poses) - 1  # the last frame it is alive
+            tfs = sorted(self.tf.get(name, []), key=lambda x: x.stamp)
+            if not tfs:
+                raise Problem(f"/tf: no transform of {name}, alive at frames {first} to {gone}")
+            stamps = [x.stamp for x in tfs]
+            for x, y in zip(tfs, tfs[1:]):
+                if x.stamp == y.stamp:
+                    raise Problem(f"/tf: two transforms of {name} stamped {x.stamp} ns (sent at {x.log_time} and {y.log_time} ns)")
+            for x in tfs:
+                f = at(x.stamp)
+                if x.stamp != f * dt_ns:
+                    raise Problem(f"/tf: {name} stamped {x.stamp} ns (sent at {x.log_time} ns), not a frame's time (a multiple of {dt_ns} ns)")
+                if x.stamp > last:
+                    raise Problem(f"/tf: {name} stamped {x.stamp} ns, after the last frame ({last} ns)")
+                if not first <= f <= gone:
+                    raise Problem(f"/tf: {name} stamped at frame {f} (sent at {x.log_time} ns), alive only at frames {first} to {gone}")
+            if stamps[0] != first * dt_ns:
+                raise Problem(f"/tf: the first transform of {name} is at frame {at(stamps[0])}, it appeared at frame {first}")
+            for x in tfs:  # a pose sent is the body's position at that frame, to the bit
+                want = poses[at(x.stamp) - first]
+                if bits(x.x, x.y) != bits(*want[:2]):
+                    raise Problem(f"/tf: {name} stamped at frame {at(x.stamp)} (sent at {x.log_time} ns) at ({x.x!r}, {x.y!r}), /bodies rebuilds ({want[0]!r}, {want[1]!r})")
+            for i, want in enumerate(poses):
+                frame = first + i
+                got, (a, b) = foxglove_pose(tfs, stamps, frame * dt_ns)
+                ex, ea = pose_error(got, want)
+                checked += 1
+                worst = [max(worst[0], ex), max(worst[1], ea)]
+                if not (ex <= POSE_TOLERANCE and ea <= POSE_TOLERANCE):
+                    bad += 1
+                    if off and off[-1][1] == name:
+                        continue  # the first of each body is enough
+                    t = frame * dt_ns
+                    if a == b and stamps[a] == t:
+                        how = "its transform stamped then"
+                    elif a == b:
+                        side = "before its first" if stamps[a] > t else "after its last"
+                        how = f"{side} transform, at frame {at(stamps[a])}, held"
+                    else:
+                        how = f"interpolated between its transforms at frames {at(stamps[a])} and {at(stamps[b])}"
+                    g = ", ".join(f"{v!r}" for v in got)
+                    w = ", ".join(f"{v!r}" for v in want)
+                    off.append((frame, name, f"shown at (x, y, angle) ({g}), {how}; /bodies has ({w}): off by {ex:.3g} relative, {ea:.3g} rad"))
+        if off:
+            frame, name, what = min(off)
+            raise Problem(f"/tf: {bad} body-frames of {len(off)} bodies not shown where /bodies has them; the first, at frame {frame} ({frame * dt_ns} ns): {name} {what}")
+        n = sum(len(v) for v in self.tf.values())
+        self.tf_summary = (f"/tf: {n} transforms give {checked} body-frames, "
+                           f"worst {worst[0]:.1e} (position, relative), {worst[1]:.1e} rad")
 
 
 def check(path):
