@@ -113,8 +113,10 @@ impl Motion {
         let (before, last) = (self.before, self.last);
         self.before = last;
         self.last = p;
+        // A sample already stamped this frame (a prediction, or a pose held from a frame
+        // before): right only if this frame is on the line that predicted it.
+        let due = self.future == Some(frame);
         if self.future.is_some_and(|f| f <= frame) {
-            // The prediction was for this frame or earlier: it is history now.
             self.future = None;
         }
         match self.line {
@@ -142,6 +144,10 @@ impl Motion {
                 let steady = near(p, line.at(frame)) && line.spacing().is_some();
                 if steady {
                     // The pose at `frame - 1` was sent exactly: the line starts there.
+                    if due {
+                        // What is stamped here was held from a frame before.
+                        out.push((frame, p));
+                    }
                     self.line = Some(line);
                     self.start_line(&line, frame, out);
                 } else {

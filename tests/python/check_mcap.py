@@ -33,17 +33,19 @@ section's, each chunk's, the summary's), and every message is decoded with
   `removed`, and `/stats.bodies` counts the live bodies.
 - `/tf` against `/bodies`, as Foxglove shows it: every transform is a body's frame
   `body/ID:GENERATION` in `world`, planar (z = 0, a unit quaternion about z), stamped at a
-  frame's time (a multiple of `dt_ns`), never after its message's `log_time` nor after the
-  last frame, only at frames its body is alive, at most once per frame and body, the first
-  one at the frame the body appeared, each one's translation the body's `/bodies` position
-  at that frame to the bit. Then, with every transform of the log preloaded, at
-  EVERY frame and for every live body, Foxglove's lookup of its frame at that frame's time
-  (the transform stamped then, else the position lerped and the rotation slerped between
-  the transforms before and after, gl-matrix style; before the first or after the last,
-  that one) is the body's `/bodies` pose: x and y within 1e-9 of max(1, |value|), the
-  angle within 1e-9 rad modulo a turn. `/tf` sends only the ends of each body's straight
-  stretches, so this fails if an end is missing (the last stretch not closed, a body gone
-  without its last pose) or a stretch is not straight or turns too far to slerp.
+  frame's time (a multiple of `dt_ns`), never before its message's `log_time` (it may be
+  after: a prediction), the first one at the frame the body appeared; one stamped at its
+  message's own time (an exact pose) has the body's `/bodies` position at that frame to the
+  bit. Then at EVERY frame and for every live body, Foxglove's lookup of its frame at that
+  frame's time, from the transform messages logged at or before it (Lichtblick never reads
+  preloaded messages ahead of the time shown; a later transform with the same timestamp
+  replaces the earlier): the transform stamped then, else the position lerped and the
+  rotation slerped between the transforms before and after, gl-matrix style; before the
+  first or after the last, that one. It must be the body's `/bodies` pose: x and y within
+  1e-9 of max(1, |value|), the angle within 1e-9 rad modulo a turn. `/tf` sends a body on
+  a straight line only as a prediction ahead, overwritten when the motion changes, so
+  this fails if a prediction is wrong and not overwritten in time, or turns too far to
+  slerp.
 - `/scene` draws exactly the live bodies at every frame, each once, in its own frame, with
   its `/bodies` name.
 - `/contacts` and `/stats` agree on the number of contacts.
@@ -358,7 +360,7 @@ class Transform:
 
 
 def foxglove_pose(transforms, stamps, t):
-    """The pose Foxglove's 3D panel gives a frame at `t`, all of its transforms loaded
+    """The pose Foxglove's 3D panel gives a frame at `t` from the transforms it holds
     (`stamps` their sorted timestamps): the one stamped `t`; between two, the translation
     lerped and the rotation slerped; before the first or after the last, that one. Also
     the indices of the transforms used."""
@@ -507,8 +509,8 @@ class Log:
                 if tr.z != 0.0 or q.x != 0.0 or q.y != 0.0 or not abs(q.z * q.z + q.w * q.w - 1.0) <= UNIT_TOLERANCE:
                     raise Problem(f"/tf frame {frame}: {name} at ({tr.x!r}, {tr.y!r}, {tr.z!r}) turned ({q.x}, {q.y}, {q.z}, {q.w}): not planar (z = 0, a unit yaw quaternion)")
                 x = Transform(tf, t)
-                if x.stamp > t:
-                    raise Problem(f"/tf frame {frame}: {name} stamped {x.stamp} ns, after its message ({t} ns)")
+                if x.stamp < t:
+                    raise Problem(f"/tf frame {frame}: {name} stamped {x.stamp} ns, before its message ({t} ns)")
                 self.tf.setdefault(name, []).append(x)
         # /scene: its last message is the whole scene, every live body in its own frame.
         for s in msgs.get("/scene", []):
@@ -533,8 +535,8 @@ class Log:
                 raise Problem(f"/events frame {frame}: stamped {ts_ns(e.timestamp)} ns at {t} ns")
 
     def check_tf(self):
-        """Every body's frame, as Foxglove shows it with all of `/tf` loaded, against `/bodies`
-        at every frame the body is alive."""
+        """Every body's frame, as Foxglove shows it from the `/tf` messages logged by then,
+        against `/bodies` at every frame the body is alive."""
         dt_ns = self.dt_ns or 0
         last = (self.frames - 1) * dt_ns
         history = self.bodies.history
@@ -552,30 +554,34 @@ class Log:
         for name, k in frame_ids.items():
             first, poses = history[k]
             gone = first + len(poses) - 1  # the last frame it is alive
-            tfs = sorted(self.tf.get(name, []), key=lambda x: x.stamp)
-            if not tfs:
+            sent = self.tf.get(name, [])  # in file order: by log time
+            if not sent:
                 raise Problem(f"/tf: no transform of {name}, alive at frames {first} to {gone}")
-            stamps = [x.stamp for x in tfs]
-            for x, y in zip(tfs, tfs[1:]):
-                if x.stamp == y.stamp:
-                    raise Problem(f"/tf: two transforms of {name} stamped {x.stamp} ns (sent at {x.log_time} and {y.log_time} ns)")
-            for x in tfs:
+            for x in sent:
                 f = at(x.stamp)
                 if x.stamp != f * dt_ns:
                     raise Problem(f"/tf: {name} stamped {x.stamp} ns (sent at {x.log_time} ns), not a frame's time (a multiple of {dt_ns} ns)")
-                if x.stamp > last:
-                    raise Problem(f"/tf: {name} stamped {x.stamp} ns, after the last frame ({last} ns)")
-                if not first <= f <= gone:
-                    raise Problem(f"/tf: {name} stamped at frame {f} (sent at {x.log_time} ns), alive only at frames {first} to {gone}")
-            if stamps[0] != first * dt_ns:
-                raise Problem(f"/tf: the first transform of {name} is at frame {at(stamps[0])}, it appeared at frame {first}")
-            for x in tfs:  # a pose sent is the body's position at that frame, to the bit
-                want = poses[at(x.stamp) - first]
-                if bits(x.x, x.y) != bits(*want[:2]):
-                    raise Problem(f"/tf: {name} stamped at frame {at(x.stamp)} (sent at {x.log_time} ns) at ({x.x!r}, {x.y!r}), /bodies rebuilds ({want[0]!r}, {want[1]!r})")
+                if x.stamp == x.log_time:  # an exact pose: the body's position, to the bit
+                    if not first <= f <= gone:
+                        raise Problem(f"/tf: {name} at frame {f}, alive only at frames {first} to {gone}")
+                    want = poses[f - first]
+                    if bits(x.x, x.y) != bits(*want[:2]):
+                        raise Problem(f"/tf: {name} at frame {f} at ({x.x!r}, {x.y!r}), /bodies rebuilds ({want[0]!r}, {want[1]!r})")
+            if sent[0].stamp != first * dt_ns:
+                raise Problem(f"/tf: the first transform of {name} is at frame {at(sent[0].stamp)}, it appeared at frame {first}")
+            # What Foxglove holds at each frame: the transforms logged by then, by stamp.
+            held, stamps, read = {}, [], 0
             for i, want in enumerate(poses):
                 frame = first + i
-                got, (a, b) = foxglove_pose(tfs, stamps, frame * dt_ns)
+                t = frame * dt_ns
+                while read < len(sent) and sent[read].log_time <= t:
+                    x = sent[read]
+                    if x.stamp not in held:
+                        bisect.insort(stamps, x.stamp)
+                    held[x.stamp] = x
+                    read += 1
+                tfs = [held[st] for st in stamps]
+                got, (a, b) = foxglove_pose(tfs, stamps, t)
                 ex, ea = pose_error(got, want)
                 checked += 1
                 worst = [max(worst[0], ex), max(worst[1], ea)]
@@ -583,7 +589,6 @@ class Log:
                     bad += 1
                     if off and off[-1][1] == name:
                         continue  # the first of each body is enough
-                    t = frame * dt_ns
                     if a == b and stamps[a] == t:
                         how = "its transform stamped then"
                     elif a == b:
