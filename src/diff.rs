@@ -15,13 +15,14 @@ use serde_json::Value;
 
 /// Topics in the order a report names them when several differ at the same time: the
 /// plain state first, the drawing last.
-const TOPIC_ORDER: [&str; 7] = [
+const TOPIC_ORDER: [&str; 8] = [
     "/bodies",
     "/contacts",
     "/stats",
     "/events",
     "/tf",
     "/scene",
+    "/scene/static",
     "/scene/contacts",
 ];
 

@@ -35,6 +35,7 @@ fn every_channel_is_protobuf_and_every_message_decodes_from_its_schema_alone() {
         channels,
         [
             ("/scene", "foxglove.SceneUpdate"),
+            ("/scene/static", "foxglove.SceneUpdate"),
             ("/tf", "foxglove.FrameTransforms"),
             ("/scene/contacts", "foxglove.SceneUpdate"),
             ("/bodies", "ricochet.Bodies"),

@@ -79,7 +79,9 @@ fn dump_refuses_an_unknown_topic_and_bad_frames() {
     assert_eq!(code, Some(2));
     assert!(lines.is_empty());
     assert!(
-        err.contains("/scene, /tf, /scene/contacts, /bodies, /contacts, /stats, /events"),
+        err.contains(
+            "/scene, /scene/static, /tf, /scene/contacts, /bodies, /contacts, /stats, /events"
+        ),
         "{err}"
     );
     let (code, _, err) = dump(&[golden, "--frames", "9..2"]);

@@ -393,7 +393,9 @@ fn diff_of_an_unknown_topic_is_an_error_naming_the_topics_there_are() {
         assert_eq!(o.status.code(), Some(2), "{topic}: {stderr}");
         assert!(o.stdout.is_empty());
         assert!(
-            stderr.contains("/bodies, /contacts, /events, /scene, /scene/contacts, /stats, /tf"),
+            stderr.contains(
+                "/bodies, /contacts, /events, /scene, /scene/contacts, /scene/static, /stats, /tf"
+            ),
             "{stderr}"
         );
     }

@@ -52,6 +52,7 @@ fn run_with_no_arguments_writes_the_asteroids_demo_with_seven_decodable_channels
             "/events",
             "/scene",
             "/scene/contacts",
+            "/scene/static",
             "/stats",
             "/tf"
         ]
@@ -61,6 +62,7 @@ fn run_with_no_arguments_writes_the_asteroids_demo_with_seven_decodable_channels
     for (name, schema) in [
         ("/scene", "foxglove.SceneUpdate"),
         ("/scene/contacts", "foxglove.SceneUpdate"),
+        ("/scene/static", "foxglove.SceneUpdate"),
         ("/tf", "foxglove.FrameTransforms"),
         ("/events", "foxglove.Log"),
         ("/bodies", "ricochet.Bodies"),

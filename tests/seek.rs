@@ -7,9 +7,10 @@
 //! (never past it: `Renderer.handleAllFramesMessages` reads preloaded messages with
 //! `receiveTime <= currentTime`, and a seek backwards clears the tree and reads them again).
 //! So the panel shows:
-//! - the entities of the last `/scene` (`foxglove.SceneUpdate`) at or before `t`: its
-//!   deletions applied, then its entities (Ricochet sends a delete-all then every body, so
-//!   that one message is the whole scene);
+//! - the entities of the last `/scene` (`foxglove.SceneUpdate`: the moving bodies) and of
+//!   the last `/scene/static` (the static ones) at or before `t`: each one's deletions
+//!   applied, then its entities (Ricochet sends a delete-all then every body, so that one
+//!   message is the whole of its bodies);
 //! - each entity in its frame (`frame_locked`), placed by the frame's transforms read by then,
 //!   kept by their own timestamp (a later one with the same timestamp replaces the earlier;
 //!   timestamps may be ahead of `t`: predictions): the transform stamped `t` if there is
@@ -160,8 +161,8 @@ struct Log {
     dt_ns: u64,
     /// `log_time` of the last message.
     end: u64,
-    /// `/scene` messages, by `log_time`.
-    scenes: Vec<(u64, Value)>,
+    /// `/scene` and `/scene/static` messages, by `log_time`.
+    scenes: [Vec<(u64, Value)>; 2],
     /// Every transform of `/tf` in file order, by child frame: `(log_time, timestamp, pose)`.
     transforms: BTreeMap<String, Vec<(u64, u64, Planar)>>,
     /// `/bodies` rebuilt in full, by frame.
@@ -178,10 +179,12 @@ impl Log {
         // Frame 1's `/bodies` (checked below: one a frame, from 0) is at `dt_ns`.
         let frame_1 = log.iter().filter(|m| m.topic == "/bodies").nth(1);
         let dt_ns = frame_1.unwrap().log_time;
-        let (mut scenes, mut transforms) = (Vec::new(), BTreeMap::<_, Vec<_>>::new());
+        let mut scenes = [Vec::new(), Vec::new()];
+        let mut transforms = BTreeMap::<_, Vec<_>>::new();
         for m in &log {
             match m.topic.as_str() {
-                "/scene" => scenes.push((m.log_time, m.data.clone())),
+                "/scene" => scenes[0].push((m.log_time, m.data.clone())),
+                "/scene/static" => scenes[1].push((m.log_time, m.data.clone())),
                 "/tf" => {
                     for tf in m.data["transforms"].as_array().unwrap() {
                         assert_eq!(tf["parent_frame_id"], "world", "{tf}");
@@ -197,7 +200,10 @@ impl Log {
                 _ => {}
             }
         }
-        assert!(scenes.is_sorted_by_key(|s| s.0), "/scene in time order");
+        assert!(
+            scenes.iter().all(|s| s.is_sorted_by_key(|s| s.0)),
+            "in time order"
+        );
         let numbered = bodies.iter().enumerate().all(|(f, b)| b["frame"] == f);
         assert!(numbered, "/bodies: frames 0, 1, 2...");
         let end = log.last().unwrap().log_time;
@@ -228,16 +234,24 @@ impl Log {
         times
     }
 
-    /// The entities at `t`: after the last `/scene` at or before `t`, as a seek shows them,
-    /// or, `played`, after every `/scene` from the start, as playing from 0 shows them.
+    /// The entities at `t`: after the last `/scene` and the last `/scene/static` at or before
+    /// `t`, as a seek shows them, or, `played`, after every message of both from the start,
+    /// as playing from 0 shows them. (Each topic has entities of its own: a deletion on one
+    /// never touches the other's.)
     fn scene(&self, t: u64, played: bool) -> BTreeMap<String, Value> {
-        let upto = self.scenes.partition_point(|s| s.0 <= t);
-        let from = if played { 0 } else { upto.saturating_sub(1) };
-        let mut entities = BTreeMap::new();
-        for (_, update) in &self.scenes[from..upto] {
-            apply(&mut entities, update);
+        let mut shown = BTreeMap::new();
+        for scenes in &self.scenes {
+            let upto = scenes.partition_point(|s| s.0 <= t);
+            let from = if played { 0 } else { upto.saturating_sub(1) };
+            let mut entities = BTreeMap::new();
+            for (_, update) in &scenes[from..upto] {
+                apply(&mut entities, update);
+            }
+            for (id, e) in entities {
+                assert!(shown.insert(id, e).is_none(), "a body on both topics");
+            }
         }
-        entities
+        shown
     }
 
     /// What the panel shows of `entities` at time `t`.

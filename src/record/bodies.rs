@@ -16,7 +16,7 @@ use ricochet_sim::{BodyKind, Entity, FrameOutput, Layers, RemovedBody, World};
 use super::motion::{Motion, Sample};
 use super::scene;
 
-/// `/bodies` lists every body in full every this many frames (and at frame 0).
+/// `/bodies` lists every moving body in full every this many frames (and at frame 0).
 pub const KEYFRAME_INTERVAL: u64 = 60;
 
 /// What was last recorded of a body alive at the end of the previous frame.
@@ -32,6 +32,9 @@ struct Known {
     motion: Motion,
     /// Its drawing turns back by its angle (an AABB part): a turn redraws the scene.
     drawn_with_angle: bool,
+    /// A static body: drawn on `/scene/static`, and listed in `/bodies` only when it appears
+    /// or changes (keyframes list the moving bodies).
+    is_static: bool,
     /// The frame it was last seen in the world.
     seen: u64,
 }
@@ -120,8 +123,11 @@ pub struct Changes {
     /// `/tf`: the transforms of the bodies that appeared, or whose stretch of straight-line
     /// motion ended.
     pub transforms: Vec<FrameTransform>,
-    /// `/scene` must be sent whole: a body appeared or went, or an AABB body turned.
+    /// `/scene` (moving bodies) must be sent whole: one appeared or went, or one with an
+    /// AABB part turned.
     pub scene_changed: bool,
+    /// `/scene/static` must be sent whole: a static body appeared, went, or turned.
+    pub static_changed: bool,
 }
 
 /// The last recorded state of every body, by slot.
@@ -154,7 +160,14 @@ impl Tracker {
     ) -> Changes {
         let frame = out.frame;
         let keyframe = !self.started || frame.is_multiple_of(KEYFRAME_INTERVAL);
-        let mut scene_changed = !self.started || !out.removed.is_empty();
+        let (mut scene_changed, mut static_changed) = (!self.started, !self.started);
+        for r in &out.removed {
+            *if r.kind == BodyKind::Static {
+                &mut static_changed
+            } else {
+                &mut scene_changed
+            } = true;
+        }
         self.started = true;
         self.frame = frame;
         let mut bodies = Vec::new();
@@ -174,7 +187,12 @@ impl Tracker {
                 if self.known[slot].is_none() {
                     self.alive += 1;
                 }
-                scene_changed = true;
+                let is_static = world.kind[i] == BodyKind::Static;
+                *if is_static {
+                    &mut static_changed
+                } else {
+                    &mut scene_changed
+                } = true;
                 let k = Known {
                     generation: e.generation,
                     position,
@@ -184,6 +202,7 @@ impl Tracker {
                     frame_id: scene::entity_id(e),
                     motion: Motion::appear(frame, position, angle, &mut samples),
                     drawn_with_angle: scene::drawing_depends_on_angle(&world.shape[i]),
+                    is_static,
                     seen: frame,
                 };
                 transforms_of(&k.frame_id, &samples, dt_ns, &mut transforms);
@@ -198,7 +217,11 @@ impl Tracker {
                 transforms_of(&k.frame_id, &samples, dt_ns, &mut transforms);
             }
             if !fresh && k.drawn_with_angle && !same(angle, k.angle) {
-                scene_changed = true;
+                *if k.is_static {
+                    &mut static_changed
+                } else {
+                    &mut scene_changed
+                } = true;
             }
             let sped = !same2(k.velocity, velocity);
             let spun = !same(k.angular_velocity, angular_velocity);
@@ -206,7 +229,7 @@ impl Tracker {
             let moved_as_predicted = same2(position, k.position + velocity * dt);
             let turned_as_predicted = same(angle, k.angle + angular_velocity * dt);
             let still = same2(position, k.position) && same(angle, k.angle);
-            let full = keyframe || fresh;
+            let full = fresh || (keyframe && !k.is_static);
             let predicted = moved_as_predicted && turned_as_predicted;
             if want_bodies && (full || sped || spun || !predicted) {
                 let mut b = pb::Body {
@@ -247,10 +270,16 @@ impl Tracker {
         if self.alive != world.len() {
             // Some bodies went (removed, or despawned between frames): forget them.
             for slot in &mut self.known {
-                if slot.as_ref().is_some_and(|k| k.seen != frame) {
+                if let Some(k) = slot.as_ref()
+                    && k.seen != frame
+                {
+                    *if k.is_static {
+                        &mut static_changed
+                    } else {
+                        &mut scene_changed
+                    } = true;
                     *slot = None;
                     self.alive -= 1;
-                    scene_changed = true;
                 }
             }
         }
@@ -273,6 +302,7 @@ impl Tracker {
             },
             transforms,
             scene_changed,
+            static_changed,
         }
     }
 }

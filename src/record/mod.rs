@@ -3,7 +3,8 @@
 //!
 //! | topic | schema | content |
 //! |---|---|---|
-//! | `/scene` | `foxglove.SceneUpdate` | every body, drawn in its own frame; sent whole when the set of bodies changes |
+//! | `/scene` | `foxglove.SceneUpdate` | every moving body, drawn in its own frame; sent whole when that set changes |
+//! | `/scene/static` | `foxglove.SceneUpdate` | every static body, the same way: sent whole when that set changes |
 //! | `/tf` | `foxglove.FrameTransforms` | each body's frame: every frame while its motion changes, one prediction per second on a straight line (Foxglove interpolates) |
 //! | `/scene/contacts` | `foxglove.SceneUpdate` | the frame's contact normals as arrows |
 //! | `/bodies` | `ricochet.Bodies` | exact body states: every body at keyframes, between them what the integrator does not predict |
@@ -24,7 +25,7 @@ use std::path::Path;
 use ricochet_log::messages::fox::{FrameTransforms, Log, SceneUpdate, log};
 use ricochet_log::messages::{Schema, ricochet as pb, timestamp};
 use ricochet_log::{ChannelId, LogError, LogWriter, Threading};
-use ricochet_sim::{FrameOutput, Layers, Simulation};
+use ricochet_sim::{BodyKind, FrameOutput, Layers, Simulation};
 
 use crate::channels::Channels;
 use bodies::Tracker;
@@ -48,6 +49,7 @@ fn pose3(p: &ricochet_geom::Pose) -> Vec<f64> {
 #[derive(Default)]
 struct Topics {
     scene: Option<ChannelId>,
+    statics: Option<ChannelId>,
     tf: Option<ChannelId>,
     arrows: Option<ChannelId>,
     bodies: Option<ChannelId>,
@@ -81,6 +83,8 @@ impl Recorder {
         let mut t = Topics::default();
         if channels.scene {
             t.scene = Some(w.add_protobuf_channel("/scene", Schema::foxglove::<SceneUpdate>())?);
+            t.statics =
+                Some(w.add_protobuf_channel("/scene/static", Schema::foxglove::<SceneUpdate>())?);
             t.tf = Some(w.add_protobuf_channel("/tf", Schema::foxglove::<FrameTransforms>())?);
             t.arrows =
                 Some(w.add_protobuf_channel("/scene/contacts", Schema::foxglove::<SceneUpdate>())?);
@@ -154,16 +158,25 @@ impl Recorder {
             let mut changes = self
                 .tracker
                 .frame(w, out, layers, self.dt, self.dt_ns, want_bodies);
+            let drawings = |statics: bool| {
+                (0..w.len())
+                    .filter(move |&i| (w.kind[i] == BodyKind::Static) == statics)
+                    .map(|i| scene::BodyDrawing {
+                        entity: w.entity[i],
+                        name: &w.name[i],
+                        shape: &w.shape[i],
+                        angle: w.angle[i],
+                        layer: w.layer[i],
+                        kind: w.kind[i],
+                    })
+            };
+            if let (Some(ch), true) = (self.topics.statics, changes.static_changed) {
+                self.writer
+                    .write(ch, t, scene::snapshot(drawings(true), ts))?;
+            }
             if let (Some(ch), true) = (self.topics.scene, changes.scene_changed) {
-                let drawings = (0..w.len()).map(|i| scene::BodyDrawing {
-                    entity: w.entity[i],
-                    name: &w.name[i],
-                    shape: &w.shape[i],
-                    angle: w.angle[i],
-                    layer: w.layer[i],
-                    kind: w.kind[i],
-                });
-                self.writer.write(ch, t, scene::snapshot(drawings, ts))?;
+                self.writer
+                    .write(ch, t, scene::snapshot(drawings(false), ts))?;
             }
             if let (Some(ch), false) = (self.topics.tf, changes.transforms.is_empty()) {
                 let transforms = std::mem::take(&mut changes.transforms);

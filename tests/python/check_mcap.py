@@ -10,7 +10,7 @@ section's, each chunk's, the summary's), and every message is decoded with
   (`/validation` optional), and the summary's message counts match what was read.
 - No message has a field its schema does not declare, and each one re-encodes to exactly
   its bytes (canonical protobuf, what a deterministic log must be).
-- `/scene`, `/scene/contacts`, `/tf` and `/events` against the OFFICIAL Foxglove schemas
+- `/scene`, `/scene/static`, `/scene/contacts`, `/tf` and `/events` against the OFFICIAL Foxglove schemas
   (the `foxglove-schemas-protobuf` package): the descriptor the log embeds declares the
   same message as the official one (field names, numbers, types, labels, nested types,
   enums), and every message parses with the official class, with no unknown field, into
@@ -21,7 +21,8 @@ section's, each chunk's, the summary's), and every message is decoded with
   `/bodies.dt` is the same every frame, `dt_ns` is it rounded to whole nanoseconds,
   `/bodies.time` is `frame * dt`, and the timestamps inside messages agree.
 - `/bodies`: every body's full state is rebuilt frame by frame exactly as `BodyStates`
-  (crates/log/src/bodies.rs) does: a keyframe replaces every body; between keyframes a body
+  (crates/log/src/bodies.rs) does: a keyframe replaces every moving body (static ones are
+  kept); between keyframes a body
   not listed, or listed without `position` / `angle`, moves as `previous + velocity * dt`
   and `previous + angular_velocity * dt` with this frame's velocities (f64, multiply then
   add), unless `still`; unlisted velocities are unchanged. A body that appears, and every
@@ -46,7 +47,7 @@ section's, each chunk's, the summary's), and every message is decoded with
   a straight line only as a prediction ahead, overwritten when the motion changes, so
   this fails if a prediction is wrong and not overwritten in time, or turns too far to
   slerp.
-- `/scene` draws exactly the live bodies at every frame, each once, in its own frame, with
+- `/scene` and `/scene/static` together draw exactly the live bodies at every frame, each once, in its own frame, with
   its `/bodies` name.
 - `/contacts` and `/stats` agree on the number of contacts.
 
@@ -74,6 +75,7 @@ EXPECTED = {
     "/scene": "foxglove.SceneUpdate",
     "/tf": "foxglove.FrameTransforms",
     "/scene/contacts": "foxglove.SceneUpdate",
+    "/scene/static": "foxglove.SceneUpdate",
     "/bodies": "ricochet.Bodies",
     "/contacts": "ricochet.Contacts",
     "/stats": "ricochet.Stats",
@@ -256,7 +258,7 @@ class Bodies:
                 if len(getattr(b, f)) not in (0, 2):
                     raise Problem(f"/bodies frame {frame}: body {k} {f} {list(getattr(b, f))}")
         if m.keyframe:
-            gone = sorted(set(before) - removed - set(listed))
+            gone = sorted(k for k in set(before) - removed - set(listed) if not before[k]["static"])
             if gone:
                 raise Problem(f"/bodies keyframe {frame}: bodies {gone[:5]} vanished without being listed in removed")
         live = {}
@@ -264,8 +266,8 @@ class Bodies:
             if k in removed:
                 continue
             b = listed.get(k)
-            if m.keyframe:
-                continue  # listed in full below
+            if m.keyframe and not old["static"]:
+                continue  # listed in full below (static bodies are kept)
             state = dict(old)
             if b is not None:
                 for f in self.FIXED:
@@ -402,7 +404,7 @@ class Log:
         self.bodies = Bodies()
         self.tf = {}  # child frame -> [Transform], in file order
         self.tf_summary = ""
-        self.scene = None  # the entities of the last /scene, by id
+        self.scenes = {}  # topic -> the entities of its last message, by id
         self.validation = False
         self.validation_mismatches = 0
 
@@ -512,19 +514,27 @@ class Log:
                 if x.stamp < t:
                     raise Problem(f"/tf frame {frame}: {name} stamped {x.stamp} ns, before its message ({t} ns)")
                 self.tf.setdefault(name, []).append(x)
-        # /scene: its last message is the whole scene, every live body in its own frame.
-        for s in msgs.get("/scene", []):
-            if [d.type for d in s.deletions] != [1] or ts_ns(s.deletions[0].timestamp) != t:
-                raise Problem(f"/scene frame {frame}: not a delete-all at {t} ns, then the scene")
-            self.scene = {}
-            for e in s.entities:
-                if e.id in self.scene or e.frame_id != e.id or not e.frame_locked or ts_ns(e.timestamp) != t:
-                    raise Problem(f"/scene frame {frame}: entity {e.id} (frame {e.frame_id}, locked {e.frame_locked}) is not a body drawn once in its own frame at {t} ns")
-                names_meta = [kv.value for kv in e.metadata if kv.key == "name"]
-                if e.id in names and names_meta != [live[names[e.id]]["name"]]:
-                    raise Problem(f"/scene frame {frame}: entity {e.id} named {names_meta}, /bodies names it {live[names[e.id]]['name']!r}")
-                self.scene[e.id] = e
-        drawn = set(self.scene or ())
+        # /scene and /scene/static: the last message of each is the whole of its bodies
+        # (moving, static), every one in its own frame.
+        for topic in ("/scene", "/scene/static"):
+            for s in msgs.get(topic, []):
+                if [d.type for d in s.deletions] != [1] or ts_ns(s.deletions[0].timestamp) != t:
+                    raise Problem(f"{topic} frame {frame}: not a delete-all at {t} ns, then the scene")
+                scene = {}
+                for e in s.entities:
+                    if e.id in scene or e.frame_id != e.id or not e.frame_locked or ts_ns(e.timestamp) != t:
+                        raise Problem(f"{topic} frame {frame}: entity {e.id} (frame {e.frame_id}, locked {e.frame_locked}) is not a body drawn once in its own frame at {t} ns")
+                    names_meta = [kv.value for kv in e.metadata if kv.key == "name"]
+                    if e.id in names and names_meta != [live[names[e.id]]["name"]]:
+                        raise Problem(f"{topic} frame {frame}: entity {e.id} named {names_meta}, /bodies names it {live[names[e.id]]['name']!r}")
+                    if e.id in names and live[names[e.id]]["static"] != (topic == "/scene/static"):
+                        raise Problem(f"{topic} frame {frame}: entity {e.id} is drawn on the wrong topic for its kind")
+                    scene[e.id] = e
+                self.scenes[topic] = scene
+        drawn = [i for scene in self.scenes.values() for i in scene]
+        if len(drawn) != len(set(drawn)):
+            raise Problem(f"/scene at frame {frame}: a body drawn on both /scene and /scene/static")
+        drawn = set(drawn)
         if drawn != set(names):
             raise Problem(f"/scene at frame {frame}: draws {sorted(drawn - set(names))[:5]}, not live bodies; does not draw {sorted(set(names) - drawn)[:5]}")
         for s in msgs.get("/scene/contacts", []):

@@ -1,6 +1,7 @@
 //! Every body's full state, frame by frame, rebuilt from a log's `/bodies` messages.
 //!
-//! `/bodies` lists every body with every field at a keyframe, and between keyframes only
+//! `/bodies` lists every moving body with every field at a keyframe (a static body only when
+//! it appears or changes), and between keyframes only
 //! what the integrator does not predict (see `proto/ricochet.proto`): an unlisted position is
 //! `previous + velocity * dt`, an unlisted angle `previous + angular_velocity * dt` (IEEE
 //! f64, multiply then add), unlisted velocities are unchanged. [`BodyStates`] applies the
@@ -52,7 +53,9 @@ impl BodyStates {
             .unwrap_or(false);
         let dt = number(message.get("dt"));
         if keyframe {
-            self.bodies.clear();
+            // A keyframe lists every moving body; static ones are listed when they change.
+            self.bodies
+                .retain(|_, b| b.get("static").and_then(Value::as_bool) == Some(true));
         }
         let list = |name: &str| message.get(name).and_then(Value::as_array);
         for body in list("removed").into_iter().flatten() {
