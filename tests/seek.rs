@@ -23,7 +23,8 @@
 //! dt_ns)`:
 //! - the entities shown are the bodies alive, each named as its body;
 //! - at a frame's time, each entity's frame is at the body's position and angle within f32
-//!   rounding;
+//!   rounding (a body with an AABB part, which does not turn, has an upright frame: angle 0,
+//!   its other parts drawn turned);
 //! - between frames `f` and `f + 1` (`/tf` sends a body on a straight line only as a
 //!   prediction ahead, which Foxglove interpolates towards), each entity is either still at
 //!   the body's pose at `f`, or moved along its last step, `pose(f) + frac * (pose(f) -
@@ -333,11 +334,15 @@ impl Log {
                 report("no /tf transform at or before t".to_owned());
                 continue;
             };
-            let want = Planar::of_body(body);
+            let body_pose = Planar::of_body(body);
+            // A body with an AABB part has an upright frame (its parts are drawn turned).
+            let upright = has_aabb(&body["shape"]);
+            let flat = |p: Planar| if upright { Planar::new(p.at, 0.0) } else { p };
+            let want = flat(body_pose);
             // Between frames: still at `f`, or moved along the last step.
             let moved = match previous.get(id) {
                 Some(b) if frac > 0.0 => {
-                    let last = Planar::of_body(b);
+                    let last = flat(Planar::of_body(b));
                     let step = Planar::new(want.at - last.at, want.yaw - last.yaw);
                     Planar::new(want.at + step.at * frac, want.yaw + step.yaw * frac)
                 }
@@ -365,7 +370,12 @@ impl Log {
             // An AABB is drawn upright at the angle the scene was drawn at; between frames its
             // body's frame has turned on by up to a frame's turn.
             let slack = wrap(pose.yaw - want.yaw).abs();
-            compare_shape(s, body, pose, slack, &mut report);
+            let placed = if upright {
+                Planar::new(pose.at, body_pose.yaw)
+            } else {
+                pose
+            };
+            compare_shape(s, body, placed, slack, &mut report);
         }
         problems
     }
@@ -382,6 +392,14 @@ fn apply(entities: &mut BTreeMap<String, Value>, update: &Value) {
     for e in update["entities"].as_array().unwrap() {
         entities.insert(e["id"].as_str().unwrap().to_owned(), e.clone());
     }
+}
+
+/// Whether a `/bodies` shape has an AABB part.
+fn has_aabb(shape: &Value) -> bool {
+    shape.get("aabb").is_some()
+        || shape["compound"]["parts"]
+            .as_array()
+            .is_some_and(|parts| parts.iter().any(has_aabb))
 }
 
 /// The bodies of a full `/bodies` message, by the name of their frame.

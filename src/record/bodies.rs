@@ -30,7 +30,9 @@ struct Known {
     frame_id: String,
     /// Its motion as `/tf` has described it.
     motion: Motion,
-    /// Its drawing turns back by its angle (an AABB part): a turn redraws the scene.
+    /// Its frame stays upright (an AABB part): `/tf` sends no rotation.
+    upright: bool,
+    /// Its drawing depends on its angle: a turn redraws the scene.
     drawn_with_angle: bool,
     /// A static body: drawn on `/scene/static`, and listed in `/bodies` only when it appears
     /// or changes (keyframes list the moving bodies).
@@ -184,6 +186,8 @@ impl Tracker {
             let fresh = !matches!(&self.known[slot], Some(k) if k.generation == e.generation);
             samples.clear();
             if fresh {
+                let upright = scene::upright(&world.shape[i]);
+                let frame_angle = if upright { 0.0 } else { angle };
                 if self.known[slot].is_none() {
                     self.alive += 1;
                 }
@@ -200,7 +204,8 @@ impl Tracker {
                     velocity,
                     angular_velocity,
                     frame_id: scene::entity_id(e),
-                    motion: Motion::appear(frame, position, angle, &mut samples),
+                    motion: Motion::appear(frame, position, frame_angle, &mut samples),
+                    upright,
                     drawn_with_angle: scene::drawing_depends_on_angle(&world.shape[i]),
                     is_static,
                     seen: frame,
@@ -213,7 +218,8 @@ impl Tracker {
             };
             k.seen = frame;
             if !fresh {
-                k.motion.frame(frame, position, angle, &mut samples);
+                let frame_angle = if k.upright { 0.0 } else { angle };
+                k.motion.frame(frame, position, frame_angle, &mut samples);
                 transforms_of(&k.frame_id, &samples, dt_ns, &mut transforms);
             }
             if !fresh && k.drawn_with_angle && !same(angle, k.angle) {

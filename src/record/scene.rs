@@ -4,8 +4,9 @@
 //! Foxglove, on a seek, takes the last message of each topic at or before the new time, and
 //! it preloads every transform of the log. So:
 //! - every body has a coordinate frame of its own, `body/INDEX:GENERATION`, child of
-//!   `world`, moved on `/tf` (`foxglove.FrameTransforms`) only in the frames where the
-//!   body's pose changed (and once when it appears);
+//!   `world`, moved on `/tf` (`foxglove.FrameTransforms`) as `motion.rs` decides. It turns
+//!   with the body, except for a body with an AABB part (which does not turn): its frame
+//!   stays upright and the entity draws the other parts turned;
 //! - `/scene` (`foxglove.SceneUpdate`) draws every body in its own frame, `frame_locked`
 //!   so it follows its frame; it is sent whole (a delete-all, then every body) when the set
 //!   of bodies changes, so its last message at any time is the whole scene then;
@@ -15,7 +16,7 @@
 //! A body's shape is drawn filled: cubes for boxes, cylinders for circles, triangle fans for
 //! polygons and capsules.
 
-use ricochet_geom::{Primitive, Shape, Vec2};
+use ricochet_geom::{Primitive, Rot, Shape, Vec2};
 use ricochet_log::messages::fox::{
     ArrowPrimitive, Color, CubePrimitive, CylinderPrimitive, FrameTransform, KeyValuePair, Point3,
     Pose, Quaternion, SceneEntity, SceneEntityDeletion, SceneUpdate, Timestamp,
@@ -118,48 +119,67 @@ fn filled(outline: Vec<Point3>, color: Color) -> TriangleListPrimitive {
     }
 }
 
-/// Adds the drawing of one primitive, in body coordinates, to `entity`. `angle` is the
-/// body's: an AABB ignores it, so its cube is turned back by it.
-fn draw(entity: &mut SceneEntity, prim: &Primitive, angle: f64, color: Color) {
+/// Adds the drawing of one primitive to `entity`, in its body's frame turned by `turn`: 0 for
+/// a body whose frame turns with it, its angle for an upright one (see [`upright`]).
+fn draw(entity: &mut SceneEntity, prim: &Primitive, turn: f64, color: Color) {
+    let rot = Rot::from_angle(turn);
+    let at = |v: Vec2| rot.apply(v);
     match prim {
-        Primitive::Circle(c) => entity.cylinders.push(CylinderPrimitive {
-            // Foxglove cylinders stand along z: lying in the XY plane needs no turn.
-            pose: planar(c.center.x, c.center.y, 0.0),
-            size: vec3(2.0 * c.radius, 2.0 * c.radius, DEPTH),
-            bottom_scale: 1.0,
-            top_scale: 1.0,
-            color: Some(color),
-        }),
-        Primitive::Aabb(b) => entity.cubes.push(CubePrimitive {
-            pose: planar(b.center.x, b.center.y, -angle),
-            size: vec3(2.0 * b.half_extents.x, 2.0 * b.half_extents.y, DEPTH),
-            color: Some(color),
-        }),
-        Primitive::Obb(b) => entity.cubes.push(CubePrimitive {
-            pose: planar(b.center.x, b.center.y, b.angle),
-            size: vec3(2.0 * b.half_extents.x, 2.0 * b.half_extents.y, DEPTH),
-            color: Some(color),
-        }),
+        Primitive::Circle(c) => {
+            let c0 = at(c.center);
+            entity.cylinders.push(CylinderPrimitive {
+                // Foxglove cylinders stand along z: lying in the XY plane needs no turn.
+                pose: planar(c0.x, c0.y, 0.0),
+                size: vec3(2.0 * c.radius, 2.0 * c.radius, DEPTH),
+                bottom_scale: 1.0,
+                top_scale: 1.0,
+                color: Some(color),
+            });
+        }
+        Primitive::Aabb(b) => {
+            // Only in an upright frame: an AABB does not turn with its body.
+            let c0 = at(b.center);
+            entity.cubes.push(CubePrimitive {
+                pose: planar(c0.x, c0.y, 0.0),
+                size: vec3(2.0 * b.half_extents.x, 2.0 * b.half_extents.y, DEPTH),
+                color: Some(color),
+            });
+        }
+        Primitive::Obb(b) => {
+            let c0 = at(b.center);
+            entity.cubes.push(CubePrimitive {
+                pose: planar(c0.x, c0.y, turn + b.angle),
+                size: vec3(2.0 * b.half_extents.x, 2.0 * b.half_extents.y, DEPTH),
+                color: Some(color),
+            });
+        }
         Primitive::Capsule(c) => {
             // A capsule is convex: its outline fans into triangles like a polygon's.
             entity
                 .triangles
-                .push(filled(capsule_outline(c.a, c.b, c.radius), color));
+                .push(filled(capsule_outline(at(c.a), at(c.b), c.radius), color));
         }
         Primitive::Polygon(p) => {
-            let pts = p.vertices().iter().map(|v| p3(*v)).collect();
+            let pts = p.vertices().iter().map(|v| p3(at(*v))).collect();
             entity.triangles.push(filled(pts, color));
         }
     }
 }
 
-/// Whether drawing `shape` depends on the body's angle: an AABB part does not turn with its
-/// body, so its drawing (in the turning body frame) changes when the body turns.
-pub fn drawing_depends_on_angle(shape: &Shape) -> bool {
+/// Whether a body's frame stays upright (its `/tf` rotation is none): a shape with an AABB
+/// part, which does not turn with its body. Its other parts are drawn turned by the body's
+/// angle in the entity itself.
+pub fn upright(shape: &Shape) -> bool {
     shape
         .primitives()
         .iter()
         .any(|p| matches!(p, Primitive::Aabb(_)))
+}
+
+/// Whether drawing `shape` depends on the body's angle: in an upright frame, every part but a
+/// centred AABB turns with the body, so `/scene` is drawn again when such a body turns.
+pub fn drawing_depends_on_angle(shape: &Shape) -> bool {
+    upright(shape) && !matches!(shape.primitives(), [Primitive::Aabb(b)] if b.center == Vec2::ZERO)
 }
 
 /// One body as a scene entity in its own frame.
@@ -170,7 +190,7 @@ pub struct BodyDrawing<'a> {
     pub name: &'a str,
     /// Its shape.
     pub shape: &'a Shape,
-    /// Its angle (for AABB parts only).
+    /// Its angle (drawn into the entity only if its frame is [`upright`]).
     pub angle: f64,
     /// Its layer, for the colour.
     pub layer: u8,
@@ -196,8 +216,9 @@ pub fn snapshot<'a>(bodies: impl Iterator<Item = BodyDrawing<'a>>, ts: Timestamp
                 ..Default::default()
             };
             let color = color(b.layer, b.kind);
+            let turn = if upright(b.shape) { b.angle } else { 0.0 };
             for prim in b.shape.primitives() {
-                draw(&mut e, prim, b.angle, color);
+                draw(&mut e, prim, turn, color);
             }
             e
         })

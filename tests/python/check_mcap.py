@@ -43,7 +43,8 @@ section's, each chunk's, the summary's), and every message is decoded with
   replaces the earlier): the transform stamped then, else the position lerped and the
   rotation slerped between the transforms before and after, gl-matrix style; before the
   first or after the last, that one. It must be the body's `/bodies` pose: x and y within
-  1e-9 of max(1, |value|), the angle within 1e-9 rad modulo a turn. `/tf` sends a body on
+  1e-9 of max(1, |value|), the angle within 1e-9 rad modulo a turn (0 for a body with an AABB part, whose frame stays
+  upright). `/tf` sends a body on
   a straight line only as a prediction ahead, overwritten when the motion changes, so
   this fails if a prediction is wrong and not overwritten in time, or turns too far to
   slerp.
@@ -196,6 +197,12 @@ def ts_ns(t):
     return t.seconds * 1_000_000_000 + t.nanos
 
 
+def has_aabb(shape):
+    """Whether a `ricochet.Shape` has an AABB part."""
+    kind = shape.WhichOneof("kind")
+    return kind == "aabb" or (kind == "compound" and any(has_aabb(p) for p in shape.compound.parts))
+
+
 class Bodies:
     """Every body's full state, rebuilt from `/bodies` keyframes and deltas as `BodyStates`
     (crates/log/src/bodies.rs) does, and every body's pose at every frame it was alive."""
@@ -325,7 +332,9 @@ class Bodies:
             self.retired.add(k)
             self.generation[k[0]] = max(self.generation.get(k[0], k[1]), k[1])
         for k, s in live.items():
-            self.history[k][1].append((*s["position"], s["angle"]))
+            # A body with an AABB part (which does not turn) has an upright frame.
+            angle = 0.0 if has_aabb(s["shape"]) else s["angle"]
+            self.history[k][1].append((*s["position"], angle))
         self.live = live
 
 
