@@ -229,7 +229,9 @@ impl LogWriter {
             .use_chunks(true)
             .chunk_size(Some(CHUNK_SIZE))
             .compression(Some(mcap::Compression::Zstd))
-            .compression_level(0)
+            // zstd level 1: on these logs (mostly f64s) about as small as the default level
+            // 3, and half again as fast (rain-10000 recorded: 64 -> 94 frames/s).
+            .compression_level(1)
             .compression_threads(0);
         let mcap = options
             .create(BufWriter::new(file))
