@@ -8,7 +8,7 @@ use std::fmt;
 /// The channels to record; all five by default.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Channels {
-    /// `/scene`: the 3D panel's drawing.
+    /// `/scene`, `/scene/static`, `/tf` and `/scene/contacts`: the 3D panel's drawing.
     pub scene: bool,
     /// `/bodies`: every body's exact state.
     pub bodies: bool,

@@ -49,8 +49,11 @@ enum Command {
     /// Run a scenario and write every frame to an MCAP log that Foxglove opens.
     ///
     /// With no scenario, runs the built-in Asteroids demo (scenarios/asteroids.toml, embedded)
-    /// into asteroids.mcap. The log has five channels: /scene (foxglove.SceneUpdate, for the
-    /// 3D panel), /bodies, /contacts, /stats (for the Plot panel) and /events (foxglove.Log).
+    /// into asteroids.mcap. The log is protobuf (official Foxglove schemas for what Foxglove
+    /// draws): /scene and /scene/static (foxglove.SceneUpdate: moving and static bodies, each
+    /// in its own frame), /tf (foxglove.FrameTransforms: those frames), /scene/contacts
+    /// (contact normals), /bodies (exact states: keyframes, then what the integrator does not
+    /// predict), /contacts, /stats (for the Plot panel) and /events (foxglove.Log).
     /// Ctrl-C (SIGINT), SIGTERM and SIGHUP stop the run and still leave a complete, indexed
     /// log. The log is written to a hidden temporary file next to OUT.mcap and renamed onto
     /// it when complete, so an existing OUT.mcap is replaced whole or not at all.
@@ -73,8 +76,9 @@ enum Command {
         #[arg(long)]
         validate: bool,
         /// Record only these channels (comma-separated: scene, bodies, contacts, stats,
-        /// events). Default: all five. Without /scene, Foxglove's 3D panel is empty but plots
-        /// and the log panel work; `ricochet diff` needs /bodies to name a divergent body.
+        /// events; scene is /scene, /scene/static, /tf and /scene/contacts). Default: all
+        /// five. Without scene, Foxglove's 3D panel is empty but plots and the log panel
+        /// work; `ricochet diff` needs /bodies to name a divergent body.
         #[arg(long, value_name = "LIST")]
         channels: Option<String>,
     },
