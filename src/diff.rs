@@ -7,7 +7,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 use std::process::ExitCode;
 
-use ricochet_log::{LogError, LogFile, LogMessage};
+use ricochet_log::{LogError, LogFile, LogMessage, Messages, RawMessage};
 
 use crate::out;
 use serde::Serialize;
@@ -317,21 +317,33 @@ fn open(path: &Path) -> Result<LogFile, DiffError> {
 
 /// Compares one topic of two logs, message by message by position: reads both logs' messages
 /// on `topic` in log-time order, one at a time, keeping only the count and the first
-/// divergence.
+/// divergence. Equal bytes are equal messages. With an exact comparison, a message is decoded
+/// only while it could still be the first divergence of the whole comparison: before this
+/// topic's first, and earlier than `best` (the earliest found so far, as time and rank).
 fn diff_topic(
     a: &LogFile,
     b: &LogFile,
     topic: &str,
     tol: f64,
+    best: Option<(u64, usize)>,
 ) -> Result<(TopicCount, Option<Divergence>), LogError> {
     let (mut ma, mut mb) = (a.topic_messages(topic)?, b.topic_messages(topic)?);
     let mut count = TopicCount::default();
-    let mut first = None;
+    let mut first: Option<Divergence> = None;
     loop {
-        match (ma.next().transpose()?, mb.next().transpose()?) {
+        match (ma.next_raw().transpose()?, mb.next_raw().transpose()?) {
             (Some(x), Some(y)) => {
                 count.messages_a += 1;
                 count.messages_b += 1;
+                if x.bytes() == y.bytes() {
+                    continue;
+                }
+                let later = best.is_some_and(|b| (x.log_time(), rank(topic)) > b);
+                if tol == 0.0 && (first.is_some() || later) {
+                    count.differing += 1;
+                    continue;
+                }
+                let (x, y) = (ma.decode(x)?, mb.decode(y)?);
                 if let Some(d) = first_in_message(topic, &x, &y, tol) {
                     count.differing += 1;
                     first.get_or_insert(d);
@@ -339,7 +351,7 @@ fn diff_topic(
             }
             (None, None) => break,
             // One log has more messages on the topic: the first extra one is the divergence
-            // when nothing differed before it, then the rest are counted (and checked).
+            // when nothing differed before it, then the rest are counted.
             (extra, rest) => {
                 let (mine, other, in_a) = match (extra, rest) {
                     (Some(m), None) => (m, &mut ma, true),
@@ -347,7 +359,7 @@ fn diff_topic(
                     _ => unreachable!("both None and both Some are matched above"),
                 };
                 let mut n = 1;
-                while other.next().transpose()?.is_some() {
+                while other.next_raw().transpose()?.is_some() {
                     n += 1;
                 }
                 if in_a {
@@ -356,10 +368,22 @@ fn diff_topic(
                     count.messages_b += n;
                 }
                 count.differing += n;
+                let time_ns = mine.log_time();
+                // Its frame, from a message small enough to decode cheaply.
+                let frame = if mine.bytes().len() <= 1 << 16 {
+                    let decoded = if in_a {
+                        ma.decode(mine)
+                    } else {
+                        mb.decode(mine)
+                    };
+                    decoded?.data.get("frame").and_then(Value::as_u64)
+                } else {
+                    None
+                };
                 first.get_or_insert(Divergence {
                     topic: topic.to_owned(),
-                    time_ns: mine.log_time,
-                    frame: mine.data.get("frame").and_then(Value::as_u64),
+                    time_ns,
+                    frame,
                     body: None,
                     field: "message count".to_owned(),
                     a: count.messages_a.to_string(),
@@ -389,6 +413,36 @@ fn lockstep(
         .map(|t| ((*t).to_owned(), TopicCount::default()))
         .collect();
     let mut first: Option<Divergence> = None;
+    // The pairs of one time whose bytes differ, decoded only when the time is over, best
+    // ranked first: the first divergence is the best ranked topic that differs at the
+    // earliest time, and the others (a whole `/scene`, say) need not be decoded.
+    let mut group: Vec<(usize, RawMessage, RawMessage)> = Vec::new();
+    let resolve = |group: &mut Vec<(usize, RawMessage, RawMessage)>,
+                   counts: &mut BTreeMap<String, TopicCount>,
+                   first: &mut Option<Divergence>,
+                   ma: &mut Messages,
+                   mb: &mut Messages|
+     -> Result<(), LogError> {
+        group.sort_by_key(|(rank, ..)| *rank);
+        for (_, x, y) in group.drain(..) {
+            let topic = x.topic().to_owned();
+            let count = counts.entry(topic.clone()).or_default();
+            if tol == 0.0 && first.is_some() {
+                // Exact comparison: the writer's encoding is canonical, so differing bytes
+                // are a differing message; past the first divergence, no need to decode.
+                count.differing += 1;
+                continue;
+            }
+            let (x, y) = (ma.decode(x)?, mb.decode(y)?);
+            if let Some(d) = first_in_message(&topic, &x, &y, tol) {
+                count.differing += 1;
+                if first.as_ref().is_none_or(|f| earlier(&d, f)) {
+                    *first = Some(d);
+                }
+            }
+        }
+        Ok(())
+    };
     loop {
         let (x, y) = match (ma.next_raw().transpose()?, mb.next_raw().transpose()?) {
             (None, None) => break,
@@ -400,24 +454,17 @@ fn lockstep(
         };
         count.messages_a += 1;
         count.messages_b += 1;
-        if x.bytes() == y.bytes() {
-            continue;
+        if group
+            .first()
+            .is_some_and(|(_, g, _)| g.log_time() != x.log_time())
+        {
+            resolve(&mut group, &mut counts, &mut first, &mut ma, &mut mb)?;
         }
-        // Past the first divergence, exact comparison counts differing messages by their
-        // bytes (the writer's encoding is canonical): no decoding.
-        if tol == 0.0 && first.as_ref().is_some_and(|f| x.log_time() > f.time_ns) {
-            count.differing += 1;
-            continue;
-        }
-        let topic = x.topic().to_owned();
-        let (x, y) = (ma.decode(x)?, mb.decode(y)?);
-        if let Some(d) = first_in_message(&topic, &x, &y, tol) {
-            count.differing += 1;
-            if first.as_ref().is_none_or(|f| earlier(&d, f)) {
-                first = Some(d);
-            }
+        if x.bytes() != y.bytes() {
+            group.push((rank(x.topic()), x, y));
         }
     }
+    resolve(&mut group, &mut counts, &mut first, &mut ma, &mut mb)?;
     Ok(Some(Report {
         equal: first.is_none(),
         tolerance: tol,
@@ -468,11 +515,15 @@ pub fn diff_files(
     }
     let mut topics = BTreeMap::new();
     let mut first: Option<Divergence> = None;
-    for topic in with_messages {
+    // Best ranked first: a later topic's messages need no decoding once they can't be first.
+    let mut ordered: Vec<&str> = with_messages.into_iter().collect();
+    ordered.sort_by_key(|t| (rank(t), *t));
+    for topic in ordered {
         if only.is_some_and(|t| t != topic) {
             continue;
         }
-        let (count, topic_first) = diff_topic(a, b, topic, tol)?;
+        let best = first.as_ref().map(|f| (f.time_ns, rank(&f.topic)));
+        let (count, topic_first) = diff_topic(a, b, topic, tol, best)?;
         if let Some(d) = topic_first
             && first.as_ref().is_none_or(|f| earlier(&d, f))
         {
@@ -563,9 +614,10 @@ pub fn render(report: &Report, a: &Path, b: &Path) -> String {
         }
     }
     s += "per topic (differing messages / messages in A, B):\n";
+    let width = report.topics.keys().map(String::len).max().unwrap_or(0);
     for (t, c) in &report.topics {
         s += &format!(
-            "  {t:<10} {:>6} / {}, {}\n",
+            "  {t:<width$} {:>6} / {}, {}\n",
             c.differing, c.messages_a, c.messages_b
         );
     }
