@@ -21,6 +21,7 @@ mod load;
 mod out;
 mod record;
 mod run;
+mod serve;
 mod validate;
 
 use std::path::PathBuf;
@@ -81,6 +82,34 @@ enum Command {
         /// work; `ricochet diff` needs /bodies to name a divergent body.
         #[arg(long, value_name = "LIST")]
         channels: Option<String>,
+    },
+    /// Step a scenario in real time and stream it live to Foxglove over WebSocket.
+    ///
+    /// With no scenario, serves the built-in Asteroids demo. In Foxglove (or Lichtblick):
+    /// Open connection, Foxglove WebSocket, ws://localhost:8765, then import the layout
+    /// foxglove/ricochet-layout.json. The channels are the log's (see `run`), the same
+    /// messages and schemas; /tf carries every moving body's pose every frame. Both
+    /// subprotocols are accepted: foxglove.websocket.v1 (Lichtblick, @foxglove/ws-protocol)
+    /// and foxglove.sdk.v1 (current Foxglove). A slow client loses messages (and is told),
+    /// never the simulation or the recording. Ctrl-C or SIGTERM stops, finishing --record.
+    ///
+    /// Example: ricochet serve scenarios/platformer.toml --record session.mcap
+    Serve {
+        /// The scenario file (TOML). Default: the built-in Asteroids demo.
+        scenario: Option<PathBuf>,
+        /// Address to listen on. A non-loopback address prints a warning: the protocol has
+        /// no authentication.
+        #[arg(long, default_value = serve::DEFAULT_BIND, value_name = "IP:PORT")]
+        bind: String,
+        /// Simulation seconds per wall-clock second.
+        #[arg(long, default_value_t = 1.0, value_name = "X")]
+        speed: f64,
+        /// Stop after this many frames after frame 0 (default: run until stopped).
+        #[arg(long, value_name = "N")]
+        frames: Option<u64>,
+        /// Also record the session to this MCAP file, as `run` writes one.
+        #[arg(long, value_name = "OUT.mcap")]
+        record: Option<PathBuf>,
     },
     /// Print a log as JSON lines, one message a line, for scripts and grep.
     ///
@@ -245,6 +274,19 @@ fn main() -> ExitCode {
             validate,
             channels.as_deref(),
         ),
+        Command::Serve {
+            scenario,
+            bind,
+            speed,
+            frames,
+            record,
+        } => serve::run(&serve::Options {
+            scenario: scenario.as_deref(),
+            bind: &bind,
+            speed,
+            frames,
+            record: record.as_deref(),
+        }),
         Command::Dump { log, topic, frames } => {
             dump::run(&log, topic.as_deref(), frames.as_deref())
         }

@@ -14,6 +14,7 @@ mod hostile;
 mod large_scenario;
 mod run_cli;
 mod seek;
+mod serve_ws;
 mod stress;
 mod util;
 mod validate_cli;

@@ -135,6 +135,10 @@ pub struct Changes {
 /// The last recorded state of every body, by slot.
 #[derive(Default)]
 pub struct Tracker {
+    /// For a live stream: `/tf` never predicts (see [`Motion::live`]).
+    live: bool,
+    /// The next frame sends every body's pose on `/tf`.
+    resend: bool,
     known: Vec<Option<Known>>,
     alive: usize,
     started: bool,
@@ -150,6 +154,19 @@ fn transforms_of(frame_id: &str, samples: &[Sample], dt_ns: u64, out: &mut Vec<F
 }
 
 impl Tracker {
+    /// Sends every body's pose on `/tf` in the next frame.
+    pub fn resend_transforms(&mut self) {
+        self.resend = true;
+    }
+
+    /// A tracker for a file (`live` false) or a live stream.
+    pub fn new(live: bool) -> Tracker {
+        Tracker {
+            live,
+            ..Tracker::default()
+        }
+    }
+
     /// The changes of frame `out.frame` (its world is `world`). `dt_ns` is the step.
     pub fn frame(
         &mut self,
@@ -204,7 +221,7 @@ impl Tracker {
                     velocity,
                     angular_velocity,
                     frame_id: scene::entity_id(e),
-                    motion: Motion::appear(frame, position, frame_angle, &mut samples),
+                    motion: Motion::appear(frame, position, frame_angle, self.live, &mut samples),
                     upright,
                     drawn_with_angle: scene::drawing_depends_on_angle(&world.shape[i]),
                     is_static,
@@ -220,6 +237,9 @@ impl Tracker {
             if !fresh {
                 let frame_angle = if k.upright { 0.0 } else { angle };
                 k.motion.frame(frame, position, frame_angle, &mut samples);
+                if self.resend {
+                    samples.push((frame, [position.x, position.y, frame_angle]));
+                }
                 transforms_of(&k.frame_id, &samples, dt_ns, &mut transforms);
             }
             if !fresh && k.drawn_with_angle && !same(angle, k.angle) {
@@ -273,6 +293,7 @@ impl Tracker {
             k.velocity = velocity;
             k.angular_velocity = angular_velocity;
         }
+        self.resend = false;
         if self.alive != world.len() {
             // Some bodies went (removed, or despawned between frames): forget them.
             for slot in &mut self.known {

@@ -24,7 +24,7 @@ use std::path::Path;
 
 use ricochet_log::messages::fox::{FrameTransforms, Log, SceneUpdate, log};
 use ricochet_log::messages::{Schema, ricochet as pb, timestamp};
-use ricochet_log::{ChannelId, LogError, LogWriter, Threading};
+use ricochet_log::{ChannelId, LogError, LogWriter, MessageSink, Threading};
 use ricochet_sim::{BodyKind, FrameOutput, Layers, Simulation};
 
 use crate::channels::Channels;
@@ -59,9 +59,9 @@ struct Topics {
     validation: Option<ChannelId>,
 }
 
-/// Writes a run's frames to an MCAP file.
-pub struct Recorder {
-    writer: LogWriter,
+/// Writes a run's frames to an MCAP file, or to any [`MessageSink`] (a live stream).
+pub struct Recorder<S: MessageSink = LogWriter> {
+    writer: S,
     dt_ns: u64,
     dt: f64,
     topics: Topics,
@@ -70,7 +70,7 @@ pub struct Recorder {
     arrows_shown: bool,
 }
 
-impl Recorder {
+impl Recorder<LogWriter> {
     /// Creates the file now (so a bad path fails before the simulation starts) and adds the
     /// chosen channels (all by default).
     pub fn create(path: &Path, dt: f64, channels: Channels) -> Result<Recorder, LogError> {
@@ -79,7 +79,21 @@ impl Recorder {
         } else {
             Threading::Thread
         };
-        let mut w = LogWriter::create_with(path, LIBRARY, threading)?;
+        let writer = LogWriter::create_with(path, LIBRARY, threading)?;
+        Recorder::new(writer, dt, channels, false)
+    }
+
+    /// Writes the summary and index. Called after an interrupted run too.
+    pub fn finish(self) -> Result<(), LogError> {
+        self.writer.finish()
+    }
+}
+
+impl<S: MessageSink> Recorder<S> {
+    /// Adds the chosen channels to `sink`. `live`: for a stream watched as it runs, where
+    /// Foxglove can't read ahead, so `/tf` sends every body's pose in every frame it
+    /// changes, never a prediction.
+    pub fn new(mut w: S, dt: f64, channels: Channels, live: bool) -> Result<Recorder<S>, LogError> {
         let mut t = Topics::default();
         if channels.scene {
             t.scene = Some(w.add_protobuf_channel("/scene", Schema::foxglove::<SceneUpdate>())?);
@@ -110,9 +124,25 @@ impl Recorder {
             dt_ns: (dt * 1e9).round() as u64,
             dt,
             topics: t,
-            tracker: Tracker::default(),
+            tracker: Tracker::new(live),
             arrows_shown: false,
         })
+    }
+
+    /// The sink, back.
+    pub fn into_sink(self) -> S {
+        self.writer
+    }
+
+    /// The step in whole nanoseconds: frame `n` is at `n * dt_ns`.
+    pub fn dt_ns(&self) -> u64 {
+        self.dt_ns
+    }
+
+    /// Sends every body's pose on `/tf` in the next frame (a live viewer that just
+    /// subscribed knows none).
+    pub fn resend_transforms(&mut self) {
+        self.tracker.resend_transforms();
     }
 
     /// Adds the `/validation` channel (`ricochet run --validate`).
@@ -215,11 +245,6 @@ impl Recorder {
             }
         }
         Ok(())
-    }
-
-    /// Writes the summary and index. Called after an interrupted run too.
-    pub fn finish(self) -> Result<(), LogError> {
-        self.writer.finish()
     }
 }
 

@@ -84,6 +84,9 @@ impl Line {
 
 /// A body's motion as `/tf` has described it so far.
 pub struct Motion {
+    /// Live: every pose that changes is sent exactly in its frame, never a prediction (a
+    /// live viewer has nothing ahead to interpolate towards).
+    live: bool,
     /// The line it is on, if `/tf` describes it by one.
     line: Option<Line>,
     /// The furthest predicted sample sent (a frame later than the frame it was sent in).
@@ -94,11 +97,18 @@ pub struct Motion {
 }
 
 impl Motion {
-    /// A body appearing at `frame`: its pose is sent.
-    pub fn appear(frame: u64, position: Vec2, angle: f64, out: &mut Vec<Sample>) -> Motion {
+    /// A body appearing at `frame`: its pose is sent. `live`: see [`Motion::live`].
+    pub fn appear(
+        frame: u64,
+        position: Vec2,
+        angle: f64,
+        live: bool,
+        out: &mut Vec<Sample>,
+    ) -> Motion {
         let p = pose3(position, angle);
         out.push((frame, p));
         Motion {
+            live,
             line: None,
             future: None,
             before: p,
@@ -113,6 +123,12 @@ impl Motion {
         let (before, last) = (self.before, self.last);
         self.before = last;
         self.last = p;
+        if self.live {
+            if p != last {
+                out.push((frame, p));
+            }
+            return;
+        }
         // A sample already stamped this frame (a prediction, or a pose held from a frame
         // before): right only if this frame is on the line that predicted it.
         let due = self.future == Some(frame);

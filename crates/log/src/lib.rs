@@ -33,4 +33,4 @@ pub use bodies::BodyStates;
 pub use error::LogError;
 pub use messages::Schema;
 pub use reader::{ChannelInfo, LogFile, LogMessage, Messages, RawMessage, read_log, read_log_file};
-pub use writer::{ChannelId, LogWriter, Threading};
+pub use writer::{ChannelId, LogWriter, MessageSink, Threading};

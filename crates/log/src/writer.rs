@@ -26,6 +26,49 @@ const QUEUE: usize = 256;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct ChannelId(u16);
 
+impl ChannelId {
+    /// The channel numbered `index` (for a [`MessageSink`] of another kind than a file).
+    pub fn from_index(index: u16) -> ChannelId {
+        ChannelId(index)
+    }
+
+    /// Its number.
+    pub fn index(self) -> u16 {
+        self.0
+    }
+}
+
+/// Where a recorder's messages go: an MCAP file ([`LogWriter`]), a live stream, or both.
+/// Channels are added first; then each message is written on its channel at a simulation
+/// time, in nondecreasing time order.
+pub trait MessageSink {
+    /// Adds a channel on `topic` for protobuf messages described by `schema`.
+    fn add_protobuf_channel(&mut self, topic: &str, schema: Schema) -> Result<ChannelId, LogError>;
+
+    /// Writes `message` on `channel` at `time_ns`.
+    fn write<M: prost::Message + Clone + Send + 'static>(
+        &mut self,
+        channel: ChannelId,
+        time_ns: u64,
+        message: M,
+    ) -> Result<(), LogError>;
+}
+
+impl MessageSink for LogWriter {
+    fn add_protobuf_channel(&mut self, topic: &str, schema: Schema) -> Result<ChannelId, LogError> {
+        LogWriter::add_protobuf_channel(self, topic, schema)
+    }
+
+    fn write<M: prost::Message + Clone + Send + 'static>(
+        &mut self,
+        channel: ChannelId,
+        time_ns: u64,
+        message: M,
+    ) -> Result<(), LogError> {
+        LogWriter::write(self, channel, time_ns, message)
+    }
+}
+
 /// Where a [`LogWriter`] encodes and compresses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Threading {

@@ -1,0 +1,211 @@
+//! The live side of `ricochet serve`: the channels, the connected clients and what each
+//! subscribed to, shared between the simulation thread (which publishes every frame's
+//! messages) and the WebSocket tasks (which add and drop clients and subscriptions).
+//!
+//! Publishing never waits on a client: each has a bounded queue; when it is full the
+//! message is dropped for that client (counted, and the client is told once by a status
+//! message when it catches up). The simulation and the recording never lose a frame.
+
+use std::collections::BTreeMap;
+use std::sync::{Arc, Mutex, MutexGuard};
+
+use ricochet_log::{ChannelId, LogError, MessageSink, Schema};
+use tokio::sync::mpsc;
+use tokio_tungstenite::tungstenite::Message;
+
+use super::protocol::{self, Channel};
+
+/// Messages queued for one client before new ones are dropped for it.
+pub const CLIENT_QUEUE: usize = 4096;
+
+/// Topics whose last message is sent again to a client that subscribes: each is a whole
+/// state (`/scene` and `/scene/static` are sent only when their bodies change).
+const LATCHED: [&str; 2] = ["/scene", "/scene/static"];
+
+/// One connected client.
+struct Client {
+    queue: mpsc::Sender<Message>,
+    /// By channel id: the client's subscription id.
+    subscriptions: BTreeMap<u32, u32>,
+    /// Messages dropped since it was last told.
+    dropped: u64,
+}
+
+/// Everything the simulation thread and the connections share.
+#[derive(Default)]
+pub struct Shared {
+    channels: Vec<Channel>,
+    /// The last message of each latched channel: (time, payload).
+    latched: BTreeMap<u32, (u64, Vec<u8>)>,
+    clients: BTreeMap<u64, Client>,
+    next_client: u64,
+    /// A client subscribed to `/tf`: the next frame sends every body's pose.
+    pub transforms_wanted: bool,
+    /// Messages dropped for slow clients, in all.
+    pub dropped: u64,
+}
+
+/// A handle on the shared state.
+#[derive(Clone, Default)]
+pub struct Hub(Arc<Mutex<Shared>>);
+
+impl Hub {
+    /// The shared state (a poisoned lock is recovered: the state stays consistent).
+    pub fn lock(&self) -> MutexGuard<'_, Shared> {
+        self.0
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+    }
+}
+
+impl Shared {
+    /// The advertised channels.
+    pub fn channels(&self) -> &[Channel] {
+        &self.channels
+    }
+
+    /// A new client with its outgoing queue; returns its id.
+    pub fn connect(&mut self, queue: mpsc::Sender<Message>) -> u64 {
+        let id = self.next_client;
+        self.next_client += 1;
+        self.clients.insert(
+            id,
+            Client {
+                queue,
+                subscriptions: BTreeMap::new(),
+                dropped: 0,
+            },
+        );
+        id
+    }
+
+    /// How many clients are connected.
+    pub fn client_count(&self) -> usize {
+        self.clients.len()
+    }
+
+    /// Forgets a client.
+    pub fn disconnect(&mut self, client: u64) {
+        self.clients.remove(&client);
+    }
+
+    /// Subscribes `client` to `channel` as `subscription`; an unknown channel is an error
+    /// message for the client. A latched channel's last message is sent at once.
+    pub fn subscribe(
+        &mut self,
+        client: u64,
+        subscription: u32,
+        channel: u32,
+    ) -> Result<(), String> {
+        let Some(topic) = self
+            .channels
+            .iter()
+            .find(|c| c.id == channel)
+            .map(|c| c.topic.clone())
+        else {
+            return Err(format!("no channel {channel}"));
+        };
+        if topic == "/tf" {
+            self.transforms_wanted = true;
+        }
+        let latched = self.latched.get(&channel).cloned();
+        if let Some(c) = self.clients.get_mut(&client) {
+            c.subscriptions.insert(channel, subscription);
+            if let Some((time, payload)) = latched {
+                let data = protocol::message_data(subscription, time, &payload);
+                if c.queue.try_send(Message::binary(data)).is_err() {
+                    c.dropped += 1;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Ends `client`'s subscriptions `ids`.
+    pub fn unsubscribe(&mut self, client: u64, ids: &[u32]) {
+        if let Some(c) = self.clients.get_mut(&client) {
+            c.subscriptions.retain(|_, sub| !ids.contains(sub));
+        }
+    }
+
+    /// Sends `data` to every client (the time, a status), dropping it for full queues.
+    pub fn broadcast(&mut self, data: &Message) {
+        for c in self.clients.values_mut() {
+            if c.queue.try_send(data.clone()).is_err() {
+                c.dropped += 1;
+            }
+        }
+    }
+
+    /// Publishes a message on `channel` to its subscribers.
+    fn publish(&mut self, channel: u32, time_ns: u64, payload: Vec<u8>) {
+        let mut dropped = 0;
+        for c in self.clients.values_mut() {
+            let Some(&sub) = c.subscriptions.get(&channel) else {
+                continue;
+            };
+            let data = Message::binary(protocol::message_data(sub, time_ns, &payload));
+            if c.queue.try_send(data).is_err() {
+                c.dropped += 1;
+                dropped += 1;
+            } else if c.dropped > 0 {
+                // It caught up: say how much it missed.
+                let text = format!(
+                    "this client was too slow: {} messages were dropped for it",
+                    c.dropped
+                );
+                let status = protocol::ServerMessage::Status {
+                    level: 1,
+                    message: &text,
+                };
+                if c.queue.try_send(Message::text(status.json())).is_ok() {
+                    c.dropped = 0;
+                }
+            }
+        }
+        self.dropped += dropped;
+        let latched = self
+            .channels
+            .iter()
+            .any(|c| c.id == channel && LATCHED.contains(&c.topic.as_str()));
+        if latched {
+            self.latched.insert(channel, (time_ns, payload));
+        }
+    }
+}
+
+/// The recorder's [`MessageSink`] for a live stream: each message encoded once and
+/// published to the clients subscribed to its channel.
+pub struct LiveSink {
+    hub: Hub,
+}
+
+impl LiveSink {
+    /// A sink publishing through `hub`.
+    pub fn new(hub: Hub) -> LiveSink {
+        LiveSink { hub }
+    }
+}
+
+impl MessageSink for LiveSink {
+    fn add_protobuf_channel(&mut self, topic: &str, schema: Schema) -> Result<ChannelId, LogError> {
+        let mut s = self.hub.lock();
+        let id = s.channels.len() as u32 + 1;
+        s.channels
+            .push(Channel::protobuf(id, topic, &schema.name, &schema.data));
+        Ok(ChannelId::from_index(id as u16))
+    }
+
+    fn write<M: prost::Message + Clone + Send + 'static>(
+        &mut self,
+        channel: ChannelId,
+        time_ns: u64,
+        message: M,
+    ) -> Result<(), LogError> {
+        let payload = message.encode_to_vec();
+        self.hub
+            .lock()
+            .publish(u32::from(channel.index()), time_ns, payload);
+        Ok(())
+    }
+}

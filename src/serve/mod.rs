@@ -1,0 +1,230 @@
+//! `ricochet serve`: a scenario stepped in real time and streamed live over the Foxglove
+//! WebSocket protocol, the same messages and schemas as `ricochet run` writes (with `/tf`
+//! sent exactly every frame a body moves: a live viewer can't interpolate towards the
+//! future), optionally recorded to a file at the same time.
+//!
+//! The simulation runs on this thread, paced by a fixed-timestep schedule (frame `n` starts
+//! at `n * dt / speed` after the start: a late frame is not skipped, the next ones catch up);
+//! the wall clock only paces, it never reaches a message. The WebSocket side runs on a tokio
+//! runtime of its own thread (`server.rs`); the two share the [`hub::Hub`].
+
+mod hub;
+mod protocol;
+mod server;
+
+use std::net::SocketAddr;
+use std::path::Path;
+use std::process::ExitCode;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+use anyhow::Context;
+use ricochet_log::{ChannelId, LogError, LogWriter, MessageSink, Schema};
+use ricochet_sim::Simulation;
+use tokio_tungstenite::tungstenite::Message;
+
+use crate::channels::Channels;
+use crate::out;
+use crate::record::Recorder;
+use hub::{Hub, LiveSink};
+
+/// Where `serve` listens unless told: what Foxglove's "Open connection" suggests.
+pub const DEFAULT_BIND: &str = "127.0.0.1:8765";
+
+/// Both sinks: the live stream and the recording.
+struct Tee {
+    live: LiveSink,
+    file: LogWriter,
+    /// The file's channel for each live channel id.
+    ids: Vec<ChannelId>,
+}
+
+impl MessageSink for Tee {
+    fn add_protobuf_channel(&mut self, topic: &str, schema: Schema) -> Result<ChannelId, LogError> {
+        let file = self.file.add_protobuf_channel(topic, schema.clone())?;
+        let live = self.live.add_protobuf_channel(topic, schema)?;
+        self.ids.push(file);
+        Ok(live)
+    }
+
+    fn write<M: prost::Message + Clone + Send + 'static>(
+        &mut self,
+        channel: ChannelId,
+        time_ns: u64,
+        message: M,
+    ) -> Result<(), LogError> {
+        let file = self.ids[usize::from(channel.index()) - 1];
+        self.file.write(file, time_ns, message.clone())?;
+        self.live.write(channel, time_ns, message)
+    }
+}
+
+/// The options of `ricochet serve`.
+pub struct Options<'a> {
+    /// The scenario (none: the built-in demo).
+    pub scenario: Option<&'a Path>,
+    /// Address to listen on.
+    pub bind: &'a str,
+    /// Simulation seconds per wall second.
+    pub speed: f64,
+    /// Stop after this many frames (default: run until interrupted).
+    pub frames: Option<u64>,
+    /// Also write the log here.
+    pub record: Option<&'a Path>,
+}
+
+/// Runs `ricochet serve`. Exit code 0 when stopped (Ctrl-C, SIGTERM, `--frames`), 2 for bad
+/// input (scenario, address, speed).
+pub fn run(o: &Options) -> anyhow::Result<ExitCode> {
+    if !(o.speed.is_finite() && o.speed > 0.0) {
+        out::error(&format!(
+            "error: --speed must be a positive number, got {}",
+            o.speed
+        ));
+        return Ok(ExitCode::from(2));
+    }
+    let scenario = match crate::load::load(o.scenario) {
+        Ok(s) => s,
+        Err(code) => return Ok(code),
+    };
+    let addr: SocketAddr = match o.bind.parse() {
+        Ok(a) => a,
+        Err(e) => {
+            out::error(&format!(
+                "error: --bind {}: {e} (expected IP:PORT, e.g. {DEFAULT_BIND})",
+                o.bind
+            ));
+            return Ok(ExitCode::from(2));
+        }
+    };
+    let interrupted = Arc::new(AtomicBool::new(false));
+    {
+        let flag = Arc::clone(&interrupted);
+        let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
+    }
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+        .context("starting the WebSocket runtime")?;
+    let listener = match runtime.block_on(tokio::net::TcpListener::bind(addr)) {
+        Ok(l) => l,
+        Err(e) => {
+            out::error(&format!("error: cannot listen on {addr}: {e}"));
+            return Ok(ExitCode::from(2));
+        }
+    };
+    let local = listener.local_addr().context("reading the bound address")?;
+    if !local.ip().is_loopback() {
+        out::note(&format!(
+            "warning: listening on {local}, beyond this machine: the Foxglove WebSocket \
+             protocol has no authentication, anyone who can reach it can watch"
+        ))?;
+    }
+    let hub = Hub::default();
+    let dt = scenario.world.dt;
+    let live = LiveSink::new(hub.clone());
+    let mut recorder: Box<dyn Frames> = match o.record {
+        None => Box::new(Recorder::new(live, dt, Channels::default(), true)?),
+        Some(path) => {
+            let file = LogWriter::create(path, crate::record::LIBRARY)
+                .with_context(|| format!("creating {}", path.display()))?;
+            let tee = Tee {
+                live,
+                file,
+                ids: Vec::new(),
+            };
+            Box::new(Recorder::new(tee, dt, Channels::default(), true)?)
+        }
+    };
+    let session = format!("ricochet-{}", scenario.name);
+    let server_hub = hub.clone();
+    let server = std::thread::Builder::new()
+        .name("serve".into())
+        .spawn(move || runtime.block_on(server::accept(listener, server_hub, session)))
+        .context("starting the WebSocket thread")?;
+    drop(server);
+    out::note(&format!(
+        "serving {} on ws://{local} (Foxglove: Open connection; layout foxglove/ricochet-layout.json); Ctrl-C stops",
+        scenario.name
+    ))?;
+    let mut sim = Simulation::new(&scenario);
+    let step = Duration::from_secs_f64(dt / o.speed);
+    let start = Instant::now();
+    let mut frame = 0u64;
+    while !interrupted.load(Ordering::SeqCst) && o.frames.is_none_or(|n| frame <= n) {
+        let due = start + step.saturating_mul(u32::try_from(frame).unwrap_or(u32::MAX));
+        if let Some(wait) = due.checked_duration_since(Instant::now()) {
+            std::thread::sleep(wait);
+        }
+        let out = sim.step();
+        if sim.first_non_finite().is_some() {
+            out::error(&format!(
+                "error: frame {}: a value overflowed; stopping",
+                out.frame
+            ));
+            break;
+        }
+        let resend = std::mem::take(&mut hub.lock().transforms_wanted);
+        if resend {
+            recorder.resend_transforms();
+        }
+        let t = out.frame.saturating_mul(recorder.dt_ns());
+        hub.lock().broadcast(&Message::binary(protocol::time(t)));
+        recorder.record(&sim, &out)?;
+        frame += 1;
+    }
+    recorder.finish()?;
+    let dropped = hub.lock().dropped;
+    out::note(&format!(
+        "served {frame} frames; {dropped} messages dropped for slow clients"
+    ))?;
+    Ok(ExitCode::SUCCESS)
+}
+
+/// A recorder to a live sink or to a tee, behind one face.
+trait Frames {
+    fn record(&mut self, sim: &Simulation, out: &ricochet_sim::FrameOutput)
+    -> Result<(), LogError>;
+    fn resend_transforms(&mut self);
+    fn dt_ns(&self) -> u64;
+    fn finish(self: Box<Self>) -> Result<(), LogError>;
+}
+
+impl Frames for Recorder<LiveSink> {
+    fn record(
+        &mut self,
+        sim: &Simulation,
+        out: &ricochet_sim::FrameOutput,
+    ) -> Result<(), LogError> {
+        Recorder::record(self, sim, out)
+    }
+    fn resend_transforms(&mut self) {
+        Recorder::resend_transforms(self);
+    }
+    fn dt_ns(&self) -> u64 {
+        Recorder::dt_ns(self)
+    }
+    fn finish(self: Box<Self>) -> Result<(), LogError> {
+        Ok(())
+    }
+}
+
+impl Frames for Recorder<Tee> {
+    fn record(
+        &mut self,
+        sim: &Simulation,
+        out: &ricochet_sim::FrameOutput,
+    ) -> Result<(), LogError> {
+        Recorder::record(self, sim, out)
+    }
+    fn resend_transforms(&mut self) {
+        Recorder::resend_transforms(self);
+    }
+    fn dt_ns(&self) -> u64 {
+        Recorder::dt_ns(self)
+    }
+    fn finish(self: Box<Self>) -> Result<(), LogError> {
+        self.into_sink().file.finish()
+    }
+}

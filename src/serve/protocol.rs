@@ -1,0 +1,171 @@
+//! The Foxglove WebSocket protocol, v1 (`foxglove.websocket.v1`, the published spec, which
+//! Lichtblick and `@foxglove/ws-protocol` speak; `foxglove.sdk.v1`, what the Foxglove SDK
+//! and current Foxglove releases name the same messages): the subset a simulation server
+//! uses. JSON text messages with an `op`; binary messages with a one-byte opcode.
+
+use std::collections::BTreeMap;
+
+use base64::Engine;
+use serde::{Deserialize, Serialize};
+
+/// The subprotocols accepted, in order of preference.
+pub const SUBPROTOCOLS: [&str; 2] = ["foxglove.websocket.v1", "foxglove.sdk.v1"];
+
+/// Binary opcode of a message on a subscription (server to client).
+pub const OP_MESSAGE_DATA: u8 = 0x01;
+/// Binary opcode of the server's time (the `time` capability).
+pub const OP_TIME: u8 = 0x02;
+
+/// A channel as `advertise` lists it: its schema inline, base64 for protobuf.
+#[derive(Serialize, Debug, Clone)]
+#[serde(rename_all = "camelCase")]
+pub struct Channel {
+    /// The server's id for it.
+    pub id: u32,
+    /// Topic.
+    pub topic: String,
+    /// Message encoding: `protobuf`.
+    pub encoding: String,
+    /// Schema name, e.g. `foxglove.SceneUpdate`.
+    pub schema_name: String,
+    /// The schema: a FileDescriptorSet, base64.
+    pub schema: String,
+    /// `protobuf`.
+    pub schema_encoding: String,
+}
+
+impl Channel {
+    /// The channel `id` on `topic`, protobuf with the FileDescriptorSet `descriptor`.
+    pub fn protobuf(id: u32, topic: &str, schema_name: &str, descriptor: &[u8]) -> Channel {
+        Channel {
+            id,
+            topic: topic.to_owned(),
+            encoding: "protobuf".to_owned(),
+            schema_name: schema_name.to_owned(),
+            schema: base64::engine::general_purpose::STANDARD.encode(descriptor),
+            schema_encoding: "protobuf".to_owned(),
+        }
+    }
+}
+
+/// A JSON message from the server.
+#[derive(Serialize, Debug)]
+#[serde(tag = "op", rename_all = "camelCase")]
+pub enum ServerMessage<'a> {
+    /// First message on every connection.
+    #[serde(rename_all = "camelCase")]
+    ServerInfo {
+        /// The server's name.
+        name: &'a str,
+        /// What it supports beyond subscribing (`time`).
+        capabilities: &'a [&'a str],
+        /// Message encodings clients may publish in (none yet).
+        supported_encodings: &'a [&'a str],
+        /// Free-form.
+        metadata: BTreeMap<String, String>,
+        /// Changes when the server restarts.
+        session_id: &'a str,
+    },
+    /// The channels a client may subscribe to.
+    Advertise {
+        /// Every channel.
+        channels: &'a [Channel],
+    },
+    /// A message for people: 0 info, 1 warning, 2 error.
+    Status {
+        /// Level.
+        level: u8,
+        /// Text.
+        message: &'a str,
+    },
+}
+
+impl ServerMessage<'_> {
+    /// As JSON text.
+    pub fn json(&self) -> String {
+        serde_json::to_string(self).unwrap_or_default()
+    }
+}
+
+/// One subscription of a `subscribe` request.
+#[derive(Deserialize, Debug, Clone, Copy)]
+#[serde(rename_all = "camelCase")]
+pub struct Subscription {
+    /// The client's id for it (sent back with every message).
+    pub id: u32,
+    /// The channel.
+    pub channel_id: u32,
+}
+
+/// A JSON message from a client (unknown ops are refused with a status).
+#[derive(Deserialize, Debug)]
+#[serde(tag = "op", rename_all = "camelCase")]
+pub enum ClientMessage {
+    /// Start receiving channels.
+    Subscribe {
+        /// The new subscriptions.
+        subscriptions: Vec<Subscription>,
+    },
+    /// Stop receiving.
+    #[serde(rename_all = "camelCase")]
+    Unsubscribe {
+        /// The client's ids of the subscriptions to end.
+        subscription_ids: Vec<u32>,
+    },
+}
+
+/// A message on a subscription: opcode, subscription id, time (ns), payload.
+pub fn message_data(subscription: u32, time_ns: u64, payload: &[u8]) -> Vec<u8> {
+    let mut out = Vec::with_capacity(13 + payload.len());
+    out.push(OP_MESSAGE_DATA);
+    out.extend_from_slice(&subscription.to_le_bytes());
+    out.extend_from_slice(&time_ns.to_le_bytes());
+    out.extend_from_slice(payload);
+    out
+}
+
+/// The server's time (ns).
+pub fn time(time_ns: u64) -> Vec<u8> {
+    let mut out = Vec::with_capacity(9);
+    out.push(OP_TIME);
+    out.extend_from_slice(&time_ns.to_le_bytes());
+    out
+}
+
+/// The subprotocol to answer a client offering `offered` (a `Sec-WebSocket-Protocol` header:
+/// comma-separated), or `None` if it offers neither.
+pub fn choose(offered: &str) -> Option<&'static str> {
+    let offered: Vec<&str> = offered.split(',').map(str::trim).collect();
+    SUBPROTOCOLS.into_iter().find(|p| offered.contains(p))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn both_subprotocols_are_accepted_and_the_published_one_preferred() {
+        assert_eq!(
+            choose("foxglove.websocket.v1"),
+            Some("foxglove.websocket.v1")
+        );
+        assert_eq!(choose("foxglove.sdk.v1"), Some("foxglove.sdk.v1"));
+        assert_eq!(
+            choose("foxglove.sdk.v1, foxglove.websocket.v1"),
+            Some("foxglove.websocket.v1")
+        );
+        assert_eq!(choose("chat, superchat"), None);
+    }
+
+    #[test]
+    fn message_data_is_opcode_subscription_time_payload_little_endian() {
+        let m = message_data(7, 0x0102_0304_0506_0708, b"ab");
+        assert_eq!(m, [1, 7, 0, 0, 0, 8, 7, 6, 5, 4, 3, 2, 1, b'a', b'b']);
+        let sub: ClientMessage =
+            serde_json::from_str(r#"{"op":"subscribe","subscriptions":[{"id":3,"channelId":9}]}"#)
+                .unwrap();
+        assert!(
+            matches!(sub, ClientMessage::Subscribe { subscriptions } if subscriptions[0].channel_id == 9)
+        );
+    }
+}

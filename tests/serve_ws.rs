@@ -1,0 +1,226 @@
+//! `ricochet serve` over a real WebSocket client (tokio-tungstenite), speaking the published
+//! Foxglove WebSocket protocol: both subprotocols accepted, any other refused; the server
+//! info and the channels advertised with their protobuf schemas; subscriptions answered
+//! with messages that decode as the log's; malformed messages and an abrupt disconnect
+//! answered without harm; SIGTERM finishes the recording as a complete log.
+
+use std::io::{BufRead, BufReader};
+use std::process::{Child, Command, Stdio};
+use std::time::Duration;
+
+use futures_util::{SinkExt, StreamExt};
+use prost::Message as _;
+use ricochet_log::messages::ricochet::Stats;
+use serde_json::Value;
+use tokio_tungstenite::tungstenite::Message;
+use tokio_tungstenite::tungstenite::client::IntoClientRequest;
+
+/// A server on a free loopback port; killed when dropped.
+struct Server {
+    child: Child,
+    url: String,
+}
+
+impl Drop for Server {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+fn serve(args: &[&str]) -> Server {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_ricochet"))
+        .args(["serve", "--bind", "127.0.0.1:0"])
+        .args(args)
+        .stderr(Stdio::piped())
+        .stdout(Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut lines = BufReader::new(child.stderr.take().unwrap()).lines();
+    let url = loop {
+        let line = lines
+            .next()
+            .expect("the server says where it listens")
+            .unwrap();
+        if let Some(rest) = line.split(" on ws://").nth(1) {
+            break format!("ws://{}", rest.split_whitespace().next().unwrap());
+        }
+    };
+    // Keep draining stderr so the server never blocks on it.
+    std::thread::spawn(move || for _ in lines {});
+    Server { child, url }
+}
+
+type Ws =
+    tokio_tungstenite::WebSocketStream<tokio_tungstenite::MaybeTlsStream<tokio::net::TcpStream>>;
+
+async fn connect(url: &str, subprotocol: &str) -> Result<(Ws, String), String> {
+    let mut request = url.into_client_request().unwrap();
+    request
+        .headers_mut()
+        .insert("Sec-WebSocket-Protocol", subprotocol.parse().unwrap());
+    let (ws, response) = tokio_tungstenite::connect_async(request)
+        .await
+        .map_err(|e| e.to_string())?;
+    let chosen = response.headers()["Sec-WebSocket-Protocol"]
+        .to_str()
+        .unwrap()
+        .to_owned();
+    Ok((ws, chosen))
+}
+
+async fn next_json(ws: &mut Ws) -> Value {
+    loop {
+        let m = tokio::time::timeout(Duration::from_secs(10), ws.next())
+            .await
+            .expect("a message within 10 s")
+            .unwrap()
+            .unwrap();
+        if let Message::Text(t) = m {
+            return serde_json::from_str(t.as_str()).unwrap();
+        }
+    }
+}
+
+/// The next message on a subscription: (subscription, time, payload).
+async fn next_data(ws: &mut Ws) -> (u32, u64, Vec<u8>) {
+    loop {
+        let m = tokio::time::timeout(Duration::from_secs(10), ws.next())
+            .await
+            .expect("a message within 10 s")
+            .unwrap()
+            .unwrap();
+        if let Message::Binary(b) = m
+            && b[0] == 1
+        {
+            let sub = u32::from_le_bytes(b[1..5].try_into().unwrap());
+            let time = u64::from_le_bytes(b[5..13].try_into().unwrap());
+            return (sub, time, b[13..].to_vec());
+        }
+    }
+}
+
+fn runtime() -> tokio::runtime::Runtime {
+    tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+        .unwrap()
+}
+
+#[test]
+fn a_client_of_either_subprotocol_gets_the_channels_and_decodable_messages() {
+    let server = serve(&["--speed", "4"]);
+    runtime().block_on(async {
+        for subprotocol in ["foxglove.websocket.v1", "foxglove.sdk.v1"] {
+            let (mut ws, chosen) = connect(&server.url, subprotocol).await.unwrap();
+            assert_eq!(chosen, subprotocol);
+            let info = next_json(&mut ws).await;
+            assert_eq!(info["op"], "serverInfo");
+            assert_eq!(info["capabilities"], serde_json::json!(["time"]));
+            let advertise = next_json(&mut ws).await;
+            assert_eq!(advertise["op"], "advertise");
+            let channels = advertise["channels"].as_array().unwrap();
+            let topics: Vec<&str> = channels
+                .iter()
+                .map(|c| c["topic"].as_str().unwrap())
+                .collect();
+            assert_eq!(
+                topics,
+                [
+                    "/scene",
+                    "/scene/static",
+                    "/tf",
+                    "/scene/contacts",
+                    "/bodies",
+                    "/contacts",
+                    "/stats",
+                    "/events"
+                ]
+            );
+            for c in channels {
+                assert_eq!(
+                    (c["encoding"].as_str(), c["schemaEncoding"].as_str()),
+                    (Some("protobuf"), Some("protobuf"))
+                );
+                assert!(c["schema"].as_str().unwrap().len() > 100, "{}", c["topic"]);
+            }
+            let id =
+                |topic: &str| channels.iter().find(|c| c["topic"] == topic).unwrap()["id"].clone();
+            let subscribe = serde_json::json!({"op": "subscribe", "subscriptions": [
+                {"id": 7, "channelId": id("/stats")}, {"id": 8, "channelId": id("/scene")}]});
+            ws.send(Message::text(subscribe.to_string())).await.unwrap();
+            // /scene is latched: its last message comes at once; /stats every frame, frame
+            // numbers rising, at frame * dt.
+            let mut frames = Vec::new();
+            let mut scenes = 0;
+            while frames.len() < 5 {
+                let (sub, time, payload) = next_data(&mut ws).await;
+                match sub {
+                    7 => {
+                        let stats = Stats::decode(payload.as_slice()).unwrap();
+                        assert_eq!(time, stats.frame * 16_666_667);
+                        frames.push(stats.frame);
+                    }
+                    8 => scenes += 1,
+                    other => panic!("subscription {other}"),
+                }
+            }
+            assert!(scenes >= 1, "the latched scene");
+            assert!(frames.windows(2).all(|w| w[1] == w[0] + 1), "{frames:?}");
+            ws.close(None).await.unwrap();
+        }
+    });
+}
+
+#[test]
+fn other_subprotocols_are_refused_and_bad_clients_harm_nobody() {
+    let server = serve(&["--speed", "4"]);
+    runtime().block_on(async {
+        let refused = connect(&server.url, "chat").await.unwrap_err();
+        assert!(refused.contains("400"), "{refused}");
+        // A client that sends garbage, then vanishes without a close.
+        let (mut bad, _) = connect(&server.url, "foxglove.websocket.v1").await.unwrap();
+        let _ = next_json(&mut bad).await;
+        let _ = next_json(&mut bad).await;
+        bad.send(Message::text("{not json")).await.unwrap();
+        let status = next_json(&mut bad).await;
+        assert_eq!((status["op"].as_str(), status["level"].as_u64()), (Some("status"), Some(2)));
+        bad.send(Message::text(r#"{"op":"subscribe","subscriptions":[{"id":1,"channelId":999}]}"#)).await.unwrap();
+        let status = next_json(&mut bad).await;
+        assert!(status["message"].as_str().unwrap().contains("999"), "{status}");
+        drop(bad);
+        // Another client is served as before.
+        let (mut good, _) = connect(&server.url, "foxglove.websocket.v1").await.unwrap();
+        let _ = next_json(&mut good).await;
+        let advertise = next_json(&mut good).await;
+        let stats = advertise["channels"].as_array().unwrap().iter().find(|c| c["topic"] == "/stats").unwrap()["id"].clone();
+        good.send(Message::text(serde_json::json!({"op": "subscribe", "subscriptions": [{"id": 1, "channelId": stats}]}).to_string())).await.unwrap();
+        let (sub, _, payload) = next_data(&mut good).await;
+        assert_eq!(sub, 1);
+        Stats::decode(payload.as_slice()).unwrap();
+    });
+}
+
+#[test]
+fn sigterm_finishes_the_recording_as_a_complete_log() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("session.mcap");
+    let mut server = serve(&["--speed", "8", "--record", out.to_str().unwrap()]);
+    std::thread::sleep(Duration::from_millis(700));
+    let pid = server.child.id().to_string();
+    let killed = Command::new("kill").args(["-TERM", &pid]).status().unwrap();
+    assert!(killed.success());
+    let status = server.child.wait().unwrap();
+    assert!(status.success(), "{status}");
+    let log = ricochet_log::read_log_file(&out).expect("a complete, indexed log");
+    let frames: Vec<u64> = log
+        .iter()
+        .filter(|m| m.topic == "/stats")
+        .map(|m| m.data["frame"].as_u64().unwrap())
+        .collect();
+    assert!(frames.len() > 5, "{} frames recorded", frames.len());
+    assert!(
+        frames.iter().enumerate().all(|(i, f)| *f == i as u64),
+        "every frame, in order"
+    );
+}
