@@ -13,6 +13,11 @@ pub const DEFAULT_NAME: &str = "scenarios/asteroids.toml";
 
 /// Reads and checks a scenario, printing the error and returning exit code 2 when bad.
 pub fn load(path: Option<&Path>) -> Result<Scenario, ExitCode> {
+    load_text(path).map(|(scenario, _)| scenario)
+}
+
+/// [`load`], with the file's text.
+pub fn load_text(path: Option<&Path>) -> Result<(Scenario, String), ExitCode> {
     let (text, name) = match path {
         None => (DEFAULT_SCENARIO.to_owned(), DEFAULT_NAME.to_owned()),
         Some(p) => match std::fs::read_to_string(p) {
@@ -23,8 +28,11 @@ pub fn load(path: Option<&Path>) -> Result<Scenario, ExitCode> {
             }
         },
     };
-    load_scenario(&text, &name).map_err(|e| {
-        crate::out::error(&format!("error: {e}"));
-        ExitCode::from(2)
-    })
+    match load_scenario(&text, &name) {
+        Ok(s) => Ok((s, text)),
+        Err(e) => {
+            crate::out::error(&format!("error: {e}"));
+            Err(ExitCode::from(2))
+        }
+    }
 }

@@ -20,8 +20,10 @@ mod files;
 mod load;
 mod out;
 mod record;
+mod replay;
 mod run;
 mod serve;
+mod session;
 mod validate;
 
 use std::path::PathBuf;
@@ -110,6 +112,17 @@ enum Command {
         /// Also record the session to this MCAP file, as `run` writes one.
         #[arg(long, value_name = "OUT.mcap")]
         record: Option<PathBuf>,
+    },
+    /// Step a session recorded by `serve --record` again, from the scenario and the inputs
+    /// it carries, into a new log; exit code 0 if it is byte-identical to the recording.
+    ///
+    /// Example: ricochet replay session.mcap -o replayed.mcap
+    Replay {
+        /// The recorded session.
+        session: PathBuf,
+        /// Where to write the replay. Default: SESSION.replay.mcap.
+        #[arg(short, long, value_name = "OUT.mcap")]
+        output: Option<PathBuf>,
     },
     /// Print a log as JSON lines, one message a line, for scripts and grep.
     ///
@@ -287,6 +300,7 @@ fn main() -> ExitCode {
             frames,
             record: record.as_deref(),
         }),
+        Command::Replay { session, output } => replay::run(&session, output),
         Command::Dump { log, topic, frames } => {
             dump::run(&log, topic.as_deref(), frames.as_deref())
         }

@@ -116,7 +116,10 @@ fn a_client_of_either_subprotocol_gets_the_channels_and_decodable_messages() {
             assert_eq!(chosen, subprotocol);
             let info = next_json(&mut ws).await;
             assert_eq!(info["op"], "serverInfo");
-            assert_eq!(info["capabilities"], serde_json::json!(["time"]));
+            assert_eq!(
+                info["capabilities"],
+                serde_json::json!(["time", "clientPublish"])
+            );
             let advertise = next_json(&mut ws).await;
             assert_eq!(advertise["op"], "advertise");
             let channels = advertise["channels"].as_array().unwrap();
@@ -134,7 +137,8 @@ fn a_client_of_either_subprotocol_gets_the_channels_and_decodable_messages() {
                     "/bodies",
                     "/contacts",
                     "/stats",
-                    "/events"
+                    "/events",
+                    "/input"
                 ]
             );
             for c in channels {
@@ -222,5 +226,97 @@ fn sigterm_finishes_the_recording_as_a_complete_log() {
     assert!(
         frames.iter().enumerate().all(|(i, f)| *f == i as u64),
         "every frame, in order"
+    );
+}
+
+#[test]
+fn inputs_from_a_client_are_applied_recorded_and_replayed_byte_for_byte() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("session.mcap");
+    let mut server = serve(&["--speed", "4", "--record", out.to_str().unwrap()]);
+    runtime().block_on(async {
+        let (mut ws, _) = connect(&server.url, "foxglove.websocket.v1").await.unwrap();
+        let info = next_json(&mut ws).await;
+        assert!(
+            info["capabilities"]
+                .as_array()
+                .unwrap()
+                .contains(&"clientPublish".into())
+        );
+        let _ = next_json(&mut ws).await;
+        let advertise = serde_json::json!({"op": "advertise", "channels": [
+            {"id": 5, "topic": "/input", "encoding": "json", "schemaName": "ricochet.Input"}]});
+        ws.send(Message::text(advertise.to_string())).await.unwrap();
+        let send = |text: &str| {
+            let mut data = vec![1u8];
+            data.extend_from_slice(&5u32.to_le_bytes());
+            data.extend_from_slice(text.as_bytes());
+            Message::binary(data)
+        };
+        for text in [
+            r#"{"action": "thrust", "body": "ship", "on": true}"#,
+            r#"{"action": "turn", "body": "ship", "input": 0.5}"#,
+            r#"{"action": "fire", "body": "ship"}"#,
+            r#"{"action": "fire", "body": "nobody"}"#,
+            r#"{"action": "warp", "body": "ship"}"#,
+        ] {
+            ws.send(send(text)).await.unwrap();
+            tokio::time::sleep(Duration::from_millis(50)).await;
+        }
+        // The two bad inputs are refused, and the client told.
+        let mut refused = Vec::new();
+        while refused.len() < 2 {
+            let status = next_json(&mut ws).await;
+            if status["op"] == "status" {
+                refused.push(status["message"].as_str().unwrap().to_owned());
+            }
+        }
+        assert!(refused[0].contains("nobody"), "{refused:?}");
+        assert!(refused[1].contains("warp"), "{refused:?}");
+        tokio::time::sleep(Duration::from_millis(200)).await;
+    });
+    let pid = server.child.id().to_string();
+    assert!(
+        Command::new("kill")
+            .args(["-TERM", &pid])
+            .status()
+            .unwrap()
+            .success()
+    );
+    assert!(server.child.wait().unwrap().success());
+    let log = ricochet_log::read_log_file(&out).unwrap();
+    let inputs: Vec<&Value> = log
+        .iter()
+        .filter(|m| m.topic == "/input")
+        .map(|m| &m.data)
+        .collect();
+    assert_eq!(inputs.len(), 5, "every input recorded, refused ones too");
+    assert!(log.iter().any(|m| {
+        m.topic == "/events"
+            && m.data["message"]
+                .as_str()
+                .unwrap()
+                .starts_with("input refused: no body named \"nobody\"")
+    }));
+    assert!(
+        log.iter()
+            .any(|m| m.topic == "/events"
+                && m.data["message"].as_str().unwrap().contains("thrust on")),
+        "the thrust was applied"
+    );
+    let replayed = dir.path().join("replayed.mcap");
+    let o = Command::new(env!("CARGO_BIN_EXE_ricochet"))
+        .args([
+            "replay",
+            out.to_str().unwrap(),
+            "-o",
+            replayed.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        std::fs::read(&out).unwrap() == std::fs::read(&replayed).unwrap(),
+        "byte-identical"
     );
 }

@@ -134,6 +134,16 @@ impl<S: MessageSink> Recorder<S> {
         self.writer
     }
 
+    /// The sink, to write channels of its own.
+    pub fn sink_mut(&mut self) -> &mut S {
+        &mut self.writer
+    }
+
+    /// The `/events` channel, if recorded.
+    pub fn events_channel(&self) -> Option<ChannelId> {
+        self.topics.events
+    }
+
     /// The step in whole nanoseconds: frame `n` is at `n * dt_ns`.
     pub fn dt_ns(&self) -> u64 {
         self.dt_ns

@@ -22,9 +22,14 @@ pub const CLIENT_QUEUE: usize = 4096;
 /// state (`/scene` and `/scene/static` are sent only when their bodies change).
 const LATCHED: [&str; 2] = ["/scene", "/scene/static"];
 
+/// Inputs waiting for the next frame, from all clients, beyond which new ones are refused.
+pub const MAX_PENDING_INPUTS: usize = 10_000;
+
 /// One connected client.
 struct Client {
     queue: mpsc::Sender<Message>,
+    /// Its channels, by its id: those on `/input` in JSON.
+    publishes: BTreeMap<u32, bool>,
     /// By channel id: the client's subscription id.
     subscriptions: BTreeMap<u32, u32>,
     /// Messages dropped since it was last told.
@@ -41,6 +46,9 @@ pub struct Shared {
     next_client: u64,
     /// A client subscribed to `/tf`: the next frame sends every body's pose.
     pub transforms_wanted: bool,
+    /// Inputs in the order they came, with the client that sent each: the next frame takes
+    /// them all.
+    pub inputs: std::collections::VecDeque<(u64, String)>,
     /// Messages dropped for slow clients, in all.
     pub dropped: u64,
 }
@@ -72,6 +80,7 @@ impl Shared {
             id,
             Client {
                 queue,
+                publishes: BTreeMap::new(),
                 subscriptions: BTreeMap::new(),
                 dropped: 0,
             },
@@ -119,6 +128,71 @@ impl Shared {
             }
         }
         Ok(())
+    }
+
+    /// `client` will publish on its channel `id`: taken if it is `/input` in JSON.
+    pub fn advertise(
+        &mut self,
+        client: u64,
+        id: u32,
+        topic: &str,
+        encoding: &str,
+    ) -> Result<(), String> {
+        let ok = topic == "/input" && encoding == "json";
+        if let Some(c) = self.clients.get_mut(&client) {
+            c.publishes.insert(id, ok);
+        }
+        if ok {
+            Ok(())
+        } else {
+            Err(format!(
+                "channel {id} ({topic}, {encoding}): clients publish on /input, in json"
+            ))
+        }
+    }
+
+    /// `client` stops publishing on `ids`.
+    pub fn unadvertise(&mut self, client: u64, ids: &[u32]) {
+        if let Some(c) = self.clients.get_mut(&client) {
+            c.publishes.retain(|id, _| !ids.contains(id));
+        }
+    }
+
+    /// An input `client` published on its channel `channel`, queued for the next frame.
+    pub fn input(&mut self, client: u64, channel: u32, payload: &[u8]) -> Result<(), String> {
+        let advertised = self
+            .clients
+            .get(&client)
+            .and_then(|c| c.publishes.get(&channel).copied());
+        if advertised != Some(true) {
+            return Err(format!(
+                "channel {channel} is not an advertised /input channel"
+            ));
+        }
+        if payload.len() > crate::session::MAX_INPUT {
+            return Err(format!(
+                "an input of {} bytes, more than {}",
+                payload.len(),
+                crate::session::MAX_INPUT
+            ));
+        }
+        if self.inputs.len() >= MAX_PENDING_INPUTS {
+            return Err("too many inputs waiting for the next frame".to_owned());
+        }
+        let text = std::str::from_utf8(payload).map_err(|_| "an input that is not UTF-8")?;
+        self.inputs.push_back((client, text.to_owned()));
+        Ok(())
+    }
+
+    /// Tells `client` something (a status message), if it is still there.
+    pub fn tell(&mut self, client: u64, level: u8, text: &str) {
+        if let Some(c) = self.clients.get_mut(&client) {
+            let status = protocol::ServerMessage::Status {
+                level,
+                message: text,
+            };
+            let _ = c.queue.try_send(Message::text(status.json()));
+        }
     }
 
     /// Ends `client`'s subscriptions `ids`.

@@ -21,12 +21,10 @@ use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use ricochet_log::{ChannelId, LogError, LogWriter, MessageSink, Schema};
-use ricochet_sim::Simulation;
 use tokio_tungstenite::tungstenite::Message;
 
-use crate::channels::Channels;
 use crate::out;
-use crate::record::Recorder;
+use crate::session::{SCENARIO_ATTACHMENT, Session};
 use hub::{Hub, LiveSink};
 
 /// Where `serve` listens unless told: what Foxglove's "Open connection" suggests.
@@ -84,7 +82,7 @@ pub fn run(o: &Options) -> anyhow::Result<ExitCode> {
         ));
         return Ok(ExitCode::from(2));
     }
-    let scenario = match crate::load::load(o.scenario) {
+    let (scenario, text) = match crate::load::load_text(o.scenario) {
         Ok(s) => s,
         Err(code) => return Ok(code),
     };
@@ -122,34 +120,65 @@ pub fn run(o: &Options) -> anyhow::Result<ExitCode> {
         ))?;
     }
     let hub = Hub::default();
-    let dt = scenario.world.dt;
     let live = LiveSink::new(hub.clone());
-    let mut recorder: Box<dyn Frames> = match o.record {
-        None => Box::new(Recorder::new(live, dt, Channels::default(), true)?),
+    let session_id = format!("ricochet-{}", scenario.name);
+    let server_hub = hub.clone();
+    let start_server = move || -> anyhow::Result<()> {
+        std::thread::Builder::new()
+            .name("serve".into())
+            .spawn(move || runtime.block_on(server::accept(listener, server_hub, session_id)))
+            .context("starting the WebSocket thread")?;
+        Ok(())
+    };
+    let note = format!(
+        "serving {} on ws://{local} (Foxglove: Open connection; layout foxglove/ricochet-layout.json); Ctrl-C stops",
+        scenario.name
+    );
+    let frames = match o.record {
+        None => {
+            let mut session = Session::new(&scenario, live, true)?;
+            start_server()?;
+            out::note(&note)?;
+            run_loop(&mut session, &hub, o, &interrupted)?
+        }
         Some(path) => {
-            let file = LogWriter::create(path, crate::record::LIBRARY)
+            let mut file = LogWriter::create(path, crate::record::LIBRARY)
                 .with_context(|| format!("creating {}", path.display()))?;
+            file.attach(SCENARIO_ATTACHMENT, "application/toml", text.as_bytes())?;
             let tee = Tee {
                 live,
                 file,
                 ids: Vec::new(),
             };
-            Box::new(Recorder::new(tee, dt, Channels::default(), true)?)
+            let mut session = Session::new(&scenario, tee, true)?;
+            start_server()?;
+            out::note(&note)?;
+            let frames = run_loop(&mut session, &hub, o, &interrupted)?;
+            session
+                .into_sink()
+                .file
+                .finish()
+                .with_context(|| format!("finishing {}", path.display()))?;
+            frames
         }
     };
-    let session = format!("ricochet-{}", scenario.name);
-    let server_hub = hub.clone();
-    let server = std::thread::Builder::new()
-        .name("serve".into())
-        .spawn(move || runtime.block_on(server::accept(listener, server_hub, session)))
-        .context("starting the WebSocket thread")?;
-    drop(server);
+    let dropped = hub.lock().dropped;
     out::note(&format!(
-        "serving {} on ws://{local} (Foxglove: Open connection; layout foxglove/ricochet-layout.json); Ctrl-C stops",
-        scenario.name
+        "served {frames} frames; {dropped} messages dropped for slow clients"
     ))?;
-    let mut sim = Simulation::new(&scenario);
-    let step = Duration::from_secs_f64(dt / o.speed);
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Steps `session` on the real-time schedule until stopped, taking the clients' inputs at
+/// each frame boundary; returns the frames stepped.
+fn run_loop<S: MessageSink>(
+    session: &mut Session<S>,
+    hub: &Hub,
+    o: &Options,
+    interrupted: &AtomicBool,
+) -> anyhow::Result<u64> {
+    let step = Duration::from_secs_f64(session.sim().scenario().world.dt / o.speed);
+    let dt_ns = session.recorder().dt_ns();
     let start = Instant::now();
     let mut frame = 0u64;
     while !interrupted.load(Ordering::SeqCst) && o.frames.is_none_or(|n| frame <= n) {
@@ -157,74 +186,32 @@ pub fn run(o: &Options) -> anyhow::Result<ExitCode> {
         if let Some(wait) = due.checked_duration_since(Instant::now()) {
             std::thread::sleep(wait);
         }
-        let out = sim.step();
-        if sim.first_non_finite().is_some() {
+        let (inputs, resend) = {
+            let mut s = hub.lock();
+            (
+                std::mem::take(&mut s.inputs),
+                std::mem::take(&mut s.transforms_wanted),
+            )
+        };
+        for (client, text) in inputs {
+            if let Err(why) = session.input(&text)? {
+                hub.lock().tell(client, 2, &format!("input refused: {why}"));
+            }
+        }
+        if resend {
+            session.recorder().resend_transforms();
+        }
+        let t = session.next_frame().saturating_mul(dt_ns);
+        hub.lock().broadcast(&Message::binary(protocol::time(t)));
+        let out = session.step()?;
+        if session.sim().first_non_finite().is_some() {
             out::error(&format!(
                 "error: frame {}: a value overflowed; stopping",
                 out.frame
             ));
             break;
         }
-        let resend = std::mem::take(&mut hub.lock().transforms_wanted);
-        if resend {
-            recorder.resend_transforms();
-        }
-        let t = out.frame.saturating_mul(recorder.dt_ns());
-        hub.lock().broadcast(&Message::binary(protocol::time(t)));
-        recorder.record(&sim, &out)?;
         frame += 1;
     }
-    recorder.finish()?;
-    let dropped = hub.lock().dropped;
-    out::note(&format!(
-        "served {frame} frames; {dropped} messages dropped for slow clients"
-    ))?;
-    Ok(ExitCode::SUCCESS)
-}
-
-/// A recorder to a live sink or to a tee, behind one face.
-trait Frames {
-    fn record(&mut self, sim: &Simulation, out: &ricochet_sim::FrameOutput)
-    -> Result<(), LogError>;
-    fn resend_transforms(&mut self);
-    fn dt_ns(&self) -> u64;
-    fn finish(self: Box<Self>) -> Result<(), LogError>;
-}
-
-impl Frames for Recorder<LiveSink> {
-    fn record(
-        &mut self,
-        sim: &Simulation,
-        out: &ricochet_sim::FrameOutput,
-    ) -> Result<(), LogError> {
-        Recorder::record(self, sim, out)
-    }
-    fn resend_transforms(&mut self) {
-        Recorder::resend_transforms(self);
-    }
-    fn dt_ns(&self) -> u64 {
-        Recorder::dt_ns(self)
-    }
-    fn finish(self: Box<Self>) -> Result<(), LogError> {
-        Ok(())
-    }
-}
-
-impl Frames for Recorder<Tee> {
-    fn record(
-        &mut self,
-        sim: &Simulation,
-        out: &ricochet_sim::FrameOutput,
-    ) -> Result<(), LogError> {
-        Recorder::record(self, sim, out)
-    }
-    fn resend_transforms(&mut self) {
-        Recorder::resend_transforms(self);
-    }
-    fn dt_ns(&self) -> u64 {
-        Recorder::dt_ns(self)
-    }
-    fn finish(self: Box<Self>) -> Result<(), LogError> {
-        self.into_sink().file.finish()
-    }
+    Ok(frame)
 }

@@ -97,6 +97,21 @@ pub struct Subscription {
     pub channel_id: u32,
 }
 
+/// A channel a client publishes on (`advertise` from a client).
+#[derive(Deserialize, Debug, Clone)]
+#[serde(rename_all = "camelCase")]
+pub struct ClientChannel {
+    /// The client's id for it.
+    pub id: u32,
+    /// Topic: only `/input` is taken.
+    pub topic: String,
+    /// Message encoding: only `json` is taken.
+    pub encoding: String,
+}
+
+/// Binary opcode of a message a client publishes on its channel.
+pub const OP_CLIENT_MESSAGE: u8 = 0x01;
+
 /// A JSON message from a client (unknown ops are refused with a status).
 #[derive(Deserialize, Debug)]
 #[serde(tag = "op", rename_all = "camelCase")]
@@ -111,6 +126,17 @@ pub enum ClientMessage {
     Unsubscribe {
         /// The client's ids of the subscriptions to end.
         subscription_ids: Vec<u32>,
+    },
+    /// Channels the client will publish on (`clientPublish`).
+    Advertise {
+        /// The channels.
+        channels: Vec<ClientChannel>,
+    },
+    /// Channels the client stops publishing on.
+    #[serde(rename_all = "camelCase")]
+    Unadvertise {
+        /// The client's channel ids.
+        channel_ids: Vec<u32>,
     },
 }
 

@@ -85,8 +85,8 @@ async fn client(
         (s.client_count() < MAX_CLIENTS).then(|| {
             let info = ServerMessage::ServerInfo {
                 name: "ricochet",
-                capabilities: &["time"],
-                supported_encodings: &[],
+                capabilities: &["time", "clientPublish"],
+                supported_encodings: &["json"],
                 metadata: Default::default(),
                 session_id: session,
             };
@@ -106,6 +106,7 @@ async fn client(
         return Err("refused: too many clients".to_owned());
     };
     tracing_note(&format!("serve: client {peer} connected"));
+    let mut limit = RateLimit::new();
     let result = async {
         for text in hello {
             out.send(Message::text(text))
@@ -127,12 +128,11 @@ async fn client(
                             let _ = queue.try_send(Message::text(status.json()));
                         }
                     }
-                    Some(Ok(Message::Binary(_))) => {
-                        let status = ServerMessage::Status {
-                            level: 2,
-                            message: "binary client messages are not supported (no client channels)",
-                        };
-                        let _ = queue.try_send(Message::text(status.json()));
+                    Some(Ok(Message::Binary(data))) => {
+                        if let Err(why) = publish(&hub, id, &data, &mut limit) {
+                            let status = ServerMessage::Status { level: 2, message: &why };
+                            let _ = queue.try_send(Message::text(status.json()));
+                        }
                     }
                     Some(Ok(_)) => {}
                 },
@@ -157,6 +157,57 @@ fn handle(hub: &Hub, client: u64, text: &str) -> Result<(), String> {
             }
         }
         ClientMessage::Unsubscribe { subscription_ids } => s.unsubscribe(client, &subscription_ids),
+        ClientMessage::Advertise { channels } => {
+            for c in channels {
+                s.advertise(client, c.id, &c.topic, &c.encoding)?;
+            }
+        }
+        ClientMessage::Unadvertise { channel_ids } => s.unadvertise(client, &channel_ids),
     }
     Ok(())
+}
+
+/// Inputs a client may send per second; beyond, they are refused (and it is told).
+pub const MAX_INPUTS_PER_SECOND: f64 = 2000.0;
+
+/// A token bucket over the wall clock (which only paces: it never reaches the session).
+struct RateLimit {
+    tokens: f64,
+    at: std::time::Instant,
+}
+
+impl RateLimit {
+    fn new() -> RateLimit {
+        RateLimit {
+            tokens: MAX_INPUTS_PER_SECOND,
+            at: std::time::Instant::now(),
+        }
+    }
+
+    fn take(&mut self) -> bool {
+        let now = std::time::Instant::now();
+        let refill = now.duration_since(self.at).as_secs_f64() * MAX_INPUTS_PER_SECOND;
+        self.tokens = (self.tokens + refill).min(MAX_INPUTS_PER_SECOND);
+        self.at = now;
+        if self.tokens >= 1.0 {
+            self.tokens -= 1.0;
+            true
+        } else {
+            false
+        }
+    }
+}
+
+/// A binary message from a client: an input on its `/input` channel.
+fn publish(hub: &Hub, client: u64, data: &[u8], limit: &mut RateLimit) -> Result<(), String> {
+    if data.len() < 5 || data[0] != protocol::OP_CLIENT_MESSAGE {
+        return Err("a binary message that is not a client message (opcode 1)".to_owned());
+    }
+    if !limit.take() {
+        return Err(format!(
+            "input refused: more than {MAX_INPUTS_PER_SECOND} inputs a second"
+        ));
+    }
+    let channel = u32::from_le_bytes([data[1], data[2], data[3], data[4]]);
+    hub.lock().input(client, channel, &data[5..])
 }

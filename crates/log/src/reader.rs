@@ -230,6 +230,8 @@ pub struct LogFile {
     /// By channel id.
     channels: BTreeMap<u16, ChannelInfo>,
     total: u64,
+    /// The attachments: name, offset and length of the record (opcode and length included).
+    attachments: Vec<(String, u64, u64)>,
 }
 
 impl LogFile {
@@ -344,13 +346,60 @@ impl LogFile {
             )));
         }
         let library = read_library(&mut file, len)?;
+        let attachments = summary
+            .attachment_indexes
+            .iter()
+            .map(|a| (a.name.clone(), a.offset, a.length))
+            .collect();
         Ok(LogFile {
+            attachments,
             path: path.to_path_buf(),
             source: Source::File(path.to_path_buf()),
             library,
             channels,
             total: stats.message_count,
         })
+    }
+
+    /// The data of the attachment named `name`, if the log has one; its CRC checked.
+    pub fn attachment(&self, name: &str) -> Result<Option<Vec<u8>>, LogError> {
+        let Some(&(_, offset, length)) = self.attachments.iter().find(|a| a.0 == name) else {
+            return Ok(None);
+        };
+        let from: &Path = match &self.source {
+            Source::File(p) => p,
+            Source::Copy(t) => t,
+        };
+        let read_error = |source| LogError::Read {
+            path: self.path.clone(),
+            source,
+        };
+        let mut file = File::open(from).map_err(read_error)?;
+        let length = usize::try_from(length)
+            .ok()
+            .filter(|l| (9..RECORD_LIMIT).contains(l))
+            .ok_or_else(|| at(&self.path)(corrupt("an attachment's index gives a bad length")))?;
+        let mut record = vec![0; length];
+        file.seek(SeekFrom::Start(offset))
+            .and_then(|_| file.read_exact(&mut record))
+            .map_err(read_error)?;
+        match mcap::parse_record(record[0], &record[9..]) {
+            Ok(mcap::records::Record::Attachment { data, crc, .. }) => {
+                if crc != 0 {
+                    let mut hasher = crc32fast::Hasher::new();
+                    hasher.update(&record[9..record.len() - 4]);
+                    if hasher.finalize() != crc {
+                        return Err(at(&self.path)(corrupt(&format!(
+                            "attachment {name}: its CRC does not match"
+                        ))));
+                    }
+                }
+                Ok(Some(data.into_owned()))
+            }
+            _ => Err(at(&self.path)(corrupt(&format!(
+                "attachment {name}: no attachment record where the index points"
+            )))),
+        }
     }
 
     /// The `library` its header names as the writer (`ricochet 0.1.0`).

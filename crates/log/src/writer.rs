@@ -110,6 +110,11 @@ enum Job {
         header: MessageHeader,
         payload: Payload,
     },
+    Attachment {
+        name: String,
+        media_type: String,
+        data: Vec<u8>,
+    },
 }
 
 /// The MCAP writer and its encode buffer: runs the jobs, on whichever thread owns it.
@@ -144,6 +149,17 @@ impl Sink {
                 };
                 self.mcap.write_to_known_channel(&header, data)
             }
+            Job::Attachment {
+                name,
+                media_type,
+                data,
+            } => self.mcap.attach(&mcap::Attachment {
+                log_time: 0,
+                create_time: 0,
+                name,
+                media_type,
+                data: std::borrow::Cow::Owned(data),
+            }),
         }
     }
 
@@ -385,6 +401,16 @@ impl LogWriter {
         message: M,
     ) -> Result<(), LogError> {
         self.write_payload(channel, time_ns, Payload::Proto(Box::new(message)))
+    }
+
+    /// Attaches a file to the log (an MCAP attachment, times 0): `ricochet serve` attaches
+    /// the scenario, so that `ricochet replay` needs nothing but the log.
+    pub fn attach(&mut self, name: &str, media_type: &str, data: &[u8]) -> Result<(), LogError> {
+        self.submit(Job::Attachment {
+            name: name.to_owned(),
+            media_type: media_type.to_owned(),
+            data: data.to_vec(),
+        })
     }
 
     /// Writes `message` as compact JSON on `channel` (a JSON channel), like

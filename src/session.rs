@@ -1,0 +1,184 @@
+//! A session: a scenario stepped frame by frame with inputs from outside (the clients of
+//! `ricochet serve`), recorded with every input on `/input`, so that `ricochet replay` can
+//! step it again and write the same log, byte for byte.
+//!
+//! An input is JSON, the script's actions addressed by body name:
+//! `{"action": "thrust", "body": "ship", "on": true}`, `{"action": "turn", "body": "ship",
+//! "input": -0.5}`, `fire`, `move` (`input`), `jump`, `set_velocity` (`velocity: [x, y]`),
+//! `apply_impulse` (`impulse`), `set_force` (`force`), `destroy`. It is applied at the next
+//! frame boundary (the step that follows), inputs of one frame in the order they came. Every
+//! input is recorded on `/input` at the frame it applies to, refused ones too: a replay
+//! refuses them again, with the same `/events` line.
+
+use ricochet_geom::Vec2;
+use ricochet_log::messages::ricochet::Input;
+use ricochet_log::messages::{Schema, fox::Log, fox::log::Level, timestamp};
+use ricochet_log::{ChannelId, LogError, MessageSink};
+use ricochet_sim::{Action, FrameOutput, Scenario, Simulation};
+use serde::Deserialize;
+
+use crate::channels::Channels;
+use crate::record::Recorder;
+
+/// The largest input accepted, bytes.
+pub const MAX_INPUT: usize = 4096;
+
+/// The name of the attachment that holds a session's scenario.
+pub const SCENARIO_ATTACHMENT: &str = "scenario.toml";
+
+fn yes() -> bool {
+    true
+}
+
+/// An input as clients send it (the script's actions, by body name).
+#[derive(Deserialize, Debug)]
+#[serde(tag = "action", rename_all = "snake_case", deny_unknown_fields)]
+enum InputText {
+    Destroy {
+        body: String,
+    },
+    SetVelocity {
+        body: String,
+        velocity: [f64; 2],
+    },
+    ApplyImpulse {
+        body: String,
+        impulse: [f64; 2],
+    },
+    SetForce {
+        body: String,
+        force: [f64; 2],
+    },
+    Thrust {
+        body: String,
+        #[serde(default = "yes")]
+        on: bool,
+    },
+    Turn {
+        body: String,
+        input: f64,
+    },
+    Fire {
+        body: String,
+    },
+    Move {
+        body: String,
+        input: f64,
+    },
+    Jump {
+        body: String,
+    },
+}
+
+impl InputText {
+    fn split(self) -> (String, Action) {
+        let v = |a: [f64; 2]| Vec2::new(a[0], a[1]);
+        match self {
+            InputText::Destroy { body } => (body, Action::Destroy),
+            InputText::SetVelocity { body, velocity } => (body, Action::SetVelocity(v(velocity))),
+            InputText::ApplyImpulse { body, impulse } => (body, Action::ApplyImpulse(v(impulse))),
+            InputText::SetForce { body, force } => (body, Action::SetForce(v(force))),
+            InputText::Thrust { body, on } => (body, Action::Thrust(on)),
+            InputText::Turn { body, input } => (body, Action::Turn(input)),
+            InputText::Fire { body } => (body, Action::Fire),
+            InputText::Move { body, input } => (body, Action::Move(input)),
+            InputText::Jump { body } => (body, Action::Jump),
+        }
+    }
+}
+
+/// A scenario being stepped, its frames written to `S` with every input.
+pub struct Session<S: MessageSink> {
+    sim: Simulation,
+    recorder: Recorder<S>,
+    input: ChannelId,
+    events: Option<ChannelId>,
+    /// The frame the next step makes.
+    next: u64,
+}
+
+impl<S: MessageSink> Session<S> {
+    /// A session of `scenario` writing to `sink` (`live`: see [`Recorder::new`]).
+    pub fn new(scenario: &Scenario, sink: S, live: bool) -> Result<Session<S>, LogError> {
+        let mut recorder = Recorder::new(sink, scenario.world.dt, Channels::default(), live)?;
+        let input = recorder
+            .sink_mut()
+            .add_protobuf_channel("/input", Schema::ricochet("ricochet.Input"))?;
+        let events = recorder.events_channel();
+        Ok(Session {
+            sim: Simulation::new(scenario),
+            recorder,
+            input,
+            events,
+            next: 0,
+        })
+    }
+
+    /// Takes an input for the next step, recording it; why it was refused, if it was (also
+    /// written to `/events`).
+    pub fn input(&mut self, text: &str) -> Result<Result<(), String>, LogError> {
+        let t = self.next * self.recorder.dt_ns();
+        let message = Input {
+            frame: self.next,
+            text: text.to_owned(),
+        };
+        self.recorder.sink_mut().write(self.input, t, message)?;
+        let verdict = self.apply(text);
+        if let (Err(why), Some(ch)) = (&verdict, self.events) {
+            let line = Log {
+                timestamp: Some(timestamp(t)),
+                level: Level::Warning as i32,
+                message: format!("input refused: {why}"),
+                name: "input".to_owned(),
+                file: String::new(),
+                line: 0,
+            };
+            self.recorder.sink_mut().write(ch, t, line)?;
+        }
+        Ok(verdict)
+    }
+
+    fn apply(&mut self, text: &str) -> Result<(), String> {
+        if text.len() > MAX_INPUT {
+            return Err(format!("{} bytes, more than {MAX_INPUT}", text.len()));
+        }
+        let input: InputText = serde_json::from_str(text).map_err(|e| format!("{e}"))?;
+        let (body, action) = input.split();
+        if let Some(field) = action.out_of_range() {
+            return Err(format!("{}: {field} out of range", action.name()));
+        }
+        let e = self
+            .sim
+            .entity_named(&body)
+            .ok_or_else(|| format!("no body named {body:?}"))?;
+        self.sim.apply(e, action).map_err(|e| e.to_string())
+    }
+
+    /// Steps one frame and records it.
+    pub fn step(&mut self) -> Result<FrameOutput, LogError> {
+        let out = self.sim.step();
+        self.recorder.record(&self.sim, &out)?;
+        self.next = out.frame + 1;
+        Ok(out)
+    }
+
+    /// The simulation.
+    pub fn sim(&self) -> &Simulation {
+        &self.sim
+    }
+
+    /// The recorder (to ask for every transform again, say).
+    pub fn recorder(&mut self) -> &mut Recorder<S> {
+        &mut self.recorder
+    }
+
+    /// The frame the next step makes.
+    pub fn next_frame(&self) -> u64 {
+        self.next
+    }
+
+    /// The sink, back.
+    pub fn into_sink(self) -> S {
+        self.recorder.into_sink()
+    }
+}
