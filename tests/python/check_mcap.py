@@ -82,7 +82,7 @@ EXPECTED = {
     "/stats": "ricochet.Stats",
     "/events": "foxglove.Log",
 }
-OPTIONAL = {"/validation": "ricochet.Validation"}
+OPTIONAL = {"/validation": "ricochet.Validation", "/input": "ricochet.Input"}
 PER_FRAME = ("/bodies", "/contacts", "/stats")
 WORLD = "world"
 BODY_FRAME = re.compile(r"body/(\d+):(\d+)")
