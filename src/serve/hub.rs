@@ -130,24 +130,13 @@ impl Shared {
         Ok(())
     }
 
-    /// `client` will publish on its channel `id`: taken if it is `/input` in JSON.
-    pub fn advertise(
-        &mut self,
-        client: u64,
-        id: u32,
-        topic: &str,
-        encoding: &str,
-    ) -> Result<(), String> {
-        let ok = topic == "/input" && encoding == "json";
+    /// `client` will publish on its channel `id`. Any channel may be advertised (Foxglove's
+    /// 3D panel advertises its click tools' topics); only messages on `/input` in JSON are
+    /// taken, others are refused when they come.
+    pub fn advertise(&mut self, client: u64, id: u32, topic: &str, encoding: &str) {
+        let input = topic == "/input" && encoding == "json";
         if let Some(c) = self.clients.get_mut(&client) {
-            c.publishes.insert(id, ok);
-        }
-        if ok {
-            Ok(())
-        } else {
-            Err(format!(
-                "channel {id} ({topic}, {encoding}): clients publish on /input, in json"
-            ))
+            c.publishes.insert(id, input);
         }
     }
 

@@ -159,7 +159,7 @@ fn handle(hub: &Hub, client: u64, text: &str) -> Result<(), String> {
         ClientMessage::Unsubscribe { subscription_ids } => s.unsubscribe(client, &subscription_ids),
         ClientMessage::Advertise { channels } => {
             for c in channels {
-                s.advertise(client, c.id, &c.topic, &c.encoding)?;
+                s.advertise(client, c.id, &c.topic, &c.encoding);
             }
         }
         ClientMessage::Unadvertise { channel_ids } => s.unadvertise(client, &channel_ids),
