@@ -243,7 +243,19 @@ fn inputs_from_a_client_are_applied_recorded_and_replayed_byte_for_byte() {
                 .unwrap()
                 .contains(&"clientPublish".into())
         );
-        let _ = next_json(&mut ws).await;
+        // Subscribing to /tf makes the server send every pose again, to this viewer only:
+        // the recording (and so the replay) never sees it.
+        let channels = next_json(&mut ws).await;
+        let tf = channels["channels"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|c| c["topic"] == "/tf")
+            .unwrap()["id"]
+            .clone();
+        let subscribe =
+            serde_json::json!({"op": "subscribe", "subscriptions": [{"id": 1, "channelId": tf}]});
+        ws.send(Message::text(subscribe.to_string())).await.unwrap();
         let advertise = serde_json::json!({"op": "advertise", "channels": [
             {"id": 5, "topic": "/input", "encoding": "json", "schemaName": "ricochet.Input"}]});
         ws.send(Message::text(advertise.to_string())).await.unwrap();

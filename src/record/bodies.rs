@@ -125,6 +125,8 @@ pub struct Changes {
     /// `/tf`: the transforms of the bodies that appeared, or whose stretch of straight-line
     /// motion ended.
     pub transforms: Vec<FrameTransform>,
+    /// Every body's pose, when [`Tracker::resend_transforms`] asked: for live viewers only.
+    pub resent: Vec<FrameTransform>,
     /// `/scene` (moving bodies) must be sent whole: one appeared or went, or one with an
     /// AABB part turned.
     pub scene_changed: bool,
@@ -192,6 +194,7 @@ impl Tracker {
         let mut bodies = Vec::new();
         let mut transforms = Vec::new();
         let mut samples = Vec::new();
+        let mut resent = Vec::new();
         for i in 0..world.len() {
             let e: Entity = world.entity[i];
             let (position, angle) = (world.position[i], world.angle[i]);
@@ -238,7 +241,9 @@ impl Tracker {
                 let frame_angle = if k.upright { 0.0 } else { angle };
                 k.motion.frame(frame, position, frame_angle, &mut samples);
                 if self.resend {
-                    samples.push((frame, [position.x, position.y, frame_angle]));
+                    let ts = ricochet_log::messages::timestamp(frame.saturating_mul(dt_ns));
+                    let pose = Vec2::new(position.x, position.y);
+                    resent.push(scene::transform(&k.frame_id, ts, pose, frame_angle));
                 }
                 transforms_of(&k.frame_id, &samples, dt_ns, &mut transforms);
             }
@@ -328,6 +333,7 @@ impl Tracker {
                 dt,
             },
             transforms,
+            resent,
             scene_changed,
             static_changed,
         }

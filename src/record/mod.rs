@@ -218,6 +218,12 @@ impl<S: MessageSink> Recorder<S> {
                 self.writer
                     .write(ch, t, scene::snapshot(drawings(false), ts))?;
             }
+            if let (Some(ch), false) = (self.topics.tf, changes.resent.is_empty()) {
+                // For a viewer that just subscribed: never recorded (a replay has no viewer).
+                let transforms = std::mem::take(&mut changes.resent);
+                self.writer
+                    .write_live(ch, t, FrameTransforms { transforms })?;
+            }
             if let (Some(ch), false) = (self.topics.tf, changes.transforms.is_empty()) {
                 let transforms = std::mem::take(&mut changes.transforms);
                 self.writer.write(ch, t, FrameTransforms { transforms })?;

@@ -271,4 +271,13 @@ impl MessageSink for LiveSink {
             .publish(u32::from(channel.index()), time_ns, payload);
         Ok(())
     }
+
+    fn write_live<M: prost::Message + Clone + Send + 'static>(
+        &mut self,
+        channel: ChannelId,
+        time_ns: u64,
+        message: M,
+    ) -> Result<(), LogError> {
+        self.write(channel, time_ns, message)
+    }
 }

@@ -56,6 +56,15 @@ impl MessageSink for Tee {
         self.file.write(file, time_ns, message.clone())?;
         self.live.write(channel, time_ns, message)
     }
+
+    fn write_live<M: prost::Message + Clone + Send + 'static>(
+        &mut self,
+        channel: ChannelId,
+        time_ns: u64,
+        message: M,
+    ) -> Result<(), LogError> {
+        self.live.write(channel, time_ns, message)
+    }
 }
 
 /// The options of `ricochet serve`.
@@ -164,9 +173,23 @@ pub fn run(o: &Options) -> anyhow::Result<ExitCode> {
     };
     let dropped = hub.lock().dropped;
     out::note(&format!(
-        "served {frames} frames; {dropped} messages dropped for slow clients"
+        "served {frames} frames; {dropped} messages dropped for slow clients; {} s of CPU",
+        cpu_seconds().map_or("?".to_owned(), |s| format!("{s:.2}"))
     ))?;
     Ok(ExitCode::SUCCESS)
+}
+
+/// CPU time this process used (user + system), from `/proc/self/stat` (Linux); `None`
+/// elsewhere.
+fn cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // Fields after the command name (in parentheses, which may hold spaces).
+    let rest = stat.rsplit_once(')')?.1;
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    let utime: f64 = fields.get(11)?.parse().ok()?;
+    let stime: f64 = fields.get(12)?.parse().ok()?;
+    // Clock ticks: 100 a second on Linux.
+    Some((utime + stime) / 100.0)
 }
 
 /// Steps `session` on the real-time schedule until stopped, taking the clients' inputs at
@@ -181,11 +204,13 @@ fn run_loop<S: MessageSink>(
     let dt_ns = session.recorder().dt_ns();
     let start = Instant::now();
     let mut frame = 0u64;
+    let mut lateness = Lateness::default();
     while !interrupted.load(Ordering::SeqCst) && o.frames.is_none_or(|n| frame <= n) {
         let due = start + step.saturating_mul(u32::try_from(frame).unwrap_or(u32::MAX));
         if let Some(wait) = due.checked_duration_since(Instant::now()) {
             std::thread::sleep(wait);
         }
+        lateness.add(Instant::now().saturating_duration_since(due));
         let (inputs, resend) = {
             let mut s = hub.lock();
             (
@@ -213,5 +238,52 @@ fn run_loop<S: MessageSink>(
         }
         frame += 1;
     }
+    out::note(&format!(
+        "frame starts late against the real-time schedule: p50 {:.3} ms, p99 {:.3} ms, max {:.3} ms",
+        lateness.quantile(0.5),
+        lateness.quantile(0.99),
+        lateness.max_ms
+    ))?;
     Ok(frame)
+}
+
+/// How late frames start, in a fixed histogram (bounded memory however long the server
+/// runs): 0.05 ms buckets up to 100 ms, then one for all later.
+struct Lateness {
+    buckets: [u64; 2001],
+    count: u64,
+    max_ms: f64,
+}
+
+impl Default for Lateness {
+    fn default() -> Self {
+        Lateness {
+            buckets: [0; 2001],
+            count: 0,
+            max_ms: 0.0,
+        }
+    }
+}
+
+impl Lateness {
+    fn add(&mut self, late: Duration) {
+        let ms = late.as_secs_f64() * 1e3;
+        let bucket = ((ms / 0.05) as usize).min(self.buckets.len() - 1);
+        self.buckets[bucket] += 1;
+        self.count += 1;
+        self.max_ms = self.max_ms.max(ms);
+    }
+
+    /// The `q` quantile, ms (the upper edge of its bucket).
+    fn quantile(&self, q: f64) -> f64 {
+        let want = (q * self.count as f64).ceil() as u64;
+        let mut seen = 0;
+        for (i, n) in self.buckets.iter().enumerate() {
+            seen += n;
+            if seen >= want.max(1) {
+                return ((i + 1) as f64 * 0.05).min(self.max_ms);
+            }
+        }
+        self.max_ms
+    }
 }

@@ -52,6 +52,17 @@ pub trait MessageSink {
         time_ns: u64,
         message: M,
     ) -> Result<(), LogError>;
+
+    /// Writes `message` to live viewers only, never to a recording (the current state again
+    /// for a viewer that just subscribed). A file ignores it.
+    fn write_live<M: prost::Message + Clone + Send + 'static>(
+        &mut self,
+        _channel: ChannelId,
+        _time_ns: u64,
+        _message: M,
+    ) -> Result<(), LogError> {
+        Ok(())
+    }
 }
 
 impl MessageSink for LogWriter {
