@@ -19,6 +19,8 @@ use tokio_tungstenite::tungstenite::client::IntoClientRequest;
 struct Server {
     child: Child,
     url: String,
+    /// Its stderr lines after the first.
+    lines: std::sync::Arc<std::sync::Mutex<Vec<String>>>,
 }
 
 impl Drop for Server {
@@ -47,8 +49,18 @@ fn serve(args: &[&str]) -> Server {
         }
     };
     // Keep draining stderr so the server never blocks on it.
-    std::thread::spawn(move || for _ in lines {});
-    Server { child, url }
+    let kept = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
+    let sink = kept.clone();
+    std::thread::spawn(move || {
+        for line in lines.map_while(Result::ok) {
+            sink.lock().unwrap().push(line);
+        }
+    });
+    Server {
+        child,
+        url,
+        lines: kept,
+    }
 }
 
 type Ws =
@@ -331,4 +343,72 @@ fn inputs_from_a_client_are_applied_recorded_and_replayed_byte_for_byte() {
         std::fs::read(&out).unwrap() == std::fs::read(&replayed).unwrap(),
         "byte-identical"
     );
+}
+
+#[test]
+fn a_client_that_never_reads_loses_messages_and_nobody_else_does() {
+    let shapes = crate::util::root().join("scenarios/shapes.toml");
+    let mut server = serve(&[shapes.to_str().unwrap(), "--speed", "40"]);
+    runtime().block_on(async {
+        // The slow client subscribes to everything, then never reads again.
+        let (mut slow, _) = connect(&server.url, "foxglove.websocket.v1").await.unwrap();
+        let _ = next_json(&mut slow).await;
+        let channels = next_json(&mut slow).await;
+        let all: Vec<Value> = channels["channels"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .enumerate()
+            .map(|(i, c)| serde_json::json!({"id": i, "channelId": c["id"]}))
+            .collect();
+        let subscribe = serde_json::json!({"op": "subscribe", "subscriptions": all});
+        slow.send(Message::text(subscribe.to_string())).await.unwrap();
+        // A good client reads /stats all along: every frame, none missing.
+        let (mut good, _) = connect(&server.url, "foxglove.websocket.v1").await.unwrap();
+        let _ = next_json(&mut good).await;
+        let channels = next_json(&mut good).await;
+        let stats = channels["channels"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|c| c["topic"] == "/stats")
+            .unwrap()["id"]
+            .clone();
+        let subscribe = serde_json::json!({"op": "subscribe", "subscriptions": [{"id": 1, "channelId": stats}]});
+        good.send(Message::text(subscribe.to_string())).await.unwrap();
+        let mut frames = Vec::new();
+        let until = std::time::Instant::now() + Duration::from_secs(6);
+        while std::time::Instant::now() < until {
+            let (_, _, payload) = next_data(&mut good).await;
+            frames.push(Stats::decode(payload.as_slice()).unwrap().frame);
+        }
+        assert!(frames.len() > 1000, "{} frames", frames.len());
+        assert!(
+            frames.windows(2).all(|w| w[1] == w[0] + 1),
+            "the good client missed frames"
+        );
+        drop(slow);
+    });
+    let pid = server.child.id().to_string();
+    assert!(
+        Command::new("kill")
+            .args(["-TERM", &pid])
+            .status()
+            .unwrap()
+            .success()
+    );
+    assert!(server.child.wait().unwrap().success());
+    std::thread::sleep(Duration::from_millis(200));
+    let lines = server.lines.lock().unwrap().clone();
+    let last = lines
+        .iter()
+        .find(|l| l.starts_with("served "))
+        .expect("a summary line");
+    let dropped: u64 = last
+        .split("; ")
+        .nth(1)
+        .and_then(|s| s.split_whitespace().next())
+        .and_then(|n| n.parse().ok())
+        .unwrap();
+    assert!(dropped > 0, "the slow client lost messages: {last}");
 }
