@@ -81,7 +81,17 @@ async fn connect(url: &str, subprotocol: &str) -> Result<(Ws, String), String> {
     Ok((ws, chosen))
 }
 
+/// The next JSON message, but for the services' advertisement (see [`services`]).
 async fn next_json(ws: &mut Ws) -> Value {
+    loop {
+        let v = any_json(ws).await;
+        if v["op"] != "advertiseServices" {
+            return v;
+        }
+    }
+}
+
+async fn any_json(ws: &mut Ws) -> Value {
     loop {
         let m = tokio::time::timeout(Duration::from_secs(10), ws.next())
             .await
@@ -130,7 +140,7 @@ fn a_client_of_either_subprotocol_gets_the_channels_and_decodable_messages() {
             assert_eq!(info["op"], "serverInfo");
             assert_eq!(
                 info["capabilities"],
-                serde_json::json!(["time", "clientPublish"])
+                serde_json::json!(["time", "clientPublish", "services"])
             );
             let advertise = next_json(&mut ws).await;
             assert_eq!(advertise["op"], "advertise");
@@ -411,4 +421,131 @@ fn a_client_that_never_reads_loses_messages_and_nobody_else_does() {
         .and_then(|n| n.parse().ok())
         .unwrap();
     assert!(dropped > 0, "the slow client lost messages: {last}");
+}
+
+/// Calls service `name` with `request`; its JSON response, or the failure's message.
+async fn call(
+    ws: &mut Ws,
+    services: &Value,
+    name: &str,
+    call: u32,
+    request: &str,
+) -> Result<Value, String> {
+    let service = services["services"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|s| s["name"] == name)
+        .unwrap_or_else(|| panic!("a service {name}"))["id"]
+        .as_u64()
+        .unwrap() as u32;
+    let mut data = vec![2u8];
+    data.extend_from_slice(&service.to_le_bytes());
+    data.extend_from_slice(&call.to_le_bytes());
+    data.extend_from_slice(&4u32.to_le_bytes());
+    data.extend_from_slice(b"json");
+    data.extend_from_slice(request.as_bytes());
+    ws.send(Message::binary(data)).await.unwrap();
+    loop {
+        let m = tokio::time::timeout(Duration::from_secs(10), ws.next())
+            .await
+            .expect("an answer within 10 s")
+            .unwrap()
+            .unwrap();
+        match m {
+            Message::Binary(b) if b[0] == 3 => {
+                assert_eq!(u32::from_le_bytes(b[5..9].try_into().unwrap()), call);
+                assert_eq!(&b[13..17], b"json");
+                return Ok(serde_json::from_slice(&b[17..]).unwrap());
+            }
+            Message::Text(t) => {
+                let v: Value = serde_json::from_str(t.as_str()).unwrap();
+                if v["op"] == "serviceCallFailure" {
+                    return Err(v["message"].as_str().unwrap().to_owned());
+                }
+            }
+            _ => {}
+        }
+    }
+}
+
+#[test]
+fn services_pause_step_and_reset_and_each_recording_segment_replays() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("session.mcap");
+    let mut server = serve(&["--speed", "4", "--record", out.to_str().unwrap()]);
+    runtime().block_on(async {
+        let (mut ws, _) = connect(&server.url, "foxglove.websocket.v1").await.unwrap();
+        let info = any_json(&mut ws).await;
+        assert!(
+            info["capabilities"]
+                .as_array()
+                .unwrap()
+                .contains(&"services".into())
+        );
+        let _ = any_json(&mut ws).await;
+        let services = any_json(&mut ws).await;
+        assert_eq!(services["op"], "advertiseServices");
+        let paused = call(&mut ws, &services, "/pause", 1, "{}").await.unwrap();
+        assert_eq!(paused["paused"], true);
+        let at = paused["frame"].as_u64().unwrap();
+        tokio::time::sleep(Duration::from_millis(300)).await;
+        // Paused: no frame went by; a step of 3 makes exactly 3.
+        let stepped = call(&mut ws, &services, "/step", 2, r#"{"frames": 3}"#)
+            .await
+            .unwrap();
+        assert_eq!(stepped["frame"].as_u64().unwrap(), at + 3);
+        let bad = call(&mut ws, &services, "/step", 3, r#"{"frames": 0}"#)
+            .await
+            .unwrap_err();
+        assert!(bad.contains("frames"), "{bad}");
+        let outside = call(
+            &mut ws,
+            &services,
+            "/load",
+            4,
+            r#"{"scenario": "/etc/passwd"}"#,
+        )
+        .await
+        .unwrap_err();
+        assert!(outside.contains("relative path"), "{outside}");
+        let reset = call(&mut ws, &services, "/reset", 5, "{}").await.unwrap();
+        assert_eq!(reset["frame"], 0);
+        assert!(
+            reset["recording"]
+                .as_str()
+                .unwrap()
+                .ends_with("session-1.mcap"),
+            "{reset}"
+        );
+        call(&mut ws, &services, "/play", 6, "{}").await.unwrap();
+        tokio::time::sleep(Duration::from_millis(300)).await;
+    });
+    let pid = server.child.id().to_string();
+    assert!(
+        Command::new("kill")
+            .args(["-TERM", &pid])
+            .status()
+            .unwrap()
+            .success()
+    );
+    assert!(server.child.wait().unwrap().success());
+    for file in ["session.mcap", "session-1.mcap"] {
+        let recorded = dir.path().join(file);
+        let replayed = dir.path().join(format!("{file}.replay"));
+        let o = Command::new(env!("CARGO_BIN_EXE_ricochet"))
+            .args([
+                "replay",
+                recorded.to_str().unwrap(),
+                "-o",
+                replayed.to_str().unwrap(),
+            ])
+            .output()
+            .unwrap();
+        assert!(
+            o.status.success(),
+            "{file}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    }
 }

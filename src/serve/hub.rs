@@ -49,6 +49,8 @@ pub struct Shared {
     /// Inputs in the order they came, with the client that sent each: the next frame takes
     /// them all.
     pub inputs: std::collections::VecDeque<(u64, String)>,
+    /// Service calls in the order they came, with the client that made each.
+    pub calls: std::collections::VecDeque<(u64, protocol::ServiceCall)>,
     /// Messages dropped for slow clients, in all.
     pub dropped: u64,
 }
@@ -173,6 +175,34 @@ impl Shared {
         Ok(())
     }
 
+    /// A service call from `client`, queued for the next frame boundary.
+    pub fn call(&mut self, client: u64, call: protocol::ServiceCall) -> Result<(), String> {
+        if self.calls.len() >= 64 {
+            return Err("too many service calls waiting".to_owned());
+        }
+        self.calls.push_back((client, call));
+        Ok(())
+    }
+
+    /// Answers `client`'s call: its JSON response, or why it failed.
+    pub fn answer(&mut self, client: u64, service: u32, call: u32, result: Result<String, String>) {
+        let Some(c) = self.clients.get_mut(&client) else {
+            return;
+        };
+        let message = match result {
+            Ok(json) => Message::binary(protocol::service_response(service, call, json.as_bytes())),
+            Err(why) => Message::text(
+                protocol::ServerMessage::ServiceCallFailure {
+                    service_id: service,
+                    call_id: call,
+                    message: &why,
+                }
+                .json(),
+            ),
+        };
+        let _ = c.queue.try_send(message);
+    }
+
     /// Tells `client` something (a status message), if it is still there.
     pub fn tell(&mut self, client: u64, level: u8, text: &str) {
         if let Some(c) = self.clients.get_mut(&client) {
@@ -253,6 +283,11 @@ impl LiveSink {
 impl MessageSink for LiveSink {
     fn add_protobuf_channel(&mut self, topic: &str, schema: Schema) -> Result<ChannelId, LogError> {
         let mut s = self.hub.lock();
+        // A new session (after a reset) adds the same topics: they keep their ids, and the
+        // clients their subscriptions.
+        if let Some(c) = s.channels.iter().find(|c| c.topic == topic) {
+            return Ok(ChannelId::from_index(c.id as u16));
+        }
         let id = s.channels.len() as u32 + 1;
         s.channels
             .push(Channel::protobuf(id, topic, &schema.name, &schema.data));

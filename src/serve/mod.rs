@@ -11,9 +11,10 @@
 mod hub;
 mod protocol;
 mod server;
+mod services;
 
 use std::net::SocketAddr;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -30,20 +31,20 @@ use hub::{Hub, LiveSink};
 /// Where `serve` listens unless told: what Foxglove's "Open connection" suggests.
 pub const DEFAULT_BIND: &str = "127.0.0.1:8765";
 
-/// Both sinks: the live stream and the recording.
-struct Tee {
+/// Where a served session's messages go: the live stream, and the recording if any.
+struct ServeSink {
     live: LiveSink,
-    file: LogWriter,
-    /// The file's channel for each live channel id.
-    ids: Vec<ChannelId>,
+    /// The recording, with its channel for each live channel id.
+    file: Option<(LogWriter, Vec<ChannelId>)>,
 }
 
-impl MessageSink for Tee {
+impl MessageSink for ServeSink {
     fn add_protobuf_channel(&mut self, topic: &str, schema: Schema) -> Result<ChannelId, LogError> {
-        let file = self.file.add_protobuf_channel(topic, schema.clone())?;
-        let live = self.live.add_protobuf_channel(topic, schema)?;
-        self.ids.push(file);
-        Ok(live)
+        if let Some((file, ids)) = &mut self.file {
+            let id = file.add_protobuf_channel(topic, schema.clone())?;
+            ids.push(id);
+        }
+        self.live.add_protobuf_channel(topic, schema)
     }
 
     fn write<M: prost::Message + Clone + Send + 'static>(
@@ -52,8 +53,10 @@ impl MessageSink for Tee {
         time_ns: u64,
         message: M,
     ) -> Result<(), LogError> {
-        let file = self.ids[usize::from(channel.index()) - 1];
-        self.file.write(file, time_ns, message.clone())?;
+        if let Some((file, ids)) = &mut self.file {
+            let id = ids[usize::from(channel.index()) - 1];
+            file.write(id, time_ns, message.clone())?;
+        }
         self.live.write(channel, time_ns, message)
     }
 
@@ -65,6 +68,55 @@ impl MessageSink for Tee {
     ) -> Result<(), LogError> {
         self.live.write(channel, time_ns, message)
     }
+}
+
+/// The recording of segment `k` of a session recorded to `path`: `path` itself, then
+/// `NAME-1.mcap`, `NAME-2.mcap`, ... (a reset or a load starts a new file).
+fn segment(path: &Path, k: u32) -> PathBuf {
+    if k == 0 {
+        return path.to_path_buf();
+    }
+    let stem = path
+        .file_stem()
+        .map_or_else(|| "session".into(), |s| s.to_string_lossy());
+    let ext = path
+        .extension()
+        .map_or_else(|| "mcap".into(), |s| s.to_string_lossy());
+    path.with_file_name(format!("{stem}-{k}.{ext}"))
+}
+
+/// A new session of `scenario` (whose file's text is `text`) for `hub`, recording to
+/// segment `k` of `record` if asked.
+fn start(
+    scenario: &ricochet_sim::Scenario,
+    text: &str,
+    hub: &Hub,
+    record: Option<&Path>,
+    k: u32,
+) -> anyhow::Result<Session<ServeSink>> {
+    let file = match record {
+        None => None,
+        Some(path) => {
+            let path = segment(path, k);
+            let mut file = LogWriter::create(&path, crate::record::LIBRARY)
+                .with_context(|| format!("creating {}", path.display()))?;
+            file.attach(SCENARIO_ATTACHMENT, "application/toml", text.as_bytes())?;
+            Some((file, Vec::new()))
+        }
+    };
+    let sink = ServeSink {
+        live: LiveSink::new(hub.clone()),
+        file,
+    };
+    Ok(Session::new(scenario, sink, true)?)
+}
+
+/// Finishes a session's recording, if it has one.
+fn finish(session: Session<ServeSink>) -> anyhow::Result<()> {
+    if let Some((file, _)) = session.into_sink().file {
+        file.finish()?;
+    }
+    Ok(())
 }
 
 /// The options of `ricochet serve`.
@@ -129,54 +181,164 @@ pub fn run(o: &Options) -> anyhow::Result<ExitCode> {
         ))?;
     }
     let hub = Hub::default();
-    let live = LiveSink::new(hub.clone());
+    let session = start(&scenario, &text, &hub, o.record, 0)?;
     let session_id = format!("ricochet-{}", scenario.name);
     let server_hub = hub.clone();
-    let start_server = move || -> anyhow::Result<()> {
-        std::thread::Builder::new()
-            .name("serve".into())
-            .spawn(move || runtime.block_on(server::accept(listener, server_hub, session_id)))
-            .context("starting the WebSocket thread")?;
-        Ok(())
-    };
-    let note = format!(
+    std::thread::Builder::new()
+        .name("serve".into())
+        .spawn(move || runtime.block_on(server::accept(listener, server_hub, session_id)))
+        .context("starting the WebSocket thread")?;
+    out::note(&format!(
         "serving {} on ws://{local} (Foxglove: Open connection; layout foxglove/ricochet-layout.json); Ctrl-C stops",
         scenario.name
-    );
-    let frames = match o.record {
-        None => {
-            let mut session = Session::new(&scenario, live, true)?;
-            start_server()?;
-            out::note(&note)?;
-            run_loop(&mut session, &hub, o, &interrupted)?
-        }
-        Some(path) => {
-            let mut file = LogWriter::create(path, crate::record::LIBRARY)
-                .with_context(|| format!("creating {}", path.display()))?;
-            file.attach(SCENARIO_ATTACHMENT, "application/toml", text.as_bytes())?;
-            let tee = Tee {
-                live,
-                file,
-                ids: Vec::new(),
-            };
-            let mut session = Session::new(&scenario, tee, true)?;
-            start_server()?;
-            out::note(&note)?;
-            let frames = run_loop(&mut session, &hub, o, &interrupted)?;
-            session
-                .into_sink()
-                .file
-                .finish()
-                .with_context(|| format!("finishing {}", path.display()))?;
-            frames
-        }
+    ))?;
+    let mut serving = Serving {
+        session,
+        scenario,
+        text,
+        segment: 0,
     };
+    let frames = run_loop(&mut serving, &hub, o, &interrupted)?;
+    finish(serving.session)?;
     let dropped = hub.lock().dropped;
     out::note(&format!(
         "served {frames} frames; {dropped} messages dropped for slow clients; {} s of CPU",
         cpu_seconds().map_or("?".to_owned(), |s| format!("{s:.2}"))
     ))?;
     Ok(ExitCode::SUCCESS)
+}
+
+/// What is being served: the session, its scenario (and the file's text), and which
+/// recording segment it writes.
+struct Serving {
+    session: Session<ServeSink>,
+    scenario: ricochet_sim::Scenario,
+    text: String,
+    segment: u32,
+}
+
+impl Serving {
+    /// Carries out a service call; the JSON response, or why it failed.
+    fn command(
+        &mut self,
+        command: services::Command,
+        hub: &Hub,
+        o: &Options,
+        paused: &mut bool,
+    ) -> anyhow::Result<Result<String, String>> {
+        let mut recording = None;
+        match command {
+            services::Command::Pause => *paused = true,
+            services::Command::Play => *paused = false,
+            services::Command::Step(n) => {
+                *paused = true;
+                for _ in 0..n {
+                    self.frame(hub)?;
+                }
+            }
+            services::Command::Reset | services::Command::Load(_) => {
+                if let services::Command::Load(path) = command {
+                    match crate::load::load_text(Some(Path::new(&path))) {
+                        Ok((scenario, text)) => (self.scenario, self.text) = (scenario, text),
+                        Err(_) => {
+                            return Ok(Err(format!(
+                                "{path}: not a scenario that loads (see the server's log)"
+                            )));
+                        }
+                    }
+                }
+                self.segment += u32::from(o.record.is_some());
+                let next = start(&self.scenario, &self.text, hub, o.record, self.segment)?;
+                finish(std::mem::replace(&mut self.session, next))?;
+                recording = o
+                    .record
+                    .map(|p| segment(p, self.segment).display().to_string());
+            }
+        }
+        let mut response = serde_json::json!({
+            "frame": self.session.next_frame(),
+            "paused": *paused,
+        });
+        if let Some(file) = recording {
+            response["recording"] = serde_json::Value::String(file);
+        }
+        Ok(Ok(response.to_string()))
+    }
+
+    /// One frame: the clients' inputs, then the step.
+    fn frame(&mut self, hub: &Hub) -> anyhow::Result<()> {
+        let dt_ns = self.session.recorder().dt_ns();
+        let (inputs, resend) = {
+            let mut s = hub.lock();
+            (
+                std::mem::take(&mut s.inputs),
+                std::mem::take(&mut s.transforms_wanted),
+            )
+        };
+        for (client, text) in inputs {
+            if let Err(why) = self.session.input(&text)? {
+                hub.lock().tell(client, 2, &format!("input refused: {why}"));
+            }
+        }
+        if resend {
+            self.session.recorder().resend_transforms();
+        }
+        let t = self.session.next_frame().saturating_mul(dt_ns);
+        hub.lock().broadcast(&Message::binary(protocol::time(t)));
+        let out = self.session.step()?;
+        if self.session.sim().first_non_finite().is_some() {
+            anyhow::bail!("frame {}: a value overflowed; stopping", out.frame);
+        }
+        Ok(())
+    }
+}
+
+/// Steps on the real-time schedule until stopped, taking the clients' inputs at each frame
+/// boundary and their service calls between frames; returns the frames stepped.
+fn run_loop(
+    serving: &mut Serving,
+    hub: &Hub,
+    o: &Options,
+    interrupted: &AtomicBool,
+) -> anyhow::Result<u64> {
+    let step = Duration::from_secs_f64(serving.scenario.world.dt / o.speed);
+    // The schedule: frame `anchor.1 + n` starts at `anchor.0 + n * step`; moved when stepping
+    // pauses, resumes, or starts over.
+    let mut anchor = (Instant::now(), 0u64);
+    let mut frames = 0u64;
+    let mut paused = false;
+    let mut lateness = Lateness::default();
+    while !interrupted.load(Ordering::SeqCst) && o.frames.is_none_or(|n| frames <= n) {
+        let calls = std::mem::take(&mut hub.lock().calls);
+        for (client, call) in calls {
+            let result = match services::parse(call.service, &call.payload) {
+                Ok(command) => serving.command(command, hub, o, &mut paused)?,
+                Err(why) => Err(why),
+            };
+            hub.lock().answer(client, call.service, call.call, result);
+            anchor = (Instant::now(), frames);
+        }
+        if paused {
+            std::thread::sleep(Duration::from_millis(5));
+            anchor = (Instant::now(), frames);
+            continue;
+        }
+        let n = u32::try_from(frames - anchor.1).unwrap_or(u32::MAX);
+        let due = anchor.0 + step.saturating_mul(n);
+        if let Some(wait) = due.checked_duration_since(Instant::now()) {
+            std::thread::sleep(wait);
+        }
+        lateness.add(Instant::now().saturating_duration_since(due));
+        serving.frame(hub)?;
+        frames += 1;
+    }
+    out::note(&format!(
+        "frame starts late against the real-time schedule: p50 {:.3} ms, p99 {:.3} ms, max {:.3} ms",
+        lateness.quantile(0.5),
+        lateness.quantile(0.99),
+        lateness.max_ms
+    ))?;
+    Ok(frames)
 }
 
 /// CPU time this process used (user + system), from `/proc/self/stat` (Linux); `None`
@@ -190,61 +352,6 @@ fn cpu_seconds() -> Option<f64> {
     let stime: f64 = fields.get(12)?.parse().ok()?;
     // Clock ticks: 100 a second on Linux.
     Some((utime + stime) / 100.0)
-}
-
-/// Steps `session` on the real-time schedule until stopped, taking the clients' inputs at
-/// each frame boundary; returns the frames stepped.
-fn run_loop<S: MessageSink>(
-    session: &mut Session<S>,
-    hub: &Hub,
-    o: &Options,
-    interrupted: &AtomicBool,
-) -> anyhow::Result<u64> {
-    let step = Duration::from_secs_f64(session.sim().scenario().world.dt / o.speed);
-    let dt_ns = session.recorder().dt_ns();
-    let start = Instant::now();
-    let mut frame = 0u64;
-    let mut lateness = Lateness::default();
-    while !interrupted.load(Ordering::SeqCst) && o.frames.is_none_or(|n| frame <= n) {
-        let due = start + step.saturating_mul(u32::try_from(frame).unwrap_or(u32::MAX));
-        if let Some(wait) = due.checked_duration_since(Instant::now()) {
-            std::thread::sleep(wait);
-        }
-        lateness.add(Instant::now().saturating_duration_since(due));
-        let (inputs, resend) = {
-            let mut s = hub.lock();
-            (
-                std::mem::take(&mut s.inputs),
-                std::mem::take(&mut s.transforms_wanted),
-            )
-        };
-        for (client, text) in inputs {
-            if let Err(why) = session.input(&text)? {
-                hub.lock().tell(client, 2, &format!("input refused: {why}"));
-            }
-        }
-        if resend {
-            session.recorder().resend_transforms();
-        }
-        let t = session.next_frame().saturating_mul(dt_ns);
-        hub.lock().broadcast(&Message::binary(protocol::time(t)));
-        let out = session.step()?;
-        if session.sim().first_non_finite().is_some() {
-            out::error(&format!(
-                "error: frame {}: a value overflowed; stopping",
-                out.frame
-            ));
-            break;
-        }
-        frame += 1;
-    }
-    out::note(&format!(
-        "frame starts late against the real-time schedule: p50 {:.3} ms, p99 {:.3} ms, max {:.3} ms",
-        lateness.quantile(0.5),
-        lateness.quantile(0.99),
-        lateness.max_ms
-    ))?;
-    Ok(frame)
 }
 
 /// How late frames start, in a fixed histogram (bounded memory however long the server

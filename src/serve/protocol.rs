@@ -48,6 +48,99 @@ impl Channel {
     }
 }
 
+/// A service as `advertiseServices` lists it: JSON requests and responses, each with a
+/// JSON Schema.
+#[derive(Serialize, Debug, Clone)]
+pub struct Service {
+    /// The server's id for it.
+    pub id: u32,
+    /// Name, e.g. `/step`.
+    pub name: String,
+    /// Type name.
+    #[serde(rename = "type")]
+    pub kind: String,
+    /// What a request is.
+    pub request: ServiceSchema,
+    /// What a response is.
+    pub response: ServiceSchema,
+}
+
+/// The encoding and schema of a service's requests or responses.
+#[derive(Serialize, Debug, Clone)]
+#[serde(rename_all = "camelCase")]
+pub struct ServiceSchema {
+    /// `json`.
+    pub encoding: String,
+    /// Schema name.
+    pub schema_name: String,
+    /// `jsonschema`.
+    pub schema_encoding: String,
+    /// The JSON Schema.
+    pub schema: String,
+}
+
+impl ServiceSchema {
+    /// JSON described by the JSON Schema `schema`, named `name`.
+    pub fn json(name: &str, schema: &str) -> ServiceSchema {
+        ServiceSchema {
+            encoding: "json".to_owned(),
+            schema_name: name.to_owned(),
+            schema_encoding: "jsonschema".to_owned(),
+            schema: schema.to_owned(),
+        }
+    }
+}
+
+/// Binary opcode of a client's service call.
+pub const OP_SERVICE_CALL: u8 = 0x02;
+/// Binary opcode of the server's answer to a service call.
+pub const OP_SERVICE_RESPONSE: u8 = 0x03;
+
+/// A service call: service id, call id, encoding, payload.
+pub struct ServiceCall {
+    /// The service.
+    pub service: u32,
+    /// The client's id for the call.
+    pub call: u32,
+    /// The request.
+    pub payload: Vec<u8>,
+}
+
+/// Parses a binary service call (opcode, service id, call id, encoding length, encoding,
+/// payload); the encoding must be `json`.
+pub fn service_call(data: &[u8]) -> Result<ServiceCall, String> {
+    let u32_at = |i: usize| {
+        data.get(i..i + 4)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .ok_or("a service call cut short")
+    };
+    let (service, call, len) = (u32_at(1)?, u32_at(5)?, u32_at(9)? as usize);
+    let encoding = data.get(13..13 + len).ok_or("a service call cut short")?;
+    if encoding != b"json" {
+        return Err(format!(
+            "service calls are json, not {:?}",
+            String::from_utf8_lossy(encoding)
+        ));
+    }
+    Ok(ServiceCall {
+        service,
+        call,
+        payload: data[13 + len..].to_vec(),
+    })
+}
+
+/// The answer to a service call, in JSON.
+pub fn service_response(service: u32, call: u32, payload: &[u8]) -> Vec<u8> {
+    let mut out = Vec::with_capacity(17 + payload.len());
+    out.push(OP_SERVICE_RESPONSE);
+    out.extend_from_slice(&service.to_le_bytes());
+    out.extend_from_slice(&call.to_le_bytes());
+    out.extend_from_slice(&4u32.to_le_bytes());
+    out.extend_from_slice(b"json");
+    out.extend_from_slice(payload);
+    out
+}
+
 /// A JSON message from the server.
 #[derive(Serialize, Debug)]
 #[serde(tag = "op", rename_all = "camelCase")]
@@ -70,6 +163,21 @@ pub enum ServerMessage<'a> {
     Advertise {
         /// Every channel.
         channels: &'a [Channel],
+    },
+    /// The services clients may call.
+    AdvertiseServices {
+        /// Every service.
+        services: &'a [Service],
+    },
+    /// A service call that failed.
+    #[serde(rename_all = "camelCase")]
+    ServiceCallFailure {
+        /// The service.
+        service_id: u32,
+        /// The call.
+        call_id: u32,
+        /// Why.
+        message: &'a str,
     },
     /// A message for people: 0 info, 1 warning, 2 error.
     Status {

@@ -85,7 +85,7 @@ async fn client(
         (s.client_count() < MAX_CLIENTS).then(|| {
             let info = ServerMessage::ServerInfo {
                 name: "ricochet",
-                capabilities: &["time", "clientPublish"],
+                capabilities: &["time", "clientPublish", "services"],
                 supported_encodings: &["json"],
                 metadata: Default::default(),
                 session_id: session,
@@ -93,7 +93,10 @@ async fn client(
             let advertise = ServerMessage::Advertise {
                 channels: s.channels(),
             };
-            let hello = [info.json(), advertise.json()];
+            let services = ServerMessage::AdvertiseServices {
+                services: &super::services::list(),
+            };
+            let hello = [info.json(), advertise.json(), services.json()];
             (s.connect(queue.clone()), hello)
         })
     };
@@ -198,10 +201,17 @@ impl RateLimit {
     }
 }
 
-/// A binary message from a client: an input on its `/input` channel.
+/// A binary message from a client: an input on its `/input` channel, or a service call.
 fn publish(hub: &Hub, client: u64, data: &[u8], limit: &mut RateLimit) -> Result<(), String> {
+    if data.first() == Some(&protocol::OP_SERVICE_CALL) {
+        let call = protocol::service_call(data)?;
+        return hub.lock().call(client, call);
+    }
     if data.len() < 5 || data[0] != protocol::OP_CLIENT_MESSAGE {
-        return Err("a binary message that is not a client message (opcode 1)".to_owned());
+        return Err(
+            "a binary message that is neither a client message (opcode 1) nor a service call (2)"
+                .to_owned(),
+        );
     }
     if !limit.take() {
         return Err(format!(

@@ -1,0 +1,126 @@
+//! The services `ricochet serve` offers (Foxglove's Call Service panel, or any client of
+//! the protocol's `services` capability), JSON in and out:
+//!
+//! | service | request | what it does |
+//! |---|---|---|
+//! | `/pause` | `{}` | stops stepping (the clients still get the last state) |
+//! | `/play` | `{}` | steps again, in real time from now |
+//! | `/step` | `{"frames": N}` (default 1, at most 10,000) | pauses, then steps N frames at once |
+//! | `/reset` | `{}` | the scenario again from frame 0; a recording goes on in a new file |
+//! | `/load` | `{"scenario": "scenarios/level.toml"}` | another scenario file (a relative path, below the server's directory), from frame 0, likewise |
+//!
+//! Every response is `{"frame": F, "paused": P}` (the next frame, and whether stepping is
+//! paused), with `"recording": "FILE"` after a reset or load that started a new file.
+
+use serde::Deserialize;
+
+use super::protocol::{Service, ServiceSchema};
+
+/// A request the simulation loop carries out at the next frame boundary.
+#[derive(Debug)]
+pub enum Command {
+    /// Stop stepping.
+    Pause,
+    /// Step again.
+    Play,
+    /// Pause, then step this many frames.
+    Step(u64),
+    /// The scenario again.
+    Reset,
+    /// Another scenario.
+    Load(String),
+}
+
+/// At most this many frames in one `/step`.
+pub const MAX_STEP: u64 = 10_000;
+
+const NAMES: [&str; 5] = ["/pause", "/play", "/step", "/reset", "/load"];
+
+/// The services, ids 1 to 5.
+pub fn list() -> Vec<Service> {
+    let empty = r#"{"type": "object", "properties": {}}"#;
+    let response = r#"{"type": "object", "properties": {"frame": {"type": "integer"}, "paused": {"type": "boolean"}, "recording": {"type": "string"}}}"#;
+    let requests = [
+        empty,
+        empty,
+        r#"{"type": "object", "properties": {"frames": {"type": "integer", "minimum": 1}}}"#,
+        empty,
+        r#"{"type": "object", "properties": {"scenario": {"type": "string"}}, "required": ["scenario"]}"#,
+    ];
+    NAMES
+        .iter()
+        .zip(requests)
+        .enumerate()
+        .map(|(i, (name, request))| Service {
+            id: i as u32 + 1,
+            name: (*name).to_owned(),
+            kind: format!("ricochet{name}"),
+            request: ServiceSchema::json(&format!("ricochet{name}.Request"), request),
+            response: ServiceSchema::json("ricochet.ServiceResponse", response),
+        })
+        .collect()
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct StepRequest {
+    #[serde(default = "one")]
+    frames: u64,
+}
+
+fn one() -> u64 {
+    1
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LoadRequest {
+    scenario: String,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Empty {}
+
+/// The command a call to service `id` with `payload` asks for, or why it can't be.
+pub fn parse(id: u32, payload: &[u8]) -> Result<Command, String> {
+    let body = if payload.is_empty() {
+        b"{}".as_slice()
+    } else {
+        payload
+    };
+    let bad = |e: serde_json::Error| format!("bad request: {e}");
+    match id {
+        1 | 2 | 4 => {
+            serde_json::from_slice::<Empty>(body).map_err(bad)?;
+            Ok(match id {
+                1 => Command::Pause,
+                2 => Command::Play,
+                _ => Command::Reset,
+            })
+        }
+        3 => {
+            let r: StepRequest = serde_json::from_slice(body).map_err(bad)?;
+            if !(1..=MAX_STEP).contains(&r.frames) {
+                return Err(format!("frames must be 1 to {MAX_STEP}, got {}", r.frames));
+            }
+            Ok(Command::Step(r.frames))
+        }
+        5 => {
+            let r: LoadRequest = serde_json::from_slice(body).map_err(bad)?;
+            let path = std::path::Path::new(&r.scenario);
+            let inside = path.is_relative()
+                && path
+                    .components()
+                    .all(|c| matches!(c, std::path::Component::Normal(_)));
+            if !inside {
+                return Err(format!(
+                    "{:?}: a scenario is loaded by a relative path below the server's directory",
+                    r.scenario
+                ));
+            }
+            Ok(Command::Load(r.scenario))
+        }
+        other => Err(format!("no service {other}")),
+    }
+}
