@@ -549,3 +549,52 @@ fn services_pause_step_and_reset_and_each_recording_segment_replays() {
         );
     }
 }
+
+#[test]
+fn a_flood_of_inputs_is_rate_limited_and_the_server_keeps_time() {
+    let server = serve(&["--speed", "2"]);
+    runtime().block_on(async {
+        let (mut flood, _) = connect(&server.url, "foxglove.websocket.v1").await.unwrap();
+        let _ = next_json(&mut flood).await;
+        let _ = next_json(&mut flood).await;
+        let advertise = serde_json::json!({"op": "advertise", "channels": [
+            {"id": 9, "topic": "/input", "encoding": "json", "schemaName": "ricochet.Input"}]});
+        flood.send(Message::text(advertise.to_string())).await.unwrap();
+        let input = br#"{"action": "turn", "body": "ship", "input": 0.25}"#;
+        for _ in 0..6000 {
+            let mut data = vec![1u8];
+            data.extend_from_slice(&9u32.to_le_bytes());
+            data.extend_from_slice(input);
+            flood.feed(Message::binary(data)).await.unwrap();
+        }
+        flood.flush().await.unwrap();
+        // Past 2,000 a second, inputs are refused and the client told.
+        let status = next_json(&mut flood).await;
+        assert!(
+            status["message"].as_str().unwrap().contains("inputs a second"),
+            "{status}"
+        );
+        // Meanwhile another client gets every frame, on time.
+        let (mut good, _) = connect(&server.url, "foxglove.websocket.v1").await.unwrap();
+        let _ = next_json(&mut good).await;
+        let channels = next_json(&mut good).await;
+        let stats = channels["channels"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|c| c["topic"] == "/stats")
+            .unwrap()["id"]
+            .clone();
+        let subscribe = serde_json::json!({"op": "subscribe", "subscriptions": [{"id": 1, "channelId": stats}]});
+        good.send(Message::text(subscribe.to_string())).await.unwrap();
+        let started = std::time::Instant::now();
+        let mut frames = Vec::new();
+        while frames.len() < 60 {
+            let (_, _, payload) = next_data(&mut good).await;
+            frames.push(Stats::decode(payload.as_slice()).unwrap().frame);
+        }
+        assert!(frames.windows(2).all(|w| w[1] == w[0] + 1), "{frames:?}");
+        // 60 frames at twice real time take half a second; a stalled server would take longer.
+        assert!(started.elapsed() < Duration::from_secs(5), "{:?}", started.elapsed());
+    });
+}
