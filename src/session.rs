@@ -10,12 +10,10 @@
 //! input is recorded on `/input` at the frame it applies to, refused ones too: a replay
 //! refuses them again, with the same `/events` line.
 
-use ricochet_geom::Vec2;
 use ricochet_log::messages::ricochet::Input;
 use ricochet_log::messages::{Schema, fox::Log, fox::log::Level, timestamp};
 use ricochet_log::{ChannelId, LogError, MessageSink};
-use ricochet_sim::{Action, FrameOutput, Scenario, Simulation};
-use serde::Deserialize;
+use ricochet_sim::{ActionFile, FrameOutput, Scenario, Simulation};
 
 use crate::channels::Channels;
 use crate::record::Recorder;
@@ -25,67 +23,6 @@ pub const MAX_INPUT: usize = 4096;
 
 /// The name of the attachment that holds a session's scenario.
 pub const SCENARIO_ATTACHMENT: &str = "scenario.toml";
-
-fn yes() -> bool {
-    true
-}
-
-/// An input as clients send it (the script's actions, by body name).
-#[derive(Deserialize, Debug)]
-#[serde(tag = "action", rename_all = "snake_case", deny_unknown_fields)]
-enum InputText {
-    Destroy {
-        body: String,
-    },
-    SetVelocity {
-        body: String,
-        velocity: [f64; 2],
-    },
-    ApplyImpulse {
-        body: String,
-        impulse: [f64; 2],
-    },
-    SetForce {
-        body: String,
-        force: [f64; 2],
-    },
-    Thrust {
-        body: String,
-        #[serde(default = "yes")]
-        on: bool,
-    },
-    Turn {
-        body: String,
-        input: f64,
-    },
-    Fire {
-        body: String,
-    },
-    Move {
-        body: String,
-        input: f64,
-    },
-    Jump {
-        body: String,
-    },
-}
-
-impl InputText {
-    fn split(self) -> (String, Action) {
-        let v = |a: [f64; 2]| Vec2::new(a[0], a[1]);
-        match self {
-            InputText::Destroy { body } => (body, Action::Destroy),
-            InputText::SetVelocity { body, velocity } => (body, Action::SetVelocity(v(velocity))),
-            InputText::ApplyImpulse { body, impulse } => (body, Action::ApplyImpulse(v(impulse))),
-            InputText::SetForce { body, force } => (body, Action::SetForce(v(force))),
-            InputText::Thrust { body, on } => (body, Action::Thrust(on)),
-            InputText::Turn { body, input } => (body, Action::Turn(input)),
-            InputText::Fire { body } => (body, Action::Fire),
-            InputText::Move { body, input } => (body, Action::Move(input)),
-            InputText::Jump { body } => (body, Action::Jump),
-        }
-    }
-}
 
 /// A scenario being stepped, its frames written to `S` with every input.
 pub struct Session<S: MessageSink> {
@@ -142,14 +79,17 @@ impl<S: MessageSink> Session<S> {
         if text.len() > MAX_INPUT {
             return Err(format!("{} bytes, more than {MAX_INPUT}", text.len()));
         }
-        let input: InputText = serde_json::from_str(text).map_err(|e| format!("{e}"))?;
-        let (body, action) = input.split();
+        // The script's actions, in JSON: the same type the scenario files' script reads.
+        let input: ActionFile = serde_json::from_str(text).map_err(|e| format!("{e}"))?;
+        let (body, action) = input
+            .body_action()
+            .ok_or("spawn is not taken as an input (yet): script it in the scenario")?;
         if let Some(field) = action.out_of_range() {
             return Err(format!("{}: {field} out of range", action.name()));
         }
         let e = self
             .sim
-            .entity_named(&body)
+            .entity_named(body)
             .ok_or_else(|| format!("no body named {body:?}"))?;
         self.sim.apply(e, action).map_err(|e| e.to_string())
     }

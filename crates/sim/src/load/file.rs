@@ -5,6 +5,8 @@
 use std::collections::BTreeMap;
 
 use ricochet_geom::ShapeDef;
+
+use crate::Action;
 use serde::Deserialize;
 use toml::Spanned;
 
@@ -300,4 +302,25 @@ pub enum ActionFile {
 
 fn yes() -> bool {
     true
+}
+
+impl ActionFile {
+    /// The body an action other than `spawn` names, and what it does to it; `None` for
+    /// `spawn`. Values are not checked here: see [`Action::out_of_range`].
+    #[must_use]
+    pub fn body_action(&self) -> Option<(&str, Action)> {
+        let v = |a: &[f64; 2]| ricochet_geom::Vec2::new(a[0], a[1]);
+        Some(match self {
+            ActionFile::Spawn { .. } => return None,
+            ActionFile::Destroy { body } => (body, Action::Destroy),
+            ActionFile::SetVelocity { body, velocity } => (body, Action::SetVelocity(v(velocity))),
+            ActionFile::ApplyImpulse { body, impulse } => (body, Action::ApplyImpulse(v(impulse))),
+            ActionFile::SetForce { body, force } => (body, Action::SetForce(v(force))),
+            ActionFile::Thrust { body, on } => (body, Action::Thrust(*on)),
+            ActionFile::Turn { body, input } => (body, Action::Turn(*input)),
+            ActionFile::Fire { body } => (body, Action::Fire),
+            ActionFile::Move { body, input } => (body, Action::Move(*input)),
+            ActionFile::Jump { body } => (body, Action::Jump),
+        })
+    }
 }

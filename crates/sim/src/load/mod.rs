@@ -5,7 +5,7 @@
 mod bodies;
 mod chunks;
 mod context;
-pub(crate) mod file;
+pub mod file;
 mod script;
 mod world;
 
