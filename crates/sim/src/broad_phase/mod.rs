@@ -43,18 +43,27 @@
 //! otherwise: with a million static tiles it costs what the moving bodies cost.
 //!
 //! # `Auto`
-//! Decided on every call from two counts only (deterministic, no timing):
+//! Decided on every call from counts and the layer table only (deterministic, no timing):
 //! - at most 32 bodies in all: `BruteForce` (at most 496 tests, no structure to keep);
 //! - at least as many static as moving bodies: `Grid` (tile maps: a static cell lookup is
 //!   `O(1)` where the static tree is `O(log n)`, and the static grid is built once);
-//! - otherwise `SortAndSweep` (moving crowds: the coherent sort costs about one pass over the
-//!   moving bodies, and unlike a grid it does not care how much body sizes vary).
+//! - a layer of at least [`CROWD`] moving bodies that interact with each other: `Grid` (a
+//!   crowd colliding among itself, like rain: one sort axis leaves thousands of bodies
+//!   sharing an x range to test against each other; `rain-10000` 3.5 -> 1.9 ms a frame);
+//! - otherwise `SortAndSweep` (moving crowds that only meet other layers, like asteroids
+//!   and bullets: the coherent sort costs about one pass over the moving bodies, and unlike
+//!   a grid it does not care how much body sizes vary; `asteroids-10000` 0.26 ms, against
+//!   0.62 with the grid).
 //!
 //! Each kind keeps its own structures, so a switch costs one build and nothing else.
 //!
 //! # Determinism
 //! Sorting uses `f64::total_cmp` with the body's key as the tie-break, so every order is a
 //! function of the current input; the output is sorted. No hashed collection, no clock.
+
+/// Moving bodies of one layer that interact with each other, from which `Auto` takes the
+/// grid (see the module docs).
+pub const CROWD: usize = 256;
 
 mod brute_force;
 mod fixed_grid;
@@ -327,9 +336,15 @@ impl BroadPhase {
         out.clear();
         let n_movers = self.movers.len();
         let n_statics = self.statics.keys.len();
+        let crowd = || {
+            self.mover_layers
+                .iter()
+                .any(|&l| interactions.interacts(l, l) && self.layer_movers(l).len() >= CROWD)
+        };
         let kind = match self.kind {
             BroadPhaseKind::Auto if n_movers + n_statics <= 32 => BroadPhaseKind::BruteForce,
             BroadPhaseKind::Auto if n_statics >= n_movers => BroadPhaseKind::Grid,
+            BroadPhaseKind::Auto if crowd() => BroadPhaseKind::Grid,
             BroadPhaseKind::Auto => BroadPhaseKind::SortAndSweep,
             k => k,
         };
