@@ -102,6 +102,13 @@ impl<S: MessageSink> Session<S> {
         Ok(out)
     }
 
+    /// Sends live viewers the whole current state: both scenes and every body's frame (after
+    /// a reset or a seek). Never recorded.
+    pub fn refresh_live(&mut self) -> Result<(), LogError> {
+        let frame = self.next.saturating_sub(1);
+        self.recorder.refresh_live(&self.sim, frame)
+    }
+
     /// The simulation.
     pub fn sim(&self) -> &Simulation {
         &self.sim

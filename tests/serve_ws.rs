@@ -470,7 +470,7 @@ async fn call(
 }
 
 #[test]
-fn services_pause_step_and_reset_and_each_recording_segment_replays() {
+fn services_pause_step_seek_and_reset_and_each_recording_segment_replays() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("session.mcap");
     let mut server = serve(&["--speed", "4", "--record", out.to_str().unwrap()]);
@@ -520,6 +520,34 @@ fn services_pause_step_and_reset_and_each_recording_segment_replays() {
         );
         call(&mut ws, &services, "/play", 6, "{}").await.unwrap();
         tokio::time::sleep(Duration::from_millis(300)).await;
+        // Seek back: the session again from frame 0 to frame 5, in a new file; forward: steps.
+        call(&mut ws, &services, "/pause", 7, "{}").await.unwrap();
+        let back = call(&mut ws, &services, "/seek", 8, r#"{"frame": 5}"#)
+            .await
+            .unwrap();
+        assert_eq!(back["frame"], 5);
+        assert!(
+            back["recording"]
+                .as_str()
+                .unwrap()
+                .ends_with("session-2.mcap"),
+            "{back}"
+        );
+        let forward = call(&mut ws, &services, "/seek", 9, r#"{"frame": 40}"#)
+            .await
+            .unwrap();
+        assert_eq!(forward["frame"], 40);
+        assert!(forward.get("recording").is_none(), "{forward}");
+        let fast = call(&mut ws, &services, "/speed", 10, r#"{"speed": 2.5}"#)
+            .await
+            .unwrap();
+        assert_eq!(fast["frame"], 40);
+        let bad = call(&mut ws, &services, "/speed", 11, r#"{"speed": 0}"#)
+            .await
+            .unwrap_err();
+        assert!(bad.contains("speed"), "{bad}");
+        call(&mut ws, &services, "/play", 12, "{}").await.unwrap();
+        tokio::time::sleep(Duration::from_millis(200)).await;
     });
     let pid = server.child.id().to_string();
     assert!(
@@ -530,7 +558,7 @@ fn services_pause_step_and_reset_and_each_recording_segment_replays() {
             .success()
     );
     assert!(server.child.wait().unwrap().success());
-    for file in ["session.mcap", "session-1.mcap"] {
+    for file in ["session.mcap", "session-1.mcap", "session-2.mcap"] {
         let recorded = dir.path().join(file);
         let replayed = dir.path().join(format!("{file}.replay"));
         let o = Command::new(env!("CARGO_BIN_EXE_ricochet"))

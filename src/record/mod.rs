@@ -149,6 +149,37 @@ impl<S: MessageSink> Recorder<S> {
         self.dt_ns
     }
 
+    /// Sends live viewers the whole state at `frame`: `/scene/static`, `/scene` and every
+    /// body's frame on `/tf` (never recorded: see [`MessageSink::write_live`]).
+    pub fn refresh_live(&mut self, sim: &Simulation, frame: u64) -> Result<(), LogError> {
+        let t = frame * self.dt_ns;
+        let ts = timestamp(t);
+        let w = sim.world();
+        if let Some(ch) = self.topics.statics {
+            self.writer
+                .write_live(ch, t, scene::snapshot(drawings(w, true), ts))?;
+        }
+        if let Some(ch) = self.topics.scene {
+            self.writer
+                .write_live(ch, t, scene::snapshot(drawings(w, false), ts))?;
+        }
+        if let Some(ch) = self.topics.tf {
+            let transforms = (0..w.len())
+                .map(|i| {
+                    let angle = if scene::upright(&w.shape[i]) {
+                        0.0
+                    } else {
+                        w.angle[i]
+                    };
+                    scene::transform(&scene::entity_id(w.entity[i]), ts, w.position[i], angle)
+                })
+                .collect();
+            self.writer
+                .write_live(ch, t, FrameTransforms { transforms })?;
+        }
+        Ok(())
+    }
+
     /// Sends every body's pose on `/tf` in the next frame (a live viewer that just
     /// subscribed knows none).
     pub fn resend_transforms(&mut self) {
@@ -198,18 +229,7 @@ impl<S: MessageSink> Recorder<S> {
             let mut changes = self
                 .tracker
                 .frame(w, out, layers, self.dt, self.dt_ns, want_bodies);
-            let drawings = |statics: bool| {
-                (0..w.len())
-                    .filter(move |&i| (w.kind[i] == BodyKind::Static) == statics)
-                    .map(|i| scene::BodyDrawing {
-                        entity: w.entity[i],
-                        name: &w.name[i],
-                        shape: &w.shape[i],
-                        angle: w.angle[i],
-                        layer: w.layer[i],
-                        kind: w.kind[i],
-                    })
-            };
+            let drawings = |statics: bool| drawings(w, statics);
             if let (Some(ch), true) = (self.topics.statics, changes.static_changed) {
                 self.writer
                     .write(ch, t, scene::snapshot(drawings(true), ts))?;
@@ -262,6 +282,23 @@ impl<S: MessageSink> Recorder<S> {
         }
         Ok(())
     }
+}
+
+/// The bodies to draw: the static ones, or the moving ones.
+fn drawings(
+    w: &ricochet_sim::World,
+    statics: bool,
+) -> impl Iterator<Item = scene::BodyDrawing<'_>> {
+    (0..w.len())
+        .filter(move |&i| (w.kind[i] == BodyKind::Static) == statics)
+        .map(|i| scene::BodyDrawing {
+            entity: w.entity[i],
+            name: &w.name[i],
+            shape: &w.shape[i],
+            angle: w.angle[i],
+            layer: w.layer[i],
+            kind: w.kind[i],
+        })
 }
 
 /// `/contacts`: every contact of the frame with the poses it was found at.

@@ -36,6 +36,8 @@ struct ServeSink {
     live: LiveSink,
     /// The recording, with its channel for each live channel id.
     file: Option<(LogWriter, Vec<ChannelId>)>,
+    /// While a seek re-simulates: the recording gets every frame, the clients none.
+    muted: bool,
 }
 
 impl MessageSink for ServeSink {
@@ -57,6 +59,9 @@ impl MessageSink for ServeSink {
             let id = ids[usize::from(channel.index()) - 1];
             file.write(id, time_ns, message.clone())?;
         }
+        if self.muted {
+            return Ok(());
+        }
         self.live.write(channel, time_ns, message)
     }
 
@@ -66,6 +71,9 @@ impl MessageSink for ServeSink {
         time_ns: u64,
         message: M,
     ) -> Result<(), LogError> {
+        if self.muted {
+            return Ok(());
+        }
         self.live.write(channel, time_ns, message)
     }
 }
@@ -107,6 +115,7 @@ fn start(
     let sink = ServeSink {
         live: LiveSink::new(hub.clone()),
         file,
+        muted: false,
     };
     Ok(Session::new(scenario, sink, true)?)
 }
@@ -197,6 +206,8 @@ pub fn run(o: &Options) -> anyhow::Result<ExitCode> {
         scenario,
         text,
         segment: 0,
+        inputs: Vec::new(),
+        speed: o.speed,
     };
     let frames = run_loop(&mut serving, &hub, o, &interrupted)?;
     finish(serving.session)?;
@@ -215,6 +226,10 @@ struct Serving {
     scenario: ricochet_sim::Scenario,
     text: String,
     segment: u32,
+    /// This session's inputs with their frames, for a seek back.
+    inputs: Vec<(u64, String)>,
+    /// Simulation seconds per wall second (`/speed`).
+    speed: f64,
 }
 
 impl Serving {
@@ -247,12 +262,32 @@ impl Serving {
                         }
                     }
                 }
-                self.segment += u32::from(o.record.is_some());
-                let next = start(&self.scenario, &self.text, hub, o.record, self.segment)?;
-                finish(std::mem::replace(&mut self.session, next))?;
-                recording = o
-                    .record
-                    .map(|p| segment(p, self.segment).display().to_string());
+                recording = self.restart(hub, o)?;
+                self.inputs.clear();
+                self.refresh()?;
+            }
+            services::Command::Speed(x) => self.speed = x,
+            services::Command::Seek(target) => {
+                let next = self.session.next_frame();
+                if target < next {
+                    // Back: the session again from frame 0, with the inputs before `target`.
+                    recording = self.restart(hub, o)?;
+                    self.inputs.retain(|(f, _)| *f < target);
+                }
+                self.session.recorder().sink_mut().muted = true;
+                let inputs = std::mem::take(&mut self.inputs);
+                let from = self.session.next_frame();
+                let mut pending = inputs.iter().filter(|(f, _)| *f >= from).peekable();
+                while self.session.next_frame() < target {
+                    let at = self.session.next_frame();
+                    while let Some((_, text)) = pending.next_if(|(f, _)| *f == at) {
+                        let _ = self.session.input(text)?;
+                    }
+                    self.session.step()?;
+                }
+                self.inputs = inputs;
+                self.session.recorder().sink_mut().muted = false;
+                self.refresh()?;
             }
         }
         let mut response = serde_json::json!({
@@ -263,6 +298,22 @@ impl Serving {
             response["recording"] = serde_json::Value::String(file);
         }
         Ok(Ok(response.to_string()))
+    }
+
+    /// A new session of the current scenario from frame 0 (a new recording segment);
+    /// returns the new recording's file.
+    fn restart(&mut self, hub: &Hub, o: &Options) -> anyhow::Result<Option<String>> {
+        self.segment += u32::from(o.record.is_some());
+        let next = start(&self.scenario, &self.text, hub, o.record, self.segment)?;
+        finish(std::mem::replace(&mut self.session, next))?;
+        Ok(o.record
+            .map(|p| segment(p, self.segment).display().to_string()))
+    }
+
+    /// The clients are sent the whole current state (after a reset, load or seek).
+    fn refresh(&mut self) -> anyhow::Result<()> {
+        self.session.refresh_live()?;
+        Ok(())
     }
 
     /// One frame: the clients' inputs, then the step.
@@ -276,6 +327,7 @@ impl Serving {
             )
         };
         for (client, text) in inputs {
+            self.inputs.push((self.session.next_frame(), text.clone()));
             if let Err(why) = self.session.input(&text)? {
                 hub.lock().tell(client, 2, &format!("input refused: {why}"));
             }
@@ -301,7 +353,6 @@ fn run_loop(
     o: &Options,
     interrupted: &AtomicBool,
 ) -> anyhow::Result<u64> {
-    let step = Duration::from_secs_f64(serving.scenario.world.dt / o.speed);
     // The schedule: frame `anchor.1 + n` starts at `anchor.0 + n * step`; moved when stepping
     // pauses, resumes, or starts over.
     let mut anchor = (Instant::now(), 0u64);
@@ -324,6 +375,7 @@ fn run_loop(
             continue;
         }
         let n = u32::try_from(frames - anchor.1).unwrap_or(u32::MAX);
+        let step = Duration::from_secs_f64(serving.scenario.world.dt / serving.speed);
         let due = anchor.0 + step.saturating_mul(n);
         if let Some(wait) = due.checked_duration_since(Instant::now()) {
             std::thread::sleep(wait);

@@ -8,6 +8,8 @@
 //! | `/step` | `{"frames": N}` (default 1, at most 10,000) | pauses, then steps N frames at once |
 //! | `/reset` | `{}` | the scenario again from frame 0; a recording goes on in a new file |
 //! | `/load` | `{"scenario": "scenarios/level.toml"}` | another scenario file (a relative path, below the server's directory), from frame 0, likewise |
+//! | `/seek` | `{"frame": N}` | to frame N: forward by stepping at once, back by stepping again from frame 0 with the inputs before N (a recording goes on in a new file that holds frames 0 to N too, so it replays on its own) |
+//! | `/speed` | `{"speed": X}` | simulation seconds per wall second, from now (0.01 to 100) |
 //!
 //! Every response is `{"frame": F, "paused": P}` (the next frame, and whether stepping is
 //! paused), with `"recording": "FILE"` after a reset or load that started a new file.
@@ -29,14 +31,20 @@ pub enum Command {
     Reset,
     /// Another scenario.
     Load(String),
+    /// To this frame.
+    Seek(u64),
+    /// Simulation seconds per wall second.
+    Speed(f64),
 }
 
 /// At most this many frames in one `/step`.
 pub const MAX_STEP: u64 = 10_000;
 
-const NAMES: [&str; 5] = ["/pause", "/play", "/step", "/reset", "/load"];
+const NAMES: [&str; 7] = [
+    "/pause", "/play", "/step", "/reset", "/load", "/seek", "/speed",
+];
 
-/// The services, ids 1 to 5.
+/// The services, ids 1 to 7.
 pub fn list() -> Vec<Service> {
     let empty = r#"{"type": "object", "properties": {}}"#;
     let response = r#"{"type": "object", "properties": {"frame": {"type": "integer"}, "paused": {"type": "boolean"}, "recording": {"type": "string"}}}"#;
@@ -46,6 +54,8 @@ pub fn list() -> Vec<Service> {
         r#"{"type": "object", "properties": {"frames": {"type": "integer", "minimum": 1}}}"#,
         empty,
         r#"{"type": "object", "properties": {"scenario": {"type": "string"}}, "required": ["scenario"]}"#,
+        r#"{"type": "object", "properties": {"frame": {"type": "integer", "minimum": 0}}, "required": ["frame"]}"#,
+        r#"{"type": "object", "properties": {"speed": {"type": "number"}}, "required": ["speed"]}"#,
     ];
     NAMES
         .iter()
@@ -81,6 +91,18 @@ struct LoadRequest {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct Empty {}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SeekRequest {
+    frame: u64,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SpeedRequest {
+    speed: f64,
+}
 
 /// The command a call to service `id` with `payload` asks for, or why it can't be.
 pub fn parse(id: u32, payload: &[u8]) -> Result<Command, String> {
@@ -120,6 +142,23 @@ pub fn parse(id: u32, payload: &[u8]) -> Result<Command, String> {
                 ));
             }
             Ok(Command::Load(r.scenario))
+        }
+        6 => {
+            let r: SeekRequest = serde_json::from_slice(body).map_err(bad)?;
+            if r.frame > ricochet_sim::MAX_FRAMES {
+                return Err(format!(
+                    "frame {} is past the last frame a log can hold",
+                    r.frame
+                ));
+            }
+            Ok(Command::Seek(r.frame))
+        }
+        7 => {
+            let r: SpeedRequest = serde_json::from_slice(body).map_err(bad)?;
+            if !(r.speed.is_finite() && (0.01..=100.0).contains(&r.speed)) {
+                return Err(format!("speed must be 0.01 to 100, got {}", r.speed));
+            }
+            Ok(Command::Speed(r.speed))
         }
         other => Err(format!("no service {other}")),
     }

@@ -3,7 +3,8 @@
 // Usage: node tests/node/client.mjs ws://127.0.0.1:PORT
 // Connects; checks the server info and every advertised channel (protobuf, with a schema);
 // subscribes to /stats and /scene and checks that /stats frames arrive in order; publishes
-// inputs on /input (two applied, one refused and answered with a status); disconnects.
+// inputs on /input (two applied, one refused and answered with a status); calls the
+// services /pause, /step, /seek (back) and /reset and checks their answers; disconnects.
 // Exits 1 with a message on any failure; prints a summary line on success.
 
 import wsProtocol from "@foxglove/ws-protocol";
@@ -50,6 +51,28 @@ client.on("serverInfo", (i) => {
   if (!i.capabilities.includes("clientPublish")) fail(`capabilities ${i.capabilities}`);
 });
 client.on("status", (s) => statuses.push(s));
+let services = [];
+client.on("advertiseServices", (list) => (services = services.concat(list)));
+const answers = new Map();
+client.on("serviceCallResponse", (r) => {
+  const text = new TextDecoder().decode(new Uint8Array(r.data.buffer, r.data.byteOffset, r.data.byteLength));
+  answers.get(r.callId)?.resolve(JSON.parse(text));
+});
+client.on("serviceCallFailure", (f) => answers.get(f.callId)?.reject(new Error(f.message)));
+let nextCall = 1;
+function callService(name, request) {
+  const service = services.find((s) => s.name === name);
+  if (!service) fail(`no service ${name}: ${services.map((s) => s.name)}`);
+  const callId = nextCall++;
+  const answer = new Promise((resolve, reject) => answers.set(callId, { resolve, reject }));
+  client.sendServiceCallRequest({
+    serviceId: service.id,
+    callId,
+    encoding: "json",
+    data: new TextEncoder().encode(JSON.stringify(request)),
+  });
+  return answer;
+}
 client.on("advertise", (list) => {
   channels = channels.concat(list);
   const topics = channels.map((c) => c.topic);
@@ -79,8 +102,22 @@ function publish() {
   send({ action: "thrust", body: "ship", on: true });
   send({ action: "turn", body: "ship", input: -0.5 });
   send({ action: "jump", body: "no such body" });
-  setTimeout(finish, 1000);
+  setTimeout(() => services_().then(finish, (e) => fail(`services: ${e.message}`)), 1000);
 }
+
+async function services_() {
+  const paused = await callService("/pause", {});
+  if (paused.paused !== true) fail(`/pause answered ${JSON.stringify(paused)}`);
+  const stepped = await callService("/step", { frames: 5 });
+  if (stepped.frame !== paused.frame + 5) fail(`/step 5 from ${paused.frame} answered ${JSON.stringify(stepped)}`);
+  const back = await callService("/seek", { frame: 10 });
+  if (back.frame !== 10 || !back.recording) fail(`/seek 10 answered ${JSON.stringify(back)}`);
+  const reset = await callService("/reset", {});
+  if (reset.frame !== 0) fail(`/reset answered ${JSON.stringify(reset)}`);
+  await callService("/play", {});
+  servicesDone = `services: paused at ${paused.frame}, stepped to ${stepped.frame}, sought back to ${back.frame}, reset to ${reset.frame}`;
+}
+let servicesDone = "";
 
 function finish() {
   for (let i = 1; i < frames.length; i++) {
@@ -92,7 +129,7 @@ function finish() {
   }
   console.log(
     `node client: ok: ${info.name}, ${channels.length} channels, ${frames.length} /stats frames ` +
-      `(${frames[0]}..${frames[frames.length - 1]}), ${scenes} /scene, 3 inputs sent, 1 refused`,
+      `(${frames[0]}..${frames[frames.length - 1]}), ${scenes} /scene, 3 inputs sent, 1 refused; ${servicesDone}`,
   );
   client.close();
   process.exit(0);
