@@ -112,6 +112,9 @@ enum Command {
         /// Also record the session to this MCAP file, as `run` writes one.
         #[arg(long, value_name = "OUT.mcap")]
         record: Option<PathBuf>,
+        /// Start paused: frame 0 is shown; the /play or /step service goes on.
+        #[arg(long)]
+        paused: bool,
     },
     /// Step a session recorded by `serve --record` again, from the scenario and the inputs
     /// it carries, into a new log; exit code 0 if it is byte-identical to the recording.
@@ -293,12 +296,14 @@ fn main() -> ExitCode {
             speed,
             frames,
             record,
+            paused,
         } => serve::run(&serve::Options {
             scenario: scenario.as_deref(),
             bind: &bind,
             speed,
             frames,
             record: record.as_deref(),
+            paused,
         }),
         Command::Replay { session, output } => replay::run(&session, output),
         Command::Dump { log, topic, frames } => {

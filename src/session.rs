@@ -5,15 +5,18 @@
 //! An input is JSON, the script's actions addressed by body name:
 //! `{"action": "thrust", "body": "ship", "on": true}`, `{"action": "turn", "body": "ship",
 //! "input": -0.5}`, `fire`, `move` (`input`), `jump`, `set_velocity` (`velocity: [x, y]`),
-//! `apply_impulse` (`impulse`), `set_force` (`force`), `destroy`. It is applied at the next
+//! `apply_impulse` (`impulse`), `set_force` (`force`), `destroy`, and `spawn` (`template`,
+//! `position`, optional `name`, `velocity`, `angle`: a body from one of the scenario's
+//! templates). It is applied at the next
 //! frame boundary (the step that follows), inputs of one frame in the order they came. Every
 //! input is recorded on `/input` at the frame it applies to, refused ones too: a replay
 //! refuses them again, with the same `/events` line.
 
+use ricochet_geom::Vec2;
 use ricochet_log::messages::ricochet::Input;
 use ricochet_log::messages::{Schema, fox::Log, fox::log::Level, timestamp};
 use ricochet_log::{ChannelId, LogError, MessageSink};
-use ricochet_sim::{ActionFile, FrameOutput, Scenario, Simulation};
+use ricochet_sim::{ActionFile, BodyKind, FrameOutput, Scenario, Simulation};
 
 use crate::channels::Channels;
 use crate::record::Recorder;
@@ -81,9 +84,19 @@ impl<S: MessageSink> Session<S> {
         }
         // The script's actions, in JSON: the same type the scenario files' script reads.
         let input: ActionFile = serde_json::from_str(text).map_err(|e| format!("{e}"))?;
-        let (body, action) = input
-            .body_action()
-            .ok_or("spawn is not taken as an input (yet): script it in the scenario")?;
+        if let ActionFile::Spawn {
+            template,
+            name,
+            position,
+            velocity,
+            angle,
+        } = &input
+        {
+            return self.spawn(template, name.as_deref(), *position, *velocity, *angle);
+        }
+        let Some((body, action)) = input.body_action() else {
+            return Err("an action that names no body".to_owned());
+        };
         if let Some(field) = action.out_of_range() {
             return Err(format!("{}: {field} out of range", action.name()));
         }
@@ -92,6 +105,46 @@ impl<S: MessageSink> Session<S> {
             .entity_named(body)
             .ok_or_else(|| format!("no body named {body:?}"))?;
         self.sim.apply(e, action).map_err(|e| e.to_string())
+    }
+
+    /// A body from the scenario's template `template`, as the script's `spawn` makes one; it
+    /// is in the world for the next step.
+    fn spawn(
+        &mut self,
+        template: &str,
+        name: Option<&str>,
+        position: [f64; 2],
+        velocity: Option<[f64; 2]>,
+        angle: Option<f64>,
+    ) -> Result<(), String> {
+        let Some(base) = self.sim.scenario().templates.get(template) else {
+            let known: Vec<&String> = self.sim.scenario().templates.keys().collect();
+            return Err(format!(
+                "no template {template:?} (the scenario has {known:?})"
+            ));
+        };
+        let mut def = base.clone();
+        if let Some(n) = name {
+            def.name = n.to_owned();
+        }
+        let finite = |v: [f64; 2]| v[0].is_finite() && v[1].is_finite();
+        if !finite(position) || !velocity.is_none_or(finite) || !angle.is_none_or(f64::is_finite) {
+            return Err("spawn: position, velocity and angle must be finite".to_owned());
+        }
+        def.position = Vec2::new(position[0], position[1]);
+        if let Some(v) = velocity {
+            if def.kind == BodyKind::Static {
+                return Err(format!(
+                    "spawn: template {template:?} is static: it can't move"
+                ));
+            }
+            def.velocity = Vec2::new(v[0], v[1]);
+        }
+        if let Some(a) = angle {
+            def.angle = a;
+        }
+        self.sim.spawn(&def);
+        Ok(())
     }
 
     /// Steps one frame and records it.

@@ -291,6 +291,7 @@ fn inputs_from_a_client_are_applied_recorded_and_replayed_byte_for_byte() {
             r#"{"action": "thrust", "body": "ship", "on": true}"#,
             r#"{"action": "turn", "body": "ship", "input": 0.5}"#,
             r#"{"action": "fire", "body": "ship"}"#,
+            r#"{"action": "spawn", "template": "asteroid_small", "name": "visitor", "position": [5.0, 5.0], "velocity": [1.0, 0.0]}"#,
             r#"{"action": "fire", "body": "nobody"}"#,
             r#"{"action": "warp", "body": "ship"}"#,
         ] {
@@ -324,7 +325,17 @@ fn inputs_from_a_client_are_applied_recorded_and_replayed_byte_for_byte() {
         .filter(|m| m.topic == "/input")
         .map(|m| &m.data)
         .collect();
-    assert_eq!(inputs.len(), 5, "every input recorded, refused ones too");
+    assert_eq!(inputs.len(), 6, "every input recorded, refused ones too");
+    // The spawned body is in /bodies from the next frame on.
+    let full = crate::util::full_bodies(&log);
+    assert!(
+        full.iter().any(|f| f["bodies"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|b| b["name"] == "visitor")),
+        "the spawned body"
+    );
     assert!(log.iter().any(|m| {
         m.topic == "/events"
             && m.data["message"]
@@ -624,5 +635,25 @@ fn a_flood_of_inputs_is_rate_limited_and_the_server_keeps_time() {
         assert!(frames.windows(2).all(|w| w[1] == w[0] + 1), "{frames:?}");
         // 60 frames at twice real time take half a second; a stalled server would take longer.
         assert!(started.elapsed() < Duration::from_secs(5), "{:?}", started.elapsed());
+    });
+}
+
+#[test]
+fn paused_serves_frame_0_and_steps_only_when_asked() {
+    let server = serve(&["--paused"]);
+    runtime().block_on(async {
+        let (mut ws, _) = connect(&server.url, "foxglove.websocket.v1").await.unwrap();
+        let _ = any_json(&mut ws).await;
+        let _ = any_json(&mut ws).await;
+        let services = any_json(&mut ws).await;
+        tokio::time::sleep(Duration::from_millis(300)).await;
+        // Paused after frame 0: the next frame is 1, however long we waited.
+        let stepped = call(&mut ws, &services, "/step", 1, r#"{"frames": 2}"#)
+            .await
+            .unwrap();
+        assert_eq!(
+            (stepped["frame"].as_u64(), stepped["paused"].as_bool()),
+            (Some(3), Some(true))
+        );
     });
 }

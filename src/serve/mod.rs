@@ -140,6 +140,8 @@ pub struct Options<'a> {
     pub frames: Option<u64>,
     /// Also write the log here.
     pub record: Option<&'a Path>,
+    /// Start paused (the clients see frame 0; `/play` or `/step` goes on).
+    pub paused: bool,
 }
 
 /// Runs `ricochet serve`. Exit code 0 when stopped (Ctrl-C, SIGTERM, `--frames`), 2 for bad
@@ -357,8 +359,13 @@ fn run_loop(
     // pauses, resumes, or starts over.
     let mut anchor = (Instant::now(), 0u64);
     let mut frames = 0u64;
-    let mut paused = false;
+    let mut paused = o.paused;
     let mut lateness = Lateness::default();
+    if paused {
+        // Frame 0 for the clients to see while paused.
+        serving.frame(hub)?;
+        frames += 1;
+    }
     while !interrupted.load(Ordering::SeqCst) && o.frames.is_none_or(|n| frames <= n) {
         let calls = std::mem::take(&mut hub.lock().calls);
         for (client, call) in calls {
@@ -370,6 +377,10 @@ fn run_loop(
             anchor = (Instant::now(), frames);
         }
         if paused {
+            // A viewer that subscribes to /tf while nothing steps gets the state at once.
+            if std::mem::take(&mut hub.lock().transforms_wanted) {
+                serving.refresh()?;
+            }
             std::thread::sleep(Duration::from_millis(5));
             anchor = (Instant::now(), frames);
             continue;
