@@ -84,6 +84,7 @@ pub use entity::{Entity, EntityAllocator};
 pub use event::{FireOutcome, GameEvent, JumpOutcome, Removal, ScriptInput};
 #[cfg(feature = "toml")]
 pub use load::file::ActionFile;
+#[cfg(feature = "toml")]
 pub use load::{ScenarioError, load_scenario};
 pub use output::{ContactRecord, FrameOutput, Phase, RemovedBody, Stats};
 pub use pipeline::Simulation;
