@@ -140,7 +140,7 @@ fn a_client_of_either_subprotocol_gets_the_channels_and_decodable_messages() {
             assert_eq!(info["op"], "serverInfo");
             assert_eq!(
                 info["capabilities"],
-                serde_json::json!(["time", "clientPublish", "services"])
+                serde_json::json!(["time", "clientPublish", "services", "playbackControl"])
             );
             let advertise = next_json(&mut ws).await;
             assert_eq!(advertise["op"], "advertise");
@@ -656,4 +656,66 @@ fn paused_serves_frame_0_and_steps_only_when_asked() {
             (Some(3), Some(true))
         );
     });
+}
+
+#[test]
+fn playback_control_pauses_seeks_and_plays_and_every_client_is_told_the_state() {
+    let server = serve(&["--speed", "2"]);
+    runtime().block_on(async {
+        let (mut ws, _) = connect(&server.url, "foxglove.sdk.v1").await.unwrap();
+        let info = any_json(&mut ws).await;
+        assert!(
+            info["capabilities"]
+                .as_array()
+                .unwrap()
+                .contains(&"playbackControl".into())
+        );
+        // The timeline: frame 0 to the scenario's last (600 frames at 60 Hz).
+        assert_eq!(
+            info["dataStartTime"],
+            serde_json::json!({"sec": 0, "nsec": 0})
+        );
+        assert_eq!(
+            info["dataEndTime"],
+            serde_json::json!({"sec": 10, "nsec": 200})
+        );
+        // Pause, seeking to 1 s (frame 60), as the SDK encodes a PlaybackControlRequest.
+        let request = |play: bool, seek: Option<u64>, id: &str| {
+            let mut data = vec![3u8, u8::from(!play)];
+            data.extend_from_slice(&1.0f32.to_le_bytes());
+            data.push(u8::from(seek.is_some()));
+            data.extend_from_slice(&seek.unwrap_or(0).to_le_bytes());
+            data.extend_from_slice(&(id.len() as u32).to_le_bytes());
+            data.extend_from_slice(id.as_bytes());
+            Message::binary(data)
+        };
+        ws.send(request(false, Some(1_000_000_000), "a"))
+            .await
+            .unwrap();
+        let (status, time, sought, id) = playback_state(&mut ws).await;
+        assert_eq!((status, sought, id.as_str()), (1, 1, "a"), "paused, sought");
+        assert_eq!(time, 59 * 16_666_667, "the frame at or before 1 s");
+        ws.send(request(true, None, "b")).await.unwrap();
+        let (status, _, sought, id) = playback_state(&mut ws).await;
+        assert_eq!((status, sought, id.as_str()), (0, 0, "b"), "playing");
+    });
+}
+
+/// The next playback state: (status, time, whether it sought, request id).
+async fn playback_state(ws: &mut Ws) -> (u8, u64, u8, String) {
+    loop {
+        let m = tokio::time::timeout(Duration::from_secs(10), ws.next())
+            .await
+            .unwrap()
+            .unwrap()
+            .unwrap();
+        if let Message::Binary(b) = m
+            && b[0] == 5
+        {
+            let time = u64::from_le_bytes(b[2..10].try_into().unwrap());
+            let len = u32::from_le_bytes(b[15..19].try_into().unwrap()) as usize;
+            let id = String::from_utf8(b[19..19 + len].to_vec()).unwrap();
+            return (b[1], time, b[14], id);
+        }
+    }
 }

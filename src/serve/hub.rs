@@ -51,6 +51,10 @@ pub struct Shared {
     pub inputs: std::collections::VecDeque<(u64, String)>,
     /// Service calls in the order they came, with the client that made each.
     pub calls: std::collections::VecDeque<(u64, protocol::ServiceCall)>,
+    /// Playback-control requests in the order they came, with the client that made each.
+    pub playback: std::collections::VecDeque<(u64, protocol::PlaybackControl)>,
+    /// The timeline's end, ns (the scenario's last frame), for `serverInfo`.
+    pub data_end_ns: u64,
     /// Messages dropped for slow clients, in all.
     pub dropped: u64,
 }
@@ -182,6 +186,11 @@ impl Shared {
         }
         self.calls.push_back((client, call));
         Ok(())
+    }
+
+    /// Sends the playback state to every client.
+    pub fn playback_state(&mut self, state: Vec<u8>) {
+        self.broadcast(&Message::binary(state));
     }
 
     /// Answers `client`'s call: its JSON response, or why it failed.

@@ -192,6 +192,9 @@ pub fn run(o: &Options) -> anyhow::Result<ExitCode> {
         ))?;
     }
     let hub = Hub::default();
+    hub.lock().data_end_ns = scenario
+        .frames
+        .saturating_mul((scenario.world.dt * 1e9).round() as u64);
     let session = start(&scenario, &text, &hub, o.record, 0)?;
     let session_id = format!("ricochet-{}", scenario.name);
     let server_hub = hub.clone();
@@ -375,6 +378,40 @@ fn run_loop(
             };
             hub.lock().answer(client, call.service, call.call, result);
             anchor = (Instant::now(), frames);
+        }
+        let requests = std::mem::take(&mut hub.lock().playback);
+        for (client, request) in requests {
+            // Foxglove's timeline: seek (to the frame at or before the time), speed, play or
+            // pause; every client is told the state that results.
+            let mut sought = false;
+            if let Some(ns) = request.seek {
+                let dt_ns = serving.session.recorder().dt_ns().max(1);
+                // Shown: the frame at or before the time (so the next one is after it).
+                let command = services::Command::Seek(ns / dt_ns + 1);
+                if let Err(why) = serving.command(command, hub, o, &mut paused)? {
+                    hub.lock().tell(client, 2, &why);
+                }
+                sought = true;
+            }
+            let speed = f64::from(request.speed);
+            if speed.is_finite() && (0.01..=100.0).contains(&speed) {
+                serving.speed = speed;
+            }
+            paused = !request.play;
+            anchor = (Instant::now(), frames);
+            let t = serving
+                .session
+                .next_frame()
+                .saturating_sub(1)
+                .saturating_mul(serving.session.recorder().dt_ns());
+            let state = protocol::playback_state(
+                request.play,
+                t,
+                serving.speed as f32,
+                sought,
+                &request.request_id,
+            );
+            hub.lock().playback_state(state);
         }
         if paused {
             // A viewer that subscribes to /tf while nothing steps gets the state at once.

@@ -141,6 +141,90 @@ pub fn service_response(service: u32, call: u32, payload: &[u8]) -> Vec<u8> {
     out
 }
 
+/// Binary opcode of a client's playback-control request (`playbackControl`, as the Foxglove
+/// SDK's protocol defines it).
+pub const OP_PLAYBACK_CONTROL: u8 = 0x03;
+/// Binary opcode of the server's playback state.
+pub const OP_PLAYBACK_STATE: u8 = 0x05;
+
+/// A playback-control request: play or pause, at a speed, maybe seeking first.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlaybackControl {
+    /// Play (else pause).
+    pub play: bool,
+    /// Playback speed, wall seconds of data per second.
+    pub speed: f32,
+    /// Seek to this time first (ns).
+    pub seek: Option<u64>,
+    /// The client's id for the request, sent back with the state.
+    pub request_id: String,
+}
+
+/// Parses a playback-control request: opcode, command (0 play, 1 pause), speed (f32),
+/// whether it seeks (u8) and to when (u64 ns), the request id (u32 length, UTF-8).
+pub fn playback_control(data: &[u8]) -> Result<PlaybackControl, String> {
+    let short = || "a playback-control request cut short".to_owned();
+    if data.len() < 1 + 1 + 4 + 1 + 8 + 4 {
+        return Err(short());
+    }
+    let play = match data[1] {
+        0 => true,
+        1 => false,
+        other => return Err(format!("playback command {other}: 0 is play, 1 pause")),
+    };
+    let speed = f32::from_le_bytes([data[2], data[3], data[4], data[5]]);
+    let seeks = data[6] != 0;
+    let mut time = [0; 8];
+    time.copy_from_slice(&data[7..15]);
+    let len = u32::from_le_bytes([data[15], data[16], data[17], data[18]]) as usize;
+    let id = data.get(19..19 + len).ok_or_else(short)?;
+    Ok(PlaybackControl {
+        play,
+        speed,
+        seek: seeks.then_some(u64::from_le_bytes(time)),
+        request_id: String::from_utf8(id.to_vec()).map_err(|_| "a request id that is not UTF-8")?,
+    })
+}
+
+/// The playback state: opcode, status (0 playing, 1 paused), current time (ns), speed, whether
+/// it just sought, the request id it answers (u32 length, UTF-8; empty for none).
+pub fn playback_state(
+    playing: bool,
+    time_ns: u64,
+    speed: f32,
+    sought: bool,
+    request_id: &str,
+) -> Vec<u8> {
+    let mut out = Vec::with_capacity(19 + request_id.len());
+    out.push(OP_PLAYBACK_STATE);
+    out.push(if playing { 0 } else { 1 });
+    out.extend_from_slice(&time_ns.to_le_bytes());
+    out.extend_from_slice(&speed.to_le_bytes());
+    out.push(u8::from(sought));
+    out.extend_from_slice(&(request_id.len() as u32).to_le_bytes());
+    out.extend_from_slice(request_id.as_bytes());
+    out
+}
+
+/// A time in `serverInfo`: seconds and nanoseconds.
+#[derive(Serialize, Debug, Clone, Copy)]
+pub struct Time {
+    /// Seconds.
+    pub sec: u32,
+    /// Nanoseconds past `sec`.
+    pub nsec: u32,
+}
+
+impl Time {
+    /// `ns` nanoseconds.
+    pub fn from_ns(ns: u64) -> Time {
+        Time {
+            sec: u32::try_from(ns / 1_000_000_000).unwrap_or(u32::MAX),
+            nsec: (ns % 1_000_000_000) as u32,
+        }
+    }
+}
+
 /// A JSON message from the server.
 #[derive(Serialize, Debug)]
 #[serde(tag = "op", rename_all = "camelCase")]
@@ -158,6 +242,10 @@ pub enum ServerMessage<'a> {
         metadata: BTreeMap<String, String>,
         /// Changes when the server restarts.
         session_id: &'a str,
+        /// Where Foxglove's timeline starts (`playbackControl`).
+        data_start_time: Time,
+        /// Where it ends: the scenario's last frame.
+        data_end_time: Time,
     },
     /// The channels a client may subscribe to.
     Advertise {

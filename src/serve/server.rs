@@ -85,10 +85,12 @@ async fn client(
         (s.client_count() < MAX_CLIENTS).then(|| {
             let info = ServerMessage::ServerInfo {
                 name: "ricochet",
-                capabilities: &["time", "clientPublish", "services"],
+                capabilities: &["time", "clientPublish", "services", "playbackControl"],
                 supported_encodings: &["json"],
                 metadata: Default::default(),
                 session_id: session,
+                data_start_time: protocol::Time::from_ns(0),
+                data_end_time: protocol::Time::from_ns(s.data_end_ns),
             };
             let advertise = ServerMessage::Advertise {
                 channels: s.channels(),
@@ -206,6 +208,15 @@ fn publish(hub: &Hub, client: u64, data: &[u8], limit: &mut RateLimit) -> Result
     if data.first() == Some(&protocol::OP_SERVICE_CALL) {
         let call = protocol::service_call(data)?;
         return hub.lock().call(client, call);
+    }
+    if data.first() == Some(&protocol::OP_PLAYBACK_CONTROL) {
+        let request = protocol::playback_control(data)?;
+        let mut s = hub.lock();
+        if s.playback.len() >= 64 {
+            return Err("too many playback requests waiting".to_owned());
+        }
+        s.playback.push_back((client, request));
+        return Ok(());
     }
     if data.len() < 5 || data[0] != protocol::OP_CLIENT_MESSAGE {
         return Err(
