@@ -54,6 +54,24 @@ impl<S: MessageSink> Session<S> {
         })
     }
 
+    /// A session going on from `sim` (a snapshot), writing to a new `sink` from its next
+    /// frame: the first frame written lists every body, as a first frame does.
+    pub fn resume(sim: Simulation, sink: S, live: bool) -> Result<Session<S>, LogError> {
+        let mut recorder = Recorder::new(sink, sim.dt(), Channels::default(), live)?;
+        let input = recorder
+            .sink_mut()
+            .add_protobuf_channel("/input", Schema::ricochet("ricochet.Input"))?;
+        let events = recorder.events_channel();
+        let next = sim.frame();
+        Ok(Session {
+            sim,
+            recorder,
+            input,
+            events,
+            next,
+        })
+    }
+
     /// Takes an input for the next step, recording it; why it was refused, if it was (also
     /// written to `/events`).
     pub fn input(&mut self, text: &str) -> Result<Result<(), String>, LogError> {

@@ -213,6 +213,8 @@ pub fn run(o: &Options) -> anyhow::Result<ExitCode> {
         segment: 0,
         inputs: Vec::new(),
         speed: o.speed,
+        snapshots: Vec::new(),
+        recording: o.record.is_some(),
     };
     let frames = run_loop(&mut serving, &hub, o, &interrupted)?;
     finish(serving.session)?;
@@ -235,7 +237,17 @@ struct Serving {
     inputs: Vec<(u64, String)>,
     /// Simulation seconds per wall second (`/speed`).
     speed: f64,
+    /// Snapshots to seek back from, when not recording: every [`SNAPSHOT_EVERY`] frames, at
+    /// most [`MAX_SNAPSHOTS`] (then every other one is dropped, and they thin out).
+    snapshots: Vec<(u64, ricochet_sim::Simulation)>,
+    /// Whether the session is recorded (then seeks back start from frame 0).
+    recording: bool,
 }
+
+/// Frames between two snapshots of a session that is not recorded.
+pub const SNAPSHOT_EVERY: u64 = 600;
+/// Snapshots kept at most: their memory is bounded whatever the session's length.
+pub const MAX_SNAPSHOTS: usize = 16;
 
 impl Serving {
     /// Carries out a service call; the JSON response, or why it failed.
@@ -269,15 +281,29 @@ impl Serving {
                 }
                 recording = self.restart(hub, o)?;
                 self.inputs.clear();
+                self.snapshots.clear();
                 self.refresh()?;
             }
             services::Command::Speed(x) => self.speed = x,
             services::Command::Seek(target) => {
                 let next = self.session.next_frame();
                 if target < next {
-                    // Back: the session again from frame 0, with the inputs before `target`.
-                    recording = self.restart(hub, o)?;
                     self.inputs.retain(|(f, _)| *f < target);
+                    self.snapshots.retain(|(f, _)| *f <= target);
+                    match self.snapshots.last() {
+                        // Not recording: from the latest snapshot at or before `target`.
+                        Some((_, snapshot)) if o.record.is_none() => {
+                            let sink = ServeSink {
+                                live: LiveSink::new(hub.clone()),
+                                file: None,
+                                muted: false,
+                            };
+                            self.session = Session::resume(snapshot.clone(), sink, true)?;
+                        }
+                        // Recording (the new file must hold the session from frame 0, to
+                        // replay on its own), or no snapshot: from frame 0.
+                        _ => recording = self.restart(hub, o)?,
+                    }
                 }
                 self.session.recorder().sink_mut().muted = true;
                 let inputs = std::mem::take(&mut self.inputs);
@@ -288,7 +314,7 @@ impl Serving {
                     while let Some((_, text)) = pending.next_if(|(f, _)| *f == at) {
                         let _ = self.session.input(text)?;
                     }
-                    self.session.step()?;
+                    self.step()?;
                 }
                 self.inputs = inputs;
                 self.session.recorder().sink_mut().muted = false;
@@ -342,9 +368,25 @@ impl Serving {
         }
         let t = self.session.next_frame().saturating_mul(dt_ns);
         hub.lock().broadcast(&Message::binary(protocol::time(t)));
+        self.step()
+    }
+
+    /// Steps the session, keeping a snapshot every [`SNAPSHOT_EVERY`] frames.
+    fn step(&mut self) -> anyhow::Result<()> {
         let out = self.session.step()?;
         if self.session.sim().first_non_finite().is_some() {
             anyhow::bail!("frame {}: a value overflowed; stopping", out.frame);
+        }
+        let next = self.session.next_frame();
+        if !self.recording && next.is_multiple_of(SNAPSHOT_EVERY) {
+            self.snapshots.push((next, self.session.sim().clone()));
+            if self.snapshots.len() > MAX_SNAPSHOTS {
+                let mut k = 0;
+                self.snapshots.retain(|_| {
+                    k += 1;
+                    k % 2 == 0
+                });
+            }
         }
         Ok(())
     }

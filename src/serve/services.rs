@@ -8,7 +8,7 @@
 //! | `/step` | `{"frames": N}` (default 1, at most 10,000) | pauses, then steps N frames at once |
 //! | `/reset` | `{}` | the scenario again from frame 0; a recording goes on in a new file |
 //! | `/load` | `{"scenario": "scenarios/level.toml"}` | another scenario file (a relative path, below the server's directory), from frame 0, likewise |
-//! | `/seek` | `{"frame": N}` | to frame N: forward by stepping at once, back by stepping again from frame 0 with the inputs before N (a recording goes on in a new file that holds frames 0 to N too, so it replays on its own) |
+//! | `/seek` | `{"frame": N}` | to frame N: forward by stepping at once, back by stepping again from the latest snapshot before N with the inputs since (recording: from frame 0, and the recording goes on in a new file that holds frames 0 to N too, so it replays on its own) |
 //! | `/speed` | `{"speed": X}` | simulation seconds per wall second, from now (0.01 to 100) |
 //!
 //! Every response is `{"frame": F, "paused": P}` (the next frame, and whether stepping is

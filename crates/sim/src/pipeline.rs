@@ -45,6 +45,7 @@ use crate::world::World;
 const FRAME_ZERO: [Stage; 4] = [Stage::Script, Stage::Cull, Stage::Detect, Stage::Lifetimes];
 
 /// A running simulation.
+#[derive(Clone)]
 pub struct Simulation {
     /// The scenario it runs (its bodies moved into the world).
     pub(crate) scenario: Scenario,

@@ -10,7 +10,7 @@ use super::grid::{CellRange, Cells};
 /// few cache lines (the cell's bucket start and its entries) and never the bodies. A box
 /// covering more than [`MAX_CELLS`](super::grid::MAX_CELLS) cells (or with irregular bounds) is kept in a list every
 /// lookup scans.
-#[derive(Debug, Default)]
+#[derive(Debug, Default, Clone)]
 pub(crate) struct FixedGrid {
     /// The cell size and table layout.
     cells: Cells,

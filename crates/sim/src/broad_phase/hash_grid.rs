@@ -11,7 +11,7 @@ use super::grid::{CellRange, Cells, MAX_CELLS};
 
 /// A uniform grid: `(cell, member)` entries counting-sorted by cell, into a dense table over
 /// the occupied cells or a table indexed by a fixed hash of the cell.
-#[derive(Debug, Default)]
+#[derive(Debug, Default, Clone)]
 pub(super) struct HashGrid {
     /// The call the grid was last built for (moving bodies).
     pub(super) frame: u64,

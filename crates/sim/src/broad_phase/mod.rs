@@ -130,7 +130,7 @@ pub struct BroadPhaseStats {
 }
 
 /// The broad phase, keeping its structures (and buffers) from one call to the next.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct BroadPhase {
     kind: BroadPhaseKind,
     chosen: BroadPhaseKind,
@@ -154,7 +154,7 @@ pub struct BroadPhase {
 }
 
 /// Buffers reused across calls.
-#[derive(Debug, Default)]
+#[derive(Debug, Default, Clone)]
 struct Scratch {
     remap: Vec<u32>,
     fresh: Vec<Slot>,

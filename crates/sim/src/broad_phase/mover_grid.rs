@@ -7,7 +7,7 @@ use super::grid::Cells;
 /// The moving boxes that are solid to the box being settled: a uniform grid rebuilt every
 /// pass, filled as boxes settle. A lookup may return a box twice, or one that does not
 /// overlap: the caller sorts, dedups and tests.
-#[derive(Debug, Default)]
+#[derive(Debug, Default, Clone)]
 pub(crate) struct MoverGrid {
     /// The cell size, and the hash of a cell to one of `buckets`.
     cells: Cells,

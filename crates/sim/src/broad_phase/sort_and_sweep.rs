@@ -16,7 +16,7 @@ use super::{BodyEntry, Member, Scratch, member};
 const NONE: u32 = u32::MAX;
 
 /// `SortAndSweep`: one layer's moving bodies, kept across calls.
-#[derive(Debug, Default)]
+#[derive(Debug, Default, Clone)]
 pub(super) struct SweepList {
     /// The call the list was last brought up to.
     pub(super) frame: u64,

@@ -8,7 +8,7 @@ use super::static_tree::StaticTree;
 use super::{BodyEntry, BroadPhaseKind, LAYERS, Member, STATIC_BIT, Scratch};
 
 /// The static bodies, sorted by key, and their structures.
-#[derive(Debug, Default)]
+#[derive(Debug, Default, Clone)]
 pub(super) struct StaticSet {
     pub(super) loaded: bool,
     /// The caller's generation (`pairs_split`), or `None` when loaded by content (`pairs`).

@@ -7,7 +7,7 @@ use ricochet_geom::{Bounds, Vec2};
 use super::Member;
 
 /// `SortAndSweep`'s static structure: a packed tree (sort-tile-recursive), built once.
-#[derive(Debug, Default)]
+#[derive(Debug, Default, Clone)]
 pub(super) struct StaticTree {
     /// Leaves of [`LEAF`] consecutive members.
     items: Vec<Member>,

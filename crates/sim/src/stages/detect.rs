@@ -54,7 +54,7 @@ pub(crate) fn has_work(w: &World, def: &WorldDef) -> bool {
 
 /// What `detect` keeps from one frame to the next: the broad phase (its sorted lists and
 /// static structures) and reused buffers.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub(crate) struct DetectState {
     broad_phase: BroadPhase,
     /// Layer pairs `detect` tests: not `ignore`, and not `separate` between two layers of

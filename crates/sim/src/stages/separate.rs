@@ -60,7 +60,7 @@ pub(crate) fn resolve_y(ctx: &mut StageCtx, st: &mut SeparateState) {
 }
 
 /// What the per-axis stages keep between passes.
-#[derive(Debug, Default)]
+#[derive(Debug, Default, Clone)]
 pub(crate) struct SeparateState {
     /// Whether any layer pair `separate`s.
     any_layer: bool,

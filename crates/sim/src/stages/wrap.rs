@@ -44,7 +44,7 @@ const IMAGE_KEY: u64 = 1 << 63;
 const SLACK: f64 = 1.0 / (1u64 << 40) as f64;
 
 /// The wrap seam's state (see the module docs).
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub(crate) struct Seam {
     /// The images' own broad phase.
     broad_phase: BroadPhase,
