@@ -214,6 +214,19 @@ fn other_subprotocols_are_refused_and_bad_clients_harm_nobody() {
         bad.send(Message::text(r#"{"op":"subscribe","subscriptions":[{"id":1,"channelId":999}]}"#)).await.unwrap();
         let status = next_json(&mut bad).await;
         assert!(status["message"].as_str().unwrap().contains("999"), "{status}");
+        // Malformed binary frames: an unknown opcode, a service call and a playback request
+        // cut short, a message on a channel never advertised.
+        for (frame, says) in [
+            (vec![9u8, 1, 2], "neither"),
+            (vec![2u8, 1, 0], "cut short"),
+            (vec![3u8, 0], "cut short"),
+            (vec![1u8, 7, 0, 0, 0, b'{', b'}'], "not an advertised"),
+        ] {
+            bad.send(Message::binary(frame)).await.unwrap();
+            let status = next_json(&mut bad).await;
+            let message = status["message"].as_str().unwrap_or_default();
+            assert!(message.contains(says), "{says}: {status}");
+        }
         drop(bad);
         // Another client is served as before.
         let (mut good, _) = connect(&server.url, "foxglove.websocket.v1").await.unwrap();
