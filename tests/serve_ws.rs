@@ -81,6 +81,21 @@ async fn connect(url: &str, subprotocol: &str) -> Result<(Ws, String), String> {
     Ok((ws, chosen))
 }
 
+/// Subscribes `ws` to `topic`, as listed in the `advertise` message `channels`, with the
+/// client's subscription id `id`.
+async fn subscribe_to(ws: &mut Ws, channels: &Value, topic: &str, id: u32) {
+    let channel = channels["channels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["topic"] == topic)
+        .unwrap_or_else(|| panic!("a channel {topic}"))["id"]
+        .clone();
+    let subscribe =
+        serde_json::json!({"op": "subscribe", "subscriptions": [{"id": id, "channelId": channel}]});
+    ws.send(Message::text(subscribe.to_string())).await.unwrap();
+}
+
 /// The next JSON message, but for the services' advertisement (see [`services`]).
 async fn next_json(ws: &mut Ws) -> Value {
     loop {
@@ -210,10 +225,20 @@ fn other_subprotocols_are_refused_and_bad_clients_harm_nobody() {
         let _ = next_json(&mut bad).await;
         bad.send(Message::text("{not json")).await.unwrap();
         let status = next_json(&mut bad).await;
-        assert_eq!((status["op"].as_str(), status["level"].as_u64()), (Some("status"), Some(2)));
-        bad.send(Message::text(r#"{"op":"subscribe","subscriptions":[{"id":1,"channelId":999}]}"#)).await.unwrap();
+        assert_eq!(
+            (status["op"].as_str(), status["level"].as_u64()),
+            (Some("status"), Some(2))
+        );
+        bad.send(Message::text(
+            r#"{"op":"subscribe","subscriptions":[{"id":1,"channelId":999}]}"#,
+        ))
+        .await
+        .unwrap();
         let status = next_json(&mut bad).await;
-        assert!(status["message"].as_str().unwrap().contains("999"), "{status}");
+        assert!(
+            status["message"].as_str().unwrap().contains("999"),
+            "{status}"
+        );
         // Malformed binary frames: an unknown opcode, a service call and a playback request
         // cut short, a message on a channel never advertised.
         for (frame, says) in [
@@ -232,8 +257,7 @@ fn other_subprotocols_are_refused_and_bad_clients_harm_nobody() {
         let (mut good, _) = connect(&server.url, "foxglove.websocket.v1").await.unwrap();
         let _ = next_json(&mut good).await;
         let advertise = next_json(&mut good).await;
-        let stats = advertise["channels"].as_array().unwrap().iter().find(|c| c["topic"] == "/stats").unwrap()["id"].clone();
-        good.send(Message::text(serde_json::json!({"op": "subscribe", "subscriptions": [{"id": 1, "channelId": stats}]}).to_string())).await.unwrap();
+        subscribe_to(&mut good, &advertise, "/stats", 1).await;
         let (sub, _, payload) = next_data(&mut good).await;
         assert_eq!(sub, 1);
         Stats::decode(payload.as_slice()).unwrap();
@@ -281,16 +305,7 @@ fn inputs_from_a_client_are_applied_recorded_and_replayed_byte_for_byte() {
         // Subscribing to /tf makes the server send every pose again, to this viewer only:
         // the recording (and so the replay) never sees it.
         let channels = next_json(&mut ws).await;
-        let tf = channels["channels"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .find(|c| c["topic"] == "/tf")
-            .unwrap()["id"]
-            .clone();
-        let subscribe =
-            serde_json::json!({"op": "subscribe", "subscriptions": [{"id": 1, "channelId": tf}]});
-        ws.send(Message::text(subscribe.to_string())).await.unwrap();
+        subscribe_to(&mut ws, &channels, "/tf", 1).await;
         let advertise = serde_json::json!({"op": "advertise", "channels": [
             {"id": 5, "topic": "/input", "encoding": "json", "schemaName": "ricochet.Input"}]});
         ws.send(Message::text(advertise.to_string())).await.unwrap();
@@ -396,20 +411,14 @@ fn a_client_that_never_reads_loses_messages_and_nobody_else_does() {
             .map(|(i, c)| serde_json::json!({"id": i, "channelId": c["id"]}))
             .collect();
         let subscribe = serde_json::json!({"op": "subscribe", "subscriptions": all});
-        slow.send(Message::text(subscribe.to_string())).await.unwrap();
+        slow.send(Message::text(subscribe.to_string()))
+            .await
+            .unwrap();
         // A good client reads /stats all along: every frame, none missing.
         let (mut good, _) = connect(&server.url, "foxglove.websocket.v1").await.unwrap();
         let _ = next_json(&mut good).await;
         let channels = next_json(&mut good).await;
-        let stats = channels["channels"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .find(|c| c["topic"] == "/stats")
-            .unwrap()["id"]
-            .clone();
-        let subscribe = serde_json::json!({"op": "subscribe", "subscriptions": [{"id": 1, "channelId": stats}]});
-        good.send(Message::text(subscribe.to_string())).await.unwrap();
+        subscribe_to(&mut good, &channels, "/stats", 1).await;
         let mut frames = Vec::new();
         let until = std::time::Instant::now() + Duration::from_secs(6);
         while std::time::Instant::now() < until {
@@ -611,7 +620,10 @@ fn a_flood_of_inputs_is_rate_limited_and_the_server_keeps_time() {
         let _ = next_json(&mut flood).await;
         let advertise = serde_json::json!({"op": "advertise", "channels": [
             {"id": 9, "topic": "/input", "encoding": "json", "schemaName": "ricochet.Input"}]});
-        flood.send(Message::text(advertise.to_string())).await.unwrap();
+        flood
+            .send(Message::text(advertise.to_string()))
+            .await
+            .unwrap();
         let input = br#"{"action": "turn", "body": "ship", "input": 0.25}"#;
         for _ in 0..6000 {
             let mut data = vec![1u8];
@@ -623,22 +635,17 @@ fn a_flood_of_inputs_is_rate_limited_and_the_server_keeps_time() {
         // Past 2,000 a second, inputs are refused and the client told.
         let status = next_json(&mut flood).await;
         assert!(
-            status["message"].as_str().unwrap().contains("inputs a second"),
+            status["message"]
+                .as_str()
+                .unwrap()
+                .contains("inputs a second"),
             "{status}"
         );
         // Meanwhile another client gets every frame, on time.
         let (mut good, _) = connect(&server.url, "foxglove.websocket.v1").await.unwrap();
         let _ = next_json(&mut good).await;
         let channels = next_json(&mut good).await;
-        let stats = channels["channels"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .find(|c| c["topic"] == "/stats")
-            .unwrap()["id"]
-            .clone();
-        let subscribe = serde_json::json!({"op": "subscribe", "subscriptions": [{"id": 1, "channelId": stats}]});
-        good.send(Message::text(subscribe.to_string())).await.unwrap();
+        subscribe_to(&mut good, &channels, "/stats", 1).await;
         let started = std::time::Instant::now();
         let mut frames = Vec::new();
         while frames.len() < 60 {
@@ -647,7 +654,11 @@ fn a_flood_of_inputs_is_rate_limited_and_the_server_keeps_time() {
         }
         assert!(frames.windows(2).all(|w| w[1] == w[0] + 1), "{frames:?}");
         // 60 frames at twice real time take half a second; a stalled server would take longer.
-        assert!(started.elapsed() < Duration::from_secs(5), "{:?}", started.elapsed());
+        assert!(
+            started.elapsed() < Duration::from_secs(5),
+            "{:?}",
+            started.elapsed()
+        );
     });
 }
 
@@ -796,15 +807,7 @@ fn seeking_back_from_a_snapshot_gives_the_state_a_straight_run_has() {
         let _ = any_json(&mut ws).await;
         let channels = any_json(&mut ws).await;
         let services = any_json(&mut ws).await;
-        let stats = channels["channels"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .find(|c| c["topic"] == "/stats")
-            .unwrap()["id"]
-            .clone();
-        let subscribe = serde_json::json!({"op": "subscribe", "subscriptions": [{"id": 1, "channelId": stats}]});
-        ws.send(Message::text(subscribe.to_string())).await.unwrap();
+        subscribe_to(&mut ws, &channels, "/stats", 1).await;
         // Forward past two snapshots (every 600 frames; not recording); back to 599 and 590
         // (before the first snapshot: from frame 0), forward to 1250, back to 601 (from the
         // snapshot of frame 600); each checked by the next frame's stats against the
@@ -818,9 +821,21 @@ fn seeking_back_from_a_snapshot_gives_the_state_a_straight_run_has() {
             id += 2;
             let want = &expected[target as usize];
             assert_eq!(got.frame, target);
-            assert_eq!(got.bodies, want["bodies"].as_u64().unwrap(), "frame {target}");
-            assert_eq!(got.kinetic_energy, want["kinetic_energy"].as_f64().unwrap(), "frame {target}");
-            assert_eq!(got.contacts, want["contacts"].as_u64().unwrap(), "frame {target}");
+            assert_eq!(
+                got.bodies,
+                want["bodies"].as_u64().unwrap(),
+                "frame {target}"
+            );
+            assert_eq!(
+                got.kinetic_energy,
+                want["kinetic_energy"].as_f64().unwrap(),
+                "frame {target}"
+            );
+            assert_eq!(
+                got.contacts,
+                want["contacts"].as_u64().unwrap(),
+                "frame {target}"
+            );
         }
     });
 }
