@@ -14,6 +14,8 @@ mod hostile;
 mod large_scenario;
 mod run_cli;
 mod seek;
+mod serve_client;
+mod serve_session;
 mod serve_ws;
 mod stress;
 mod util;

@@ -26,11 +26,13 @@ pub mod messages;
 mod bodies;
 mod decode;
 mod error;
+mod log_file;
 mod reader;
 mod writer;
 
 pub use bodies::BodyStates;
 pub use error::LogError;
+pub use log_file::{ChannelInfo, LogFile, Messages, RawMessage};
 pub use messages::Schema;
-pub use reader::{ChannelInfo, LogFile, LogMessage, Messages, RawMessage, read_log, read_log_file};
+pub use reader::{LogMessage, read_log, read_log_file};
 pub use writer::{ChannelId, LogWriter, MessageSink, Threading};

@@ -1,0 +1,418 @@
+//! A log file read as a stream: opened with every check but the data section's, then its
+//! messages one at a time (decoded, or raw to compare bytes), so memory does not grow with
+//! the log's length.
+
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::io::{BufReader, Read, Seek, SeekFrom};
+use std::path::Path;
+
+use mcap::McapError;
+use mcap::read::Summary;
+use mcap::sans_io::{LinearReaderOptions, SummaryReadEvent, SummaryReader, SummaryReaderOptions};
+
+use crate::LogError;
+use crate::decode::Decoder;
+use crate::reader::{
+    FOOTER_LEN, Footer, LogMessage, RECORD_LIMIT, at, check_magic, classify, corrupt, decode,
+    truncated,
+};
+
+/// One message of a log, not yet decoded: what [`Messages::next_raw`] yields.
+pub struct RawMessage {
+    inner: mcap::Message<'static>,
+}
+
+impl RawMessage {
+    /// Topic of the message's channel.
+    pub fn topic(&self) -> &str {
+        &self.inner.channel.topic
+    }
+
+    /// Log time, nanoseconds of simulation time.
+    pub fn log_time(&self) -> u64 {
+        self.inner.log_time
+    }
+
+    /// The encoded payload.
+    pub fn bytes(&self) -> &[u8] {
+        &self.inner.data
+    }
+}
+
+/// One channel of a log, from its summary.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ChannelInfo {
+    /// Topic.
+    pub topic: String,
+    /// Name of the channel's schema, or empty without one.
+    pub schema_name: String,
+    /// Encoding of the schema (`jsonschema`), or empty without one.
+    pub schema_encoding: String,
+    /// Encoding of the messages (`json`).
+    pub message_encoding: String,
+    /// How many messages the channel holds, by the summary's statistics.
+    pub messages: u64,
+}
+
+/// A log file opened for streaming: its two ends, footer, header and summary
+/// (with the summary's CRC) are checked when it is opened, and its messages
+/// are read one at a time by [`messages`](Self::messages), so memory does not
+/// grow with the log's length.
+#[derive(Debug)]
+pub struct LogFile {
+    /// The path it was opened by, for messages.
+    path: std::path::PathBuf,
+    /// What its messages are read from.
+    source: Source,
+    library: String,
+    /// By channel id.
+    channels: BTreeMap<u16, ChannelInfo>,
+    total: u64,
+    /// The attachments: name, offset and length of the record (opcode and length included).
+    attachments: Vec<(String, u64, u64)>,
+}
+
+impl LogFile {
+    /// Opens the log at `path` and checks everything but its data section:
+    /// the magic at both ends, the footer, the summary's CRC, the summary
+    /// (schemas, channels, statistics) and the header. A file cut short is
+    /// [`LogError::Truncated`], other damage [`LogError::Corrupt`].
+    pub fn open(path: &Path) -> Result<LogFile, LogError> {
+        Self::open_inner(path).map_err(at(path))
+    }
+
+    fn open_inner(path: &Path) -> Result<LogFile, LogError> {
+        let read_error = |source| LogError::Read {
+            path: path.to_path_buf(),
+            source,
+        };
+        let mut file = File::open(path).map_err(read_error)?;
+        let meta = file.metadata().map_err(read_error)?;
+        if !meta.is_file() {
+            // A pipe (`<(zcat log.mcap.gz)`) can be read once only: copied to a temporary
+            // file first, which is then streamed as many times as needed.
+            let mut copy = tempfile::NamedTempFile::new().map_err(read_error)?;
+            std::io::copy(&mut file, &mut copy).map_err(read_error)?;
+            let copy = copy.into_temp_path();
+            let mut log = Self::open_inner(&copy)?;
+            log.path = path.to_path_buf();
+            log.source = Source::Copy(copy);
+            return Ok(log);
+        }
+        let len = meta.len();
+        let magic = mcap::MAGIC.len() as u64;
+        // The first bytes and the last ones, as `check_magic` wants them.
+        if len < 2 * magic {
+            let mut all = Vec::new();
+            file.read_to_end(&mut all).map_err(read_error)?;
+            check_magic(&all)?;
+            return Err(truncated("too short to be a log"));
+        }
+        let mut head = vec![0; magic as usize];
+        file.read_exact(&mut head).map_err(read_error)?;
+        let tail_len = len.min(magic + FOOTER_LEN as u64);
+        let mut tail = vec![0; tail_len as usize];
+        file.seek(SeekFrom::Start(len - tail_len))
+            .map_err(read_error)?;
+        file.read_exact(&mut tail).map_err(read_error)?;
+        if head != mcap::MAGIC {
+            return Err(corrupt(
+                "does not start with the MCAP magic: not an MCAP file",
+            ));
+        }
+        if tail[tail.len() - magic as usize..] != *mcap::MAGIC {
+            return Err(truncated(&format!(
+                "{len} bytes that do not end with the MCAP magic: the file was cut short, \
+                 or its writer stopped before finishing it"
+            )));
+        }
+        if tail.len() < magic as usize + FOOTER_LEN {
+            return Err(corrupt("too short to hold a footer"));
+        }
+        let footer = Footer::parse(&tail[..FOOTER_LEN], len)?;
+
+        // The summary's CRC covers it and the footer up to the CRC field.
+        let crc_end = len - magic - 4;
+        file.seek(SeekFrom::Start(footer.summary_start))
+            .map_err(read_error)?;
+        let mut hasher = crc32fast::Hasher::new();
+        let mut covered = (&mut file).take(crc_end - footer.summary_start);
+        let mut buf = vec![0; 64 * 1024];
+        loop {
+            let n = covered.read(&mut buf).map_err(read_error)?;
+            if n == 0 {
+                break;
+            }
+            hasher.update(&buf[..n]);
+        }
+        footer.check_crc(hasher.finalize())?;
+
+        let summary = read_summary(&mut file, len).map_err(|e| classify(e, "summary"))?;
+        let summary =
+            summary.ok_or_else(|| corrupt("no summary section; a finished log always has one"))?;
+        let stats = summary
+            .stats
+            .ok_or_else(|| corrupt("no statistics record; a finished log always has one"))?;
+        let mut channels = BTreeMap::new();
+        for (id, channel) in &summary.channels {
+            let (schema_name, schema_encoding) = channel
+                .schema
+                .as_ref()
+                .map(|s| (s.name.clone(), s.encoding.clone()))
+                .unwrap_or_default();
+            channels.insert(
+                *id,
+                ChannelInfo {
+                    topic: channel.topic.clone(),
+                    schema_name,
+                    schema_encoding,
+                    message_encoding: channel.message_encoding.clone(),
+                    messages: stats.channel_message_counts.get(id).copied().unwrap_or(0),
+                },
+            );
+        }
+        let counted: u64 = channels.values().map(|c| c.messages).sum();
+        if counted != stats.message_count
+            || stats
+                .channel_message_counts
+                .keys()
+                .any(|id| !channels.contains_key(id))
+        {
+            return Err(corrupt(&format!(
+                "the statistics count {} messages, but {counted} on the summary's channels",
+                stats.message_count
+            )));
+        }
+        let library = read_library(&mut file, len)?;
+        let attachments = summary
+            .attachment_indexes
+            .iter()
+            .map(|a| (a.name.clone(), a.offset, a.length))
+            .collect();
+        Ok(LogFile {
+            attachments,
+            path: path.to_path_buf(),
+            source: Source::File(path.to_path_buf()),
+            library,
+            channels,
+            total: stats.message_count,
+        })
+    }
+
+    /// The data of the attachment named `name`, if the log has one; its CRC checked.
+    pub fn attachment(&self, name: &str) -> Result<Option<Vec<u8>>, LogError> {
+        let Some(&(_, offset, length)) = self.attachments.iter().find(|a| a.0 == name) else {
+            return Ok(None);
+        };
+        let from: &Path = match &self.source {
+            Source::File(p) => p,
+            Source::Copy(t) => t,
+        };
+        let read_error = |source| LogError::Read {
+            path: self.path.clone(),
+            source,
+        };
+        let mut file = File::open(from).map_err(read_error)?;
+        let length = usize::try_from(length)
+            .ok()
+            .filter(|l| (9..RECORD_LIMIT).contains(l))
+            .ok_or_else(|| at(&self.path)(corrupt("an attachment's index gives a bad length")))?;
+        let mut record = vec![0; length];
+        file.seek(SeekFrom::Start(offset))
+            .and_then(|_| file.read_exact(&mut record))
+            .map_err(read_error)?;
+        match mcap::parse_record(record[0], &record[9..]) {
+            Ok(mcap::records::Record::Attachment { data, crc, .. }) => {
+                if crc != 0 {
+                    let mut hasher = crc32fast::Hasher::new();
+                    hasher.update(&record[9..record.len() - 4]);
+                    if hasher.finalize() != crc {
+                        return Err(at(&self.path)(corrupt(&format!(
+                            "attachment {name}: its CRC does not match"
+                        ))));
+                    }
+                }
+                Ok(Some(data.into_owned()))
+            }
+            _ => Err(at(&self.path)(corrupt(&format!(
+                "attachment {name}: no attachment record where the index points"
+            )))),
+        }
+    }
+
+    /// The `library` its header names as the writer (`ricochet 0.1.0`).
+    pub fn library(&self) -> &str {
+        &self.library
+    }
+
+    /// Its channels, in channel id order.
+    pub fn channels(&self) -> impl Iterator<Item = &ChannelInfo> {
+        self.channels.values()
+    }
+
+    /// How many messages it holds, by its statistics.
+    pub fn message_count(&self) -> u64 {
+        self.total
+    }
+
+    /// Every message, in file order, decoded one at a time.
+    pub fn messages(&self) -> Result<Messages, LogError> {
+        self.stream(None)
+    }
+
+    /// The messages on `topic`, in file order. The whole file is still read
+    /// and checked (the data section holds every topic).
+    pub fn topic_messages(&self, topic: &str) -> Result<Messages, LogError> {
+        self.stream(Some(topic.to_owned()))
+    }
+
+    fn stream(&self, topic: Option<String>) -> Result<Messages, LogError> {
+        let from: &Path = match &self.source {
+            Source::File(p) => p,
+            Source::Copy(t) => t,
+        };
+        let file = File::open(from).map_err(|source| LogError::Read {
+            path: self.path.clone(),
+            source,
+        })?;
+        let options = LinearReaderOptions::default()
+            .with_prevalidate_chunk_crcs(true)
+            .with_validate_data_section_crc(true)
+            .with_validate_summary_section_crc(true)
+            .with_check_finishes_after_end_magic(true)
+            .with_record_length_limit(RECORD_LIMIT);
+        Ok(Messages {
+            reader: mcap::io::MessageReader::new_with_options(BufReader::new(file), options),
+            topic,
+            path: self.path.clone(),
+            expected: self
+                .channels
+                .iter()
+                .filter(|(_, c)| c.messages > 0)
+                .map(|(id, c)| (*id, c.messages))
+                .collect(),
+            counts: BTreeMap::new(),
+            done: false,
+            decoder: Decoder::default(),
+        })
+    }
+}
+
+/// Where a [`LogFile`]'s messages are read from.
+#[derive(Debug)]
+enum Source {
+    /// The file itself.
+    File(std::path::PathBuf),
+    /// A copy of what a pipe held, deleted with the `LogFile`.
+    Copy(tempfile::TempPath),
+}
+
+/// The messages of a [`LogFile`], read and decoded one at a time. Chunk CRCs
+/// are checked before a chunk's messages are yielded; the data section's CRC,
+/// the summary's and the message counts against the statistics at the end.
+/// After an error it yields nothing more.
+pub struct Messages {
+    reader: mcap::io::MessageReader<BufReader<File>>,
+    topic: Option<String>,
+    path: std::path::PathBuf,
+    expected: BTreeMap<u16, u64>,
+    counts: BTreeMap<u16, u64>,
+    done: bool,
+    decoder: Decoder,
+}
+
+impl Messages {
+    fn fail<T>(&mut self, error: LogError) -> Option<Result<T, LogError>> {
+        self.done = true;
+        Some(Err(at(&self.path)(error)))
+    }
+
+    /// The message [`next`](Iterator::next) would yield, with the same checks, but not
+    /// decoded: to compare payloads byte for byte before decoding them.
+    pub fn next_raw(&mut self) -> Option<Result<RawMessage, LogError>> {
+        while !self.done {
+            let Some(message) = self.reader.next() else {
+                self.done = true;
+                if self.counts != self.expected {
+                    return self.fail(corrupt(&format!(
+                        "the data section holds {:?} messages (per channel id) but the \
+                         summary counts {:?}",
+                        self.counts, self.expected
+                    )));
+                }
+                return None;
+            };
+            let message = match message {
+                Ok(m) => m,
+                Err(error) => return self.fail(classify(error, "data section")),
+            };
+            *self.counts.entry(message.channel.id).or_insert(0) += 1;
+            if self
+                .topic
+                .as_ref()
+                .is_none_or(|t| *t == message.channel.topic)
+            {
+                return Some(Ok(RawMessage { inner: message }));
+            }
+        }
+        None
+    }
+
+    /// Decodes a message [`next_raw`](Self::next_raw) yielded.
+    pub fn decode(&mut self, raw: RawMessage) -> Result<LogMessage, LogError> {
+        decode(&mut self.decoder, raw.inner).map_err(|e| {
+            self.done = true;
+            at(&self.path)(e)
+        })
+    }
+}
+
+impl Iterator for Messages {
+    type Item = Result<LogMessage, LogError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        Some(match self.next_raw()? {
+            Ok(raw) => self.decode(raw),
+            Err(e) => Err(e),
+        })
+    }
+}
+
+/// Reads the summary section through mcap's sans-io summary reader.
+fn read_summary(file: &mut File, len: u64) -> Result<Option<Summary>, McapError> {
+    let options = SummaryReaderOptions::default()
+        .with_file_size(len)
+        .with_record_length_limit(RECORD_LIMIT);
+    let mut reader = SummaryReader::new_with_options(options);
+    while let Some(event) = reader.next_event() {
+        match event? {
+            SummaryReadEvent::ReadRequest(need) => {
+                let n = file.read(reader.insert(need))?;
+                reader.notify_read(n);
+            }
+            SummaryReadEvent::SeekRequest(to) => reader.notify_seeked(file.seek(to)?),
+        }
+    }
+    Ok(reader.finish())
+}
+
+/// Reads the `library` field of the header record, right after the magic.
+fn read_library(file: &mut File, len: u64) -> Result<String, LogError> {
+    let no_header = || corrupt("no header record after the magic");
+    let magic = mcap::MAGIC.len() as u64;
+    let mut op_len = [0; 9];
+    file.seek(SeekFrom::Start(magic))
+        .and_then(|_| file.read_exact(&mut op_len))
+        .map_err(|_| no_header())?;
+    let record_len = u64::from_le_bytes(op_len[1..].try_into().unwrap_or([0; 8]));
+    if op_len[0] != mcap::records::op::HEADER || record_len > len.saturating_sub(magic + 9) {
+        return Err(no_header());
+    }
+    let mut data = vec![0; record_len as usize];
+    file.read_exact(&mut data).map_err(|_| no_header())?;
+    match mcap::parse_record(mcap::records::op::HEADER, &data) {
+        Ok(mcap::records::Record::Header(header)) => Ok(header.library),
+        _ => Err(no_header()),
+    }
+}
