@@ -84,6 +84,10 @@ enum Command {
         /// work; `ricochet diff` needs /bodies to name a divergent body.
         #[arg(long, value_name = "LIST")]
         channels: Option<String>,
+        /// Threads for the parallel stages (detect's narrow phase). Default: every core. The
+        /// log is the same bytes with any count: only the time changes.
+        #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=256))]
+        threads: Option<u16>,
     },
     /// Step a scenario in real time and stream it live to Foxglove over WebSocket.
     ///
@@ -267,6 +271,7 @@ fn main() -> ExitCode {
         frames: None,
         validate: false,
         channels: None,
+        threads: None,
     });
     // An error that ends a command is exit code 1 ("the run failed"), except for `diff`, whose
     // 1 means "the logs differ": there it is 2, like an unreadable file.
@@ -283,12 +288,14 @@ fn main() -> ExitCode {
             frames,
             validate,
             channels,
+            threads,
         } => run::run(
             scenario.as_deref(),
             output,
             frames,
             validate,
             channels.as_deref(),
+            threads.map(usize::from),
         ),
         Command::Serve {
             scenario,

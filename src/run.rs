@@ -25,6 +25,7 @@ pub fn run(
     frames: Option<u64>,
     validate: bool,
     channels: Option<&str>,
+    threads: Option<usize>,
 ) -> anyhow::Result<ExitCode> {
     let channels = match channels.map(Channels::parse).transpose() {
         Ok(c) => c.unwrap_or_default(),
@@ -111,6 +112,11 @@ pub fn run(
     let started = Instant::now();
     let mut sim = Simulation::new(&scenario);
     sim.capture_detect_poses = validate;
+    sim.set_threads(
+        threads.unwrap_or_else(|| {
+            std::thread::available_parallelism().map_or(1, std::num::NonZero::get)
+        }),
+    );
     let mut contacts = 0u64;
     let mut peak_bodies = 0usize;
     let mut ran = 0u64;

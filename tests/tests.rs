@@ -18,5 +18,6 @@ mod serve_client;
 mod serve_session;
 mod serve_ws;
 mod stress;
+mod threads;
 mod util;
 mod validate_cli;

@@ -281,6 +281,8 @@ pub enum BroadPhaseKind {
     SortAndSweep,
     /// A uniform grid, hashed deterministically.
     Grid,
+    /// Sort and sweep along x within horizontal strips as tall as the tallest body.
+    Strips,
     /// Chosen per call from the number of moving and static bodies (see the module docs).
     #[default]
     Auto,
@@ -288,13 +290,14 @@ pub enum BroadPhaseKind {
 
 impl BroadPhaseKind {
     /// The name scenario files and `/stats` use: `brute-force`, `sort-and-sweep`, `grid`,
-    /// `auto`.
+    /// `strips`, `auto`.
     #[must_use]
     pub fn name(self) -> &'static str {
         match self {
             BroadPhaseKind::BruteForce => "brute-force",
             BroadPhaseKind::SortAndSweep => "sort-and-sweep",
             BroadPhaseKind::Grid => "grid",
+            BroadPhaseKind::Strips => "strips",
             BroadPhaseKind::Auto => "auto",
         }
     }

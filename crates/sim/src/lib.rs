@@ -68,6 +68,7 @@ mod event;
 #[cfg(feature = "toml")]
 mod load;
 mod output;
+mod parallel;
 mod pipeline;
 mod scenario;
 mod stage_set;

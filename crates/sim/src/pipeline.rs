@@ -32,6 +32,7 @@
 use crate::action::{Action, Event};
 use crate::entity::Entity;
 use crate::output::FrameOutput;
+use crate::parallel::Workers;
 use crate::scenario::Scenario;
 use crate::stage_set::Stage;
 use crate::stages::detect::DetectState;
@@ -66,6 +67,8 @@ pub struct Simulation {
     pub(crate) detect: DetectState,
     /// The obstacle grids of `resolve_x` and `resolve_y`.
     pub(crate) separate: SeparateState,
+    /// The threads of the parallel stages (`parallel.rs`); one by default.
+    pub(crate) workers: Workers,
 }
 
 impl Simulation {
@@ -122,7 +125,23 @@ impl Simulation {
             capture_detect_poses: false,
             pending: Vec::new(),
             focus: None,
+            workers: Workers::default(),
         }
+    }
+
+    /// Runs the parallel stages on `threads` threads in all (0 or 1: the calling thread
+    /// only, the default). The thread count changes the time a step takes, never its
+    /// result: every log is the same bytes with any count.
+    pub fn set_threads(&mut self, threads: usize) {
+        if threads != self.threads() {
+            self.workers = Workers::new(threads);
+        }
+    }
+
+    /// The threads the parallel stages use (1: the calling thread only).
+    #[must_use]
+    pub fn threads(&self) -> usize {
+        self.workers.threads()
     }
 
     /// The bodies, to read: a write goes through the simulation's methods
@@ -204,7 +223,12 @@ impl Simulation {
             Stage::MoveY => motion::move_y(ctx.world, dt, self.separate.carries()),
             Stage::ResolveY => separate::resolve_y(&mut ctx, &mut self.separate),
             Stage::Turn => motion::turn(ctx.world, dt),
-            Stage::Detect => detect::run(&mut ctx, &mut self.detect, self.capture_detect_poses),
+            Stage::Detect => detect::run(
+                &mut ctx,
+                &mut self.detect,
+                self.capture_detect_poses,
+                &self.workers,
+            ),
             Stage::Lifetimes => lifetimes::run(&mut ctx),
             Stage::Bounds => bounds::run(&mut ctx),
             Stage::Sleep => sleep::run(&mut ctx),

@@ -1,5 +1,5 @@
 //! Every broad phase, forced by the scenario, gives the same simulation: the choice changes
-//! speed only. Each shipped scenario runs under all four settings and every frame's state,
+//! speed only. Each shipped scenario runs under all five settings and every frame's state,
 //! contacts, events and removals are compared with brute force (the O(n²) reference).
 
 use ricochet_sim::broad_phase::BroadPhaseKind;
@@ -15,10 +15,11 @@ const SCENARIOS: [&str; 7] = [
     "stress/extreme-sizes.toml",
 ];
 
-const KINDS: [BroadPhaseKind; 4] = [
+const KINDS: [BroadPhaseKind; 5] = [
     BroadPhaseKind::BruteForce,
     BroadPhaseKind::SortAndSweep,
     BroadPhaseKind::Grid,
+    BroadPhaseKind::Strips,
     BroadPhaseKind::Auto,
 ];
 
@@ -36,7 +37,7 @@ fn every_broad_phase_gives_the_same_simulation() {
                 Simulation::new(&s)
             })
             .collect();
-        let mut ran = [false; 4];
+        let mut ran = [false; 5];
         for frame in 0..=200 {
             let outs: Vec<_> = sims.iter_mut().map(Simulation::step).collect();
             let reference = &outs[0];
@@ -56,7 +57,7 @@ fn every_broad_phase_gives_the_same_simulation() {
             }
         }
         assert!(
-            ran[..3].iter().all(|r| *r),
+            ran[..4].iter().all(|r| *r),
             "{name}: detect ran under every kind"
         );
     }

@@ -89,7 +89,7 @@ fn broad_phase_names_are_kebab_case_only() {
         assert_eq!(e.field, "world.broad_phase", "{name}");
         assert_eq!(
             e.problem,
-            format!("expected auto, brute-force, sort-and-sweep or grid, got \"{name}\"")
+            format!("expected auto, brute-force, sort-and-sweep, grid or strips, got \"{name}\"")
         );
     }
 }

@@ -254,7 +254,7 @@ impl CellRange {
 
 /// `floor(v * inv_cell)`, clamped to `i32`: monotone in `v`.
 #[inline]
-fn cell_coord(v: f64, inv_cell: f64) -> i32 {
+pub(super) fn cell_coord(v: f64, inv_cell: f64) -> i32 {
     // Clamped, then floored by hand (`f64::floor` is a call on baseline x86-64): the cast
     // truncates toward zero, a negative fraction steps down. NaN becomes 0; only regular
     // bounds get here.

@@ -22,6 +22,8 @@ pub(super) struct StaticSet {
     /// Whether `trees` (`SortAndSweep`) and `grids` (`Grid`) hold the current set.
     pub(super) built_trees: bool,
     pub(super) built_grids: bool,
+    /// Whether the broad phase's static strip lists (`Strips`) hold the current set.
+    pub(super) built_strips: bool,
     pub(super) trees: Vec<StaticTree>,
     pub(super) grids: Vec<HashGrid>,
 }
@@ -60,6 +62,7 @@ impl StaticSet {
             .collect();
         self.built_trees = false;
         self.built_grids = false;
+        self.built_strips = false;
         // Free the old structures now: a million tiles' worth should not linger.
         self.trees = Vec::new();
         self.grids = Vec::new();

@@ -211,11 +211,12 @@ pub(crate) fn world_settings(
             "brute-force" => BroadPhaseKind::BruteForce,
             "sort-and-sweep" => BroadPhaseKind::SortAndSweep,
             "grid" => BroadPhaseKind::Grid,
+            "strips" => BroadPhaseKind::Strips,
             other => {
                 return Err(ctx.err(
                     k.span(),
                     "world.broad_phase",
-                    format!("expected auto, brute-force, sort-and-sweep or grid, got \"{other}\""),
+                    format!("expected auto, brute-force, sort-and-sweep, grid or strips, got \"{other}\""),
                 ));
             }
         };

@@ -39,6 +39,7 @@ use crate::def::{BodyKind, Doomed, Layers, Response, WorldDef};
 use crate::entity::Entity;
 use crate::event::{GameEvent, Removal};
 use crate::output::{ContactRecord, Phase};
+use crate::parallel::Workers;
 use crate::stages::push::separate_along_normal;
 use crate::stages::remove::remove;
 use crate::stages::separate::is_box;
@@ -76,6 +77,11 @@ pub(crate) struct DetectState {
     seam: Seam,
     /// Narrow-phase tests per layer pair this frame, `[a * n + b]`.
     tests: Vec<u64>,
+    /// This frame's pairs for the narrow phase (dense indices, response), their contacts at
+    /// the poses the pass started from, and the bodies a response has moved since.
+    plan: Vec<(usize, usize, Response)>,
+    contacts: Vec<Contact>,
+    pushed: Vec<bool>,
 }
 
 impl DetectState {
@@ -97,6 +103,9 @@ impl DetectState {
             pairs: Vec::new(),
             seam: Seam::new(kind),
             tests: vec![0; n * n],
+            plan: Vec::new(),
+            contacts: Vec::new(),
+            pushed: Vec::new(),
         }
     }
 }
@@ -190,7 +199,13 @@ fn candidate_pairs(ctx: &mut StageCtx, st: &mut DetectState) -> Vec<(u32, u32)> 
 
 /// Runs the pass. With `capture_poses`, every body's pose at the start of it goes into
 /// [`crate::FrameOutput::detect_poses`].
-pub(crate) fn run(ctx: &mut StageCtx, st: &mut DetectState, capture_poses: bool) {
+/// `workers` compute the narrow phase's contacts (the thread count changes nothing else).
+pub(crate) fn run(
+    ctx: &mut StageCtx,
+    st: &mut DetectState,
+    capture_poses: bool,
+    workers: &Workers,
+) {
     let def = ctx.def;
     let layers = &def.layers;
     if capture_poses {
@@ -205,6 +220,9 @@ pub(crate) fn run(ctx: &mut StageCtx, st: &mut DetectState, capture_poses: bool)
     let mut doomed: Vec<(Entity, Entity)> = Vec::new();
     let mut swept: Vec<(usize, usize)> = Vec::new();
     let mut woken: Vec<usize> = Vec::new();
+    // The pairs the narrow phase tests, in order, with their responses.
+    let mut plan = std::mem::take(&mut st.plan);
+    plan.clear();
     for &(i, j) in &pairs {
         let (i, j) = (i as usize, j as usize);
         let w = &ctx.world;
@@ -223,9 +241,43 @@ pub(crate) fn run(ctx: &mut StageCtx, st: &mut DetectState, capture_poses: bool)
             swept.push((i, j));
             continue;
         }
+        plan.push((i, j, response));
+    }
+    // Every planned pair's contact at the poses the pass starts from, on the workers
+    // (`parallel.rs`): a pure function of shapes and poses, gathered in order.
+    let mut contacts = std::mem::take(&mut st.contacts);
+    {
+        let w = &*ctx.world;
+        let plan = &plan;
+        workers.map(
+            plan.len(),
+            |k| {
+                let (i, j, _) = plan[k];
+                contact(&w.shape[i], &w.pose(i), &w.shape[j], &w.pose(j))
+            },
+            &mut contacts,
+        );
+    }
+    // Bodies a response of this pass moved: their later pairs are tested again.
+    let pushed = &mut st.pushed;
+    pushed.clear();
+    pushed.resize(ctx.world.len(), false);
+    for (k, &(i, j, response)) in plan.iter().enumerate() {
         ctx.out.stats.narrow_tests += 1;
+        let w = &ctx.world;
         let (pose_a, mut pose_b) = (w.pose(i), w.pose(j));
-        let mut c = contact(&w.shape[i], &pose_a, &w.shape[j], &pose_b);
+        let mut c = if pushed[i] || pushed[j] {
+            contact(&w.shape[i], &pose_a, &w.shape[j], &pose_b)
+        } else {
+            contacts[k]
+        };
+        let before = (w.position[i], w.position[j]);
+        let mut note_pushes = |w: &World| {
+            pushed[i] |=
+                w.position[i].to_array().map(f64::to_bits) != before.0.to_array().map(f64::to_bits);
+            pushed[j] |=
+                w.position[j].to_array().map(f64::to_bits) != before.1.to_array().map(f64::to_bits);
+        };
         // A fast body against static or kinematic geometry: time of impact, then the push
         // (`sweep_normal.rs`; not through the wrap seam).
         if response == Response::Separate
@@ -233,6 +285,7 @@ pub(crate) fn run(ctx: &mut StageCtx, st: &mut DetectState, capture_poses: bool)
             && let Some(hit) = sweep_normal::stop(w, (i, j), &c, &mut ctx.out.stats.narrow_tests)
         {
             sweep_normal::apply(ctx, (i, j), &hit);
+            note_pushes(ctx.world);
             continue;
         }
         // Through the seam: `b`'s images next to `a`, the deepest (the first on a tie).
@@ -262,7 +315,10 @@ pub(crate) fn run(ctx: &mut StageCtx, st: &mut DetectState, capture_poses: bool)
             c,
             (pose_a, pose_b),
         );
+        note_pushes(ctx.world);
     }
+    st.plan = plan;
+    st.contacts = contacts;
     st.pairs = pairs;
     for (k, count) in per_layer_pair.iter_mut().enumerate() {
         if *count > 0 {

@@ -1,0 +1,581 @@
+//! `Strips`: sort and sweep in horizontal strips.
+//!
+//! Space is cut into horizontal strips of height `H`, a power of two at least as tall as
+//! every body (one `H` per call for every list, so lists can be swept against each other).
+//! A body belongs to the strip holding its `min.y`; each list (one layer's moving bodies, or
+//! one layer's static bodies) is sorted by `(strip, min.x)`. Two boxes that overlap have
+//! their `min.y` less than `H` apart, so their strips are the same or neighbours: a list is
+//! swept within each strip and against the next strip, two lists strip against neighbouring
+//! strip, and nothing else is ever looked at. Where a single sort axis would test every
+//! body sharing an x range (rain: thousands of drops over the same x range, falling in y),
+//! a strip holds only the bodies within `H` in y of each other.
+//!
+//! Like `SortAndSweep`, a moving list is kept from the previous call and re-sorted by
+//! insertion sort (nearly sorted: a body changes strip rarely). A slot carries its body's
+//! bounds, so a sweep reads one array in order. Static lists are sorted once, and again only
+//! when the static bodies or `H` change.
+//!
+//! Two runs of very different sizes (a hundred actors over a floor of thousands of tiles)
+//! are not walked together: each body of the smaller one finds its candidates in the larger
+//! by binary search (`[min.x - widest, max.x]`).
+//!
+//! # Why neighbouring strips are enough
+//! `H` is an exact power of two (so `y / H` is exact: a multiplication by a power of two),
+//! at least `1 + 1e-9` times the tallest body's computed height. If `p.min.y <= q.min.y` and
+//! they overlap, `q.min.y <= p.max.y < p.min.y + H`, so `floor(q.min.y / H)` is at most
+//! `floor(p.min.y / H) + 1`. Strips are clamped to `i32`, which is monotone: it only merges
+//! strips, so two bodies further apart than one strip still do not overlap. A body with NaN
+//! or inverted bounds overlaps nothing wherever it is filed. With an infinite or NaN
+//! height, or none below `2^1000`, there is one strip: plain sort and sweep.
+//!
+//! # Determinism
+//! Orders are by `(strip, min.x as f64::total_cmp, handle)`: a function of the input.
+
+use std::cmp::Ordering;
+
+use ricochet_geom::Bounds;
+
+use super::grid::cell_coord;
+use super::{
+    BodyEntry, BroadPhase, BroadPhaseStats, Interactions, LAYERS, Member, STATIC_BIT, member,
+};
+
+/// No index: a body gone from a list.
+const NONE: u32 = u32::MAX;
+
+/// One list: bodies sorted by strip, then by `min.x`.
+#[derive(Debug, Default, Clone)]
+pub(super) struct StripList {
+    /// The call the list was last brought up to (moving bodies).
+    pub(super) frame: u64,
+    /// `1 / H` of the current order (0: one strip).
+    inv_h: f64,
+    /// The bodies, sorted by [`strip_order`].
+    order: Vec<Slot>,
+    /// The keys of the list's bodies at the last update, in key order (`local` indexes it).
+    keys: Vec<u64>,
+    /// The widest body's `max.x - min.x` (at least 0; NaN ignored).
+    width: f64,
+    /// `(strip, first slot)` of each run of one strip, in order, then `(_, order.len())`.
+    runs: Vec<(i32, u32)>,
+    /// Update buffers: old local to new, bodies new to the list.
+    remap: Vec<u32>,
+    fresh: Vec<Slot>,
+    merged: Vec<Slot>,
+}
+
+/// A body's place in a [`StripList`], with its bounds.
+#[derive(Clone, Copy, Debug)]
+struct Slot {
+    /// `min.x` as [`order_key`].
+    min: u64,
+    /// `max.x + 0.0` as [`order_key`].
+    max: u64,
+    /// `floor(min.y / H)`, clamped.
+    strip: i32,
+    /// The body's index in the list's key order.
+    local: u32,
+    m: Member,
+}
+
+impl Slot {
+    #[inline]
+    fn new(m: Member, local: u32, inv_h: f64) -> Slot {
+        Slot {
+            min: order_key(m.bounds.min.x),
+            max: order_key(m.bounds.max.x + 0.0),
+            strip: cell_coord(m.bounds.min.y, inv_h),
+            local,
+            m,
+        }
+    }
+}
+
+/// `f64::total_cmp` as an integer (`-0.0` before `+0.0`: a query bound gets `+ 0.0` first).
+#[inline]
+fn order_key(x: f64) -> u64 {
+    let bits = x.to_bits();
+    bits ^ (((bits as i64 >> 63) as u64) | (1 << 63))
+}
+
+/// The list order; `local` (key order) breaks ties, so the order is a function of the input.
+#[inline]
+fn strip_order(a: &Slot, b: &Slot) -> Ordering {
+    a.strip
+        .cmp(&b.strip)
+        .then(a.min.cmp(&b.min))
+        .then(a.local.cmp(&b.local))
+}
+
+/// `1 / H` for bodies at most `height` tall with coordinates up to `max_abs`: `H` the least
+/// power of two at least `height * (1 + 1e-9)` (and `max_abs / 2^30`, so strips stay well
+/// inside `i32`), between `2^-1000` and `2^1000`; 0 (one strip) when there is no such `H`.
+pub(super) fn inv_strip_height(height: f64, max_abs: f64) -> f64 {
+    /// `2^e` for `-1022 <= e <= 1023`, exactly.
+    fn pow2(e: i64) -> f64 {
+        f64::from_bits(((1023 + e) as u64) << 52)
+    }
+    let need = (height * (1.0 + 1e-9)).max(max_abs * pow2(-30));
+    if need.is_nan() || need > pow2(1000) {
+        return 0.0; // NaN, infinite or too tall
+    }
+    let need = need.max(pow2(-1000));
+    // The power of two at or below `need` (its exponent bits), doubled if below.
+    let mut h = f64::from_bits(need.to_bits() & 0x7ff0_0000_0000_0000);
+    if h < need {
+        h *= 2.0;
+    }
+    1.0 / h
+}
+
+/// Whether `inv_h` should be replaced by `want` (a strip height that fits this call's
+/// bodies): when it is too small for them, or more than 8 times taller than they need.
+pub(super) fn restrip(inv_h: f64, want: f64) -> bool {
+    inv_h.to_bits() != want.to_bits() && (inv_h > want || want > 8.0 * inv_h || inv_h == 0.0)
+}
+
+impl StripList {
+    /// The list's `1 / H`.
+    pub(super) fn inv_h(&self) -> f64 {
+        self.inv_h
+    }
+
+    /// A list of static `members` (in key order), fully sorted.
+    pub(super) fn statics(members: &[Member], inv_h: f64) -> StripList {
+        let mut list = StripList {
+            inv_h,
+            ..StripList::default()
+        };
+        list.order = members
+            .iter()
+            .enumerate()
+            .map(|(i, m)| Slot::new(*m, i as u32, inv_h))
+            .collect();
+        list.order.sort_unstable_by(strip_order);
+        list.width = members
+            .iter()
+            .map(|m| m.bounds.max.x - m.bounds.min.x)
+            .fold(0.0, f64::max);
+        list.find_runs();
+        list
+    }
+
+    /// Reconciles the list with this call's bodies (`handles` into `bodies`, key order) and
+    /// strip height: bodies gone are dropped, bodies kept get their new bounds, and bodies
+    /// new to the list or to their strip are sorted apart and merged in (a body that wraps
+    /// from the bottom of the world to the top would cost an insertion sort the whole list).
+    /// Returns the insertion sort's moves.
+    pub(super) fn update(&mut self, handles: &[u32], bodies: &[BodyEntry], inv_h: f64) -> u64 {
+        let restripped = self.inv_h.to_bits() != inv_h.to_bits();
+        self.inv_h = inv_h;
+        self.fresh.clear();
+        let same = self.keys.len() == handles.len()
+            && handles
+                .iter()
+                .zip(&self.keys)
+                .all(|(&h, &k)| bodies[h as usize].key == k);
+        if same {
+            // In list order: the slots are written in sequence, the bodies read at random.
+            for s in &mut self.order {
+                let h = handles[s.local as usize];
+                let slot = Slot::new(member(&bodies[h as usize], h), s.local, inv_h);
+                if slot.strip == s.strip && !restripped {
+                    *s = slot;
+                } else {
+                    s.local = NONE;
+                    self.fresh.push(slot);
+                }
+            }
+        } else {
+            self.reconcile(handles, bodies, inv_h, restripped);
+        }
+        let reordered = !same || !self.fresh.is_empty();
+        self.width = handles
+            .iter()
+            .map(|&h| {
+                let b = &bodies[h as usize].bounds;
+                b.max.x - b.min.x
+            })
+            .fold(0.0, |w, x| if x > w { x } else { w });
+        let moved = if reordered {
+            self.settle()
+        } else {
+            insertion_sort(&mut self.order)
+        };
+        self.find_runs();
+        moved
+    }
+
+    /// [`StripList::update`] when the bodies are not the same as last time: merges the old
+    /// keys with the new ones (both ascending). Kept bodies get their new bounds in place,
+    /// or go to `fresh` with the new ones when their strip changed.
+    fn reconcile(&mut self, handles: &[u32], bodies: &[BodyEntry], inv_h: f64, restripped: bool) {
+        self.remap.clear();
+        self.remap.resize(self.keys.len(), NONE);
+        let mut i = 0;
+        for (j, &h) in handles.iter().enumerate() {
+            let b = &bodies[h as usize];
+            while i < self.keys.len() && self.keys[i] < b.key {
+                i += 1;
+            }
+            if i < self.keys.len() && self.keys[i] == b.key {
+                self.remap[i] = j as u32;
+                i += 1;
+            } else {
+                self.fresh.push(Slot::new(member(b, h), j as u32, inv_h));
+            }
+        }
+        self.keys.clear();
+        self.keys
+            .extend(handles.iter().map(|&h| bodies[h as usize].key));
+        for s in &mut self.order {
+            let j = self.remap[s.local as usize];
+            if j == NONE {
+                s.local = NONE;
+                continue;
+            }
+            let h = handles[j as usize];
+            let slot = Slot::new(member(&bodies[h as usize], h), j, inv_h);
+            if slot.strip == s.strip && !restripped {
+                *s = slot;
+            } else {
+                s.local = NONE;
+                self.fresh.push(slot);
+            }
+        }
+    }
+
+    /// Sorts `order` again: drops the slots marked `NONE`, insertion-sorts the rest (nearly
+    /// sorted) and merges in `fresh` (sorted first). Returns the insertion sort's moves.
+    fn settle(&mut self) -> u64 {
+        self.order.retain(|s| s.local != NONE);
+        let moved = insertion_sort(&mut self.order);
+        self.fresh.sort_unstable_by(strip_order);
+        self.merged.clear();
+        self.merged.reserve(self.order.len() + self.fresh.len());
+        let (mut i, mut j) = (0, 0);
+        while i < self.order.len() && j < self.fresh.len() {
+            if strip_order(&self.order[i], &self.fresh[j]) == Ordering::Less {
+                self.merged.push(self.order[i]);
+                i += 1;
+            } else {
+                self.merged.push(self.fresh[j]);
+                j += 1;
+            }
+        }
+        self.merged.extend_from_slice(&self.order[i..]);
+        self.merged.extend_from_slice(&self.fresh[j..]);
+        std::mem::swap(&mut self.order, &mut self.merged);
+        moved
+    }
+
+    /// Finds the runs of one strip in `order`.
+    fn find_runs(&mut self) {
+        self.runs.clear();
+        let mut last = None;
+        for (k, s) in self.order.iter().enumerate() {
+            if last != Some(s.strip) {
+                self.runs.push((s.strip, k as u32));
+                last = Some(s.strip);
+            }
+        }
+        self.runs.push((i32::MAX, self.order.len() as u32));
+    }
+
+    /// The slots of run `r`, and its strip.
+    #[inline]
+    fn run(&self, r: usize) -> (i32, &[Slot]) {
+        let (strip, start) = self.runs[r];
+        (
+            strip,
+            &self.order[start as usize..self.runs[r + 1].1 as usize],
+        )
+    }
+
+    /// How many runs.
+    #[inline]
+    fn run_count(&self) -> usize {
+        self.runs.len() - 1
+    }
+}
+
+/// Insertion sort for a nearly sorted list; past `8n + 64` moves it gives up and sorts.
+fn insertion_sort(order: &mut [Slot]) -> u64 {
+    let budget = 8 * order.len() as u64 + 64;
+    let mut moved = 0;
+    for i in 1..order.len() {
+        if strip_order(&order[i - 1], &order[i]) != Ordering::Greater {
+            continue;
+        }
+        let x = order[i];
+        let mut j = i;
+        while j > 0 && strip_order(&x, &order[j - 1]) == Ordering::Less {
+            order[j] = order[j - 1];
+            j -= 1;
+        }
+        order[j] = x;
+        moved += (i - j) as u64;
+        if moved > budget {
+            order.sort_unstable_by(strip_order);
+            break;
+        }
+    }
+    moved
+}
+
+/// Tests `p` and `q`, emitting the pair when one is dynamic and their bounds overlap.
+#[inline]
+fn test(p: &Member, q: &Member, out: &mut Vec<(u32, u32)>) -> u64 {
+    if !(p.dynamic || q.dynamic) {
+        return 0;
+    }
+    if p.bounds.overlaps(&q.bounds) {
+        out.push((p.handle, q.handle));
+    }
+    1
+}
+
+/// Tests `p` against the slots of `others` (sorted by `min.x`) until one starts past `p`'s
+/// end along x.
+#[inline]
+fn scan(p: &Slot, others: &[Slot], out: &mut Vec<(u32, u32)>) -> u64 {
+    let mut tested = 0;
+    for s in others {
+        if s.min > p.max {
+            break;
+        }
+        tested += test(&p.m, &s.m, out);
+    }
+    tested
+}
+
+/// Every overlapping pair within one run.
+fn within(run: &[Slot], out: &mut Vec<(u32, u32)>) -> u64 {
+    let mut tested = 0;
+    for (k, p) in run.iter().enumerate() {
+        let rest = &run[k + 1..];
+        if rest.first().is_some_and(|next| next.min <= p.max) {
+            tested += scan(p, rest, out);
+        }
+    }
+    tested
+}
+
+/// Every overlapping pair with one slot from each run, walking both in `min.x` order.
+fn merged(xs: &[Slot], ys: &[Slot], out: &mut Vec<(u32, u32)>) -> u64 {
+    let mut tested = 0;
+    let (mut i, mut j) = (0, 0);
+    while i < xs.len() && j < ys.len() {
+        if xs[i].min <= ys[j].min {
+            if ys[j].min <= xs[i].max {
+                tested += scan(&xs[i], &ys[j..], out);
+            }
+            i += 1;
+        } else {
+            if xs[i].min <= ys[j].max {
+                tested += scan(&ys[j], &xs[i..], out);
+            }
+            j += 1;
+        }
+    }
+    tested
+}
+
+/// Every overlapping pair with one slot from each run, each slot of `small` finding its
+/// candidates in `large` (none wider than `width`) by binary search.
+fn searched(small: &[Slot], large: &[Slot], width: f64, out: &mut Vec<(u32, u32)>) -> u64 {
+    let mut tested = 0;
+    for p in small {
+        let b = &p.m.bounds;
+        if b.min.x.is_nan() {
+            continue; // overlaps nothing
+        }
+        // Slots starting before `lower` end before `b.min.x` (a relative margin far above
+        // rounding error).
+        let mut lower = b.min.x - width * (1.0 + 1e-12);
+        lower -= lower.abs() * 1e-12 + f64::MIN_POSITIVE;
+        let lower = order_key(lower);
+        let lo = large.partition_point(|s| s.min < lower);
+        tested += scan(p, &large[lo..], out);
+    }
+    tested
+}
+
+/// Every overlapping pair of two runs, by whichever walk is cheaper.
+fn pair_runs(
+    (xs, x_width): (&[Slot], f64),
+    (ys, y_width): (&[Slot], f64),
+    out: &mut Vec<(u32, u32)>,
+) -> u64 {
+    let log = |n: usize| u64::from(usize::BITS - n.leading_zeros()) + 2;
+    let walk = (xs.len() + ys.len()) as u64;
+    if xs.len() as u64 * log(ys.len()) < walk {
+        searched(xs, ys, y_width, out)
+    } else if ys.len() as u64 * log(xs.len()) < walk {
+        searched(ys, xs, x_width, out)
+    } else {
+        merged(xs, ys, out)
+    }
+}
+
+/// Every overlapping pair within one list with a dynamic body. Returns the tests.
+pub(super) fn strip_self(list: &StripList, out: &mut Vec<(u32, u32)>) -> u64 {
+    let mut tested = 0;
+    for r in 0..list.run_count() {
+        let (strip, run) = list.run(r);
+        tested += within(run, out);
+        if r + 1 < list.run_count() {
+            let (next, above) = list.run(r + 1);
+            if i64::from(next) == i64::from(strip) + 1 {
+                tested += pair_runs((run, list.width), (above, list.width), out);
+            }
+        }
+    }
+    tested
+}
+
+/// Every overlapping pair with one body from each list (and a dynamic one); both lists
+/// have the same strip height. Returns the tests.
+pub(super) fn strip_cross(x: &StripList, y: &StripList, out: &mut Vec<(u32, u32)>) -> u64 {
+    debug_assert_eq!(x.inv_h.to_bits(), y.inv_h.to_bits(), "one strip height");
+    let mut tested = 0;
+    let mut first = 0;
+    for r in 0..x.run_count() {
+        let (strip, run) = x.run(r);
+        let strip = i64::from(strip);
+        while first < y.run_count() && i64::from(y.runs[first].0) < strip - 1 {
+            first += 1;
+        }
+        let mut k = first;
+        while k < y.run_count() && i64::from(y.runs[k].0) <= strip + 1 {
+            let (_, other) = y.run(k);
+            tested += pair_runs((run, x.width), (other, y.width), out);
+            k += 1;
+        }
+    }
+    tested
+}
+
+/// The tallest finite `max.y - min.y` of `bounds` (NaN and inverted boxes ignored; an
+/// infinite one gives infinity), and the largest finite `|coordinate|`.
+pub(super) fn extent<'a>(bounds: impl Iterator<Item = &'a Bounds>) -> (f64, f64) {
+    let (mut height, mut max_abs): (f64, f64) = (0.0, 0.0);
+    for b in bounds {
+        let h = b.max.y - b.min.y;
+        if h > height {
+            height = h;
+        }
+        for v in [b.min.x, b.min.y, b.max.x, b.max.y] {
+            let a = v.abs();
+            if a > max_abs && a.is_finite() {
+                max_abs = a;
+            }
+        }
+    }
+    (height, max_abs)
+}
+
+impl BroadPhase {
+    /// `Strips` for every pair of interacting layers: moving lists swept within themselves
+    /// and against each other, dynamic bodies against the static lists. One strip height
+    /// for all of them, kept from call to call while it fits (see [`restrip`]).
+    pub(super) fn by_strips(
+        &mut self,
+        bodies: &[BodyEntry],
+        interactions: &Interactions,
+        out: &mut Vec<(u32, u32)>,
+        stats: &mut BroadPhaseStats,
+    ) {
+        if !self.statics.built_strips {
+            self.static_extent = extent(self.statics.entries.iter().map(|(b, _)| b));
+        }
+        let (height, max_abs) = extent(self.movers.iter().map(|&h| &bodies[h as usize].bounds));
+        let want = inv_strip_height(
+            height.max(self.static_extent.0),
+            max_abs.max(self.static_extent.1),
+        );
+        if restrip(self.inv_h, want) {
+            self.inv_h = want;
+        }
+        let inv_h = self.inv_h;
+        if !self.statics.built_strips
+            || self
+                .static_strips
+                .iter()
+                .any(|s| s.inv_h().to_bits() != inv_h.to_bits())
+        {
+            self.statics.built_strips = true;
+            self.static_rebuilds += 1;
+            let mut by_layer: Vec<Vec<Member>> = (0..LAYERS).map(|_| Vec::new()).collect();
+            for (s, &(bounds, layer)) in self.statics.entries.iter().enumerate() {
+                by_layer[usize::from(layer)].push(Member {
+                    bounds,
+                    handle: s as u32 | STATIC_BIT,
+                    dynamic: false,
+                });
+            }
+            self.static_strips = by_layer
+                .iter()
+                .map(|members| StripList::statics(members, inv_h))
+                .collect();
+        }
+        let layers = std::mem::take(&mut self.mover_layers);
+        for (k, &a) in layers.iter().enumerate() {
+            for &b in &layers[k..] {
+                if !interactions.interacts(a, b) {
+                    stats.layer_pairs_skipped += 1;
+                    continue;
+                }
+                if self.dynamic[usize::from(a)] == 0 && self.dynamic[usize::from(b)] == 0 {
+                    continue;
+                }
+                stats.resorted += self.ensure_strip(a, bodies);
+                stats.resorted += self.ensure_strip(b, bodies);
+                let list = |l: u8| &self.strips[usize::from(l)];
+                stats.tested += if a == b {
+                    strip_self(list(a), out)
+                } else {
+                    strip_cross(list(a), list(b), out)
+                };
+            }
+            if self.dynamic[usize::from(a)] == 0 {
+                continue;
+            }
+            if self
+                .statics
+                .layers
+                .iter()
+                .any(|&b| interactions.interacts(a, b))
+            {
+                stats.resorted += self.ensure_strip(a, bodies);
+            }
+            for &b in &self.statics.layers {
+                if !interactions.interacts(a, b) {
+                    stats.layer_pairs_skipped += 1;
+                    continue;
+                }
+                stats.tested += strip_cross(
+                    &self.strips[usize::from(a)],
+                    &self.static_strips[usize::from(b)],
+                    out,
+                );
+            }
+        }
+        self.mover_layers = layers;
+    }
+
+    /// Brings layer `l`'s moving list up to this call, once per call. Returns the re-sort's
+    /// moves.
+    fn ensure_strip(&mut self, l: u8, bodies: &[BodyEntry]) -> u64 {
+        let list = &mut self.strips[usize::from(l)];
+        if list.frame == self.frame {
+            return 0;
+        }
+        list.frame = self.frame;
+        let (lo, hi) = (
+            self.layer_start[usize::from(l)] as usize,
+            self.layer_start[usize::from(l) + 1] as usize,
+        );
+        list.update(&self.movers[lo..hi], bodies, self.inv_h)
+    }
+}
