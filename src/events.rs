@@ -25,7 +25,7 @@ pub struct EventLine {
 /// The `name #id` of a body alive at the end of the frame or removed during it.
 fn body(world: &World, out: &FrameOutput, e: Entity) -> String {
     let name = match world.index_of(e) {
-        Some(i) => world.name[i].as_str(),
+        Some(i) => world.name(i),
         None => out
             .removed
             .iter()

@@ -68,7 +68,7 @@ impl Validation {
 /// A non-finite body for people: `body NAME #id:generation has a non-finite FIELD [x, y]`.
 pub fn describe(sim: &Simulation, bad: &NonFinite) -> String {
     let w = sim.world();
-    let name = w.index_of(bad.body).map_or("?", |i| w.name[i].as_str());
+    let name = w.index_of(bad.body).map_or("?", |i| w.name(i));
     format!(
         "body {} #{} has a non-finite {} [{}, {}]",
         crate::out::escape_controls(name),

@@ -25,10 +25,10 @@ fn run(s: &mut Simulation, frames: u64) -> Vec<FrameOutput> {
 fn assert_finite(w: &World) {
     for i in 0..w.len() {
         assert!(
-            w.position[i].is_finite() && w.velocity[i].is_finite() && w.angle[i].is_finite(),
+            w.position[i].is_finite() && w.velocity(i).is_finite() && w.angle[i].is_finite(),
             "body {i}: {} {}",
             w.position[i],
-            w.velocity[i]
+            w.velocity(i)
         );
     }
 }
@@ -45,7 +45,7 @@ fn worst_solid_overlap(s: &Simulation) -> f64 {
             {
                 continue;
             }
-            worst = worst.max(contact(&w.shape[i], &w.pose(i), &w.shape[j], &w.pose(j)).depth);
+            worst = worst.max(contact(w.shape(i), &w.pose(i), w.shape(j), &w.pose(j)).depth);
         }
     }
     worst
@@ -187,20 +187,20 @@ fn a_stack_of_fifty_boxes_rests_for_ten_thousand_frames_without_creep_or_jitter(
             }
             for i in 1..s.world().len() {
                 assert!(
-                    s.world().grounded[i],
+                    s.world().grounded(i),
                     "frame {frame}: {} is not grounded",
-                    s.world().name[i]
+                    s.world().name(i)
                 );
             }
         }
     }
     // Box k rests with its centre at k + 0.5.
     for i in 1..s.world().len() {
-        let k: f64 = s.world().name[i][3..].parse().unwrap();
+        let k: f64 = s.world().name(i)[3..].parse().unwrap();
         assert!(
             (s.world().position[i].y - (k + 0.5)).abs() <= 1e-9,
             "{}: {}",
-            s.world().name[i],
+            s.world().name(i),
             s.world().position[i]
         );
     }

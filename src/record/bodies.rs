@@ -198,7 +198,7 @@ impl Tracker {
         for i in 0..world.len() {
             let e: Entity = world.entity[i];
             let (position, angle) = (world.position[i], world.angle[i]);
-            let (velocity, angular_velocity) = (world.velocity[i], world.angular_velocity[i]);
+            let (velocity, angular_velocity) = (world.velocity(i), world.angular_velocity(i));
             let slot = e.index as usize;
             if self.known.len() <= slot {
                 self.known.resize_with(slot + 1, || None);
@@ -206,7 +206,7 @@ impl Tracker {
             let fresh = !matches!(&self.known[slot], Some(k) if k.generation == e.generation);
             samples.clear();
             if fresh {
-                let upright = scene::upright(&world.shape[i]);
+                let upright = scene::upright(world.shape(i));
                 let frame_angle = if upright { 0.0 } else { angle };
                 if self.known[slot].is_none() {
                     self.alive += 1;
@@ -226,7 +226,7 @@ impl Tracker {
                     frame_id: scene::entity_id(e),
                     motion: Motion::appear(frame, position, frame_angle, self.live, &mut samples),
                     upright,
-                    drawn_with_angle: scene::drawing_depends_on_angle(&world.shape[i]),
+                    drawn_with_angle: scene::drawing_depends_on_angle(world.shape(i)),
                     is_static,
                     seen: frame,
                 };
@@ -269,9 +269,9 @@ impl Tracker {
                     ..Default::default()
                 };
                 if full {
-                    b.name = Some(world.name[i].clone());
+                    b.name = Some(world.name(i).to_owned());
                     b.layer = Some(layers.name(world.layer[i]).to_owned());
-                    b.shape = Some(shape_message(&ShapeDef::from_shape(&world.shape[i])));
+                    b.shape = Some(shape_message(&ShapeDef::from_shape(world.shape(i))));
                     b.r#static = Some(world.kind[i] == BodyKind::Static);
                     b.position = xy(position);
                     b.angle = Some(angle);

@@ -166,7 +166,7 @@ impl<S: MessageSink> Recorder<S> {
         if let Some(ch) = self.topics.tf {
             let transforms = (0..w.len())
                 .map(|i| {
-                    let angle = if scene::upright(&w.shape[i]) {
+                    let angle = if scene::upright(w.shape(i)) {
                         0.0
                     } else {
                         w.angle[i]
@@ -293,8 +293,8 @@ fn drawings(
         .filter(move |&i| (w.kind[i] == BodyKind::Static) == statics)
         .map(|i| scene::BodyDrawing {
             entity: w.entity[i],
-            name: &w.name[i],
-            shape: &w.shape[i],
+            name: w.name(i),
+            shape: w.shape(i),
             angle: w.angle[i],
             layer: w.layer[i],
             kind: w.kind[i],

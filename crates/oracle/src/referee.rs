@@ -32,8 +32,8 @@ pub(crate) fn body<'a>(sim: &'a Simulation, out: &'a FrameOutput, e: Entity) -> 
     if let Some(i) = sim.world().index_of(e) {
         let w = sim.world();
         return Some(Body {
-            name: &w.name[i],
-            shape: &w.shape[i],
+            name: w.name(i),
+            shape: w.shape(i),
             kind: w.kind[i],
             layer: w.layer[i],
         });

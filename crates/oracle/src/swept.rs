@@ -93,7 +93,7 @@ impl Referee {
         detect: &Pose,
     ) -> Option<Vec2> {
         if let Some(i) = sim.world().index_of(e) {
-            return Some(sim.world().start_position[i]);
+            return Some(sim.world().start_position(i));
         }
         if let Some((frame, positions)) = &self.previous
             && *frame + 1 == out.frame

@@ -15,7 +15,8 @@
 
 use ricochet_geom::{Shape, Vec2};
 use ricochet_sim::{
-    BodyDef, BodyKind, Controller, LayerId, Layers, Response, Scenario, WorldBounds, WorldDef,
+    BodyDef, BodyKind, Controller, LayerId, Layers, Response, Scenario, TileRows, WorldBounds,
+    WorldDef,
 };
 
 use crate::{Rng, layers, scenario};
@@ -223,27 +224,51 @@ pub fn platformer(tiles: usize, actors: usize, frames: u64) -> Scenario {
         .div_ceil(8)
         .max(2)
         * 8;
-    let mut bodies = Vec::with_capacity(tiles + actors);
+    // Each floor's tiles as rows between the gaps: a few numbers per row, not a body
+    // definition per tile (the `k`-th tile of a row is at `start + (k, 0)`, exactly
+    // `(col + 0.5, y)`: small integers and halves are exact).
+    let mut rows: Vec<(Vec2, u32)> = Vec::new();
+    let mut placed = 0usize;
     let mut floor = 0usize;
     'floors: loop {
+        let y = floor as f64 * FLOOR_SPACING;
+        let mut run: Option<(usize, u32)> = None;
+        // Ends at the first column after the last tile (`floor` is then the first incomplete
+        // floor, as the actors below expect).
+        let mut done = false;
         for col in 0..width {
-            if bodies.len() == tiles {
-                break 'floors;
+            if placed == tiles {
+                done = true;
+                break;
             }
             if floor > 0 && (col + 3 * floor) % 8 == 4 {
+                if let Some((c, n)) = run.take() {
+                    rows.push((Vec2::new(c as f64 + 0.5, y), n));
+                }
                 continue;
             }
-            bodies.push(BodyDef {
-                name: "tile".to_owned(),
-                layer: TILE,
-                kind: BodyKind::Static,
-                shape: Shape::aabb(Vec2::splat(0.5)).expect("positive half extents"),
-                position: Vec2::new(col as f64 + 0.5, floor as f64 * FLOOR_SPACING),
-                ..BodyDef::default()
-            });
+            match &mut run {
+                Some((_, n)) => *n += 1,
+                None => run = Some((col, 1)),
+            }
+            placed += 1;
+        }
+        if let Some((c, n)) = run {
+            rows.push((Vec2::new(c as f64 + 0.5, y), n));
+        }
+        if done {
+            break 'floors;
         }
         floor += 1;
     }
+    let tile_rows = TileRows {
+        name: "tile".to_owned(),
+        layer: TILE,
+        shape: Shape::aabb(Vec2::splat(0.5)).expect("positive half extents"),
+        step: Vec2::new(1.0, 0.0),
+        rows,
+    };
+    let mut bodies = Vec::with_capacity(actors);
     // Actors start above the complete floors (`floor` is the first incomplete one).
     let floors = floor.max(1);
     for k in 0..actors {
@@ -275,7 +300,10 @@ pub fn platformer(tiles: usize, actors: usize, frames: u64) -> Scenario {
             ],
         ),
     );
-    scenario(name, world, bodies, frames)
+    Scenario {
+        tiles: vec![tile_rows],
+        ..scenario(name, world, bodies, frames)
+    }
 }
 
 /// One shape of kind `k % 5` (circle, aabb, obb, capsule, polygon) about `size` across.
@@ -382,13 +410,9 @@ mod tests {
     #[test]
     fn scenes_have_the_asked_sizes_and_are_deterministic() {
         let s = Scene::parse("platformer-1000-30").unwrap().build(10);
-        assert_eq!(s.bodies.len(), 1030);
-        let tiles = s
-            .bodies
-            .iter()
-            .filter(|b| b.kind == BodyKind::Static)
-            .count();
-        assert_eq!(tiles, 1000);
+        assert_eq!(s.body_count(), 1030);
+        assert_eq!(s.bodies.len(), 30);
+        assert_eq!(s.tiles[0].len(), 1000);
         let a = Scene::parse("asteroids-300").unwrap().build(10);
         assert_eq!(a.bodies.len(), 300 + BULLETS + 1);
         assert_eq!(a, Scene::parse("asteroids-300").unwrap().build(10));
@@ -403,6 +427,49 @@ mod tests {
             })
             .collect();
         assert_eq!(kinds.len(), 5, "{kinds:?}");
+    }
+
+    /// Issue #15: a tile map is data, not a million full bodies. The budget is the issue's
+    /// 64 bytes a static tile, everything the world holds included (tables, rows of the
+    /// actors, the id allocator).
+    #[test]
+    fn a_million_tile_world_holds_at_most_64_bytes_a_tile() {
+        let tiles = 1_000_000;
+        let s = platformer(tiles, 1, 1);
+        let sim = ricochet_sim::Simulation::from_scenario(s);
+        let w = sim.world();
+        assert_eq!(w.len(), tiles + 1);
+        assert!((0..tiles).all(|i| w.is_scenery(i)));
+        let per_tile = w.heap_bytes() as f64 / tiles as f64;
+        assert!(per_tile <= 64.0, "{per_tile} bytes a tile");
+    }
+
+    #[test]
+    fn platformer_tile_rows_are_the_tiles_one_by_one() {
+        // The rows expand to the floors the module docs describe: 1×1 tiles at `(col +
+        // 0.5, 5 floor)`, a gap every 8 columns on every floor but the lowest.
+        let s = platformer(100, 1, 1);
+        let defs: Vec<BodyDef> = s.tiles[0].defs().collect();
+        assert_eq!(defs.len(), 100);
+        let width = 32; // sqrt(800) = 28.3, up to a multiple of 8
+        let mut expected = Vec::new();
+        'f: for floor in 0.. {
+            for col in 0..width {
+                if expected.len() == 100 {
+                    break 'f;
+                }
+                if floor > 0 && (col + 3 * floor) % 8 == 4 {
+                    continue;
+                }
+                expected.push(Vec2::new(col as f64 + 0.5, floor as f64 * 5.0));
+            }
+        }
+        let got: Vec<Vec2> = defs.iter().map(|d| d.position).collect();
+        assert_eq!(got, expected);
+        assert!(
+            defs.iter()
+                .all(|d| d.kind == BodyKind::Static && d.name == "tile")
+        );
     }
 
     #[test]

@@ -47,6 +47,7 @@ pub fn scenario(name: &str, world: WorldDef, bodies: Vec<BodyDef>, frames: u64) 
         world,
         frames,
         templates: std::collections::BTreeMap::new(),
+        tiles: Vec::new(),
         bodies,
         script: Vec::new(),
     }

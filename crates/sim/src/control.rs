@@ -163,7 +163,7 @@ impl Simulation {
     /// A body's velocity, or `None` when it is not alive.
     #[must_use]
     pub fn velocity(&self, e: Entity) -> Option<Vec2> {
-        self.world.index_of(e).map(|i| self.world.velocity[i])
+        self.world.index_of(e).map(|i| self.world.velocity(i))
     }
 
     /// A body's angular velocity in radians/s, or `None` when it is not alive.
@@ -171,13 +171,13 @@ impl Simulation {
     pub fn angular_velocity(&self, e: Entity) -> Option<f64> {
         self.world
             .index_of(e)
-            .map(|i| self.world.angular_velocity[i])
+            .map(|i| self.world.angular_velocity(i))
     }
 
     /// Whether a body was held up by something it stands on in the last step.
     #[must_use]
     pub fn grounded(&self, e: Entity) -> Option<bool> {
-        self.world.index_of(e).map(|i| self.world.grounded[i])
+        self.world.index_of(e).map(|i| self.world.grounded(i))
     }
 
     /// Moves a body to `position` now (a teleport: swept tests of this frame start there).
@@ -227,7 +227,7 @@ impl Simulation {
         if !force.is_finite() {
             return Err(ControlError::OutOfRange { field: "force" });
         }
-        self.world.force[i] = force;
+        *self.world.force_mut(i) = force;
         self.world.wake(i);
         self.world.refresh_active();
         Ok(())
@@ -259,8 +259,8 @@ impl Simulation {
         let w = &self.world;
         w.movers().iter().find_map(|&i| {
             let i = i as usize;
-            let (p, v) = (w.position[i], w.velocity[i]);
-            let (a, av) = (w.angle[i], w.angular_velocity[i]);
+            let (p, v) = (w.position[i], w.velocity(i));
+            let (a, av) = (w.angle[i], w.angular_velocity(i));
             let bad = if !p.is_finite() {
                 Some(("position", [p.x, p.y]))
             } else if !v.is_finite() {

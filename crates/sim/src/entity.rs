@@ -43,6 +43,18 @@ impl EntityAllocator {
         }
     }
 
+    /// Makes room for `additional` more ids.
+    pub fn reserve(&mut self, additional: usize) {
+        self.generations.reserve_exact(additional);
+    }
+
+    /// Heap bytes held (a B-tree entry of the free set counted at its key's size plus a
+    /// pointer's).
+    #[must_use]
+    pub fn heap_bytes(&self) -> usize {
+        self.generations.capacity() * 4 + self.free.len() * 12
+    }
+
     /// Frees `entity`'s slot for reuse with the next generation.
     pub fn free(&mut self, entity: Entity) {
         let g = &mut self.generations[entity.index as usize];

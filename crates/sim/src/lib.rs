@@ -65,6 +65,7 @@ mod control;
 mod def;
 mod entity;
 mod event;
+mod interned;
 #[cfg(feature = "toml")]
 mod load;
 mod output;
@@ -89,7 +90,7 @@ pub use load::file::ActionFile;
 pub use load::{ScenarioError, load_scenario};
 pub use output::{ContactRecord, FrameOutput, Phase, RemovedBody, Stats};
 pub use pipeline::Simulation;
-pub use scenario::Scenario;
+pub use scenario::{Scenario, TileRows};
 pub use stage_set::{Stage, StageSet};
 pub use stages::SLOP;
 pub use world::{Inputs, World};

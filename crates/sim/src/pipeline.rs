@@ -76,7 +76,10 @@ impl Simulation {
     #[must_use]
     pub fn new(scenario: &Scenario) -> Simulation {
         let mut world = World::new();
-        world.reserve(scenario.bodies.len());
+        world.reserve(scenario.body_count());
+        for t in &scenario.tiles {
+            world.spawn_tiles(t);
+        }
         for b in &scenario.bodies {
             world.spawn(b);
         }
@@ -86,6 +89,7 @@ impl Simulation {
             world: scenario.world.clone(),
             frames: scenario.frames,
             templates: scenario.templates.clone(),
+            tiles: Vec::new(),
             bodies: Vec::new(),
             script: scenario.script.clone(),
         };
@@ -97,8 +101,11 @@ impl Simulation {
     #[must_use]
     pub fn from_scenario(mut scenario: Scenario) -> Simulation {
         let mut world = World::new();
+        world.reserve(scenario.body_count());
+        for t in std::mem::take(&mut scenario.tiles) {
+            world.spawn_tiles(&t);
+        }
         let mut bodies = std::mem::take(&mut scenario.bodies);
-        world.reserve(bodies.len());
         // Spawned in file order from the back of the reversed list, whose memory is given
         // back every few thousand bodies: the peak is the world plus a little, not the
         // world plus every definition.
@@ -244,15 +251,7 @@ impl Simulation {
         // Swept tests run from here to wherever the frame's motion ends. Static bodies never
         // move, so only the moving ones need it.
         let w = &mut self.world;
-        if 2 * w.movers().len() >= w.len() {
-            // Mostly moving bodies: one straight copy is cheaper than a gather.
-            w.start_position.copy_from_slice(&w.position);
-        } else {
-            for k in 0..w.movers().len() {
-                let i = w.movers()[k] as usize;
-                w.start_position[i] = w.position[i];
-            }
-        }
+        w.start_frame();
         for stage in Stage::ALL {
             let allowed = self.frame > 0 || FRAME_ZERO.contains(&stage);
             if allowed && self.has_work(stage) {

@@ -1,11 +1,14 @@
-//! A scenario: the world's settings, the bodies at frame 0, the templates they spawn from,
-//! and the script of timed events. Built in code, or loaded from a file by
+//! A scenario: the world's settings, the bodies at frame 0 (rows of identical static tiles,
+//! then one definition per body), the templates they spawn from, and the script of timed
+//! events. Built in code, or loaded from a file by
 //! [`crate::load_scenario`] (feature `toml`).
 
 use std::collections::BTreeMap;
 
 use crate::action::Event;
-use crate::def::{BodyDef, WorldDef};
+use ricochet_geom::{Shape, Vec2};
+
+use crate::def::{BodyDef, LayerId, WorldDef};
 
 /// A checked scenario, ready to simulate.
 #[derive(Clone, Debug, PartialEq)]
@@ -18,7 +21,10 @@ pub struct Scenario {
     pub frames: u64,
     /// Body prototypes by name.
     pub templates: BTreeMap<String, BodyDef>,
-    /// Bodies at frame 0, in file order (which is their id order).
+    /// Static tiles at frame 0, spawned first (ids from 0 on), in order: a level's tiles
+    /// as a few numbers per row instead of a [`BodyDef`] each. Scenario files have none.
+    pub tiles: Vec<TileRows>,
+    /// Bodies at frame 0, in file order (which is their id order), after the tiles.
     pub bodies: Vec<BodyDef>,
     /// Script events sorted by frame (file order within a frame).
     pub script: Vec<Event>,
@@ -26,15 +32,69 @@ pub struct Scenario {
 
 impl Default for Scenario {
     /// An empty scene: the default [`WorldDef`] (1/60 s, no gravity, one layer), 600
-    /// frames, no bodies, templates or script.
+    /// frames, no tiles, bodies, templates or script.
     fn default() -> Self {
         Scenario {
             name: "scenario".to_owned(),
             world: WorldDef::default(),
             frames: 600,
             templates: BTreeMap::new(),
+            tiles: Vec::new(),
             bodies: Vec::new(),
             script: Vec::new(),
         }
+    }
+}
+
+/// Rows of identical static bodies (a tile map's tiles): the `k`-th tile of a row starting
+/// at `start` is the body `BodyDef { name, layer, kind: Static, shape, position: start +
+/// step * k, ..BodyDef::default() }`. 24 bytes a row, however many tiles it holds.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TileRows {
+    /// Every tile's name.
+    pub name: String,
+    /// Every tile's layer.
+    pub layer: LayerId,
+    /// Every tile's shape.
+    pub shape: Shape,
+    /// From one tile of a row to the next.
+    pub step: Vec2,
+    /// Each row: its first tile's position and how many tiles it has.
+    pub rows: Vec<(Vec2, u32)>,
+}
+
+impl TileRows {
+    /// How many tiles.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.rows.iter().map(|&(_, n)| n as usize).sum()
+    }
+
+    /// Whether there are no tiles.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The tiles as definitions, in spawn order (what [`crate::World::spawn_tiles`] spawns).
+    pub fn defs(&self) -> impl Iterator<Item = BodyDef> + '_ {
+        self.rows.iter().flat_map(move |&(start, count)| {
+            (0..count).map(move |k| BodyDef {
+                name: self.name.clone(),
+                layer: self.layer,
+                kind: crate::BodyKind::Static,
+                shape: self.shape.clone(),
+                position: start + self.step * f64::from(k),
+                ..BodyDef::default()
+            })
+        })
+    }
+}
+
+impl Scenario {
+    /// How many bodies frame 0 has: the tiles and the bodies.
+    #[must_use]
+    pub fn body_count(&self) -> usize {
+        self.tiles.iter().map(TileRows::len).sum::<usize>() + self.bodies.len()
     }
 }

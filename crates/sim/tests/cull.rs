@@ -18,7 +18,11 @@ fn culling_that_freezes_nothing_changes_nothing() {
     run_side_by_side(&mut plain, &mut culled, 300, |a, b, _, c| {
         totals.add(a);
         assert_eq!(b.stats.frozen, 0, "frame {}: froze a body", b.frame);
-        assert!(c.world().frozen.iter().all(|f| !f), "frame {}", b.frame);
+        assert!(
+            (0..c.world().len()).all(|i| !c.world().frozen(i)),
+            "frame {}",
+            b.frame
+        );
         assert!(
             b.stats.stages_run.contains(Stage::Cull),
             "frame {}",
@@ -116,7 +120,7 @@ impl Model {
     fn assert_matches(&self, sim: &Simulation, frame: u64, frozen: bool) {
         let i = index(sim, self.name);
         let w = sim.world();
-        assert_eq!(w.frozen[i], frozen, "frame {frame}: {} frozen", self.name);
+        assert_eq!(w.frozen(i), frozen, "frame {frame}: {} frozen", self.name);
         assert_eq!(
             (w.position[i].x.to_bits(), w.position[i].y.to_bits()),
             (self.x.to_bits(), self.y.to_bits()),
@@ -127,12 +131,13 @@ impl Model {
             self.y
         );
         assert_eq!(
-            w.velocity[i],
+            w.velocity(i),
             ricochet_geom::Vec2::new(0.0, 1.0),
             "frame {frame}"
         );
         assert_eq!(
-            w.lifetime[i], self.lifetime,
+            w.lifetime(i),
+            self.lifetime,
             "frame {frame}: {} lifetime",
             self.name
         );
@@ -209,7 +214,7 @@ lifetime = 1000
             // Bit for bit where it started, with its lifetime paused.
             assert_eq!(s.world().position[1], ricochet_geom::Vec2::new(rock_x, 0.0));
             assert_eq!(
-                s.world().lifetime[1],
+                s.world().lifetime(1),
                 Some(1000),
                 "frame {frame}: lifetime paused"
             );

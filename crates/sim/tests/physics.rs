@@ -133,7 +133,7 @@ fn a_falling_box_lands_flush_and_grounded() {
             "frame {frame}: box sunk {} into the floor",
             o.y
         );
-        if s.world().grounded[1] && landed_at.is_none() {
+        if s.world().grounded(1) && landed_at.is_none() {
             landed_at = Some(frame);
             assert!(
                 out.contacts.iter().all(|c| c.phase == Phase::Y),
@@ -145,7 +145,7 @@ fn a_falling_box_lands_flush_and_grounded() {
     // Free fall from 2.5 above the floor at 20 units/s² takes 0.5 s: about frame 30.
     let landed = landed_at.expect("the box lands");
     assert!((29..=32).contains(&landed), "landed at frame {landed}");
-    assert!(s.world().grounded[1]);
+    assert!(s.world().grounded(1));
     assert!(
         (s.world().position[1].y - 0.5).abs() <= SLOP,
         "{}",
@@ -177,11 +177,11 @@ fn a_corner_hit_resolves_along_one_axis_only() {
     assert_eq!(c.resolved.x, 0.0, "nothing along x");
     assert!((c.resolved.y - 0.08).abs() < 1e-12, "{:?}", c.resolved);
     assert_eq!(
-        s.world().velocity[1],
+        s.world().velocity(1),
         Vec2::new(6.0, 0.0),
         "x velocity kept, y stopped"
     );
-    assert!(s.world().grounded[1]);
+    assert!(s.world().grounded(1));
 }
 
 #[test]
@@ -208,5 +208,5 @@ fn a_body_running_into_a_wall_stops_flush() {
         "{}",
         s.world().position[1]
     );
-    assert_eq!(s.world().velocity[1].x, 0.0);
+    assert_eq!(s.world().velocity(1).x, 0.0);
 }

@@ -79,7 +79,7 @@ fn a_box_rides_a_lift_right_left_up_down_and_diagonally() {
     let (lift, rider) = (entity(&s, "lift"), entity(&s, "box"));
     s.step(); // frame 0: nothing moves
     s.step(); // frame 1: the box settles on the still lift, and rides it from now on
-    assert_eq!(s.world().carrier[1], Some(lift));
+    assert_eq!(s.world().carrier(1), Some(lift));
     let dt = s.dt();
     let mut lift_at = s.position(lift).unwrap();
     let mut rider_x = s.position(rider).unwrap().x;
@@ -115,7 +115,7 @@ fn a_box_rides_a_lift_right_left_up_down_and_diagonally() {
             );
             stands_on_lift(&s, rider, [0.4, 0.4], lift, &when);
             assert!(crushes(&out).is_empty(), "{when}: {:?}", out.events);
-            assert_eq!(s.world().carrier[1], Some(lift), "{when}");
+            assert_eq!(s.world().carrier(1), Some(lift), "{when}");
         }
     }
 }
@@ -204,7 +204,7 @@ fn a_runner_rides_a_lift_jumps_off_it_and_lands_back_on_it() {
         }
         airborne += 1;
         assert_eq!(s.position(runner).unwrap().x, x, "in the air, not carried");
-        assert_eq!(s.world().carrier[1], None);
+        assert_eq!(s.world().carrier(1), None);
         assert!(airborne < 120, "it lands");
     }
     // 10 units/s up at 20 units/s² down: about a second in the air, while the lift went about
@@ -249,7 +249,7 @@ fn a_box_with_no_gravity_still_rides_a_lift_it_rests_on() {
         s.step();
         let x = s.position(rider).unwrap().x - s.position(lift).unwrap().x;
         assert!((x - offset).abs() < 1e-13, "frame {k}: offset {x}");
-        assert_eq!(s.world().carrier[1], Some(lift), "frame {k}");
+        assert_eq!(s.world().carrier(1), Some(lift), "frame {k}");
     }
 }
 
@@ -265,7 +265,7 @@ fn a_stack_of_boxes_rides_a_lift() {
     let (lift, top) = (entity(&s, "lift"), entity(&s, "top"));
     s.step();
     s.step();
-    assert_eq!(s.world().carrier[2], Some(entity(&s, "box")));
+    assert_eq!(s.world().carrier(2), Some(entity(&s, "box")));
     for v in [
         Vec2::new(3.0, 0.0),
         Vec2::new(0.0, -3.0),
@@ -407,7 +407,7 @@ fn a_rider_carried_into_a_wall_stops_at_it_and_the_lift_slides_on() {
     let (b, l) = (bounds(&s, rider, [0.4, 0.4]), bounds(&s, lift, LIFT));
     assert!(l.min.x > b.max.x, "the lift slid on: {l:?}, {b:?}");
     assert!(b.max.y < l.max.y, "and the box fell: {b:?}");
-    assert_eq!(s.world().carrier[1], None);
+    assert_eq!(s.world().carrier(1), None);
 }
 
 #[test]
@@ -425,9 +425,9 @@ fn a_rider_moved_by_the_game_rides_nothing_until_it_lands_again() {
     s.apply(lift, Action::SetVelocity(Vec2::new(3.0, 0.0)))
         .unwrap();
     s.step();
-    assert_eq!(s.world().carrier[1], Some(lift));
+    assert_eq!(s.world().carrier(1), Some(lift));
     s.set_position(rider, Vec2::new(-5.0, 2.0)).unwrap();
-    assert_eq!(s.world().carrier[1], None);
+    assert_eq!(s.world().carrier(1), None);
     for frame in 0..60 {
         s.step();
         assert_eq!(s.position(rider).unwrap().x, -5.0, "frame {frame}");

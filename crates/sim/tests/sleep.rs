@@ -18,7 +18,11 @@ fn sleeping_that_never_triggers_changes_nothing() {
     run_side_by_side(&mut plain, &mut sleepy, 300, |a, b, _, s| {
         totals.add(a);
         assert_eq!(b.stats.asleep, 0, "frame {}: a body fell asleep", b.frame);
-        assert!(s.world().asleep.iter().all(|f| !f), "frame {}", b.frame);
+        assert!(
+            (0..s.world().len()).all(|i| !s.world().asleep(i)),
+            "frame {}",
+            b.frame
+        );
         if b.frame > 0 {
             assert!(
                 b.stats.stages_run.contains(Stage::Sleep),
@@ -62,27 +66,27 @@ fn boxes(sleep_after: Option<u32>) -> Tiles {
 fn assert_sleepers_rest(sim: &Simulation, frame: u64) {
     let w = sim.world();
     for i in 0..w.len() {
-        if w.asleep[i] {
+        if w.asleep(i) {
             assert_eq!(
-                w.velocity[i],
+                w.velocity(i),
                 ricochet_geom::Vec2::ZERO,
                 "frame {frame}: {}",
-                w.name[i]
+                w.name(i)
             );
             assert!(
-                w.grounded[i],
+                w.grounded(i),
                 "frame {frame}: {} sleeps ungrounded",
-                w.name[i]
+                w.name(i)
             );
             assert!(
                 !w.active().contains(&(i as u32)),
                 "frame {frame}: {}",
-                w.name[i]
+                w.name(i)
             );
         }
     }
     assert_eq!(
-        w.asleep.iter().filter(|a| **a).count(),
+        (0..w.len()).filter(|&i| w.asleep(i)).count(),
         w.sleeping(),
         "frame {frame}"
     );
@@ -107,9 +111,13 @@ fn resting_boxes_fall_asleep_without_changing_any_state() {
             sleepy.world().digest(),
             "frame {frame}: digests differ\nplain: {:?} {:?}\nsleepy: {:?} {:?}",
             plain.world().position,
-            plain.world().velocity,
+            (0..plain.world().len())
+                .map(|i| plain.world().velocity(i))
+                .collect::<Vec<_>>(),
             sleepy.world().position,
-            sleepy.world().velocity,
+            (0..sleepy.world().len())
+                .map(|i| sleepy.world().velocity(i))
+                .collect::<Vec<_>>(),
         );
         assert_eq!(
             a.stats.asleep, 0,
@@ -169,9 +177,13 @@ fn a_sleeping_box_wakes_when_something_lands_on_it() {
             sleepy.world().digest(),
             "frame {frame}: digests differ\nplain: {:?} {:?}\nsleepy: {:?} {:?}",
             plain.world().position,
-            plain.world().velocity,
+            (0..plain.world().len())
+                .map(|i| plain.world().velocity(i))
+                .collect::<Vec<_>>(),
             sleepy.world().position,
-            sleepy.world().velocity,
+            (0..sleepy.world().len())
+                .map(|i| sleepy.world().velocity(i))
+                .collect::<Vec<_>>(),
         );
         assert!(a.contacts.len() >= b.contacts.len(), "frame {frame}");
         assert_sleepers_rest(&sleepy, frame);
@@ -183,7 +195,7 @@ fn a_sleeping_box_wakes_when_something_lands_on_it() {
             landed_at = Some(frame);
             assert!(asleep_before, "frame {frame}: lone was not asleep when hit");
             assert!(
-                !sleepy.world().asleep[lone],
+                !sleepy.world().asleep(lone),
                 "frame {frame}: lone still asleep after the landing"
             );
             assert!(
@@ -194,7 +206,7 @@ fn a_sleeping_box_wakes_when_something_lands_on_it() {
                 b.events
             );
         }
-        asleep_before = sleepy.world().asleep[lone];
+        asleep_before = sleepy.world().asleep(lone);
     }
     assert_eq!(
         landed_at,
@@ -218,7 +230,9 @@ fn sleeping_changes_nothing(scene: Tiles, frames: u64) -> (Simulation, Simulatio
             plain.world().digest(),
             sleepy.world().digest(),
             "frame {frame}: digests differ (asleep {:?}, active {:?})\nplain:  {:?}\nsleepy: {:?}",
-            sleepy.world().asleep,
+            (0..sleepy.world().len())
+                .map(|i| sleepy.world().asleep(i))
+                .collect::<Vec<_>>(),
             sleepy.world().active(),
             plain.world().position,
             sleepy.world().position,

@@ -44,7 +44,7 @@ fn run(sim: &mut Simulation, frames: u32, thickness: f64, what: &str) -> (f64, f
     let lowest = |sim: &mut Simulation| {
         let i = sim.world().find("thing").unwrap();
         let w = sim.world();
-        (w.shape[i].bounds(&w.pose(i)).min.y, w.position[i].y)
+        (w.shape(i).bounds(&w.pose(i)).min.y, w.position[i].y)
     };
     let mut above = lowest(sim).0 >= 0.0;
     for frame in 1..=frames {
@@ -111,8 +111,8 @@ fn the_landing_frame_puts_a_fast_crate_exactly_flush() {
     sim.step();
     let i = sim.world().find("thing").unwrap();
     assert_eq!(sim.world().position[i].y, 0.4);
-    assert_eq!(sim.world().velocity[i].y, 0.0);
-    assert!(sim.world().grounded[i]);
+    assert_eq!(sim.world().velocity(i).y, 0.0);
+    assert!(sim.world().grounded(i));
 }
 
 #[test]
@@ -141,7 +141,7 @@ fn a_fast_crate_thrown_sideways_stops_flush_against_a_thin_wall() {
     sim.step();
     let i = sim.world().find("thing").unwrap();
     assert_eq!(sim.world().position[i].x, 9.6);
-    assert_eq!(sim.world().velocity[i].x, 0.0);
+    assert_eq!(sim.world().velocity(i).x, 0.0);
 }
 
 #[test]
@@ -255,7 +255,7 @@ fn a_fast_ball_rolling_over_a_tiled_floor_is_not_stopped_at_the_seams() {
             sim.step();
         }
         let i = sim.world().find("thing").unwrap();
-        let (p, v) = (sim.world().position[i], sim.world().velocity[i]);
+        let (p, v) = (sim.world().position[i], sim.world().velocity(i));
         assert_eq!(v.x, 30.0, "gravity {g}: the ball slowed to {v}");
         assert!((p.x - 30.0).abs() < 1e-9, "gravity {g}: the ball is at {p}");
         assert!((p.y - 0.1).abs() <= 1e-6, "gravity {g}: the ball is at {p}");

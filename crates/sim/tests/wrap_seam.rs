@@ -325,7 +325,7 @@ fn reference(
                 } else {
                     ricochet_geom::Pose::new(pose(j).position + o, pose(j).angle)
                 };
-                let c = ricochet_geom::contact(&w.shape[i], &pose(i), &w.shape[j], &image);
+                let c = ricochet_geom::contact(w.shape(i), &pose(i), w.shape(j), &image);
                 if best.is_none_or(|(d, _)| c.depth > d) {
                     best = Some((c.depth, image.position));
                 }

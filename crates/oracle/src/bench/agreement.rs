@@ -133,7 +133,7 @@ pub fn compare_contacts(
             return false;
         };
         let size = b.max - b.min;
-        let moved = (w.position[i] - w.start_position[i]).abs();
+        let moved = (w.position[i] - w.start_position(i)).abs();
         b.wrap && (moved.x > 0.5 * size.x || moved.y > 0.5 * size.y)
     };
     let end_pose = |e: Entity| w.index_of(e).map(|i| w.pose(i));

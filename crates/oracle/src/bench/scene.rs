@@ -81,9 +81,9 @@ impl RapierScene {
         };
         let filter = LayerFilter::new(&sim.scenario().world.layers);
         for i in 0..w.len() {
-            let pose = collider_pose(&w.shape[i], &w.pose(i))?;
+            let pose = collider_pose(w.shape(i), &w.pose(i))?;
             // The shape in its own frame: the collider's pose carries the whole placement.
-            let (_, shape) = place(&w.shape[i], &Pose::default(), ricochet_geom::Vec2::ZERO)?;
+            let (_, shape) = place(w.shape(i), &Pose::default(), ricochet_geom::Vec2::ZERO)?;
             let types = if w.kind[i] == BodyKind::Dynamic {
                 ActiveCollisionTypes::default() | ActiveCollisionTypes::FIXED_FIXED
             } else {
@@ -113,7 +113,7 @@ impl RapierScene {
             ));
         }
         for &(i, handle) in &self.moving {
-            let pose = collider_pose(&w.shape[i], &w.pose(i))?;
+            let pose = collider_pose(w.shape(i), &w.pose(i))?;
             // `get_mut` marks the collider modified: touch only the ones that moved.
             if self
                 .colliders

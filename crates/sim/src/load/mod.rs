@@ -196,6 +196,7 @@ fn load(text: &str, file: &str, chunked: bool) -> Result<Scenario, ScenarioError
         world,
         frames,
         templates,
+        tiles: Vec::new(),
         bodies,
         script,
     })

@@ -41,12 +41,12 @@ pub(crate) fn kinematic_root(w: &World, carrier: Option<Entity>) -> Option<usize
     let mut next = carrier;
     for _ in 0..MAX_CHAIN {
         let j = w.index_of(next?)?;
-        if w.frozen[j] || w.asleep[j] {
+        if w.frozen(j) || w.asleep(j) {
             return None;
         }
         match w.kind[j] {
             BodyKind::Kinematic => return Some(j),
-            BodyKind::Dynamic => next = w.carrier[j],
+            BodyKind::Dynamic => next = w.carrier(j),
             BodyKind::Static => return None,
         }
     }
@@ -57,10 +57,10 @@ pub(crate) fn kinematic_root(w: &World, carrier: Option<Entity>) -> Option<usize
 /// `velocity[axis] * dt`, exactly what `move_x`/`move_y` add to the carrier itself; `0` when
 /// it rides nothing that moves.
 pub(crate) fn displacement(w: &World, i: usize, axis: usize, dt: f64) -> f64 {
-    if w.carrier[i].is_none() {
+    if w.carrier(i).is_none() {
         return 0.0;
     }
-    kinematic_root(w, w.carrier[i]).map_or(0.0, |k| w.velocity[k][axis] * dt)
+    kinematic_root(w, w.carrier(i)).map_or(0.0, |k| w.velocity(k)[axis] * dt)
 }
 
 /// Whether a box with bounds `rider` still rests on a carrier with bounds `carrier`: its

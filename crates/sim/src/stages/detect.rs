@@ -226,12 +226,12 @@ pub(crate) fn run(
     for &(i, j) in &pairs {
         let (i, j) = (i as usize, j as usize);
         let w = &ctx.world;
-        let resting = |k: usize| w.kind[k] == BodyKind::Static || w.asleep[k];
-        if w.frozen[i] || w.frozen[j] || (resting(i) && resting(j)) {
+        let resting = |k: usize| w.kind[k] == BodyKind::Static || w.asleep(k);
+        if w.frozen(i) || w.frozen(j) || (resting(i) && resting(j)) {
             continue;
         }
         let response = layers.response(w.layer[i], w.layer[j]);
-        if response == Response::Separate && is_box(&w.shape[i]) && is_box(&w.shape[j]) {
+        if response == Response::Separate && is_box(w.shape(i)) && is_box(w.shape(j)) {
             continue;
         }
         ctx.out.stats.broad_pairs += 1;
@@ -253,7 +253,7 @@ pub(crate) fn run(
             plan.len(),
             |k| {
                 let (i, j, _) = plan[k];
-                contact(&w.shape[i], &w.pose(i), &w.shape[j], &w.pose(j))
+                contact(w.shape(i), &w.pose(i), w.shape(j), &w.pose(j))
             },
             &mut contacts,
         );
@@ -267,7 +267,7 @@ pub(crate) fn run(
         let w = &ctx.world;
         let (pose_a, mut pose_b) = (w.pose(i), w.pose(j));
         let mut c = if pushed[i] || pushed[j] {
-            contact(&w.shape[i], &pose_a, &w.shape[j], &pose_b)
+            contact(w.shape(i), &pose_a, w.shape(j), &pose_b)
         } else {
             contacts[k]
         };
@@ -292,7 +292,7 @@ pub(crate) fn run(
         for offset in st.seam.offsets(i, j) {
             ctx.out.stats.narrow_tests += 1;
             let image = Pose::new(w.position[j] + offset, w.angle[j]);
-            let d = contact(&w.shape[i], &pose_a, &w.shape[j], &image);
+            let d = contact(w.shape(i), &pose_a, w.shape(j), &image);
             if d.depth > c.depth {
                 (c, pose_b) = (d, image);
             }
@@ -305,7 +305,7 @@ pub(crate) fn run(
         if c.depth <= threshold {
             continue;
         }
-        woken.extend([i, j].into_iter().filter(|&k| w.asleep[k]));
+        woken.extend([i, j].into_iter().filter(|&k| w.asleep(k)));
         respond(
             ctx,
             &mut doomed,
@@ -364,20 +364,20 @@ fn run_swept(
         let w = &ctx.world;
         // Straight from the frame's start to its end, at the end angles.
         let sweep = |k: usize| Sweep {
-            start: w.start_position[k],
+            start: w.start_position(k),
             end: w.position[k],
             angle: w.angle[k],
         };
-        let mut first = time_of_impact(&w.shape[i], &sweep(i), &w.shape[j], &sweep(j));
+        let mut first = time_of_impact(w.shape(i), &sweep(i), w.shape(j), &sweep(j));
         // Through the seam: `b`'s images next to `a`, the earliest (the first on a tie).
         for offset in seam.offsets(i, j) {
             ctx.out.stats.narrow_tests += 1;
             let image = Sweep {
-                start: w.start_position[j] + offset,
+                start: w.start_position(j) + offset,
                 end: w.position[j] + offset,
                 angle: w.angle[j],
             };
-            let hit = time_of_impact(&w.shape[i], &sweep(i), &w.shape[j], &image);
+            let hit = time_of_impact(w.shape(i), &sweep(i), w.shape(j), &image);
             if let Some(h) = hit
                 && first.as_ref().is_none_or(|f| h.t < f.t)
             {
@@ -386,7 +386,7 @@ fn run_swept(
         }
         if let Some(impact) = first {
             // The mover is the body that went further: a bullet against a drifting rock.
-            let travel = |k: usize| (w.position[k] - w.start_position[k]).length();
+            let travel = |k: usize| (w.position[k] - w.start_position(k)).length();
             let mover = if travel(j) > travel(i) {
                 w.entity[j]
             } else {
@@ -418,7 +418,7 @@ fn run_swept(
         woken.extend(
             [hit.pair.0, hit.pair.1]
                 .into_iter()
-                .filter(|&k| w.asleep[k]),
+                .filter(|&k| w.asleep(k)),
         );
         let before = doomed.len();
         respond(

@@ -14,18 +14,7 @@ pub(crate) fn has_work(w: &World) -> bool {
 /// Counts down the lifetimes of the bodies not frozen, and removes those that ran out.
 pub(crate) fn run(ctx: &mut StageCtx) {
     let mut expired = Vec::new();
-    let w = &mut *ctx.world;
-    for (i, life) in w.lifetime.iter_mut().enumerate() {
-        if w.frozen[i] {
-            continue;
-        }
-        if let Some(l) = life {
-            *l = l.saturating_sub(1);
-            if *l == 0 {
-                expired.push(w.entity[i]);
-            }
-        }
-    }
+    ctx.world.count_down_lifetimes(&mut expired);
     for e in expired {
         remove(ctx, e, Removal::Expired, false);
     }

@@ -9,7 +9,7 @@ use crate::world::World;
 
 /// Whether an active body is grounded.
 pub(crate) fn has_grounded(w: &World) -> bool {
-    w.active().iter().any(|&i| w.grounded[i as usize])
+    w.active().iter().any(|&i| w.grounded(i as usize))
 }
 
 /// Every body starts the frame's motion airborne; `resolve_y` (a push upwards) or `detect`
@@ -19,8 +19,8 @@ pub(crate) fn has_grounded(w: &World) -> bool {
 pub(crate) fn unground(w: &mut World) {
     for k in 0..w.active().len() {
         let i = w.active()[k] as usize;
-        w.grounded[i] = false;
-        w.on_static[i] = false;
+        *w.grounded_mut(i) = false;
+        *w.on_static_mut(i) = false;
     }
 }
 
@@ -29,7 +29,7 @@ pub(crate) fn has_controls(w: &World) -> bool {
     w.any_controller()
         && w.active()
             .iter()
-            .any(|&i| w.controller[i as usize].is_some())
+            .any(|&i| w.controller(i as usize).is_some())
 }
 
 /// Inputs become velocities: a ship's turn input sets its angular velocity, a runner's or
@@ -40,14 +40,14 @@ pub(crate) fn controls(w: &mut World) {
     }
     for k in 0..w.active().len() {
         let i = w.active()[k] as usize;
-        match &w.controller[i] {
+        match w.controller(i) {
             Some(Controller::Ship { turn_rate, .. }) => {
-                w.angular_velocity[i] = w.inputs[i].turn * turn_rate;
+                *w.angular_velocity_mut(i) = w.inputs(i).turn * turn_rate;
             }
             Some(Controller::Runner { run_speed, .. }) => {
-                w.velocity[i].x = w.inputs[i].run * run_speed;
+                w.velocity_mut(i).x = w.inputs(i).run * run_speed;
             }
-            Some(Controller::Walker { speed }) => w.velocity[i].x = *speed,
+            Some(Controller::Walker { speed }) => w.velocity_mut(i).x = *speed,
             None => {}
         }
     }
@@ -55,8 +55,8 @@ pub(crate) fn controls(w: &mut World) {
 
 /// The ship's engine force along its heading, when the engine is on.
 fn thrust(w: &World, i: usize) -> Vec2 {
-    match &w.controller[i] {
-        Some(Controller::Ship { thrust, .. }) if w.inputs[i].thrust => {
+    match w.controller(i) {
+        Some(Controller::Ship { thrust, .. }) if w.inputs(i).thrust => {
             let (s, c) = libm::sincos(w.angle[i]);
             Vec2::new(c, s) * *thrust
         }
@@ -73,15 +73,15 @@ pub(crate) fn has_forces(w: &World, def: &WorldDef) -> bool {
     (g != Vec2::ZERO
         && w.active().iter().any(|&i| {
             let i = i as usize;
-            dynamic(i) && w.gravity_scale[i] != 0.0
+            dynamic(i) && w.gravity_scale(i) != 0.0
         }))
         || (w.any_controller()
             && w.active()
                 .iter()
-                .any(|&i| w.inputs[i as usize].thrust && dynamic(i as usize)))
+                .any(|&i| w.inputs(i as usize).thrust && dynamic(i as usize)))
         // One contiguous column beats a gather through the active list; a static body's
         // force only makes the stage run for nothing.
-        || w.force.iter().any(|f| *f != Vec2::ZERO)
+        || w.any_force()
 }
 
 /// `a = sum(f) / m` with gravity as the force `m * g * gravity_scale`; `v += a * dt`.
@@ -92,10 +92,10 @@ pub(crate) fn forces(w: &mut World, def: &WorldDef) {
         if w.kind[i] != BodyKind::Dynamic {
             continue;
         }
-        let m = w.mass[i];
-        let sum = w.force[i] + thrust(w, i) + g * (m * w.gravity_scale[i]);
+        let m = w.mass(i);
+        let sum = w.force(i) + thrust(w, i) + g * (m * w.gravity_scale(i));
         let a = sum / m;
-        w.velocity[i] += a * dt;
+        *w.velocity_mut(i) += a * dt;
     }
 }
 
@@ -103,7 +103,7 @@ pub(crate) fn forces(w: &mut World, def: &WorldDef) {
 pub(crate) fn has_motion(w: &World) -> bool {
     w.active()
         .iter()
-        .any(|&i| w.velocity[i as usize] != Vec2::ZERO)
+        .any(|&i| w.velocity(i as usize) != Vec2::ZERO)
 }
 
 /// `position[axis] += velocity[axis] * dt` for every active body, a rider first carried by
@@ -113,14 +113,14 @@ pub(crate) fn has_motion(w: &World) -> bool {
 fn move_axis(w: &mut World, dt: f64, axis: usize, carries: bool) {
     for k in 0..w.active().len() {
         let i = w.active()[k] as usize;
-        if carries && w.carrier[i].is_some() {
+        if carries && w.carrier(i).is_some() {
             let d = carry::displacement(w, i, axis, dt);
             // Nothing is added for no motion: `-0.0 + 0.0` would change a zero's sign.
             if d != 0.0 {
                 w.position[i][axis] += d;
             }
         }
-        w.position[i][axis] += w.velocity[i][axis] * dt;
+        w.position[i][axis] += w.velocity(i)[axis] * dt;
     }
 }
 
@@ -138,13 +138,13 @@ pub(crate) fn move_y(w: &mut World, dt: f64, carries: bool) {
 pub(crate) fn has_turning(w: &World) -> bool {
     w.active()
         .iter()
-        .any(|&i| w.angular_velocity[i as usize] != 0.0)
+        .any(|&i| w.angular_velocity(i as usize) != 0.0)
 }
 
 /// `angle += angular_velocity * dt`.
 pub(crate) fn turn(w: &mut World, dt: f64) {
     for k in 0..w.active().len() {
         let i = w.active()[k] as usize;
-        w.angle[i] += w.angular_velocity[i] * dt;
+        w.angle[i] += w.angular_velocity(i) * dt;
     }
 }

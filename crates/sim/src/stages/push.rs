@@ -26,26 +26,26 @@ pub(crate) fn separate_along_normal(
     if di {
         let p = -normal * (depth * share);
         w.position[i] += p;
-        let vn = w.velocity[i].dot(normal);
+        let vn = w.velocity(i).dot(normal);
         if vn > 0.0 {
-            w.velocity[i] -= normal * vn;
+            *w.velocity_mut(i) -= normal * vn;
         }
         if normal.y < -0.7 {
-            w.grounded[i] = true;
-            w.on_static[i] |= w.kind[j] == BodyKind::Static;
+            *w.grounded_mut(i) = true;
+            *w.on_static_mut(i) |= w.kind[j] == BodyKind::Static;
         }
         pushed = p;
     }
     if dj {
         let p = normal * (depth * share);
         w.position[j] += p;
-        let vn = w.velocity[j].dot(normal);
+        let vn = w.velocity(j).dot(normal);
         if vn < 0.0 {
-            w.velocity[j] -= normal * vn;
+            *w.velocity_mut(j) -= normal * vn;
         }
         if normal.y > 0.7 {
-            w.grounded[j] = true;
-            w.on_static[j] |= w.kind[i] == BodyKind::Static;
+            *w.grounded_mut(j) = true;
+            *w.on_static_mut(j) |= w.kind[i] == BodyKind::Static;
         }
         pushed = p;
     }

@@ -15,23 +15,19 @@ pub(crate) fn remove(ctx: &mut StageCtx, entity: Entity, cause: Removal, split: 
     };
     let removed = RemovedBody {
         entity,
-        name: w.name[i].clone(),
+        name: w.name(i).to_owned(),
         layer: w.layer[i],
-        shape: w.shape[i].clone(),
+        shape: w.shape(i).clone(),
         pose: w.pose(i),
-        velocity: w.velocity[i],
-        angular_velocity: w.angular_velocity[i],
+        velocity: w.velocity(i),
+        angular_velocity: w.angular_velocity(i),
         kind: w.kind[i],
     };
     ctx.out.events.push(GameEvent::Removed {
         body: entity,
         cause,
     });
-    let children = if split {
-        std::mem::take(&mut w.split[i])
-    } else {
-        Vec::new()
-    };
+    let children = if split { w.take_split(i) } else { Vec::new() };
     w.despawn(i);
     for child in children {
         let Some(template) = ctx.templates.get(&child.template) else {

@@ -56,36 +56,37 @@ fn apply(ctx: &mut StageCtx, i: usize, action: &Action) {
         }
         Action::SetVelocity(velocity) => {
             if w.kind[i] != BodyKind::Static {
-                w.velocity[i] = *velocity;
+                *w.velocity_mut(i) = *velocity;
             }
             ScriptInput::Velocity(*velocity)
         }
         Action::ApplyImpulse(impulse) => {
             if w.kind[i] == BodyKind::Dynamic {
-                w.velocity[i] += *impulse / w.mass[i];
+                let m = w.mass(i);
+                *w.velocity_mut(i) += *impulse / m;
             }
             ScriptInput::Impulse(*impulse)
         }
         Action::SetForce(force) => {
-            w.force[i] = *force;
+            *w.force_mut(i) = *force;
             ScriptInput::Force(*force)
         }
         Action::Thrust(on) => {
-            w.inputs[i].thrust = *on;
+            w.inputs_mut(i).thrust = *on;
             ScriptInput::Thrust(*on)
         }
         Action::Turn(input) => {
-            w.inputs[i].turn = *input;
+            w.inputs_mut(i).turn = *input;
             ScriptInput::Turn(*input)
         }
         Action::Move(input) => {
-            w.inputs[i].run = *input;
+            w.inputs_mut(i).run = *input;
             ScriptInput::Move(*input)
         }
-        Action::Jump => ScriptInput::Jump(match &w.controller[i] {
-            Some(Controller::Runner { jump_speed, .. }) if w.grounded[i] => {
-                w.velocity[i].y = *jump_speed;
-                w.grounded[i] = false;
+        Action::Jump => ScriptInput::Jump(match w.controller(i).cloned() {
+            Some(Controller::Runner { jump_speed, .. }) if w.grounded(i) => {
+                w.velocity_mut(i).y = jump_speed;
+                *w.grounded_mut(i) = false;
                 JumpOutcome::Jumped
             }
             Some(Controller::Runner { .. }) => JumpOutcome::NotGrounded,
@@ -108,7 +109,7 @@ fn fire(ctx: &mut StageCtx, i: usize) -> FireOutcome {
         bullet_speed,
         muzzle,
         ..
-    }) = &w.controller[i]
+    }) = w.controller(i)
     else {
         return FireOutcome::NotAShip;
     };
@@ -119,7 +120,7 @@ fn fire(ctx: &mut StageCtx, i: usize) -> FireOutcome {
     let heading = Vec2::new(c, s);
     let mut def = template.clone();
     def.position = w.position[i] + heading * *muzzle;
-    def.velocity = w.velocity[i] + heading * *bullet_speed;
+    def.velocity = w.velocity(i) + heading * *bullet_speed;
     def.angle = w.angle[i];
     let ship = w.entity[i];
     let bullet = w.spawn(&def);

@@ -45,7 +45,7 @@ pub(crate) fn has_work(w: &World, st: &SeparateState) -> bool {
     st.any_layer
         && w.active().iter().any(|&i| {
             let i = i as usize;
-            w.kind[i] == BodyKind::Dynamic && is_box(&w.shape[i])
+            w.kind[i] == BodyKind::Dynamic && is_box(w.shape(i))
         })
 }
 
@@ -122,7 +122,7 @@ impl SeparateState {
         let mut boxes = Vec::new();
         for i in 0..w.len() {
             if w.kind[i] == BodyKind::Static
-                && is_box(&w.shape[i])
+                && is_box(w.shape(i))
                 && self.separating[usize::from(w.layer[i])]
             {
                 boxes.push((box_bounds(w, i), self.static_entities.len() as u32));
@@ -136,7 +136,7 @@ impl SeparateState {
 /// The exact bounds of box `i`: bit for bit `Shape::bounds`, without its general path for a
 /// box on the body origin (the usual case).
 fn box_bounds(w: &World, i: usize) -> Bounds {
-    match &w.shape[i] {
+    match w.shape(i) {
         Shape::Primitive(Primitive::Aabb(b)) if b.center == Vec2::ZERO => {
             // `position + 0` is `position` (up to the sign of a zero, which compares equal).
             Bounds::around(w.position[i], b.half_extents)
@@ -223,11 +223,11 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
     extents.clear();
     for &i in w.movers() {
         let k = i as usize;
-        if !is_box(&w.shape[k]) || w.frozen[k] || !st.separating[usize::from(w.layer[k])] {
+        if !is_box(w.shape(k)) || w.frozen(k) || !st.separating[usize::from(w.layer[k])] {
             continue;
         }
         let b = box_bounds(w, k);
-        if w.kind[k] == BodyKind::Dynamic && !w.asleep[k] {
+        if w.kind[k] == BodyKind::Dynamic && !w.asleep(k) {
             order.push((b.min[axis], i));
             extents.push((b.max - b.min).max_element());
         }
@@ -237,10 +237,10 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
     st.movers.reset(&mut extents, order.len());
     for &i in w.movers() {
         let k = i as usize;
-        if is_box(&w.shape[k])
-            && !w.frozen[k]
+        if is_box(w.shape(k))
+            && !w.frozen(k)
             && st.separating[usize::from(w.layer[k])]
-            && (w.kind[k] == BodyKind::Kinematic || w.asleep[k])
+            && (w.kind[k] == BodyKind::Kinematic || w.asleep(k))
         {
             st.movers.insert(&box_bounds(w, k), i);
         }
@@ -257,9 +257,9 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
         let mut next = 0;
         // What it rode into the frame, and the first kinematic box that pushes it (riders:
         // `stages/carry.rs`). `resolve_y` records what holds it up now.
-        let old_carrier = ctx.world.carrier[i];
+        let old_carrier = ctx.world.carrier(i);
         if axis == 1 {
-            ctx.world.carrier[i] = None;
+            *ctx.world.carrier_mut(i) = None;
         }
         let mut pushed_by = None;
         // Where the box started along the axis, relative to where it is now: the first
@@ -267,7 +267,7 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
         // moved at most half its size cannot get past a static box's middle (it goes in by
         // at most that, less than half the pair's size), so today's push is right for it
         // and the sweep is skipped (`sweep_axis.rs`).
-        let back = ctx.world.start_position[i][axis] - ctx.world.position[i][axis];
+        let back = ctx.world.start_position(i)[axis] - ctx.world.position[i][axis];
         let size = {
             let b = box_bounds(ctx.world, i);
             b.max[axis] - b.min[axis]
@@ -310,7 +310,7 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
                     bounds: o.bounds,
                     back: if o.moving {
                         let j = o.index as usize;
-                        w.start_position[j][axis] - w.position[j][axis]
+                        w.start_position(j)[axis] - w.position[j][axis]
                     } else {
                         0.0
                     },
@@ -342,7 +342,7 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
             let w = &*ctx.world;
             let (a, b) = if i < j { (i, j) } else { (j, i) };
             // A box that was still already (resting on the sleeper) does not wake it.
-            if w.asleep[j] && !w.still[i] {
+            if w.asleep(j) && !w.still(i) {
                 woken.push(j);
             }
             let kind = w.kind[j];
@@ -353,7 +353,7 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
             // touches.
             let pair_contact = |w: &World| {
                 let (pose_a, pose_b) = (w.pose(a), w.pose(b));
-                let c = contact(&w.shape[a], &pose_a, &w.shape[b], &pose_b);
+                let c = contact(w.shape(a), &pose_a, w.shape(b), &pose_b);
                 (c, pose_a, pose_b)
             };
             let before = (!after).then(|| pair_contact(w));
@@ -364,8 +364,8 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
             let (c, pose_a, pose_b) = before.unwrap_or_else(|| pair_contact(w));
             if axis == 1 && moved[axis] > 0.0 {
                 // Held up: by a static body (it may sleep), or by a carrier it rides.
-                w.on_static[i] |= kind == BodyKind::Static;
-                w.carrier[i] = (kind != BodyKind::Static).then(|| w.entity[j]);
+                *w.on_static_mut(i) |= kind == BodyKind::Static;
+                *w.carrier_mut(i) = (kind != BodyKind::Static).then(|| w.entity[j]);
             }
             out.contacts.push(ContactRecord {
                 a: w.entity[a],
@@ -410,7 +410,7 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
 /// `stop`: exactly `face ∓ half extent` for a box on the body origin.
 fn flush(w: &World, i: usize, bi: &Bounds, axis: usize, stop: sweep_axis::Stop) -> f64 {
     let p = w.position[i][axis];
-    match &w.shape[i] {
+    match w.shape(i) {
         Shape::Primitive(Primitive::Aabb(b)) if b.center == Vec2::ZERO => {
             if stop.towards_max {
                 stop.face - b.half_extents[axis]
@@ -427,15 +427,15 @@ fn flush(w: &World, i: usize, bi: &Bounds, axis: usize, stop: sweep_axis::Stop) 
 /// landing (pushed up) and walkers turning round (pushed along x).
 fn apply_push(w: &mut crate::World, i: usize, axis: usize, to: f64, push: f64) {
     w.position[i][axis] = to;
-    let v = &mut w.velocity[i][axis];
+    let v = &mut w.velocity_mut(i)[axis];
     if (push < 0.0 && *v > 0.0) || (push > 0.0 && *v < 0.0) {
         *v = 0.0;
     }
     if axis == 1 && push > 0.0 {
-        w.grounded[i] = true;
+        *w.grounded_mut(i) = true;
     }
     if axis == 0
-        && let Some(Controller::Walker { speed }) = &mut w.controller[i]
+        && let Some(Controller::Walker { speed }) = w.controller_mut(i)
         && ((push < 0.0 && *speed > 0.0) || (push > 0.0 && *speed < 0.0))
     {
         *speed = -*speed;
@@ -462,11 +462,11 @@ fn rider(
     }
     let bi = box_bounds(w, i);
     if axis == 1
-        && w.carrier[i].is_none()
+        && w.carrier(i).is_none()
         && let Some(c) = old_carrier.and_then(|e| w.index_of(e))
         && carry::still_rides(&bi, &box_bounds(w, c))
     {
-        w.carrier[i] = old_carrier;
+        *w.carrier_mut(i) = old_carrier;
     }
     let by = pushed_by.or_else(|| carry::kinematic_root(w, old_carrier))?;
     obstacles(st, w, &bi, 0, found);

@@ -29,18 +29,18 @@ pub(crate) fn run(ctx: &mut StageCtx) {
     let w = &mut *ctx.world;
     for k in 0..w.active().len() {
         let i = w.active()[k] as usize;
-        let still = w.velocity[i] == Vec2::ZERO
-            && w.angular_velocity[i] == 0.0
-            && w.position[i].x.to_bits() == w.start_position[i].x.to_bits()
-            && w.position[i].y.to_bits() == w.start_position[i].y.to_bits();
-        w.still[i] = still;
-        let resting = still && w.kind[i] == BodyKind::Dynamic && w.on_static[i];
-        w.rest_frames[i] = if resting {
-            w.rest_frames[i].saturating_add(1)
+        let still = w.velocity(i) == Vec2::ZERO
+            && w.angular_velocity(i) == 0.0
+            && w.position[i].x.to_bits() == w.start_position(i).x.to_bits()
+            && w.position[i].y.to_bits() == w.start_position(i).y.to_bits();
+        *w.still_mut(i) = still;
+        let resting = still && w.kind[i] == BodyKind::Dynamic && w.on_static(i);
+        *w.rest_frames_mut(i) = if resting {
+            w.rest_frames(i).saturating_add(1)
         } else {
             0
         };
-        if w.rest_frames[i] >= after {
+        if w.rest_frames(i) >= after {
             w.put_to_sleep(i);
         }
     }

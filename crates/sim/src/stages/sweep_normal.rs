@@ -34,22 +34,22 @@ pub(crate) fn stop(
     tests: &mut u64,
 ) -> Option<Impact> {
     let dynamic = |k: usize| w.kind[k] == BodyKind::Dynamic;
-    if dynamic(i) == dynamic(j) || w.asleep[i] || w.asleep[j] {
+    if dynamic(i) == dynamic(j) || w.asleep(i) || w.asleep(j) {
         return None;
     }
-    let moved = |k: usize| w.position[k] - w.start_position[k];
+    let moved = |k: usize| w.position[k] - w.start_position(k);
     let relative = moved(i) - moved(j);
-    let reach = 0.5 * (w.shape[i].min_width() + w.shape[j].min_width());
+    let reach = 0.5 * (w.shape(i).min_width() + w.shape(j).min_width());
     if relative == Vec2::ZERO || relative.length() <= reach {
         return None;
     }
     *tests += 1;
     let sweep = |k: usize| Sweep {
-        start: w.start_position[k],
+        start: w.start_position(k),
         end: w.position[k],
         angle: w.angle[k],
     };
-    let impact = time_of_impact(&w.shape[i], &sweep(i), &w.shape[j], &sweep(j))?;
+    let impact = time_of_impact(w.shape(i), &sweep(i), w.shape(j), &sweep(j))?;
     if impact.t <= 0.0 && impact.contact.depth > SLOP {
         // Overlapping when the frame began: the push decides, as before. (Touching then is
         // swept like any other touch: a body flush on a floor that falls through it stays.)
@@ -77,7 +77,7 @@ pub(crate) fn apply(ctx: &mut StageCtx, (i, j): (usize, usize), impact: &Impact)
     };
     let end = w.position[d];
     w.position[d] = at;
-    let c = contact(&w.shape[i], &w.pose(i), &w.shape[j], &w.pose(j));
+    let c = contact(w.shape(i), &w.pose(i), w.shape(j), &w.pose(j));
     let (normal, depth) = if c.depth > SLOP {
         (c.normal, c.depth)
     } else {

@@ -29,7 +29,7 @@ pub fn active_as_documented(sim: &Simulation) -> Vec<u32> {
     w.movers()
         .iter()
         .copied()
-        .filter(|&i| !w.frozen[i as usize] && !w.asleep[i as usize])
+        .filter(|&i| !w.frozen(i as usize) && !w.asleep(i as usize))
         .collect()
 }
 

@@ -210,7 +210,7 @@ fn harmonic_run(
         sim.step();
         if s % u64::from(k) == 0 {
             let (x, _) = h.exact(s as f64 * dt);
-            let (p, v) = (sim.world().position[0], sim.world().velocity[0]);
+            let (p, v) = (sim.world().position[0], sim.world().velocity(0));
             position = position.max((p - x).length());
             energy = energy.max((h.energy(p, v) - e0).abs() / e0);
         }

@@ -1,0 +1,212 @@
+//! Values many bodies share, stored once: the world's shape and name tables. A body holds a
+//! `u32` id; a value lives while some body uses it and its id is then reused.
+//!
+//! Ids are private to the world and never reach an output, so which id a value gets does
+//! not matter for determinism (it is a function of the spawn and removal history anyway).
+
+use std::collections::BTreeMap;
+
+use ricochet_geom::{Bounds, Primitive, Shape};
+
+/// Values stored once, looked up by a key that is equal exactly when the values are.
+#[derive(Clone, Debug)]
+pub(crate) struct Interned<K: Ord, V> {
+    /// Each id's key and value (`None` once no body uses it).
+    entries: Vec<Option<(K, V)>>,
+    /// How many bodies use each id.
+    users: Vec<u32>,
+    /// Ids no body uses, to reuse.
+    free: Vec<u32>,
+    /// The id of each key in use.
+    ids: BTreeMap<K, u32>,
+}
+
+impl<K: Ord, V> Default for Interned<K, V> {
+    fn default() -> Self {
+        Interned {
+            entries: Vec::new(),
+            users: Vec::new(),
+            free: Vec::new(),
+            ids: BTreeMap::new(),
+        }
+    }
+}
+
+impl<K: Ord + Clone, V> Interned<K, V> {
+    /// The id of `key`'s value, one more user counted; `value` makes it when it is new.
+    pub(crate) fn acquire<Q>(&mut self, key: &Q, value: impl FnOnce() -> V) -> u32
+    where
+        K: std::borrow::Borrow<Q>,
+        Q: Ord + ToOwned<Owned = K> + ?Sized,
+    {
+        if let Some(&id) = self.ids.get(key) {
+            self.users[id as usize] += 1;
+            return id;
+        }
+        let entry = Some((key.to_owned(), value()));
+        let id = match self.free.pop() {
+            Some(id) => {
+                self.entries[id as usize] = entry;
+                self.users[id as usize] = 1;
+                id
+            }
+            None => {
+                self.entries.push(entry);
+                self.users.push(1);
+                u32::try_from(self.entries.len() - 1).expect("fewer than 2^32 distinct values")
+            }
+        };
+        self.ids.insert(key.to_owned(), id);
+        id
+    }
+
+    /// One user of `id` fewer; the value is dropped with its last user.
+    pub(crate) fn release(&mut self, id: u32) {
+        let users = &mut self.users[id as usize];
+        *users -= 1;
+        if *users == 0
+            && let Some((key, _)) = self.entries[id as usize].take()
+        {
+            self.ids.remove(&key);
+            self.free.push(id);
+        }
+    }
+
+    /// The value of an id in use.
+    #[inline]
+    pub(crate) fn get(&self, id: u32) -> &V {
+        &self.entries[id as usize].as_ref().expect("an id in use").1
+    }
+
+    /// The key of an id in use.
+    #[inline]
+    pub(crate) fn key(&self, id: u32) -> &K {
+        &self.entries[id as usize].as_ref().expect("an id in use").0
+    }
+
+    /// The value of `id`, if it is in use.
+    pub(crate) fn try_get(&self, id: u32) -> Option<&V> {
+        self.entries.get(id as usize)?.as_ref().map(|(_, v)| v)
+    }
+
+    /// How many ids have been handed out (some may be free now).
+    pub(crate) fn len(&self) -> u32 {
+        self.entries.len() as u32
+    }
+
+    /// The id of `key`'s value, if a body uses it.
+    pub(crate) fn id<Q>(&self, key: &Q) -> Option<u32>
+    where
+        K: std::borrow::Borrow<Q>,
+        Q: Ord + ?Sized,
+    {
+        self.ids.get(key).copied()
+    }
+
+    /// Heap bytes held, counting `key_bytes` for each key's own heap.
+    pub(crate) fn heap_bytes(&self, key_bytes: impl Fn(&K) -> usize) -> usize {
+        let keys: usize = self.ids.keys().map(&key_bytes).sum::<usize>() * 2;
+        self.entries.capacity() * size_of::<Option<(K, V)>>()
+            + self.users.capacity() * 4
+            + self.free.capacity() * 4
+            // A B-tree node holds up to 11 keys and values; count each entry at full size.
+            + self.ids.len() * (size_of::<K>() + 4 + 8)
+            + keys
+    }
+}
+
+/// The shapes of the world, one copy each: keyed by the bits of every number that defines
+/// them, so two shapes share an id only when they are the same bit for bit (`-0.0` and
+/// `0.0` are different shapes here; `==` would call them equal).
+/// Each shape is kept with its bounds at angle 0 relative to the body (scenery's bounds).
+pub(crate) type ShapeTable = Interned<Vec<u64>, (Shape, Bounds)>;
+
+/// The bits that define `shape` into `out` (cleared first): per primitive its kind and
+/// fields, in order.
+pub(crate) fn shape_key(shape: &Shape, out: &mut Vec<u64>) {
+    out.clear();
+    for p in shape.primitives() {
+        match p {
+            Primitive::Circle(c) => out.extend([0.0, c.center.x, c.center.y, c.radius].map(bits)),
+            Primitive::Aabb(b) => out.extend(
+                [
+                    1.0,
+                    b.center.x,
+                    b.center.y,
+                    b.half_extents.x,
+                    b.half_extents.y,
+                ]
+                .map(bits),
+            ),
+            Primitive::Obb(b) => out.extend(
+                [
+                    2.0,
+                    b.center.x,
+                    b.center.y,
+                    b.half_extents.x,
+                    b.half_extents.y,
+                    b.angle,
+                ]
+                .map(bits),
+            ),
+            Primitive::Capsule(c) => {
+                out.extend([3.0, c.a.x, c.a.y, c.b.x, c.b.y, c.radius].map(bits));
+            }
+            Primitive::Polygon(poly) => {
+                out.push(bits(4.0));
+                out.push(poly.vertices().len() as u64);
+                // The normals follow from the vertices.
+                for v in poly.vertices() {
+                    out.extend([bits(v.x), bits(v.y)]);
+                }
+            }
+        }
+    }
+    // A single primitive and a compound of that one primitive are different shapes.
+    if matches!(shape, Shape::Compound(_)) {
+        out.push(u64::MAX);
+    }
+}
+
+fn bits(x: impl Into<f64>) -> u64 {
+    x.into().to_bits()
+}
+
+/// The body names of the world, one copy each.
+pub(crate) type NameTable = Interned<String, ()>;
+
+#[cfg(test)]
+mod tests {
+    use ricochet_geom::Vec2;
+
+    use super::*;
+
+    #[test]
+    fn equal_shapes_share_an_id_and_a_freed_id_is_reused() {
+        let mut t = ShapeTable::default();
+        let mut key = Vec::new();
+        let mut id = |t: &mut ShapeTable, s: &Shape| {
+            shape_key(s, &mut key);
+            t.acquire(key.as_slice(), || {
+                (s.clone(), s.bounds(&ricochet_geom::Pose::default()))
+            })
+        };
+        let tile = Shape::aabb(Vec2::splat(0.5)).unwrap();
+        let a = id(&mut t, &tile);
+        assert_eq!(id(&mut t, &tile.clone()), a);
+        let ball = Shape::circle(0.5).unwrap();
+        let b = id(&mut t, &ball);
+        assert_ne!(a, b);
+        // Equal by `==`, different bits: not shared.
+        let signed = Shape::capsule(Vec2::new(-0.0, 0.0), Vec2::new(1.0, 0.0), 0.5).unwrap();
+        let unsigned = Shape::capsule(Vec2::new(0.0, 0.0), Vec2::new(1.0, 0.0), 0.5).unwrap();
+        assert_eq!(signed, unsigned);
+        assert_ne!(id(&mut t, &signed), id(&mut t, &unsigned));
+        t.release(b);
+        assert_eq!(t.get(a).0, tile);
+        let c = id(&mut t, &Shape::circle(2.0).unwrap());
+        assert_eq!(c, b, "the freed id is reused");
+        t.release(a);
+        assert_eq!(t.get(a).0, tile, "one user left");
+    }
+}
