@@ -287,6 +287,18 @@ impl BroadPhase {
         self.split(statics, static_generation, movers, interactions, true, out)
     }
 
+    /// Static bodies the caller keeps out of [`BroadPhase::pairs_split_handles`] because
+    /// their layers pair with no layer at all (a tile map that only the per-axis stages
+    /// meet): `count` of them in `layers`. They count as static bodies for `Auto`'s choice
+    /// and the stats, and their layers as layer pairs skipped, exactly as if they had been
+    /// given, but cost nothing to keep. Takes effect with the next change of static
+    /// generation.
+    pub(crate) fn set_inert_statics(&mut self, count: usize, layers: &[u8]) {
+        self.statics.inert = count;
+        self.statics.inert_layers.clear();
+        self.statics.inert_layers.extend_from_slice(layers);
+    }
+
     /// Like [`BroadPhase::pairs_split`], but each pair is left as the two handles the
     /// algorithm met it by, in no particular order: an index into `movers`, or
     /// [`STATIC_BIT`] with an index into `statics`. For a caller that maps its entries back
@@ -354,7 +366,7 @@ impl BroadPhase {
         self.frame += 1;
         out.clear();
         let n_movers = self.movers.len();
-        let n_statics = self.statics.keys.len();
+        let n_statics = self.statics.count();
         let crowd = || {
             self.mover_layers
                 .iter()

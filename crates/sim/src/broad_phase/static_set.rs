@@ -17,8 +17,13 @@ pub(super) struct StaticSet {
     pub(super) entries: Vec<(Bounds, u8)>,
     /// `pairs`: this call's dense index of each static body.
     pub(super) dense: Vec<u32>,
-    /// Layers with static bodies, ascending.
+    /// Layers with static bodies, ascending (the inert ones' included).
     pub(super) layers: Vec<u8>,
+    /// Static bodies the caller keeps out because their layers pair with nothing
+    /// ([`BroadPhase::set_inert_statics`](super::BroadPhase::set_inert_statics)): counted,
+    /// never stored.
+    pub(super) inert: usize,
+    pub(super) inert_layers: Vec<u8>,
     /// Whether `trees` (`SortAndSweep`) and `grids` (`Grid`) hold the current set.
     pub(super) built_trees: bool,
     pub(super) built_grids: bool,
@@ -29,6 +34,11 @@ pub(super) struct StaticSet {
 }
 
 impl StaticSet {
+    /// How many static bodies there are, the inert ones included.
+    pub(super) fn count(&self) -> usize {
+        self.keys.len() + self.inert
+    }
+
     /// Whether static body `s` is `b`, bit for bit.
     pub(super) fn same(&self, s: usize, b: &BodyEntry) -> bool {
         self.keys.get(s).is_some_and(|&k| k == b.key) && {
@@ -55,6 +65,9 @@ impl StaticSet {
         let mut present = [false; LAYERS];
         for (_, l) in &self.entries {
             present[usize::from(*l)] = true;
+        }
+        for &l in &self.inert_layers {
+            present[usize::from(l)] = true;
         }
         self.layers = (0..LAYERS)
             .filter(|&l| present[l])

@@ -6,7 +6,11 @@
 //! other are never paired (a layer that ignores itself is never swept against itself), and
 //! static and kinematic bodies never pair with each other: those pairs are never produced,
 //! so never counted. Static bodies are handed over only when they change
-//! ([`World::static_generation`]). A candidate pair is then dropped before the narrow phase
+//! ([`World::static_generation`]), and only those of a layer `detect` pairs with some layer:
+//! a tile map that its actors meet only in the per-axis stages (two layers of boxes that
+//! `separate`) is not indexed here at all (`BroadPhase::set_inert_statics` counts it, so the
+//! choice of algorithm and the stats are as if it were). Pairs come back as handles and are
+//! turned into world indices here. A candidate pair is then dropped before the narrow phase
 //! when a body is frozen outside the active region, when both are at rest (asleep or
 //! static), or when two boxes `separate` (the per-axis stages own those). The rest are
 //! tested exactly, in `(a, b)` id order, and respond:
@@ -34,7 +38,7 @@
 
 use ricochet_geom::{Contact, Pose, Sweep, Vec2, contact, time_of_impact};
 
-use crate::broad_phase::{BodyEntry, BroadPhase, BroadPhaseKind, Interactions};
+use crate::broad_phase::{BodyEntry, BroadPhase, BroadPhaseKind, Interactions, STATIC_BIT};
 use crate::def::{BodyKind, Doomed, Layers, Response, WorldDef};
 use crate::entity::Entity;
 use crate::event::{GameEvent, Removal};
@@ -70,6 +74,8 @@ pub(crate) struct DetectState {
     separate_swept: Vec<bool>,
     /// The static generation `statics` was built at.
     static_generation: Option<u64>,
+    /// Bumped whenever `statics` is rebuilt: the broad phase's static generation.
+    statics_version: u64,
     statics: Vec<BodyEntry>,
     movers: Vec<BodyEntry>,
     pairs: Vec<(u32, u32)>,
@@ -98,6 +104,7 @@ impl DetectState {
                 .map(|l| (0..n).any(|m| layers.sweeps(l as u8, m as u8)))
                 .collect(),
             static_generation: None,
+            statics_version: 0,
             statics: Vec::new(),
             movers: Vec::new(),
             pairs: Vec::new(),
@@ -143,20 +150,41 @@ fn candidate_pairs(ctx: &mut StageCtx, st: &mut DetectState) -> Vec<(u32, u32)> 
         }
         st.interactions = interactions(&ctx.def.layers, &st.box_only);
         st.separate_swept = separate_swept(&ctx.def.layers, &st.box_only);
+        // The static layers detect pairs may have changed.
+        st.static_generation = None;
     }
     if st.static_generation != Some(w.static_generation()) {
+        // Only static bodies of a layer that detect pairs with some layer: a tile map that
+        // meets its actors only in the per-axis stages costs the broad phase nothing.
+        let n_layers = st.box_only.len();
+        let paired: Vec<bool> = (0..n_layers)
+            .map(|l| (0..n_layers).any(|m| st.interactions.interacts(l as u8, m as u8)))
+            .collect();
         st.statics.clear();
+        st.statics_version += 1;
+        let (mut inert, mut inert_layers) = (0, Vec::new());
         for i in 0..w.len() {
-            if w.kind[i] == BodyKind::Static {
+            if w.kind[i] != BodyKind::Static {
+                continue;
+            }
+            let layer = w.layer[i];
+            if paired.get(usize::from(layer)).copied().unwrap_or(false) {
                 let bounds = w.bounds(i);
                 st.statics.push(BodyEntry {
                     key: w.key(i),
                     bounds,
-                    layer: w.layer[i],
+                    layer,
                     kind: BodyKind::Static,
                 });
+            } else {
+                inert += 1;
+                if !inert_layers.contains(&layer) {
+                    inert_layers.push(layer);
+                }
             }
         }
+        // Counted as the broad phase always counted them (its choice, the stats), not kept.
+        st.broad_phase.set_inert_statics(inert, &inert_layers);
         if let Some(b) = wrap {
             st.seam.statics_changed(&b, &st.statics);
         }
@@ -172,16 +200,39 @@ fn candidate_pairs(ctx: &mut StageCtx, st: &mut DetectState) -> Vec<(u32, u32)> 
         }
         None => w.mover_entries(&st.sweeping, &st.separate_swept, &mut st.movers, |_, _| {}),
     }
-    let generation = w.static_generation();
+    let generation = st.statics_version;
     let mut pairs = std::mem::take(&mut st.pairs);
-    let bp = st.broad_phase.pairs_split(
+    // By handles (a place among the movers, or among `statics` with `STATIC_BIT`), turned
+    // into world indices here: `statics` holds only some of the static bodies, so places
+    // in the broad phase's dense order are not world indices.
+    let bp = st.broad_phase.pairs_split_handles(
         &st.statics,
         generation,
         &st.movers,
         &st.interactions,
         &mut pairs,
     );
-    st.static_generation = Some(generation);
+    {
+        let (movers, statics) = (w.movers(), &st.statics);
+        let world_index = |h: u32| -> u32 {
+            if h & STATIC_BIT == 0 {
+                return movers[h as usize];
+            }
+            let key = statics[(h & !STATIC_BIT) as usize].key;
+            let e = Entity {
+                index: (key >> 32) as u32,
+                generation: key as u32,
+            };
+            // Every static body in `statics` is alive: it was rebuilt since the last change.
+            w.index_of(e).map_or(u32::MAX, |i| i as u32)
+        };
+        for p in &mut pairs {
+            let (i, j) = (world_index(p.0), world_index(p.1));
+            *p = (i.min(j), i.max(j));
+        }
+        pairs.sort_unstable_by_key(|&(i, j)| (u64::from(i) << 32) | u64::from(j));
+    }
+    st.static_generation = Some(w.static_generation());
     if let Some(b) = wrap {
         st.seam.add_pairs(
             &b,
