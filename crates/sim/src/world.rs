@@ -218,9 +218,16 @@ impl LocalBounds {
     /// The bounds of `shape` at `angle` and position `p`.
     #[inline]
     fn at(&mut self, shape: &Shape, angle: f64, p: Vec2) -> Bounds {
+        self.at_with(|| shape, angle, p)
+    }
+
+    /// [`LocalBounds::at`], looking the shape up only when the bounds must be recomputed
+    /// (once per body: a body that turned keeps its any-angle bounds).
+    #[inline]
+    fn at_with<'s>(&mut self, shape: impl FnOnce() -> &'s Shape, angle: f64, p: Vec2) -> Bounds {
         if !self.any_angle && self.angle.to_bits() != angle.to_bits() {
             // The farthest corner of the angle-0 box is as far as any point of the shape.
-            let b = shape.bounds(&Pose::default());
+            let b = shape().bounds(&Pose::default());
             let r = b.min.abs().max(b.max.abs()).length();
             // A rotated point may round one ulp past the exact radius.
             let r = r + r * 1e-12;
@@ -808,14 +815,16 @@ impl World {
             let i = i as usize;
             let r = self.row[i] as usize;
             let p = self.position[i];
-            let shape = &self.shapes.get(self.shape_id[i]).0;
-            let mut bounds = self.rows.local_bounds[r].at(shape, self.angle[i], p);
+            // The shape table is read only when needed (a scene's shapes may all differ).
+            let (shapes, id) = (&self.shapes, self.shape_id[i]);
+            let shape = || &shapes.get(id).0;
+            let mut bounds = self.rows.local_bounds[r].at_with(shape, self.angle[i], p);
             let layer = self.layer[i];
             let moved = self.rows.start_position[r] - p;
             if moved != Vec2::ZERO
                 && (sweeping[usize::from(layer)]
                     || (separate_swept[usize::from(layer)]
-                        && moved.length() > 0.5 * shape.min_width()))
+                        && moved.length() > 0.5 * shape().min_width()))
             {
                 bounds = bounds.union(bounds.translated(moved));
             }
