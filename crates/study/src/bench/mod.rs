@@ -1,6 +1,6 @@
 //! The benchmark behind `ricochet bench`: Ricochet's full step against rapier2d's
-//! collision-only pipeline, on the scenes of [`ricochet_scenes::bench`], in the same process
-//! on the same frames. [`measure`](mod@measure) runs one scene; [`report`] makes the table,
+//! collision-only pipeline and Box2D v3's step, on the scenes of [`ricochet_scenes::bench`],
+//! in the same process on the same frames. [`measure`](mod@measure) runs one scene; [`report`] makes the table,
 //! the CSV and each scene's contact summary.
 
 pub mod measure;
