@@ -123,8 +123,11 @@ fn threshold(response: Response) -> f64 {
 ///    would show. Anything else is a disagreement.
 ///
 /// Depths are compared only as a figure (`max_depth_difference`): Box2D's manifold is built
-/// for its solver, not as a minimum translation (it keeps a polygon's reference face unless
-/// the other is better by `0.1 × linear slop`, and clips points to the face).
+/// for its solver, not as a minimum translation (its points are the incident edge clipped to
+/// the reference face, a capsule's core clipped likewise), so its deepest point can differ
+/// from the penetration depth even where both engines agree that the pair penetrates
+/// (measured: 4 capsule pairs of 64 594 on `rain-10000` differ by more than `1e-5`, at most by
+/// `4.9e-4`).
 #[must_use]
 pub fn compare_box2d(
     sim: &Simulation,
