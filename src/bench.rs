@@ -1,6 +1,6 @@
-//! `ricochet bench`: Ricochet's full step against rapier2d's collision-only pipeline, on
-//! built-in scenes of parametric size (`ricochet_scenes::bench`: `asteroids-N`,
-//! `platformer-T-A`, `rain-N`), in the same process on the same frames. The measurement and
+//! `ricochet bench`: Ricochet's full step against rapier2d's collision-only pipeline and
+//! Box2D v3's step, on built-in scenes of parametric size (`ricochet_scenes::bench`:
+//! `asteroids-N`, `platformer-T-A`, `rain-N`), in the same process on the same frames. The measurement and
 //! the report are [`ricochet_study::bench`]'s; this file parses the names, runs each scene in
 //! its own process, prints the table and writes the CSV.
 //!
@@ -46,8 +46,8 @@ fn run_child(name: &str, frames: u64) -> anyhow::Result<Row> {
 }
 /// Runs the named scenes (or [`DEFAULT_SCENES`]), `frames` timed frames each, prints the
 /// table, writes the CSV. Each scene runs in its own process (see [`CHILD_ENV`]). Exit code
-/// 0 when every scene's contact sets agree, 1 when one does not, 2 for an unknown scene name
-/// or a zero frame count.
+/// 0 when every scene's contact sets agree with both rapier's and Box2D's, 1 when one does
+/// not, 2 for an unknown scene name or a zero frame count.
 pub fn run(scenes: &[String], frames: u64, csv: Option<&Path>) -> anyhow::Result<ExitCode> {
     let names: Vec<String> = if scenes.is_empty() {
         DEFAULT_SCENES.iter().map(|s| (*s).to_owned()).collect()

@@ -209,13 +209,22 @@ enum Command {
         #[arg(long, value_name = "FILE")]
         svg: Option<PathBuf>,
     },
-    /// Time Ricochet's full step against rapier2d's collision-only pipeline on built-in scenes.
+    /// Time Ricochet's full step against rapier2d's collision-only pipeline and Box2D v3 on
+    /// built-in scenes.
     ///
     /// Scenes: asteroids-N (N asteroids, 100 swept bullets, a ship), platformer-T-A (T static
-    /// tiles, A actors), rain-N (N mixed shapes falling through static geometry). Both engines
-    /// run in one process on the same frames and poses; prints median and p95 time per frame,
-    /// the ratio, whether the contact sets agree, and peak memory. Exit code 1 if any contact
-    /// set disagrees. Timings are figures, never assertions.
+    /// tiles, A actors), rain-N (N mixed shapes falling through static geometry). All three
+    /// engines run in one process on the same frames and poses. Columns: Ricochet's and
+    /// rapier's median and p95 time per frame and their ratio (rapier / ricochet), whether
+    /// rapier's contact set agrees, memory (ricochet after its setup, peak at the end), Ricochet
+    /// alone; then Box2D: "box2d collide" (broad + narrow phase, pairs + collide from its own
+    /// profile), "box2d step" (its whole b2World_Step, solver included), "box2d sync" (copying
+    /// the changed poses in with b2Body_SetTransform, which moves broad-phase proxies), "b2
+    /// ratio" (box2d collide / ricochet) and "box2d agree" (end-of-frame contact pairs
+    /// agreed/compared).
+    /// Box2D's bodies are dynamic with every motion locked, teleported to Ricochet's poses
+    /// (ricochet-box2d's docs say why). Exit code 1 if any contact set disagrees with either
+    /// engine. Timings are figures, never assertions.
     ///
     /// Example: ricochet bench asteroids-10000 platformer-10000-1000 --frames 50 --csv bench.csv
     Bench {

@@ -1,11 +1,14 @@
-//! `ricochet bench`: Ricochet's step against rapier's collision-only pipeline. Only the
-//! shape of the output and the contact-set agreement are checked; no time is asserted.
+//! `ricochet bench`: Ricochet's step against rapier's collision-only pipeline and Box2D's
+//! step. Only the shape of the output and the contact-set agreements are checked; no time is
+//! asserted.
 
 use crate::util::{ricochet, root};
 
 const HEADER: &str = "scene,frames,ricochet_median_ms,ricochet_p95_ms,rapier_median_ms,\
                       rapier_p95_ms,ratio,contact_agreement,peak_mem_mb,\
-                      ricochet_alone_median_ms";
+                      ricochet_alone_median_ms,box2d_collide_median_ms,\
+                      box2d_collide_p95_ms,box2d_step_median_ms,box2d_sync_median_ms,\
+                      box2d_ratio,box2d_contact_agreement,box2d_mem_mb";
 
 #[test]
 fn bench_writes_a_row_per_scene_and_the_contact_sets_agree() {
@@ -28,12 +31,14 @@ fn bench_writes_a_row_per_scene_and_the_contact_sets_agree() {
     assert_eq!(lines.next(), Some(HEADER));
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     assert_eq!(rows.len(), scenes.len(), "{text}");
+    // The agreed/compared columns: with rapier, with Box2D.
+    let agreements = [7, 15];
     for (row, scene) in rows.iter().zip(scenes) {
-        assert_eq!(row.len(), 10, "{text}");
+        assert_eq!(row.len(), 17, "{text}");
         assert_eq!(row[0], scene);
         assert_eq!(row[1], "5");
         for (k, field) in row.iter().enumerate().skip(2) {
-            if k == 7 {
+            if agreements.contains(&k) {
                 continue;
             }
             let v: f64 = field
@@ -41,10 +46,13 @@ fn bench_writes_a_row_per_scene_and_the_contact_sets_agree() {
                 .unwrap_or_else(|_| panic!("{scene}: column {k} {field:?} is not a number"));
             assert!(v.is_finite() && v >= 0.0, "{scene}: column {k} = {v}");
         }
-        let (agreed, compared) = row[7].split_once('/').expect("agreed/compared");
-        let (agreed, compared): (u64, u64) = (agreed.parse().unwrap(), compared.parse().unwrap());
-        assert_eq!(agreed, compared, "{scene}: contact sets differ\n{stderr}");
-        assert!(compared > 0, "{scene}: nothing was compared\n{stderr}");
+        for k in agreements {
+            let (agreed, compared) = row[k].split_once('/').expect("agreed/compared");
+            let (agreed, compared): (u64, u64) =
+                (agreed.parse().unwrap(), compared.parse().unwrap());
+            assert_eq!(agreed, compared, "{scene}: contact sets differ\n{stderr}");
+            assert!(compared > 0, "{scene}: nothing was compared\n{stderr}");
+        }
     }
 }
 

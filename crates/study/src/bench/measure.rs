@@ -1,27 +1,34 @@
-//! The measurement of `ricochet bench`: one scene stepped by both engines, each step timed,
-//! the contact sets compared on every frame, the process's peak memory read.
+//! The measurement of `ricochet bench`: one scene stepped by Ricochet, rapier and Box2D, each
+//! step timed, the contact sets compared on every frame, the process's peak memory read.
 //!
-//! Frame 0 (the initial state) is stepped by both engines untimed (rapier's first step builds
-//! its tree from scratch). Then for each of `frames` frames: Ricochet's `Simulation::step()`
-//! is timed; every moving body's pose is copied into rapier (untimed); rapier's
-//! `CollisionPipeline::step` is timed; the two contact sets are compared
-//! ([`ricochet_oracle::bench::compare_contacts`] documents the rule) on every frame, frame 0
-//! included.
+//! Frame 0 (the initial state) is stepped by all three untimed (rapier's and Box2D's first
+//! steps pair every shape from scratch). Then for each of `frames` frames: Ricochet's
+//! `Simulation::step()` is timed; every moving body's pose is copied into rapier (untimed);
+//! rapier's `CollisionPipeline::step` is timed; the two contact sets are compared
+//! ([`ricochet_oracle::bench::compare_contacts`] documents the rule); then the changed poses
+//! are copied into Box2D (`b2Body_SetTransform`, timed apart as `box2d_sync`: it moves a
+//! shape's broad-phase proxy when the shape leaves its fat box, part of Box2D's broad phase
+//! that its step does not see); Box2D steps once, and its own profile
+//! (`b2World_GetProfile`) gives its broad plus narrow phase (`pairs + collide`) and its whole
+//! step; its contact set is compared ([`ricochet_box2d::compare_box2d`] documents the rule).
+//! Every frame is compared, frame 0 included.
 //!
 //! Memory is the process's peak resident set (`VmHWM` in `/proc/self/status`, reset at the
 //! scene's start by writing `5` to `/proc/self/clear_refs`): `ricochet_mb` is read once
-//! Ricochet's world is built and has stepped frame 0, before rapier's world exists (the
-//! scenario and the simulation's copy of it both count: `Simulation::new` clones it);
-//! `peak_mb` at the end of the scene, both engines alive. Both include the process's own
-//! few megabytes; the caller runs each scene in a fresh process so that they do not include
-//! heap the allocator kept from an earlier scene.
+//! Ricochet's world is built and has stepped frame 0, before rapier's and Box2D's worlds exist
+//! (the scenario and the simulation's copy of it both count: `Simulation::new` clones it);
+//! `peak_mb` at the end of the scene, all three alive. Both include the process's own few
+//! megabytes; the caller runs each scene in a fresh process so that they do not include heap
+//! the allocator kept from an earlier scene. `box2d_mb` is what Box2D itself allocated
+//! (`b2GetByteCount`), after its world is built.
 //!
-//! Wall time is measured with [`Instant`]: it is a benchmark figure, and never reaches a log
-//! or a test assertion.
+//! Wall time is measured with [`Instant`] (Box2D's profile reads its own clock): it is a
+//! benchmark figure, and never reaches a log or a test assertion.
 
 use std::time::{Duration, Instant};
 
 use anyhow::Context;
+use ricochet_box2d::{BOX2D_CONTACT_TOLERANCE, Box2dAgreement, Box2dScene, compare_box2d};
 use ricochet_oracle::bench::{CONTACT_TOLERANCE, ContactAgreement, RapierScene, compare_contacts};
 use ricochet_scenes::bench::Scene;
 use ricochet_sim::Simulation;
@@ -88,9 +95,23 @@ pub struct Row {
     pub ricochet_mb: Option<f64>,
     /// Peak resident set at the end of the scene, MB (`None` off Linux).
     pub peak_mb: Option<f64>,
-    /// Median of `frames` more Ricochet steps with rapier idle: Ricochet with the caches to
-    /// itself (between interleaved steps, rapier's step evicts Ricochet's data).
+    /// Median of `frames` more Ricochet steps with rapier and Box2D idle: Ricochet with the
+    /// caches to itself (between interleaved steps, the other engines evict Ricochet's data).
     pub ricochet_alone_median_ms: f64,
+    /// Box2D's broad plus narrow phase per frame (`pairs + collide` of its profile), median.
+    pub box2d_collide_median_ms: f64,
+    /// Box2D's broad plus narrow phase, 95th percentile (nearest rank).
+    pub box2d_collide_p95_ms: f64,
+    /// Box2D's whole step per frame (`step` of its profile: collide, solver, continuous,
+    /// sensors), median.
+    pub box2d_step_median_ms: f64,
+    /// Copying the changed poses into Box2D (`b2Body_SetTransform`, which moves broad-phase
+    /// proxies), median per frame. Not part of either figure above.
+    pub box2d_sync_median_ms: f64,
+    /// How the contact sets compared with Box2D's over the run.
+    pub box2d_agreement: Box2dAgreement,
+    /// What Box2D allocated for its world (`b2GetByteCount`), MB.
+    pub box2d_mb: f64,
 }
 
 impl Row {
@@ -100,13 +121,26 @@ impl Row {
         self.rapier_median_ms / self.ricochet_median_ms
     }
 
-    /// Whether every compared contact agreed.
+    /// Box2D's collide median over Ricochet's median.
+    #[must_use]
+    pub fn box2d_ratio(&self) -> f64 {
+        self.box2d_collide_median_ms / self.ricochet_median_ms
+    }
+
+    /// Whether every compared contact agreed, with rapier and with Box2D.
     #[must_use]
     pub fn agrees(&self) -> bool {
-        self.agreement.all_agree()
+        self.agreement.all_agree() && self.box2d_agreement.all_agree()
     }
 }
-/// Runs one scene: both engines, `frames` timed frames after frame 0.
+/// Box2D's profile figures (milliseconds) as durations, for [`percentiles`].
+fn durations(ms: &[f64]) -> Vec<Duration> {
+    ms.iter()
+        .map(|&ms| Duration::from_secs_f64(ms.max(0.0) * 1e-3))
+        .collect()
+}
+
+/// Runs one scene: all three engines, `frames` timed frames after frame 0.
 /// `name` is the scene's name as asked (it names the row); `progress` hears what the run is
 /// doing (`NAME: N bodies, F frames`, the setup time, a note every 30 s).
 pub fn run_scene(
@@ -126,6 +160,19 @@ pub fn run_scene(
     let mut rapier = RapierScene::new(&sim).with_context(|| format!("{name}: rapier scene"))?;
     rapier.step();
     let mut agreement = compare_contacts(&sim, &out0, &rapier.penetrating(), CONTACT_TOLERANCE);
+    let mut box2d = Box2dScene::new(&sim).with_context(|| format!("{name}: Box2D scene"))?;
+    box2d
+        .step()
+        .with_context(|| format!("{name}: Box2D frame 0"))?;
+    let box2d_mb = ricochet_box2d::allocated_mb().with_context(|| format!("{name}: Box2D"))?;
+    let mut box2d_agreement = compare_box2d(
+        &sim,
+        &out0,
+        &box2d
+            .touching()
+            .with_context(|| format!("{name}: Box2D frame 0"))?,
+        BOX2D_CONTACT_TOLERANCE,
+    );
     drop(out0);
     progress(&format!(
         "{name}: set up in {:.1} s",
@@ -133,6 +180,9 @@ pub fn run_scene(
     ));
     let mut ricochet_times = Vec::with_capacity(usize::try_from(frames).unwrap_or(0));
     let mut rapier_times = Vec::with_capacity(ricochet_times.capacity());
+    let mut box2d_collide = Vec::with_capacity(ricochet_times.capacity());
+    let mut box2d_step = Vec::with_capacity(ricochet_times.capacity());
+    let mut box2d_sync = Vec::with_capacity(ricochet_times.capacity());
     let started = Instant::now();
     let mut last_note = Instant::now();
     for frame in 1..=frames {
@@ -151,6 +201,19 @@ pub fn run_scene(
             &rapier.penetrating(),
             CONTACT_TOLERANCE,
         ));
+        let box2d_frame = || format!("{name}: Box2D frame {frame}");
+        let t = Instant::now();
+        box2d.sync(&sim).with_context(box2d_frame)?;
+        box2d_sync.push(t.elapsed());
+        box2d.step().with_context(box2d_frame)?;
+        box2d_collide.push(box2d.times().collide_ms);
+        box2d_step.push(box2d.times().step_ms);
+        box2d_agreement.add(&compare_box2d(
+            &sim,
+            &out,
+            &box2d.touching().with_context(box2d_frame)?,
+            BOX2D_CONTACT_TOLERANCE,
+        ));
         if last_note.elapsed() > Duration::from_secs(30) {
             progress(&format!(
                 "{name}: frame {frame}/{frames} after {:.0} s",
@@ -160,7 +223,8 @@ pub fn run_scene(
         }
     }
     let peak_mb = status_mb("VmHWM");
-    // The same number of frames again, Ricochet alone (rapier's world stays, untouched).
+    // The same number of frames again, Ricochet alone (rapier's and Box2D's worlds stay,
+    // untouched).
     let mut alone_times = Vec::with_capacity(ricochet_times.len());
     for _ in 0..frames {
         let t = Instant::now();
@@ -171,6 +235,9 @@ pub fn run_scene(
     let (ricochet_alone_median_ms, _) = percentiles(&alone_times);
     let (ricochet_median_ms, ricochet_p95_ms) = percentiles(&ricochet_times);
     let (rapier_median_ms, rapier_p95_ms) = percentiles(&rapier_times);
+    let (box2d_collide_median_ms, box2d_collide_p95_ms) = percentiles(&durations(&box2d_collide));
+    let (box2d_step_median_ms, _) = percentiles(&durations(&box2d_step));
+    let (box2d_sync_median_ms, _) = percentiles(&box2d_sync);
     Ok(Row {
         scene: name.to_owned(),
         bodies,
@@ -183,6 +250,12 @@ pub fn run_scene(
         ricochet_mb,
         peak_mb,
         ricochet_alone_median_ms,
+        box2d_collide_median_ms,
+        box2d_collide_p95_ms,
+        box2d_step_median_ms,
+        box2d_sync_median_ms,
+        box2d_agreement,
+        box2d_mb,
     })
 }
 
