@@ -144,7 +144,7 @@ pub fn compare_box2d(
             return false;
         };
         let size = b.max - b.min;
-        let moved = (w.position[i] - w.start_position[i]).abs();
+        let moved = (w.position[i] - w.start_position(i)).abs();
         b.wrap && (moved.x > 0.5 * size.x || moved.y > 0.5 * size.y)
     };
     let end_pose = |e: Entity| w.index_of(e).map(|i| w.pose(i));
@@ -182,7 +182,7 @@ pub fn compare_box2d(
         }
         let name = |e: Entity| {
             w.index_of(e)
-                .map_or_else(|| format!("#{e}"), |i| format!("{} #{e}", w.name[i]))
+                .map_or_else(|| format!("#{e}"), |i| format!("{} #{e}", w.name(i)))
         };
         let separation = box2d.get(&key).copied().filter(|&s| s < 0.0);
         match (ricochet.get(&key), separation) {

@@ -92,8 +92,8 @@ impl Box2dScene {
         // moves it; its pose comes from Ricochet alone.
         let locked = MotionLocks::new(true, true, true);
         for i in 0..w.len() {
-            let at = placement(&w.shape[i], &w.pose(i))?;
-            let shape = local_shape(&w.shape[i])?;
+            let at = placement(w.shape(i), &w.pose(i))?;
+            let shape = local_shape(w.shape(i))?;
             let kind = match w.kind[i] {
                 BodyKind::Static => BodyType::Static,
                 BodyKind::Kinematic => BodyType::Kinematic,
@@ -168,7 +168,7 @@ impl Box2dScene {
             ));
         }
         for (i, held) in &mut self.moving {
-            let at = placement(&w.shape[*i], &w.pose(*i))?;
+            let at = placement(w.shape(*i), &w.pose(*i))?;
             if at == *held {
                 continue;
             }
