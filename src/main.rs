@@ -217,7 +217,8 @@ enum Command {
     /// engines run in one process on the same frames and poses. Columns: Ricochet's and
     /// rapier's median and p95 time per frame and their ratio (rapier / ricochet), whether
     /// rapier's contact set agrees, memory (ricochet after its setup, peak at the end), Ricochet
-    /// alone; then Box2D: "box2d collide" (broad + narrow phase, pairs + collide from its own
+    /// alone with 1 thread and with 2 ("alone 2t": the parallel stages; every ratio is 1 thread
+    /// against 1); then Box2D: "box2d collide" (broad + narrow phase, pairs + collide from its own
     /// profile), "box2d step" (its whole b2World_Step, solver included), "box2d sync" (copying
     /// the changed poses in with b2Body_SetTransform, which moves broad-phase proxies), "b2
     /// ratio" (box2d collide / ricochet) and "box2d agree" (end-of-frame contact pairs

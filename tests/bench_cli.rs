@@ -8,7 +8,8 @@ const HEADER: &str = "scene,frames,ricochet_median_ms,ricochet_p95_ms,rapier_med
                       rapier_p95_ms,ratio,contact_agreement,peak_mem_mb,\
                       ricochet_alone_median_ms,box2d_collide_median_ms,\
                       box2d_collide_p95_ms,box2d_step_median_ms,box2d_sync_median_ms,\
-                      box2d_ratio,box2d_contact_agreement,box2d_mem_mb";
+                      box2d_ratio,box2d_contact_agreement,box2d_mem_mb,\
+                      ricochet_alone_2t_median_ms";
 
 #[test]
 fn bench_writes_a_row_per_scene_and_the_contact_sets_agree() {
@@ -34,7 +35,7 @@ fn bench_writes_a_row_per_scene_and_the_contact_sets_agree() {
     // The agreed/compared columns: with rapier, with Box2D.
     let agreements = [7, 15];
     for (row, scene) in rows.iter().zip(scenes) {
-        assert_eq!(row.len(), 17, "{text}");
+        assert_eq!(row.len(), 18, "{text}");
         assert_eq!(row[0], scene);
         assert_eq!(row[1], "5");
         for (k, field) in row.iter().enumerate().skip(2) {

@@ -98,6 +98,10 @@ pub struct Row {
     /// Median of `frames` more Ricochet steps with rapier and Box2D idle: Ricochet with the
     /// caches to itself (between interleaved steps, the other engines evict Ricochet's data).
     pub ricochet_alone_median_ms: f64,
+    /// The same frames as `ricochet_alone_median_ms`, stepped by a clone of the simulation
+    /// with two threads (`Simulation::set_threads`; the parallel stages give the same bytes),
+    /// median. The ratios are one thread against one thread.
+    pub ricochet_alone_2t_median_ms: f64,
     /// Box2D's broad plus narrow phase per frame (`pairs + collide` of its profile), median.
     pub box2d_collide_median_ms: f64,
     /// Box2D's broad plus narrow phase, 95th percentile (nearest rank).
@@ -225,14 +229,21 @@ pub fn run_scene(
     let peak_mb = status_mb("VmHWM");
     // The same number of frames again, Ricochet alone (rapier's and Box2D's worlds stay,
     // untouched).
-    let mut alone_times = Vec::with_capacity(ricochet_times.len());
-    for _ in 0..frames {
-        let t = Instant::now();
-        let out = sim.step();
-        alone_times.push(t.elapsed());
-        drop(out);
-    }
-    let (ricochet_alone_median_ms, _) = percentiles(&alone_times);
+    // Then the same frames with two threads, on a clone taken here.
+    let mut twin = sim.clone();
+    twin.set_threads(2);
+    let alone = |sim: &mut Simulation| {
+        let mut times = Vec::with_capacity(ricochet_times.len());
+        for _ in 0..frames {
+            let t = Instant::now();
+            let out = sim.step();
+            times.push(t.elapsed());
+            drop(out);
+        }
+        percentiles(&times).0
+    };
+    let ricochet_alone_median_ms = alone(&mut sim);
+    let ricochet_alone_2t_median_ms = alone(&mut twin);
     let (ricochet_median_ms, ricochet_p95_ms) = percentiles(&ricochet_times);
     let (rapier_median_ms, rapier_p95_ms) = percentiles(&rapier_times);
     let (box2d_collide_median_ms, box2d_collide_p95_ms) = percentiles(&durations(&box2d_collide));
@@ -250,6 +261,7 @@ pub fn run_scene(
         ricochet_mb,
         peak_mb,
         ricochet_alone_median_ms,
+        ricochet_alone_2t_median_ms,
         box2d_collide_median_ms,
         box2d_collide_p95_ms,
         box2d_step_median_ms,

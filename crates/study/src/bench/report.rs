@@ -10,7 +10,8 @@ pub const CSV_HEADER: &str = "scene,frames,ricochet_median_ms,ricochet_p95_ms,ra
                               rapier_p95_ms,ratio,contact_agreement,peak_mem_mb,\
                               ricochet_alone_median_ms,box2d_collide_median_ms,\
                               box2d_collide_p95_ms,box2d_step_median_ms,box2d_sync_median_ms,\
-                              box2d_ratio,box2d_contact_agreement,box2d_mem_mb";
+                              box2d_ratio,box2d_contact_agreement,box2d_mem_mb,\
+                              ricochet_alone_2t_median_ms";
 
 /// What the table's columns mean, printed below it.
 pub const NOTES: &str = "median and p95 (nearest rank) of each engine's time per frame, \
@@ -18,7 +19,8 @@ pub const NOTES: &str = "median and p95 (nearest rank) of each engine's time per
                          VmHWM of the scene's own process (ricochet: after its setup and frame \
                          0, before the other engines' worlds exist; peak: at the end); alone = \
                          median of as many further Ricochet frames with the others idle (caches \
-                         to itself); box2d collide = broad + narrow phase from Box2D's own \
+                         to itself), 1 thread, and the same frames again with 2 threads (alone \
+                         2t; the ratios are 1 thread against 1); box2d collide = broad + narrow phase from Box2D's own \
                          profile (pairs + collide), box2d step = its whole b2World_Step (solver \
                          included), box2d sync = copying the changed poses in \
                          (b2Body_SetTransform through boxdd's checked API: Box2D moves a \
@@ -52,12 +54,12 @@ fn mb(v: Option<f64>) -> String {
     v.map_or_else(|| "n/a".to_owned(), |v| format!("{v:.1}"))
 }
 
-/// One line of the table: seventeen cells, right-aligned but for the scene's name.
-fn line(s: &mut String, c: [String; 17]) {
+/// One line of the table: eighteen cells, right-aligned but for the scene's name.
+fn line(s: &mut String, c: [String; 18]) {
     let _ = writeln!(
         s,
         "{:<26} {:>8} {:>6} {:>10} {:>10} {:>10} {:>10} {:>8} {:>19} {:>9} {:>9} {:>10} \
-         {:>10} {:>10} {:>10} {:>8} {:>19}",
+         {:>10} {:>10} {:>10} {:>10} {:>8} {:>19}",
         c[0],
         c[1],
         c[2],
@@ -74,7 +76,8 @@ fn line(s: &mut String, c: [String; 17]) {
         c[13],
         c[14],
         c[15],
-        c[16]
+        c[16],
+        c[17]
     );
 }
 
@@ -96,6 +99,7 @@ pub fn table(rows: &[Row]) -> String {
             "ricochet",
             "peak",
             "alone",
+            "alone 2t",
             "box2d",
             "box2d",
             "box2d",
@@ -114,6 +118,7 @@ pub fn table(rows: &[Row]) -> String {
             "agreed/compared",
             "MB",
             "MB",
+            "ms/frame",
             "ms/frame",
             "collide ms",
             "step ms",
@@ -142,6 +147,7 @@ pub fn table(rows: &[Row]) -> String {
                 mb(r.ricochet_mb),
                 mb(r.peak_mb),
                 ms(r.ricochet_alone_median_ms),
+                ms(r.ricochet_alone_2t_median_ms),
                 ms(r.box2d_collide_median_ms),
                 ms(r.box2d_step_median_ms),
                 ms(r.box2d_sync_median_ms),
@@ -165,7 +171,7 @@ pub fn csv_text(rows: &[Row]) -> String {
         let _ = writeln!(
             s,
             "{},{},{:.4},{:.4},{:.4},{:.4},{:.6},{}/{},{},{:.4},{:.4},{:.4},{:.4},{:.4},{:.6},\
-             {}/{},{:.1}",
+             {}/{},{:.1},{:.4}",
             r.scene,
             r.frames,
             r.ricochet_median_ms,
@@ -184,7 +190,8 @@ pub fn csv_text(rows: &[Row]) -> String {
             r.box2d_ratio(),
             r.box2d_agreement.agreed,
             r.box2d_agreement.compared,
-            r.box2d_mb
+            r.box2d_mb,
+            r.ricochet_alone_2t_median_ms
         );
     }
     s
