@@ -2,22 +2,27 @@
 //! step timed, the contact sets compared on every frame, the process's peak memory read.
 //!
 //! Frame 0 (the initial state) is stepped by all three untimed (rapier's and Box2D's first
-//! steps pair every shape from scratch). Then for each of `frames` frames: Ricochet's
+//! steps pair every shape from scratch), and the simulation is cloned there (a clone steps
+//! bit for bit as the original). Then for each of `frames` frames: Ricochet's
 //! `Simulation::step()` is timed; every moving body's pose is copied into rapier (untimed);
 //! rapier's `CollisionPipeline::step` is timed; the two contact sets are compared
-//! ([`ricochet_oracle::bench::compare_contacts`] documents the rule); then the changed poses
-//! are copied into Box2D (`b2Body_SetTransform`, timed apart as `box2d_sync`: it moves a
-//! shape's broad-phase proxy when the shape leaves its fat box, part of Box2D's broad phase
-//! that its step does not see); Box2D steps once, and its own profile
-//! (`b2World_GetProfile`) gives its broad plus narrow phase (`pairs + collide`) and its whole
-//! step; its contact set is compared ([`ricochet_box2d::compare_box2d`] documents the rule).
-//! Every frame is compared, frame 0 included.
+//! ([`ricochet_oracle::bench::compare_contacts`] documents the rule). Then as many frames
+//! again with rapier idle, Ricochet alone: one thread, and the same frames with two threads
+//! on a clone. Last, Box2D in a pass of its own (three engines interleaved would evict each
+//! other's caches and slow all three): the frame-0 clone steps the same frames again,
+//! untimed, and after each the changed poses are copied into Box2D (`b2Body_SetTransform`,
+//! timed apart as `box2d_sync`: it moves a shape's broad-phase proxy when the shape leaves its
+//! fat box, part of Box2D's broad phase that its step does not see); Box2D steps once, and
+//! its own profile (`b2World_GetProfile`) gives its broad plus narrow phase
+//! (`pairs + collide`) and its whole step; its contact set is compared
+//! ([`ricochet_box2d::compare_box2d`] documents the rule). Every frame is compared, frame 0
+//! included.
 //!
 //! Memory is the process's peak resident set (`VmHWM` in `/proc/self/status`, reset at the
 //! scene's start by writing `5` to `/proc/self/clear_refs`): `ricochet_mb` is read once
 //! Ricochet's world is built and has stepped frame 0, before rapier's and Box2D's worlds exist
 //! (the scenario and the simulation's copy of it both count: `Simulation::new` clones it);
-//! `peak_mb` at the end of the scene, all three alive. Both include the process's own few
+//! `peak_mb` at the end of the scene (the high-water mark of the whole run). Both include the process's own few
 //! megabytes; the caller runs each scene in a fresh process so that they do not include heap
 //! the allocator kept from an earlier scene. `box2d_mb` is what Box2D itself allocated
 //! (`b2GetByteCount`), after its world is built.
@@ -161,34 +166,29 @@ pub fn run_scene(
     progress(&format!("{name}: {bodies} bodies, {frames} frames"));
     let out0 = sim.step();
     let ricochet_mb = status_mb("VmHWM");
+    // Box2D runs in a pass of its own, on a clone stepping the same frames again: three
+    // engines interleaved would evict each other's caches and slow all three.
+    let mut replay = sim.clone();
     let mut rapier = RapierScene::new(&sim).with_context(|| format!("{name}: rapier scene"))?;
     rapier.step();
     let mut agreement = compare_contacts(&sim, &out0, &rapier.penetrating(), CONTACT_TOLERANCE);
-    let mut box2d = Box2dScene::new(&sim).with_context(|| format!("{name}: Box2D scene"))?;
-    box2d
-        .step()
-        .with_context(|| format!("{name}: Box2D frame 0"))?;
-    let box2d_mb = ricochet_box2d::allocated_mb().with_context(|| format!("{name}: Box2D"))?;
-    let mut box2d_agreement = compare_box2d(
-        &sim,
-        &out0,
-        &box2d
-            .touching()
-            .with_context(|| format!("{name}: Box2D frame 0"))?,
-        BOX2D_CONTACT_TOLERANCE,
-    );
-    drop(out0);
     progress(&format!(
         "{name}: set up in {:.1} s",
         setup.elapsed().as_secs_f64()
     ));
     let mut ricochet_times = Vec::with_capacity(usize::try_from(frames).unwrap_or(0));
     let mut rapier_times = Vec::with_capacity(ricochet_times.capacity());
-    let mut box2d_collide = Vec::with_capacity(ricochet_times.capacity());
-    let mut box2d_step = Vec::with_capacity(ricochet_times.capacity());
-    let mut box2d_sync = Vec::with_capacity(ricochet_times.capacity());
     let started = Instant::now();
     let mut last_note = Instant::now();
+    let mut note = |what: &str, frame: u64| {
+        if last_note.elapsed() > Duration::from_secs(30) {
+            progress(&format!(
+                "{name}: {what} frame {frame}/{frames} after {:.0} s",
+                started.elapsed().as_secs_f64()
+            ));
+            last_note = Instant::now();
+        }
+    };
     for frame in 1..=frames {
         let t = Instant::now();
         let out = sim.step();
@@ -205,31 +205,10 @@ pub fn run_scene(
             &rapier.penetrating(),
             CONTACT_TOLERANCE,
         ));
-        let box2d_frame = || format!("{name}: Box2D frame {frame}");
-        let t = Instant::now();
-        box2d.sync(&sim).with_context(box2d_frame)?;
-        box2d_sync.push(t.elapsed());
-        box2d.step().with_context(box2d_frame)?;
-        box2d_collide.push(box2d.times().collide_ms);
-        box2d_step.push(box2d.times().step_ms);
-        box2d_agreement.add(&compare_box2d(
-            &sim,
-            &out,
-            &box2d.touching().with_context(box2d_frame)?,
-            BOX2D_CONTACT_TOLERANCE,
-        ));
-        if last_note.elapsed() > Duration::from_secs(30) {
-            progress(&format!(
-                "{name}: frame {frame}/{frames} after {:.0} s",
-                started.elapsed().as_secs_f64()
-            ));
-            last_note = Instant::now();
-        }
+        note("rapier", frame);
     }
-    let peak_mb = status_mb("VmHWM");
-    // The same number of frames again, Ricochet alone (rapier's and Box2D's worlds stay,
-    // untouched).
-    // Then the same frames with two threads, on a clone taken here.
+    // The same number of frames again, Ricochet alone (rapier's world stays, untouched),
+    // then the same frames with two threads, on a clone taken here.
     let mut twin = sim.clone();
     twin.set_threads(2);
     let alone = |sim: &mut Simulation| {
@@ -244,6 +223,44 @@ pub fn run_scene(
     };
     let ricochet_alone_median_ms = alone(&mut sim);
     let ricochet_alone_2t_median_ms = alone(&mut twin);
+    drop((sim, twin, rapier));
+    // Box2D on the clone taken after frame 0: the same frames and poses (a clone steps bit
+    // for bit as the original), Ricochet's steps untimed.
+    let mut box2d = Box2dScene::new(&replay).with_context(|| format!("{name}: Box2D scene"))?;
+    box2d
+        .step()
+        .with_context(|| format!("{name}: Box2D frame 0"))?;
+    let box2d_mb = ricochet_box2d::allocated_mb().with_context(|| format!("{name}: Box2D"))?;
+    let mut box2d_agreement = compare_box2d(
+        &replay,
+        &out0,
+        &box2d
+            .touching()
+            .with_context(|| format!("{name}: Box2D frame 0"))?,
+        BOX2D_CONTACT_TOLERANCE,
+    );
+    drop(out0);
+    let mut box2d_collide = Vec::with_capacity(ricochet_times.len());
+    let mut box2d_step = Vec::with_capacity(ricochet_times.len());
+    let mut box2d_sync = Vec::with_capacity(ricochet_times.len());
+    for frame in 1..=frames {
+        let out = replay.step();
+        let box2d_frame = || format!("{name}: Box2D frame {frame}");
+        let t = Instant::now();
+        box2d.sync(&replay).with_context(box2d_frame)?;
+        box2d_sync.push(t.elapsed());
+        box2d.step().with_context(box2d_frame)?;
+        box2d_collide.push(box2d.times().collide_ms);
+        box2d_step.push(box2d.times().step_ms);
+        box2d_agreement.add(&compare_box2d(
+            &replay,
+            &out,
+            &box2d.touching().with_context(box2d_frame)?,
+            BOX2D_CONTACT_TOLERANCE,
+        ));
+        note("Box2D", frame);
+    }
+    let peak_mb = status_mb("VmHWM");
     let (ricochet_median_ms, ricochet_p95_ms) = percentiles(&ricochet_times);
     let (rapier_median_ms, rapier_p95_ms) = percentiles(&rapier_times);
     let (box2d_collide_median_ms, box2d_collide_p95_ms) = percentiles(&durations(&box2d_collide));
