@@ -3,7 +3,8 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 
-use ricochet_sim::{ContactRecord, Entity, FrameOutput, Phase, Response, SLOP, Simulation};
+use ricochet_oracle::bench::{FramePairs, threshold, wrapped};
+use ricochet_sim::{Entity, FrameOutput, Response, Simulation};
 
 use crate::MAX_AGREEMENT_DETAILS;
 #[cfg(doc)]
@@ -88,16 +89,6 @@ impl Box2dAgreement {
     }
 }
 
-/// How deep Ricochet may leave a pair of this response: `SLOP` for `separate` (the per-axis
-/// passes leave boxes flush, a push leaves at most `SLOP`), 0 otherwise.
-fn threshold(response: Response) -> f64 {
-    if response == Response::Separate {
-        SLOP
-    } else {
-        0.0
-    }
-}
-
 /// Compares one frame's contacts with the pairs Box2D reports touching at the end-of-frame
 /// poses (`box2d` from [`Box2dScene::touching`], after [`Box2dScene::sync`] and
 /// [`Box2dScene::step`] on the same `sim`: the smallest manifold separation of each pair).
@@ -139,38 +130,14 @@ pub fn compare_box2d(
     let w = sim.world();
     let layers = &sim.scenario().world.layers;
     let frame = out.frame;
-    let wrapped = |e: Entity| -> bool {
-        let (Some(b), Some(i)) = (sim.scenario().world.bounds, w.index_of(e)) else {
-            return false;
-        };
-        let size = b.max - b.min;
-        let moved = (w.position[i] - w.start_position(i)).abs();
-        b.wrap && (moved.x > 0.5 * size.x || moved.y > 0.5 * size.y)
-    };
-    let end_pose = |e: Entity| w.index_of(e).map(|i| w.pose(i));
-    let at_end =
-        |c: &ContactRecord| end_pose(c.a) == Some(c.pose_a) && end_pose(c.b) == Some(c.pose_b);
-
-    let mut ricochet: BTreeMap<(Entity, Entity), f64> = BTreeMap::new();
-    let mut covered: BTreeSet<(Entity, Entity)> = BTreeSet::new();
-    let mut elsewhere: BTreeSet<(Entity, Entity)> = BTreeSet::new();
-    for c in &out.contacts {
-        let key = (c.a, c.b);
-        if wrapped(c.a) || wrapped(c.b) {
-            report.excluded += 1;
-            continue;
-        }
-        if c.phase == Phase::Swept {
-            covered.insert(key);
-        }
-        if at_end(c) {
-            let depth = ricochet.entry(key).or_insert(f64::NEG_INFINITY);
-            *depth = depth.max(c.depth);
-        } else {
-            report.other_poses += 1;
-            elsewhere.insert(key);
-        }
-    }
+    let FramePairs {
+        at_end: ricochet,
+        swept: covered,
+        elsewhere,
+        excluded,
+    } = FramePairs::of(sim, out, |_| report.other_poses += 1);
+    report.excluded += excluded;
+    let wrapped = |e: Entity| wrapped(sim, e);
 
     let penetrating = box2d.iter().filter(|&(_, &s)| s < 0.0).map(|(k, _)| *k);
     let keys: BTreeSet<(Entity, Entity)> = ricochet.keys().copied().chain(penetrating).collect();

@@ -4,10 +4,11 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 
+use crate::bench::threshold;
 use rapier2d_f64::prelude::{ActiveCollisionTypes, ColliderBuilder, PhysicsWorld};
 use ricochet_geom::{Pose, Primitive, Shape, Vec2};
 use ricochet_sim::{
-    BodyKind, ContactRecord, Entity, FrameOutput, LayerId, Layers, Phase, Response, SLOP, Scenario,
+    BodyKind, ContactRecord, Entity, FrameOutput, LayerId, Layers, Phase, Response, Scenario,
     Simulation, Stage,
 };
 
@@ -54,15 +55,6 @@ fn angle_between(a: Vec2, b: Vec2) -> f64 {
 /// Whether the shape is resolved per axis by Ricochet: a single AABB.
 fn is_box(s: &Shape) -> bool {
     matches!(s, Shape::Primitive(Primitive::Aabb(_)))
-}
-
-/// The depth at which a response starts: `SLOP` for `separate`, 0 otherwise.
-pub(crate) fn threshold(response: Response) -> f64 {
-    if response == Response::Separate {
-        SLOP
-    } else {
-        0.0
-    }
 }
 
 /// A contact record recomputed by parry at the record's own poses (see [`recheck`]).

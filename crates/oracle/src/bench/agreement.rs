@@ -2,14 +2,15 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 
-use ricochet_sim::{ContactRecord, Entity, FrameOutput, Phase, Response, Simulation};
+use ricochet_sim::{ContactRecord, Entity, FrameOutput, Response, Simulation};
 
 use super::MAX_AGREEMENT_DETAILS;
+use super::frame_pairs::{FramePairs, threshold, wrapped};
 #[cfg(doc)]
 use super::{CONTACT_TOLERANCE, RapierScene};
 use crate::OracleError;
 use crate::convert::depth;
-use crate::referee::{Recheck, body, recheck, threshold};
+use crate::referee::{Recheck, body, recheck};
 
 /// How one frame's (or a whole run's) contact sets compare. Every compared item either
 /// agrees or is counted as a disagreement with a sentence in `details`. Serialisable: the
@@ -125,41 +126,18 @@ pub fn compare_contacts(
     tol: f64,
 ) -> ContactAgreement {
     let mut report = ContactAgreement::default();
-    let w = sim.world();
     let layers = &sim.scenario().world.layers;
     let frame = out.frame;
-    let wrapped = |e: Entity| -> bool {
-        let (Some(b), Some(i)) = (sim.scenario().world.bounds, w.index_of(e)) else {
-            return false;
-        };
-        let size = b.max - b.min;
-        let moved = (w.position[i] - w.start_position(i)).abs();
-        b.wrap && (moved.x > 0.5 * size.x || moved.y > 0.5 * size.y)
-    };
-    let end_pose = |e: Entity| w.index_of(e).map(|i| w.pose(i));
-    let at_end =
-        |c: &ContactRecord| end_pose(c.a) == Some(c.pose_a) && end_pose(c.b) == Some(c.pose_b);
-
-    let mut ricochet: BTreeMap<(Entity, Entity), f64> = BTreeMap::new();
-    let mut covered: BTreeSet<(Entity, Entity)> = BTreeSet::new();
-    let mut elsewhere: BTreeSet<(Entity, Entity)> = BTreeSet::new();
-    for c in &out.contacts {
-        let key = (c.a, c.b);
-        if wrapped(c.a) || wrapped(c.b) {
-            report.excluded += 1;
-            continue;
-        }
-        if c.phase == Phase::Swept {
-            covered.insert(key);
-        }
-        if at_end(c) {
-            let depth = ricochet.entry(key).or_insert(f64::NEG_INFINITY);
-            *depth = depth.max(c.depth);
-            continue;
-        }
-        elsewhere.insert(key);
+    let FramePairs {
+        at_end: ricochet,
+        swept: covered,
+        elsewhere,
+        excluded,
+    } = FramePairs::of(sim, out, |c| {
         check_at_record_poses(sim, out, c, tol, &mut report);
-    }
+    });
+    report.excluded += excluded;
+    let wrapped = |e: Entity| wrapped(sim, e);
 
     let keys: BTreeSet<(Entity, Entity)> = ricochet.keys().chain(rapier.keys()).copied().collect();
     for key in keys {

@@ -39,9 +39,11 @@
 //! [`CollisionPipeline`]: rapier2d_f64::prelude::CollisionPipeline
 
 mod agreement;
+mod frame_pairs;
 mod scene;
 
 pub use agreement::{ContactAgreement, compare_contacts};
+pub use frame_pairs::{FramePairs, Pair, threshold, wrapped};
 pub use scene::RapierScene;
 
 /// The tolerance of the contact-set comparison, world units, on both sides of touching:

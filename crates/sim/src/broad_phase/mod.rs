@@ -73,12 +73,14 @@
 pub const CROWD: usize = 256;
 
 mod brute_force;
+mod by_layers;
 mod fixed_grid;
 mod grid;
 mod hash_grid;
 mod interactions;
 mod mover_grid;
 mod sort_and_sweep;
+mod sorted;
 mod static_set;
 mod static_tree;
 mod strips;
@@ -92,7 +94,7 @@ pub(crate) use fixed_grid::FixedGrid;
 use hash_grid::HashGrid;
 pub use interactions::Interactions;
 pub(crate) use mover_grid::MoverGrid;
-use sort_and_sweep::{Slot, SweepList, SweepView, sweep_cross, sweep_self};
+use sort_and_sweep::{Slot, SweepList};
 use static_set::StaticSet;
 use strips::StripList;
 use tally::Tally;
@@ -350,8 +352,7 @@ impl BroadPhase {
 
     /// This call's moving bodies of `layer`, in key order.
     fn layer_movers(&self, layer: u8) -> &[u32] {
-        let l = usize::from(layer);
-        &self.movers[self.layer_start[l] as usize..self.layer_start[l + 1] as usize]
+        of_layer(&self.movers, &self.layer_start, layer)
     }
 
     /// Chooses the algorithm, finds the pairs and, with `dense`, resolves them (`all_given`:
@@ -388,8 +389,6 @@ impl BroadPhase {
         };
         if kind == BroadPhaseKind::BruteForce {
             self.brute_force(bodies, interactions, out, &mut stats);
-        } else if kind == BroadPhaseKind::Strips {
-            self.by_strips(bodies, interactions, out, &mut stats);
         } else {
             self.by_layers(kind, bodies, interactions, out, &mut stats);
         }
@@ -399,133 +398,6 @@ impl BroadPhase {
         stats.pairs = out.len() as u64;
         stats.static_rebuilds = self.static_rebuilds;
         stats
-    }
-
-    /// Per pair of interacting layers: moving–moving through the per-call structures,
-    /// dynamic–static through the static ones.
-    fn by_layers(
-        &mut self,
-        kind: BroadPhaseKind,
-        bodies: &[BodyEntry],
-        interactions: &Interactions,
-        out: &mut Vec<(u32, u32)>,
-        stats: &mut BroadPhaseStats,
-    ) {
-        let built = match kind {
-            BroadPhaseKind::SortAndSweep => &mut self.statics.built_trees,
-            _ => &mut self.statics.built_grids,
-        };
-        if !*built {
-            *built = true;
-            self.statics.build(kind, &mut self.scratch);
-            self.static_rebuilds += 1;
-        }
-        let layers = std::mem::take(&mut self.mover_layers);
-        for (k, &a) in layers.iter().enumerate() {
-            for &b in &layers[k..] {
-                if !interactions.interacts(a, b) {
-                    stats.layer_pairs_skipped += 1;
-                    continue;
-                }
-                let (da, db) = (self.dynamic[usize::from(a)], self.dynamic[usize::from(b)]);
-                if da == 0 && db == 0 {
-                    continue;
-                }
-                if kind == BroadPhaseKind::SortAndSweep {
-                    stats.resorted += self.ensure_sweep(a, bodies);
-                    stats.resorted += self.ensure_sweep(b, bodies);
-                    let mut ranges = std::mem::take(&mut self.scratch.ranges);
-                    let view = |l: u8| SweepView {
-                        list: &self.sweeps[usize::from(l)],
-                        handles: self.layer_movers(l),
-                        bodies,
-                    };
-                    if a == b {
-                        stats.tested += sweep_self(view(a), out);
-                    } else {
-                        stats.tested += sweep_cross(view(a), view(b), &mut ranges, out);
-                    }
-                    self.scratch.ranges = ranges;
-                } else if a == b {
-                    self.ensure_grid(a, bodies);
-                    stats.tested += self.grids[usize::from(a)].self_pairs(out);
-                } else {
-                    // Query the larger layer's grid with the smaller's bodies.
-                    let (na, nb) = (self.layer_movers(a).len(), self.layer_movers(b).len());
-                    let (grid, query) = if na > nb { (a, b) } else { (b, a) };
-                    self.ensure_grid(grid, bodies);
-                    let g = &self.grids[usize::from(grid)];
-                    for &h in self.layer_movers(query) {
-                        let q = member(&bodies[h as usize], h);
-                        stats.tested += g.query(&q.bounds, |m| {
-                            if q.dynamic || m.dynamic {
-                                out.push((q.handle, m.handle));
-                            }
-                        });
-                    }
-                }
-            }
-            if self.dynamic[usize::from(a)] == 0 {
-                continue;
-            }
-            for &b in &self.statics.layers {
-                if !interactions.interacts(a, b) {
-                    stats.layer_pairs_skipped += 1;
-                    continue;
-                }
-                let l = usize::from(a);
-                for k in self.layer_start[l] as usize..self.layer_start[l + 1] as usize {
-                    let h = self.movers[k];
-                    let q = &bodies[h as usize];
-                    if q.kind != BodyKind::Dynamic {
-                        continue;
-                    }
-                    let mut emit = |m: &Member| out.push((h, m.handle));
-                    stats.tested += if kind == BroadPhaseKind::SortAndSweep {
-                        let tree = &self.statics.trees[usize::from(b)];
-                        tree.query(&q.bounds, &mut self.scratch.stack, &mut emit)
-                    } else {
-                        self.statics.grids[usize::from(b)].query(&q.bounds, &mut emit)
-                    };
-                }
-            }
-        }
-        self.mover_layers = layers;
-    }
-
-    /// Brings layer `l`'s sorted list up to this call, once per call. Returns the re-sort's
-    /// moves.
-    fn ensure_sweep(&mut self, l: u8, bodies: &[BodyEntry]) -> u64 {
-        let list = &mut self.sweeps[usize::from(l)];
-        if list.frame == self.frame {
-            return 0;
-        }
-        list.frame = self.frame;
-        let (lo, hi) = (
-            self.layer_start[usize::from(l)] as usize,
-            self.layer_start[usize::from(l) + 1] as usize,
-        );
-        list.update(&self.movers[lo..hi], bodies, &mut self.scratch)
-    }
-
-    /// Builds layer `l`'s grid of moving bodies, once per call.
-    fn ensure_grid(&mut self, l: u8, bodies: &[BodyEntry]) {
-        let (lo, hi) = (
-            self.layer_start[usize::from(l)] as usize,
-            self.layer_start[usize::from(l) + 1] as usize,
-        );
-        let grid = &mut self.grids[usize::from(l)];
-        if grid.frame == self.frame {
-            return;
-        }
-        grid.frame = self.frame;
-        grid.members.clear();
-        grid.members.extend(
-            self.movers[lo..hi]
-                .iter()
-                .map(|&h| member(&bodies[h as usize], h)),
-        );
-        grid.build(&mut self.scratch.extents, false);
     }
 
     /// Turns handles into dense indices, orders each pair and sorts them.
@@ -564,6 +436,13 @@ impl BroadPhase {
         out.sort_unstable_by_key(|&(i, j)| (u64::from(i) << 32) | u64::from(j));
         debug_assert!(out.windows(2).all(|w| w[0] < w[1]), "each pair once");
     }
+}
+
+/// Layer `l`'s moving bodies among `movers`, grouped by layer as `layer_start` says
+/// (`movers[layer_start[l]..layer_start[l + 1]]`).
+fn of_layer<'a>(movers: &'a [u32], layer_start: &[u32], l: u8) -> &'a [u32] {
+    let l = usize::from(l);
+    &movers[layer_start[l] as usize..layer_start[l + 1] as usize]
 }
 
 /// `b` as a [`Member`] named `handle`.

@@ -10,6 +10,7 @@ use std::cmp::Ordering;
 
 use ricochet_geom::Bounds;
 
+use super::sorted::{self, order_key};
 use super::{BodyEntry, Member, Scratch, member};
 
 /// No index: a body gone from a layer's list.
@@ -53,14 +54,6 @@ impl Slot {
             local,
         }
     }
-}
-
-/// `f64::total_cmp` as an integer: `order_key(a) < order_key(b)` exactly when `a` comes
-/// first. `-0.0` comes before `+0.0`, so a query bound is normalised with `+ 0.0` first.
-#[inline]
-fn order_key(x: f64) -> u64 {
-    let bits = x.to_bits();
-    bits ^ (((bits as i64 >> 63) as u64) | (1 << 63))
 }
 
 /// The key order as tie-break, so the order is a function of the input, never of the calls
@@ -183,34 +176,9 @@ impl SweepList {
     }
 }
 
-/// Insertion sort for a nearly sorted list, keeping `pos` up to date; past `8n + 64` moves
-/// it gives up and sorts.
+/// Insertion sort for a nearly sorted list, keeping `pos` up to date.
 fn insertion_sort(order: &mut [Slot], pos: &mut [u32]) -> u64 {
-    let budget = 8 * order.len() as u64 + 64;
-    let mut moved = 0;
-    for i in 1..order.len() {
-        if sweep_order(&order[i - 1], &order[i]) != Ordering::Greater {
-            continue;
-        }
-        let x = order[i];
-        let mut j = i;
-        while j > 0 && sweep_order(&x, &order[j - 1]) == Ordering::Less {
-            order[j] = order[j - 1];
-            pos[order[j].local as usize] = j as u32;
-            j -= 1;
-        }
-        order[j] = x;
-        pos[x.local as usize] = j as u32;
-        moved += (i - j) as u64;
-        if moved > budget {
-            order.sort_unstable_by(sweep_order);
-            for (p, s) in order.iter().enumerate() {
-                pos[s.local as usize] = p as u32;
-            }
-            break;
-        }
-    }
-    moved
+    sorted::insertion_sort(order, sweep_order, |s, p| pos[s.local as usize] = p as u32)
 }
 
 /// Tests `p` (whose `max.x` key is `max`) against the bodies of `others` (sorted) ahead of

@@ -36,9 +36,8 @@ use std::cmp::Ordering;
 use ricochet_geom::Bounds;
 
 use super::grid::cell_coord;
-use super::{
-    BodyEntry, BroadPhase, BroadPhaseStats, Interactions, LAYERS, Member, STATIC_BIT, member,
-};
+use super::sorted::{self, order_key};
+use super::{BodyEntry, BroadPhase, BroadPhaseStats, LAYERS, Member, STATIC_BIT, member, of_layer};
 
 /// No index: a body gone from a list.
 const NONE: u32 = u32::MAX;
@@ -89,13 +88,6 @@ impl Slot {
             m,
         }
     }
-}
-
-/// `f64::total_cmp` as an integer (`-0.0` before `+0.0`: a query bound gets `+ 0.0` first).
-#[inline]
-fn order_key(x: f64) -> u64 {
-    let bits = x.to_bits();
-    bits ^ (((bits as i64 >> 63) as u64) | (1 << 63))
 }
 
 /// The list order; `local` (key order) breaks ties, so the order is a function of the input.
@@ -299,28 +291,9 @@ impl StripList {
     }
 }
 
-/// Insertion sort for a nearly sorted list; past `8n + 64` moves it gives up and sorts.
+/// Insertion sort for a nearly sorted list.
 fn insertion_sort(order: &mut [Slot]) -> u64 {
-    let budget = 8 * order.len() as u64 + 64;
-    let mut moved = 0;
-    for i in 1..order.len() {
-        if strip_order(&order[i - 1], &order[i]) != Ordering::Greater {
-            continue;
-        }
-        let x = order[i];
-        let mut j = i;
-        while j > 0 && strip_order(&x, &order[j - 1]) == Ordering::Less {
-            order[j] = order[j - 1];
-            j -= 1;
-        }
-        order[j] = x;
-        moved += (i - j) as u64;
-        if moved > budget {
-            order.sort_unstable_by(strip_order);
-            break;
-        }
-    }
-    moved
+    sorted::insertion_sort(order, strip_order, |_, _| {})
 }
 
 /// Tests `p` and `q`, emitting the pair when one is dynamic and their bounds overlap.
@@ -476,16 +449,10 @@ pub(super) fn extent<'a>(bounds: impl Iterator<Item = &'a Bounds>) -> (f64, f64)
 }
 
 impl BroadPhase {
-    /// `Strips` for every pair of interacting layers: moving lists swept within themselves
-    /// and against each other, dynamic bodies against the static lists. One strip height
-    /// for all of them, kept from call to call while it fits (see [`restrip`]).
-    pub(super) fn by_strips(
-        &mut self,
-        bodies: &[BodyEntry],
-        interactions: &Interactions,
-        out: &mut Vec<(u32, u32)>,
-        stats: &mut BroadPhaseStats,
-    ) {
+    /// Before a `Strips` call: the strip height for this call's bodies (kept while it fits,
+    /// see [`restrip`]), and the static lists, sorted again when the static bodies or the
+    /// height changed.
+    pub(super) fn prepare_strips(&mut self, bodies: &[BodyEntry]) {
         if !self.statics.built_strips {
             self.static_extent = extent(self.statics.entries.iter().map(|(b, _)| b));
         }
@@ -498,70 +465,62 @@ impl BroadPhase {
             self.inv_h = want;
         }
         let inv_h = self.inv_h;
-        if !self.statics.built_strips
-            || self
+        if self.statics.built_strips
+            && self
                 .static_strips
                 .iter()
-                .any(|s| s.inv_h().to_bits() != inv_h.to_bits())
+                .all(|s| s.inv_h().to_bits() == inv_h.to_bits())
         {
-            self.statics.built_strips = true;
-            self.static_rebuilds += 1;
-            let mut by_layer: Vec<Vec<Member>> = (0..LAYERS).map(|_| Vec::new()).collect();
-            for (s, &(bounds, layer)) in self.statics.entries.iter().enumerate() {
-                by_layer[usize::from(layer)].push(Member {
-                    bounds,
-                    handle: s as u32 | STATIC_BIT,
-                    dynamic: false,
-                });
-            }
-            self.static_strips = by_layer
-                .iter()
-                .map(|members| StripList::statics(members, inv_h))
-                .collect();
+            return;
         }
-        let layers = std::mem::take(&mut self.mover_layers);
-        for (k, &a) in layers.iter().enumerate() {
-            for &b in &layers[k..] {
-                if !interactions.interacts(a, b) {
-                    stats.layer_pairs_skipped += 1;
-                    continue;
-                }
-                if self.dynamic[usize::from(a)] == 0 && self.dynamic[usize::from(b)] == 0 {
-                    continue;
-                }
-                stats.resorted += self.ensure_strip(a, bodies);
-                stats.resorted += self.ensure_strip(b, bodies);
-                let list = |l: u8| &self.strips[usize::from(l)];
-                stats.tested += if a == b {
-                    strip_self(list(a), out)
-                } else {
-                    strip_cross(list(a), list(b), out)
-                };
-            }
-            if self.dynamic[usize::from(a)] == 0 {
-                continue;
-            }
-            if self
-                .statics
-                .layers
-                .iter()
-                .any(|&b| interactions.interacts(a, b))
-            {
-                stats.resorted += self.ensure_strip(a, bodies);
-            }
-            for &b in &self.statics.layers {
-                if !interactions.interacts(a, b) {
-                    stats.layer_pairs_skipped += 1;
-                    continue;
-                }
-                stats.tested += strip_cross(
-                    &self.strips[usize::from(a)],
-                    &self.static_strips[usize::from(b)],
-                    out,
-                );
-            }
+        self.statics.built_strips = true;
+        self.static_rebuilds += 1;
+        let mut by_layer: Vec<Vec<Member>> = (0..LAYERS).map(|_| Vec::new()).collect();
+        for (s, &(bounds, layer)) in self.statics.entries.iter().enumerate() {
+            by_layer[usize::from(layer)].push(Member {
+                bounds,
+                handle: s as u32 | STATIC_BIT,
+                dynamic: false,
+            });
         }
-        self.mover_layers = layers;
+        self.static_strips = by_layer
+            .iter()
+            .map(|members| StripList::statics(members, inv_h))
+            .collect();
+    }
+
+    /// The pairs of moving layers `a` and `b` (the same, or two).
+    pub(super) fn strip_pairs(
+        &mut self,
+        (a, b): (u8, u8),
+        bodies: &[BodyEntry],
+        out: &mut Vec<(u32, u32)>,
+        stats: &mut BroadPhaseStats,
+    ) {
+        stats.resorted += self.ensure_strip(a, bodies);
+        stats.resorted += self.ensure_strip(b, bodies);
+        let list = |l: u8| &self.strips[usize::from(l)];
+        stats.tested += if a == b {
+            strip_self(list(a), out)
+        } else {
+            strip_cross(list(a), list(b), out)
+        };
+    }
+
+    /// The pairs of moving layer `a` with static layer `b`.
+    pub(super) fn strip_static_pairs(
+        &mut self,
+        (a, b): (u8, u8),
+        bodies: &[BodyEntry],
+        out: &mut Vec<(u32, u32)>,
+        stats: &mut BroadPhaseStats,
+    ) {
+        stats.resorted += self.ensure_strip(a, bodies);
+        stats.tested += strip_cross(
+            &self.strips[usize::from(a)],
+            &self.static_strips[usize::from(b)],
+            out,
+        );
     }
 
     /// Brings layer `l`'s moving list up to this call, once per call. Returns the re-sort's
@@ -572,10 +531,10 @@ impl BroadPhase {
             return 0;
         }
         list.frame = self.frame;
-        let (lo, hi) = (
-            self.layer_start[usize::from(l)] as usize,
-            self.layer_start[usize::from(l) + 1] as usize,
-        );
-        list.update(&self.movers[lo..hi], bodies, self.inv_h)
+        list.update(
+            of_layer(&self.movers, &self.layer_start, l),
+            bodies,
+            self.inv_h,
+        )
     }
 }

@@ -1,0 +1,169 @@
+//! The per-layer-pair dispatch of the algorithms that keep structures (`SortAndSweep`,
+//! `Grid`, `Strips`): every pair of interacting moving layers through the per-call
+//! structures, every moving layer's dynamic bodies against every interacting static layer
+//! through the static ones, counting the layer combinations skipped.
+
+use crate::def::BodyKind;
+
+use super::sort_and_sweep::{SweepView, sweep_cross, sweep_self};
+use super::{
+    BodyEntry, BroadPhase, BroadPhaseKind, BroadPhaseStats, Interactions, Member, member, of_layer,
+};
+
+impl BroadPhase {
+    /// Per pair of interacting layers: moving–moving through the per-call structures,
+    /// dynamic–static through the static ones.
+    pub(super) fn by_layers(
+        &mut self,
+        kind: BroadPhaseKind,
+        bodies: &[BodyEntry],
+        interactions: &Interactions,
+        out: &mut Vec<(u32, u32)>,
+        stats: &mut BroadPhaseStats,
+    ) {
+        if kind == BroadPhaseKind::Strips {
+            self.prepare_strips(bodies);
+        } else {
+            let built = match kind {
+                BroadPhaseKind::SortAndSweep => &mut self.statics.built_trees,
+                _ => &mut self.statics.built_grids,
+            };
+            if !*built {
+                *built = true;
+                self.statics.build(kind, &mut self.scratch);
+                self.static_rebuilds += 1;
+            }
+        }
+        let layers = std::mem::take(&mut self.mover_layers);
+        let static_layers = std::mem::take(&mut self.statics.layers);
+        for (k, &a) in layers.iter().enumerate() {
+            for &b in &layers[k..] {
+                if !interactions.interacts(a, b) {
+                    stats.layer_pairs_skipped += 1;
+                    continue;
+                }
+                let (da, db) = (self.dynamic[usize::from(a)], self.dynamic[usize::from(b)]);
+                if da != 0 || db != 0 {
+                    self.moving_pairs(kind, (a, b), bodies, out, stats);
+                }
+            }
+            if self.dynamic[usize::from(a)] == 0 {
+                continue;
+            }
+            for &b in &static_layers {
+                if interactions.interacts(a, b) {
+                    self.static_pairs(kind, (a, b), bodies, out, stats);
+                } else {
+                    stats.layer_pairs_skipped += 1;
+                }
+            }
+        }
+        self.mover_layers = layers;
+        self.statics.layers = static_layers;
+    }
+
+    /// The pairs of moving layers `a` and `b` (the same layer, or two) with a dynamic body.
+    fn moving_pairs(
+        &mut self,
+        kind: BroadPhaseKind,
+        (a, b): (u8, u8),
+        bodies: &[BodyEntry],
+        out: &mut Vec<(u32, u32)>,
+        stats: &mut BroadPhaseStats,
+    ) {
+        match kind {
+            BroadPhaseKind::Strips => self.strip_pairs((a, b), bodies, out, stats),
+            BroadPhaseKind::SortAndSweep => {
+                stats.resorted += self.ensure_sweep(a, bodies);
+                stats.resorted += self.ensure_sweep(b, bodies);
+                let mut ranges = std::mem::take(&mut self.scratch.ranges);
+                let view = |l: u8| SweepView {
+                    list: &self.sweeps[usize::from(l)],
+                    handles: self.layer_movers(l),
+                    bodies,
+                };
+                if a == b {
+                    stats.tested += sweep_self(view(a), out);
+                } else {
+                    stats.tested += sweep_cross(view(a), view(b), &mut ranges, out);
+                }
+                self.scratch.ranges = ranges;
+            }
+            _ if a == b => {
+                self.ensure_grid(a, bodies);
+                stats.tested += self.grids[usize::from(a)].self_pairs(out);
+            }
+            _ => {
+                // Query the larger layer's grid with the smaller's bodies.
+                let (na, nb) = (self.layer_movers(a).len(), self.layer_movers(b).len());
+                let (grid, query) = if na > nb { (a, b) } else { (b, a) };
+                self.ensure_grid(grid, bodies);
+                let g = &self.grids[usize::from(grid)];
+                for &h in self.layer_movers(query) {
+                    let q = member(&bodies[h as usize], h);
+                    stats.tested += g.query(&q.bounds, |m| {
+                        if q.dynamic || m.dynamic {
+                            out.push((q.handle, m.handle));
+                        }
+                    });
+                }
+            }
+        }
+    }
+
+    /// The pairs of moving layer `a`'s dynamic bodies with static layer `b`.
+    fn static_pairs(
+        &mut self,
+        kind: BroadPhaseKind,
+        (a, b): (u8, u8),
+        bodies: &[BodyEntry],
+        out: &mut Vec<(u32, u32)>,
+        stats: &mut BroadPhaseStats,
+    ) {
+        if kind == BroadPhaseKind::Strips {
+            self.strip_static_pairs((a, b), bodies, out, stats);
+            return;
+        }
+        for &h in of_layer(&self.movers, &self.layer_start, a) {
+            let q = &bodies[h as usize];
+            if q.kind != BodyKind::Dynamic {
+                continue;
+            }
+            let mut emit = |m: &Member| out.push((h, m.handle));
+            stats.tested += if kind == BroadPhaseKind::SortAndSweep {
+                let tree = &self.statics.trees[usize::from(b)];
+                tree.query(&q.bounds, &mut self.scratch.stack, &mut emit)
+            } else {
+                self.statics.grids[usize::from(b)].query(&q.bounds, &mut emit)
+            };
+        }
+    }
+
+    /// Brings layer `l`'s sorted list up to this call, once per call. Returns the re-sort's
+    /// moves.
+    fn ensure_sweep(&mut self, l: u8, bodies: &[BodyEntry]) -> u64 {
+        let list = &mut self.sweeps[usize::from(l)];
+        if list.frame == self.frame {
+            return 0;
+        }
+        list.frame = self.frame;
+        let handles = of_layer(&self.movers, &self.layer_start, l);
+        list.update(handles, bodies, &mut self.scratch)
+    }
+
+    /// Builds layer `l`'s grid of moving bodies, once per call.
+    fn ensure_grid(&mut self, l: u8, bodies: &[BodyEntry]) {
+        let grid = &mut self.grids[usize::from(l)];
+        if grid.frame == self.frame {
+            return;
+        }
+        grid.frame = self.frame;
+        grid.members.clear();
+        grid.members.extend(
+            of_layer(&self.movers, &self.layer_start, l)
+                .iter()
+                .map(|&h| member(&bodies[h as usize], h)),
+        );
+        grid.build(&mut self.scratch.extents, false);
+    }
+}
