@@ -18,7 +18,8 @@ use std::sync::Arc;
 /// few microseconds.
 const MIN_PARALLEL: usize = 256;
 
-/// A pool of worker threads (none with one thread), shared by clones of a simulation.
+/// A pool of worker threads besides the calling one (none with one thread in all), shared
+/// by clones of a simulation.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Workers {
     pool: Option<Arc<rayon::ThreadPool>>,
@@ -31,7 +32,7 @@ impl Workers {
         let pool = (threads > 1)
             .then(|| {
                 rayon::ThreadPoolBuilder::new()
-                    .num_threads(threads)
+                    .num_threads(threads - 1)
                     .thread_name(|k| format!("ricochet-worker-{k}"))
                     .build()
                     .ok()
@@ -41,25 +42,39 @@ impl Workers {
         Workers { pool }
     }
 
-    /// How many threads a map uses.
+    /// How many threads a map uses, the calling one included.
     pub(crate) fn threads(&self) -> usize {
-        self.pool.as_ref().map_or(1, |p| p.current_num_threads())
+        self.pool
+            .as_ref()
+            .map_or(1, |p| p.current_num_threads() + 1)
     }
 
     /// `out` (cleared first) becomes `[f(0), f(1), ..., f(n - 1)]`, computed on the pool's
-    /// threads when there are enough items.
+    /// threads when there are enough items: one contiguous chunk per thread, the calling
+    /// thread computing the first while the workers compute the others, gathered in order.
     pub(crate) fn map<T, F>(&self, n: usize, f: F, out: &mut Vec<T>)
     where
         T: Send,
         F: Fn(usize) -> T + Sync + Send,
     {
         out.clear();
-        match &self.pool {
-            Some(pool) if n >= MIN_PARALLEL => {
-                use rayon::prelude::*;
-                pool.install(|| (0..n).into_par_iter().map(f).collect_into_vec(out));
+        let Some(pool) = self.pool.as_ref().filter(|_| n >= MIN_PARALLEL) else {
+            out.extend((0..n).map(f));
+            return;
+        };
+        let threads = pool.current_num_threads() + 1;
+        let chunk = n.div_ceil(threads);
+        let mut rest: Vec<Vec<T>> = (1..threads).map(|_| Vec::new()).collect();
+        let f = &f;
+        pool.in_place_scope(|scope| {
+            for (k, part) in rest.iter_mut().enumerate() {
+                let range = ((k + 1) * chunk).min(n)..((k + 2) * chunk).min(n);
+                scope.spawn(move |_| part.extend(range.map(f)));
             }
-            _ => out.extend((0..n).map(f)),
+            out.extend((0..chunk.min(n)).map(f));
+        });
+        for part in &mut rest {
+            out.append(part);
         }
     }
 }
