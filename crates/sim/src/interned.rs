@@ -1,10 +1,11 @@
-//! Values many bodies share, stored once: the world's shape and name tables. A body holds a
-//! `u32` id; a value lives while some body uses it and its id is then reused.
+//! Values many bodies share, stored once: the world's shape table ([`ShapeTable`]) and name
+//! table ([`Interned`]). A body holds a `u32` id; a value lives while some body uses it and
+//! its id is then reused.
 //!
 //! Ids are private to the world and never reach an output, so which id a value gets does
 //! not matter for determinism (it is a function of the spawn and removal history anyway).
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 
 use ricochet_geom::{Bounds, Primitive, Shape};
 
@@ -72,26 +73,10 @@ impl<K: Ord + Clone, V> Interned<K, V> {
         }
     }
 
-    /// The value of an id in use.
-    #[inline]
-    pub(crate) fn get(&self, id: u32) -> &V {
-        &self.entries[id as usize].as_ref().expect("an id in use").1
-    }
-
     /// The key of an id in use.
     #[inline]
     pub(crate) fn key(&self, id: u32) -> &K {
         &self.entries[id as usize].as_ref().expect("an id in use").0
-    }
-
-    /// The value of `id`, if it is in use.
-    pub(crate) fn try_get(&self, id: u32) -> Option<&V> {
-        self.entries.get(id as usize)?.as_ref().map(|(_, v)| v)
-    }
-
-    /// How many ids have been handed out (some may be free now).
-    pub(crate) fn len(&self) -> u32 {
-        self.entries.len() as u32
     }
 
     /// The id of `key`'s value, if a body uses it.
@@ -115,11 +100,107 @@ impl<K: Ord + Clone, V> Interned<K, V> {
     }
 }
 
-/// The shapes of the world, one copy each: keyed by the bits of every number that defines
-/// them, so two shapes share an id only when they are the same bit for bit (`-0.0` and
-/// `0.0` are different shapes here; `==` would call them equal).
-/// Each shape is kept with its bounds at angle 0 relative to the body (scenery's bounds).
-pub(crate) type ShapeTable = Interned<Vec<u64>, (Shape, Bounds)>;
+/// The shapes of the world, one copy each, each with its bounds at angle 0 relative to the
+/// body (scenery's bounds). Two shapes share an id only when they are the same bit for bit
+/// (`-0.0` and `0.0` are different shapes here; `==` would call them equal): they are found
+/// by a hash of those bits ([`shape_key`]), and a candidate's bits are compared in full. The
+/// bits are not kept: a scene of 100,000 different asteroids keeps each shape once and 16
+/// bytes of index, not a second copy of its numbers.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct ShapeTable {
+    /// Each id's shape and bounds (`None` once no body uses it).
+    entries: Vec<Option<(Shape, Bounds)>>,
+    /// How many bodies use each id.
+    users: Vec<u32>,
+    /// Ids no body uses, to reuse.
+    free: Vec<u32>,
+    /// `(hash of the shape's bits, id)` of every shape in use.
+    ids: BTreeSet<(u64, u32)>,
+    /// A candidate's bits, while comparing.
+    scratch: Vec<u64>,
+}
+
+impl ShapeTable {
+    /// The id of the shape whose bits are `key` ([`shape_key`]), one more user counted;
+    /// `value` makes it (with its bounds) when it is new.
+    pub(crate) fn acquire(&mut self, key: &[u64], value: impl FnOnce() -> (Shape, Bounds)) -> u32 {
+        let hash = fnv1a(key);
+        for &(_, id) in self.ids.range((hash, 0)..=(hash, u32::MAX)) {
+            let (shape, _) = self.entries[id as usize].as_ref().expect("an id in use");
+            shape_key(shape, &mut self.scratch);
+            if self.scratch.as_slice() == key {
+                self.users[id as usize] += 1;
+                return id;
+            }
+        }
+        let entry = Some(value());
+        let id = match self.free.pop() {
+            Some(id) => {
+                self.entries[id as usize] = entry;
+                self.users[id as usize] = 1;
+                id
+            }
+            None => {
+                self.entries.push(entry);
+                self.users.push(1);
+                u32::try_from(self.entries.len() - 1).expect("fewer than 2^32 distinct shapes")
+            }
+        };
+        self.ids.insert((hash, id));
+        id
+    }
+
+    /// One user of `id` fewer; the shape is dropped with its last user.
+    pub(crate) fn release(&mut self, id: u32) {
+        let users = &mut self.users[id as usize];
+        *users -= 1;
+        if *users == 0
+            && let Some((shape, _)) = self.entries[id as usize].take()
+        {
+            shape_key(&shape, &mut self.scratch);
+            self.ids.remove(&(fnv1a(&self.scratch), id));
+            self.free.push(id);
+        }
+    }
+
+    /// The shape and bounds of an id in use.
+    #[inline]
+    pub(crate) fn get(&self, id: u32) -> &(Shape, Bounds) {
+        self.entries[id as usize].as_ref().expect("an id in use")
+    }
+
+    /// The shape and bounds of `id`, if it is in use.
+    pub(crate) fn try_get(&self, id: u32) -> Option<&(Shape, Bounds)> {
+        self.entries.get(id as usize)?.as_ref()
+    }
+
+    /// How many ids have been handed out (some may be free now).
+    pub(crate) fn len(&self) -> u32 {
+        self.entries.len() as u32
+    }
+
+    /// Heap bytes held (a compound's parts not included).
+    pub(crate) fn heap_bytes(&self) -> usize {
+        self.entries.capacity() * size_of::<Option<(Shape, Bounds)>>()
+            + self.users.capacity() * 4
+            + self.free.capacity() * 4
+            // A B-tree node holds up to 11 keys; count each entry at a full node's share.
+            + self.ids.len() * (size_of::<(u64, u32)>() + 8)
+            + self.scratch.capacity() * 8
+    }
+}
+
+/// A 64-bit FNV-1a hash of `key`'s words: fixed, so the table's layout is a function of the
+/// shapes alone (it never reaches an output anyway).
+fn fnv1a(key: &[u64]) -> u64 {
+    let mut h = 0xcbf2_9ce4_8422_2325_u64;
+    for &w in key {
+        for b in w.to_le_bytes() {
+            h = (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+    h
+}
 
 /// The bits that define `shape` into `out` (cleared first): per primitive its kind and
 /// fields, in order.

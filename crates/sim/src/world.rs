@@ -900,7 +900,6 @@ impl World {
         fn cap<T>(v: &Vec<T>) -> usize {
             v.capacity() * size_of::<T>()
         }
-        let shape_heap = |k: &Vec<u64>| k.capacity() * 8;
         let compound_parts: usize = (0..self.shapes_len())
             .filter_map(|id| self.shapes.try_get(id))
             .map(|(s, _)| match s {
@@ -916,7 +915,7 @@ impl World {
             + cap(&self.shape_id)
             + cap(&self.name_id)
             + cap(&self.row)
-            + self.shapes.heap_bytes(shape_heap)
+            + self.shapes.heap_bytes()
             + compound_parts
             + self.names.heap_bytes(|k| k.len())
             + self.rows.heap_bytes()
