@@ -246,6 +246,28 @@ impl CellRange {
         span(self.x).saturating_mul(span(self.y))
     }
 
+    /// Whether the range is at most two cells wide and two high.
+    pub(super) fn within_two(self) -> bool {
+        i64::from(self.x.1) - i64::from(self.x.0) <= 1
+            && i64::from(self.y.1) - i64::from(self.y.0) <= 1
+    }
+
+    /// The range's lower-left cell alone.
+    pub(super) fn corner(self) -> CellRange {
+        CellRange {
+            x: (self.x.0, self.x.0),
+            y: (self.y.0, self.y.0),
+        }
+    }
+
+    /// The range reaching one cell further down and to the left (saturating).
+    pub(super) fn reach_back(self) -> CellRange {
+        CellRange {
+            x: (self.x.0.saturating_sub(1), self.x.1),
+            y: (self.y.0.saturating_sub(1), self.y.1),
+        }
+    }
+
     /// The cells, row by row.
     pub(super) fn cells(self) -> impl Iterator<Item = (i32, i32)> {
         (self.y.0..=self.y.1).flat_map(move |cy| (self.x.0..=self.x.1).map(move |cx| (cx, cy)))

@@ -68,9 +68,9 @@ pub(crate) struct SeparateState {
     separating: Vec<bool>,
     /// The static generation `statics` was built at.
     static_generation: Option<u64>,
-    /// Static boxes of separating layers; handles index `static_entities`.
+    /// Static boxes of separating layers, each with its rank among all the static bodies
+    /// (its dense index follows, [`static_index`]) and its layer.
     statics: FixedGrid,
-    static_entities: Vec<(Entity, LayerId)>,
     movers: MoverGrid,
     found: Vec<Obstacle>,
     /// The pass's dynamic boxes, `(lowest coordinate along the axis, dense index)`.
@@ -118,18 +118,19 @@ impl SeparateState {
             return;
         }
         self.static_generation = Some(w.static_generation());
-        self.static_entities.clear();
+        self.statics = FixedGrid::default();
         let mut boxes = Vec::new();
+        let mut rank = 0;
         for i in 0..w.len() {
-            if w.kind[i] == BodyKind::Static
-                && is_box(w.shape(i))
-                && self.separating[usize::from(w.layer[i])]
-            {
-                boxes.push((box_bounds(w, i), self.static_entities.len() as u32));
-                self.static_entities.push((w.entity[i], w.layer[i]));
+            if w.kind[i] != BodyKind::Static {
+                continue;
             }
+            if is_box(w.shape(i)) && self.separating[usize::from(w.layer[i])] {
+                boxes.push((box_bounds(w, i), rank, w.layer[i]));
+            }
+            rank += 1;
         }
-        self.statics = FixedGrid::new(boxes.into_iter());
+        self.statics = FixedGrid::new(&boxes);
     }
 }
 
@@ -169,21 +170,33 @@ fn overlap(a: &Bounds, b: &Bounds, axis: usize) -> f64 {
     a.max[axis].min(b.max[axis]) - a.min[axis].max(b.min[axis])
 }
 
+/// The dense index of the static body of rank `s` among the static bodies: `s` plus the
+/// moving bodies before it. `movers` are the moving bodies' dense indices, ascending, so
+/// mover `k` has `movers[k] - k` static bodies before it (a non-decreasing count).
+fn static_index(movers: &[u32], s: u32) -> u32 {
+    // Usually every static body comes first (a level's tiles before its actors).
+    if movers.first().is_none_or(|&m| m > s) {
+        return s;
+    }
+    let (mut lo, mut hi) = (0, movers.len());
+    while lo < hi {
+        let mid = usize::midpoint(lo, hi);
+        if movers[mid] - mid as u32 <= s {
+            lo = mid + 1;
+        } else {
+            hi = mid;
+        }
+    }
+    s + lo as u32
+}
+
 /// Every body that may be an obstacle for a box with bounds `q`, as dense indices from
 /// `from` on, ascending and without repeats, into `found`.
 fn obstacles(st: &mut SeparateState, w: &World, q: &Bounds, from: u32, found: &mut Vec<Obstacle>) {
     found.clear();
     let movers = w.movers();
-    st.statics.query(q, |s, bounds| {
-        // A static body's dense index: its rank among the static bodies plus the moving
-        // bodies before it.
-        let (e, layer) = st.static_entities[s as usize];
-        // Usually every static body comes first (a level's tiles before its actors).
-        let before = match movers.first() {
-            Some(&m) if w.entity[m as usize] > e => 0,
-            _ => movers.partition_point(|&m| w.entity[m as usize] < e) as u32,
-        };
-        let index = s + before;
+    st.statics.query(q, |s, bounds, layer| {
+        let index = static_index(movers, s);
         if index >= from {
             found.push(Obstacle {
                 index,
