@@ -219,12 +219,8 @@ fn candidate_pairs(ctx: &mut StageCtx, st: &mut DetectState) -> Vec<(u32, u32)> 
                 return movers[h as usize];
             }
             let key = statics[(h & !STATIC_BIT) as usize].key;
-            let e = Entity {
-                index: (key >> 32) as u32,
-                generation: key as u32,
-            };
             // Every static body in `statics` is alive: it was rebuilt since the last change.
-            w.index_of(e).map_or(u32::MAX, |i| i as u32)
+            w.index_of_key(key).map_or(u32::MAX, |i| i as u32)
         };
         for p in &mut pairs {
             let (i, j) = (world_index(p.0), world_index(p.1));

@@ -33,7 +33,6 @@ use ricochet_geom::{Bounds, Vec2};
 
 use crate::broad_phase::{BodyEntry, BroadPhase, BroadPhaseKind, Interactions, STATIC_BIT};
 use crate::def::WorldBounds;
-use crate::entity::Entity;
 use crate::world::World;
 
 /// Keys of image entries: above every real key (an entity's index is below `2^31`).
@@ -225,11 +224,7 @@ impl Seam {
         let world_index = |h: u32| -> u32 {
             if h & STATIC_BIT != 0 {
                 let key = statics[(h & !STATIC_BIT) as usize].key;
-                let e = Entity {
-                    index: (key >> 32) as u32,
-                    generation: key as u32,
-                };
-                w.index_of(e).map_or(u32::MAX, |i| i as u32)
+                w.index_of_key(key).map_or(u32::MAX, |i| i as u32)
             } else {
                 self.bodies[h as usize]
             }

@@ -25,13 +25,18 @@
 //! Scenery is a static body whose definition has nothing but a name, layer, shape, position
 //! and angle ([`World::is_scenery`]). [`World::heap_bytes`] counts what the columns hold.
 
-use ricochet_geom::{Bounds, Pose, Shape, Vec2};
+use ricochet_geom::{Pose, Shape, Vec2};
 
-use crate::broad_phase::BodyEntry;
 use crate::def::{BodyDef, BodyKind, Controller, LayerId, Split};
 use crate::entity::{Entity, EntityAllocator};
 use crate::interned::{NameTable, ShapeTable, shape_key};
 use crate::scenario::TileRows;
+
+mod bounds;
+mod rows;
+
+use bounds::LocalBounds;
+use rows::Rows;
 
 /// What a controller's inputs currently are.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -90,249 +95,6 @@ pub struct World {
     non_boxes: Vec<u32>,
     /// Scratch for a shape's key.
     key: Vec<u64>,
-}
-
-/// The columns of the bodies that have a row, indexed by row.
-#[derive(Clone, Debug, Default)]
-struct Rows {
-    /// The body of each row.
-    entity: Vec<Entity>,
-    mass: Vec<f64>,
-    start_position: Vec<Vec2>,
-    velocity: Vec<Vec2>,
-    angular_velocity: Vec<f64>,
-    force: Vec<Vec2>,
-    gravity_scale: Vec<f64>,
-    lifetime: Vec<Option<u32>>,
-    controller: Vec<Option<Controller>>,
-    inputs: Vec<Inputs>,
-    grounded: Vec<bool>,
-    on_static: Vec<bool>,
-    carrier: Vec<Option<Entity>>,
-    still: Vec<bool>,
-    split: Vec<Vec<Split>>,
-    frozen: Vec<bool>,
-    asleep: Vec<bool>,
-    rest_frames: Vec<u32>,
-    local_bounds: Vec<LocalBounds>,
-}
-
-/// The row columns every body reads (a copy), with what scenery reads: each gets a reader
-/// `name(i)` by dense index.
-macro_rules! row_readers {
-    ($($(#[$doc:meta])* $get:ident: $ty:ty = $scenery:expr;)*) => {
-        impl World {
-            $(
-                $(#[$doc])*
-                #[must_use]
-                #[inline]
-                pub fn $get(&self, i: usize) -> $ty {
-                    match self.row[i] {
-                        NO_ROW => $scenery,
-                        r => self.rows.$get[r as usize],
-                    }
-                }
-            )*
-        }
-    };
-}
-
-/// The row columns the stages write: each gets, inside the crate, a writer `name_mut(i)`
-/// by dense index (scenery written to, a script's force or input sent to a tile, gets a row
-/// first).
-macro_rules! row_writers {
-    ($($get:ident, $get_mut:ident: $ty:ty;)*) => {
-        impl World {
-            $(
-                #[doc = concat!("[`World::", stringify!($get), "`] of body `i`, to change.")]
-                #[inline]
-                pub(crate) fn $get_mut(&mut self, i: usize) -> &mut $ty {
-                    let r = self.row_of(i);
-                    &mut self.rows.$get[r]
-                }
-            )*
-        }
-    };
-}
-
-row_readers! {
-    /// Mass (dynamic bodies).
-    mass: f64 = 1.0;
-    /// Velocity.
-    velocity: Vec2 = Vec2::ZERO;
-    /// Angular velocity.
-    angular_velocity: f64 = 0.0;
-    /// Constant force.
-    force: Vec2 = Vec2::ZERO;
-    /// Gravity multiplier.
-    gravity_scale: f64 = 1.0;
-    /// Frames left to live.
-    lifetime: Option<u32> = None;
-    /// Current inputs.
-    inputs: Inputs = Inputs::default();
-    /// Standing on something: pushed up by a `separate` response this frame.
-    grounded: bool = false;
-    /// Standing on a static body: pushed up by one this frame (what sleeping needs).
-    on_static: bool = false;
-    /// What a box stands on and rides (`stages/carry.rs`): the kinematic or dynamic box that
-    /// last pushed it up in the last `resolve_y` (or that it still rests on, flush), `None`
-    /// on a static body or in the air. `move_x` and `move_y` move it by that carrier's
-    /// displacement before its own motion.
-    carrier: Option<Entity> = None;
-    /// Ended the last frame where it started it, with zero velocity (a box resting on a
-    /// sleeper does not wake it).
-    still: bool = false;
-    /// Frozen outside the active region: not moved, not tested, lifetime paused.
-    frozen: bool = false;
-    /// Asleep: at rest on static geometry, not integrated until something touches it.
-    asleep: bool = false;
-    /// Consecutive frames a dynamic body has ended exactly where it started, grounded.
-    rest_frames: u32 = 0;
-}
-
-row_writers! {
-    velocity, velocity_mut: Vec2;
-    angular_velocity, angular_velocity_mut: f64;
-    force, force_mut: Vec2;
-    inputs, inputs_mut: Inputs;
-    grounded, grounded_mut: bool;
-    on_static, on_static_mut: bool;
-    carrier, carrier_mut: Option<Entity>;
-    still, still_mut: bool;
-    frozen, frozen_mut: bool;
-    rest_frames, rest_frames_mut: u32;
-}
-
-/// A body's bounds relative to its position, kept from one frame to the next.
-#[derive(Clone, Copy, Debug)]
-struct LocalBounds {
-    /// The angle they were computed at.
-    angle: f64,
-    /// Good at every angle (a shape that turning does not change, or a body that has turned
-    /// and is bounded by the disc that holds it at every angle).
-    any_angle: bool,
-    bounds: Bounds,
-}
-
-impl LocalBounds {
-    /// The bounds of `shape` at `angle` and position `p`.
-    #[inline]
-    fn at(&mut self, shape: &Shape, angle: f64, p: Vec2) -> Bounds {
-        self.at_with(|| shape, angle, p)
-    }
-
-    /// [`LocalBounds::at`], looking the shape up only when the bounds must be recomputed
-    /// (once per body: a body that turned keeps its any-angle bounds).
-    #[inline]
-    fn at_with<'s>(&mut self, shape: impl FnOnce() -> &'s Shape, angle: f64, p: Vec2) -> Bounds {
-        if !self.any_angle && self.angle.to_bits() != angle.to_bits() {
-            // The farthest corner of the angle-0 box is as far as any point of the shape.
-            let b = shape().bounds(&Pose::default());
-            let r = b.min.abs().max(b.max.abs()).length();
-            // A rotated point may round one ulp past the exact radius.
-            let r = r + r * 1e-12;
-            self.bounds = Bounds {
-                min: Vec2::splat(-r),
-                max: Vec2::splat(r),
-            };
-            self.any_angle = true;
-        }
-        placed(self.bounds, p)
-    }
-
-    fn new(shape: &Shape, angle: f64) -> LocalBounds {
-        LocalBounds {
-            angle,
-            any_angle: turning_keeps_bounds(shape),
-            bounds: shape.bounds(&Pose::new(Vec2::ZERO, angle)),
-        }
-    }
-}
-
-/// Whether a shape's bounds are the same at every angle: circles and AABBs (which ignore
-/// rotation) centred on the body origin.
-fn turning_keeps_bounds(shape: &Shape) -> bool {
-    !shape.primitives().iter().any(|p| p.turns_with_body())
-}
-
-impl Rows {
-    /// Appends a row for `def`'s body `e`.
-    fn push(&mut self, e: Entity, def: &BodyDef) {
-        let moves = def.kind != BodyKind::Static;
-        self.entity.push(e);
-        self.mass.push(def.mass);
-        self.start_position.push(def.position);
-        self.velocity
-            .push(if moves { def.velocity } else { Vec2::ZERO });
-        self.angular_velocity
-            .push(if moves { def.angular_velocity } else { 0.0 });
-        self.force.push(def.force);
-        self.gravity_scale.push(def.gravity_scale);
-        self.lifetime.push(def.lifetime);
-        self.controller.push(def.controller.clone());
-        self.inputs.push(Inputs::default());
-        self.grounded.push(false);
-        self.on_static.push(false);
-        self.carrier.push(None);
-        self.still.push(false);
-        self.split.push(def.split.clone());
-        self.frozen.push(false);
-        self.asleep.push(false);
-        self.rest_frames.push(0);
-        self.local_bounds
-            .push(LocalBounds::new(&def.shape, def.angle));
-    }
-
-    /// Removes row `r`, moving the last row into its place.
-    fn swap_remove(&mut self, r: usize) {
-        self.entity.swap_remove(r);
-        self.mass.swap_remove(r);
-        self.start_position.swap_remove(r);
-        self.velocity.swap_remove(r);
-        self.angular_velocity.swap_remove(r);
-        self.force.swap_remove(r);
-        self.gravity_scale.swap_remove(r);
-        self.lifetime.swap_remove(r);
-        self.controller.swap_remove(r);
-        self.inputs.swap_remove(r);
-        self.grounded.swap_remove(r);
-        self.on_static.swap_remove(r);
-        self.carrier.swap_remove(r);
-        self.still.swap_remove(r);
-        self.split.swap_remove(r);
-        self.frozen.swap_remove(r);
-        self.asleep.swap_remove(r);
-        self.rest_frames.swap_remove(r);
-        self.local_bounds.swap_remove(r);
-    }
-
-    /// Heap bytes of the columns (capacities).
-    fn heap_bytes(&self) -> usize {
-        fn cap<T>(v: &Vec<T>) -> usize {
-            v.capacity() * size_of::<T>()
-        }
-        let children: usize = self.split.iter().map(cap).sum();
-        cap(&self.entity)
-            + cap(&self.mass)
-            + cap(&self.start_position)
-            + cap(&self.velocity)
-            + cap(&self.angular_velocity)
-            + cap(&self.force)
-            + cap(&self.gravity_scale)
-            + cap(&self.lifetime)
-            + cap(&self.controller)
-            + cap(&self.inputs)
-            + cap(&self.grounded)
-            + cap(&self.on_static)
-            + cap(&self.carrier)
-            + cap(&self.still)
-            + cap(&self.split)
-            + children
-            + cap(&self.frozen)
-            + cap(&self.asleep)
-            + cap(&self.rest_frames)
-            + cap(&self.local_bounds)
-    }
 }
 
 impl World {
@@ -763,85 +525,6 @@ impl World {
         self.with_lifetime > 0
     }
 
-    /// Bounds of body `i` for the broad phase: they hold the shape, and are exact for a body
-    /// that has not turned since it was created (or whose bounds turning does not change).
-    /// A body that has turned is bounded by the square around the disc that holds its shape
-    /// at every angle, so turning never costs a rotation here.
-    pub fn bounds(&mut self, i: usize) -> Bounds {
-        let p = self.position[i];
-        match self.row[i] {
-            NO_ROW => {
-                // Scenery never turns: its bounds at its angle, translated.
-                let (shape, zero) = self.shapes.get(self.shape_id[i]);
-                let angle = self.angle[i];
-                let local = if angle.to_bits() == 0 {
-                    *zero
-                } else {
-                    shape.bounds(&Pose::new(Vec2::ZERO, angle))
-                };
-                placed(local, p)
-            }
-            r => {
-                let shape = &self.shapes.get(self.shape_id[i]).0;
-                self.rows.local_bounds[r as usize].at(shape, self.angle[i], p)
-            }
-        }
-    }
-
-    /// Body `i`'s entity as one number, ordered as entities are: the broad phase's key.
-    pub(crate) fn key(&self, i: usize) -> u64 {
-        let e = self.entity[i];
-        (u64::from(e.index) << 32) | u64::from(e.generation)
-    }
-
-    /// The broad phase's view of every moving body, in [`World::movers`] order, into `out`:
-    /// [`World::bounds`], widened over the frame's motion for a body of a layer in
-    /// `sweeping` (a bullet that went right through something is still paired with it), or of
-    /// a layer in `separate_swept` that moved more than half its [`Shape::min_width`] (a
-    /// `separate` pair that time of impact may have to stop), and
-    /// a frozen body handed over as kinematic (it keeps its place in the dense order; the
-    /// caller drops its pairs). `visit` sees each entry's place in `out` and its bounds as
-    /// they are made (the wrap seam looks for bodies near an edge without another pass).
-    pub(crate) fn mover_entries(
-        &mut self,
-        sweeping: &[bool],
-        separate_swept: &[bool],
-        out: &mut Vec<BodyEntry>,
-        mut visit: impl FnMut(usize, &Bounds),
-    ) {
-        out.clear();
-        out.reserve(self.movers.len());
-        for &i in &self.movers {
-            let i = i as usize;
-            let r = self.row[i] as usize;
-            let p = self.position[i];
-            // The shape table is read only when needed (a scene's shapes may all differ).
-            let (shapes, id) = (&self.shapes, self.shape_id[i]);
-            let shape = || &shapes.get(id).0;
-            let mut bounds = self.rows.local_bounds[r].at_with(shape, self.angle[i], p);
-            let layer = self.layer[i];
-            let moved = self.rows.start_position[r] - p;
-            if moved != Vec2::ZERO
-                && (sweeping[usize::from(layer)]
-                    || (separate_swept[usize::from(layer)]
-                        && moved.length() > 0.5 * shape().min_width()))
-            {
-                bounds = bounds.union(bounds.translated(moved));
-            }
-            visit(out.len(), &bounds);
-            out.push(BodyEntry {
-                key: self.key(i),
-                bounds,
-                layer,
-                kind: if self.rows.frozen[r] {
-                    BodyKind::Kinematic
-                } else {
-                    self.kind[i]
-                },
-            });
-        }
-    }
-
     /// The pose of body `i`.
     #[must_use]
     pub fn pose(&self, i: usize) -> ricochet_geom::Pose {
@@ -929,17 +612,5 @@ impl World {
     /// How many ids the shape table has handed out (some may be free).
     fn shapes_len(&self) -> u32 {
         self.shapes.len()
-    }
-}
-
-/// Bounds `b`, relative to a body, placed at `p`.
-#[inline]
-fn placed(b: Bounds, p: Vec2) -> Bounds {
-    // Translating rounds differently from placing the shape at `p` (a rounding or two,
-    // each at most half an ulp of these magnitudes): pad by more than that.
-    let pad = (p.abs() + b.min.abs().max(b.max.abs())) * 1e-15;
-    Bounds {
-        min: b.min + p - pad,
-        max: b.max + p + pad,
     }
 }

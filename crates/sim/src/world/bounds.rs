@@ -1,0 +1,162 @@
+//! Each body's bounds for the broad phase: the bounds relative to the body kept from frame
+//! to frame ([`LocalBounds`]), placed at the body's position, and the moving bodies' entries.
+
+use ricochet_geom::{Bounds, Pose, Shape, Vec2};
+
+use super::{NO_ROW, World};
+use crate::broad_phase::BodyEntry;
+use crate::def::BodyKind;
+use crate::entity::Entity;
+
+/// A body's bounds relative to its position, kept from one frame to the next.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct LocalBounds {
+    /// The angle they were computed at.
+    angle: f64,
+    /// Good at every angle (a shape that turning does not change, or a body that has turned
+    /// and is bounded by the disc that holds it at every angle).
+    any_angle: bool,
+    bounds: Bounds,
+}
+
+impl LocalBounds {
+    /// The bounds of `shape` at `angle` and position `p`.
+    #[inline]
+    pub(super) fn at(&mut self, shape: &Shape, angle: f64, p: Vec2) -> Bounds {
+        self.at_with(|| shape, angle, p)
+    }
+
+    /// [`LocalBounds::at`], looking the shape up only when the bounds must be recomputed
+    /// (once per body: a body that turned keeps its any-angle bounds).
+    #[inline]
+    fn at_with<'s>(&mut self, shape: impl FnOnce() -> &'s Shape, angle: f64, p: Vec2) -> Bounds {
+        if !self.any_angle && self.angle.to_bits() != angle.to_bits() {
+            // The farthest corner of the angle-0 box is as far as any point of the shape.
+            let b = shape().bounds(&Pose::default());
+            let r = b.min.abs().max(b.max.abs()).length();
+            // A rotated point may round one ulp past the exact radius.
+            let r = r + r * 1e-12;
+            self.bounds = Bounds {
+                min: Vec2::splat(-r),
+                max: Vec2::splat(r),
+            };
+            self.any_angle = true;
+        }
+        placed(self.bounds, p)
+    }
+
+    pub(super) fn new(shape: &Shape, angle: f64) -> LocalBounds {
+        LocalBounds {
+            angle,
+            any_angle: turning_keeps_bounds(shape),
+            bounds: shape.bounds(&Pose::new(Vec2::ZERO, angle)),
+        }
+    }
+}
+
+/// Whether a shape's bounds are the same at every angle: circles and AABBs (which ignore
+/// rotation) centred on the body origin.
+fn turning_keeps_bounds(shape: &Shape) -> bool {
+    !shape.primitives().iter().any(|p| p.turns_with_body())
+}
+
+impl World {
+    /// Bounds of body `i` for the broad phase: they hold the shape, and are exact for a body
+    /// that has not turned since it was created (or whose bounds turning does not change).
+    /// A body that has turned is bounded by the square around the disc that holds its shape
+    /// at every angle, so turning never costs a rotation here.
+    pub fn bounds(&mut self, i: usize) -> Bounds {
+        let p = self.position[i];
+        match self.row[i] {
+            NO_ROW => {
+                // Scenery never turns: its bounds at its angle, translated.
+                let (shape, zero) = self.shapes.get(self.shape_id[i]);
+                let angle = self.angle[i];
+                let local = if angle.to_bits() == 0 {
+                    *zero
+                } else {
+                    shape.bounds(&Pose::new(Vec2::ZERO, angle))
+                };
+                placed(local, p)
+            }
+            r => {
+                let shape = &self.shapes.get(self.shape_id[i]).0;
+                self.rows.local_bounds[r as usize].at(shape, self.angle[i], p)
+            }
+        }
+    }
+
+    /// Body `i`'s entity as one number, ordered as entities are: the broad phase's key.
+    pub(crate) fn key(&self, i: usize) -> u64 {
+        let e = self.entity[i];
+        (u64::from(e.index) << 32) | u64::from(e.generation)
+    }
+
+    /// The dense index of the live body whose [`World::key`] is `key`.
+    pub(crate) fn index_of_key(&self, key: u64) -> Option<usize> {
+        self.index_of(Entity {
+            index: (key >> 32) as u32,
+            generation: key as u32,
+        })
+    }
+
+    /// The broad phase's view of every moving body, in [`World::movers`] order, into `out`:
+    /// [`World::bounds`], widened over the frame's motion for a body of a layer in
+    /// `sweeping` (a bullet that went right through something is still paired with it), or of
+    /// a layer in `separate_swept` that moved more than half its [`Shape::min_width`] (a
+    /// `separate` pair that time of impact may have to stop), and
+    /// a frozen body handed over as kinematic (it keeps its place in the dense order; the
+    /// caller drops its pairs). `visit` sees each entry's place in `out` and its bounds as
+    /// they are made (the wrap seam looks for bodies near an edge without another pass).
+    pub(crate) fn mover_entries(
+        &mut self,
+        sweeping: &[bool],
+        separate_swept: &[bool],
+        out: &mut Vec<BodyEntry>,
+        mut visit: impl FnMut(usize, &Bounds),
+    ) {
+        out.clear();
+        out.reserve(self.movers.len());
+        for &i in &self.movers {
+            let i = i as usize;
+            let r = self.row[i] as usize;
+            let p = self.position[i];
+            // The shape table is read only when needed (a scene's shapes may all differ).
+            let (shapes, id) = (&self.shapes, self.shape_id[i]);
+            let shape = || &shapes.get(id).0;
+            let mut bounds = self.rows.local_bounds[r].at_with(shape, self.angle[i], p);
+            let layer = self.layer[i];
+            let moved = self.rows.start_position[r] - p;
+            if moved != Vec2::ZERO
+                && (sweeping[usize::from(layer)]
+                    || (separate_swept[usize::from(layer)]
+                        && moved.length() > 0.5 * shape().min_width()))
+            {
+                bounds = bounds.union(bounds.translated(moved));
+            }
+            visit(out.len(), &bounds);
+            out.push(BodyEntry {
+                key: self.key(i),
+                bounds,
+                layer,
+                kind: if self.rows.frozen[r] {
+                    BodyKind::Kinematic
+                } else {
+                    self.kind[i]
+                },
+            });
+        }
+    }
+}
+
+/// Bounds `b`, relative to a body, placed at `p`.
+#[inline]
+fn placed(b: Bounds, p: Vec2) -> Bounds {
+    // Translating rounds differently from placing the shape at `p` (a rounding or two,
+    // each at most half an ulp of these magnitudes): pad by more than that.
+    let pad = (p.abs() + b.min.abs().max(b.max.abs())) * 1e-15;
+    Bounds {
+        min: b.min + p - pad,
+        max: b.max + p + pad,
+    }
+}
