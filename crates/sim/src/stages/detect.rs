@@ -87,7 +87,9 @@ pub(crate) struct DetectState {
     /// the poses the pass started from, and the bodies a response has moved since.
     plan: Vec<(usize, usize, Response)>,
     contacts: Vec<Contact>,
+    /// Per body, all false between passes (only the `moved` ones are set, then cleared).
     pushed: Vec<bool>,
+    moved: Vec<usize>,
 }
 
 impl DetectState {
@@ -113,6 +115,7 @@ impl DetectState {
             plan: Vec::new(),
             contacts: Vec::new(),
             pushed: Vec::new(),
+            moved: Vec::new(),
         }
     }
 }
@@ -305,9 +308,9 @@ pub(crate) fn run(
             &mut contacts,
         );
     }
-    // Bodies a response of this pass moved: their later pairs are tested again.
-    let pushed = &mut st.pushed;
-    pushed.clear();
+    // Bodies a response of this pass moved: their later pairs are tested again. Only those
+    // are set, and cleared after the pass, so a million tiles cost nothing here.
+    let (pushed, moved) = (&mut st.pushed, &mut st.moved);
     pushed.resize(ctx.world.len(), false);
     for (k, &(i, j, response)) in plan.iter().enumerate() {
         ctx.out.stats.narrow_tests += 1;
@@ -320,10 +323,13 @@ pub(crate) fn run(
         };
         let before = (w.position[i], w.position[j]);
         let mut note_pushes = |w: &World| {
-            pushed[i] |=
-                w.position[i].to_array().map(f64::to_bits) != before.0.to_array().map(f64::to_bits);
-            pushed[j] |=
-                w.position[j].to_array().map(f64::to_bits) != before.1.to_array().map(f64::to_bits);
+            for (k, was) in [(i, before.0), (j, before.1)] {
+                let bits = |p: Vec2| p.to_array().map(f64::to_bits);
+                if bits(w.position[k]) != bits(was) && !pushed[k] {
+                    pushed[k] = true;
+                    moved.push(k);
+                }
+            }
         };
         // A fast body against static or kinematic geometry: time of impact, then the push
         // (`sweep_normal.rs`; not through the wrap seam).
@@ -363,6 +369,9 @@ pub(crate) fn run(
             (pose_a, pose_b),
         );
         note_pushes(ctx.world);
+    }
+    for k in st.moved.drain(..) {
+        st.pushed[k] = false;
     }
     st.plan = plan;
     st.contacts = contacts;
