@@ -11,12 +11,19 @@
 //! frame boundary (the step that follows), inputs of one frame in the order they came. Every
 //! input is recorded on `/input` at the frame it applies to, refused ones too: a replay
 //! refuses them again, with the same `/events` line.
+//!
+//! Inputs are checked as strictly as a scenario file's values: every vector (a velocity, an
+//! impulse, a force, a spawn's position and velocity) finite and within ±1e15
+//! (`ricochet_geom::MAX_COORDINATE`), and an impulse or a force refused when the velocity it
+//! makes (in one frame, for a force) would be beyond that. What still overflows (gravity of
+//! 1e308, say) stops the session at its last good frame: the frame that overflowed, and its
+//! inputs, are never written, so the log holds frames 0 to N, complete, as `run` leaves it.
 
 use ricochet_geom::Vec2;
 use ricochet_log::messages::ricochet::Input;
 use ricochet_log::messages::{Schema, fox::Log, fox::log::Level, timestamp};
 use ricochet_log::{ChannelId, LogError, MessageSink};
-use ricochet_sim::{ActionFile, BodyKind, FrameOutput, Scenario, Simulation};
+use ricochet_sim::{Action, ActionFile, BodyKind, FrameOutput, Scenario, Simulation};
 
 use crate::channels::Channels;
 use crate::record::Recorder;
@@ -27,6 +34,51 @@ pub const MAX_INPUT: usize = 4096;
 /// The name of the attachment that holds a session's scenario.
 pub const SCENARIO_ATTACHMENT: &str = "scenario.toml";
 
+/// The largest velocity an input may set or make, units/s, and the largest vector it may
+/// carry: the coordinates Ricochet accepts (a scenario file's ±1e15).
+pub const MAX_INPUT_VALUE: f64 = ricochet_geom::MAX_COORDINATE;
+
+/// Why a step was not recorded.
+#[derive(Debug)]
+pub enum StepError {
+    /// Writing the frame failed.
+    Log(LogError),
+    /// The step made a value non-finite: neither it nor its inputs were written, and the
+    /// session steps no more (its simulation can't be trusted).
+    Overflow {
+        /// The frame that overflowed (the log holds the frames before it).
+        frame: u64,
+        /// Which body and value.
+        what: String,
+    },
+}
+
+impl std::fmt::Display for StepError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            StepError::Log(e) => e.fmt(f),
+            StepError::Overflow { frame, what } => {
+                write!(f, "frame {frame}: {what}; the simulation overflowed")
+            }
+        }
+    }
+}
+
+impl std::error::Error for StepError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            StepError::Log(e) => Some(e),
+            StepError::Overflow { .. } => None,
+        }
+    }
+}
+
+impl From<LogError> for StepError {
+    fn from(e: LogError) -> StepError {
+        StepError::Log(e)
+    }
+}
+
 /// A scenario being stepped, its frames written to `S` with every input.
 pub struct Session<S: MessageSink> {
     sim: Simulation,
@@ -35,6 +87,11 @@ pub struct Session<S: MessageSink> {
     events: Option<ChannelId>,
     /// The frame the next step makes.
     next: u64,
+    /// The next frame's inputs, each with its refusal's `/events` line: written just before
+    /// the frame (the order they always had), so a frame that overflows leaves no trace.
+    unwritten: Vec<(Input, Option<Log>)>,
+    /// The step that overflowed, if one did (then nothing more is stepped).
+    overflowed: Option<(u64, String)>,
 }
 
 impl<S: MessageSink> Session<S> {
@@ -51,6 +108,8 @@ impl<S: MessageSink> Session<S> {
             input,
             events,
             next: 0,
+            unwritten: Vec::new(),
+            overflowed: None,
         })
     }
 
@@ -69,30 +128,32 @@ impl<S: MessageSink> Session<S> {
             input,
             events,
             next,
+            unwritten: Vec::new(),
+            overflowed: None,
         })
     }
 
-    /// Takes an input for the next step, recording it; why it was refused, if it was (also
-    /// written to `/events`).
+    /// Takes an input for the next step, recorded with it; why it was refused, if it was
+    /// (also written to `/events`).
     pub fn input(&mut self, text: &str) -> Result<Result<(), String>, LogError> {
-        let t = self.next * self.recorder.dt_ns();
+        let t = self.next.saturating_mul(self.recorder.dt_ns());
         let message = Input {
             frame: self.next,
             text: text.to_owned(),
         };
-        self.recorder.sink_mut().write(self.input, t, message)?;
         let verdict = self.apply(text);
-        if let (Err(why), Some(ch)) = (&verdict, self.events) {
-            let line = Log {
+        let line = match (&verdict, self.events) {
+            (Err(why), Some(_)) => Some(Log {
                 timestamp: Some(timestamp(t)),
                 level: Level::Warning as i32,
                 message: format!("input refused: {why}"),
                 name: "input".to_owned(),
                 file: String::new(),
                 line: 0,
-            };
-            self.recorder.sink_mut().write(ch, t, line)?;
-        }
+            }),
+            _ => None,
+        };
+        self.unwritten.push((message, line));
         Ok(verdict)
     }
 
@@ -118,11 +179,53 @@ impl<S: MessageSink> Session<S> {
         if let Some(field) = action.out_of_range() {
             return Err(format!("{}: {field} out of range", action.name()));
         }
+        if let Action::SetVelocity(v) | Action::ApplyImpulse(v) | Action::SetForce(v) = action
+            && !within(v)
+        {
+            return Err(format!(
+                "{}: {} beyond ±{MAX_INPUT_VALUE:e}",
+                action.name(),
+                vector(v)
+            ));
+        }
+        if self.overflowed.is_some() {
+            return Err("the session overflowed: it steps no more".to_owned());
+        }
         let e = self
             .sim
             .entity_named(body)
             .ok_or_else(|| format!("no body named {body:?}"))?;
+        self.check_velocity(e, &action)?;
         self.sim.apply(e, action).map_err(|e| e.to_string())
+    }
+
+    /// Refuses an impulse, or a force, that would make a dynamic body's velocity (after one
+    /// frame, for a force) non-finite or beyond ±[`MAX_INPUT_VALUE`]: a tiny mass turns a
+    /// bounded impulse into any speed.
+    fn check_velocity(&self, e: ricochet_sim::Entity, action: &Action) -> Result<(), String> {
+        let w = self.sim.world();
+        let Some(i) = w.index_of(e) else {
+            return Ok(());
+        };
+        if w.kind[i] != BodyKind::Dynamic {
+            return Ok(());
+        }
+        let v = w.velocity(i);
+        let made = match action {
+            Action::ApplyImpulse(j) => v + *j / w.mass(i),
+            Action::SetForce(f) => v + *f / w.mass(i) * self.sim.dt(),
+            _ => return Ok(()),
+        };
+        if within(made) {
+            Ok(())
+        } else {
+            Err(format!(
+                "{}: it would make {:?}'s velocity {}, beyond ±{MAX_INPUT_VALUE:e}",
+                action.name(),
+                w.name(i),
+                vector(made)
+            ))
+        }
     }
 
     /// A body from the scenario's template `template`, as the script's `spawn` makes one; it
@@ -145,9 +248,15 @@ impl<S: MessageSink> Session<S> {
         if let Some(n) = name {
             def.name = n.to_owned();
         }
-        let finite = |v: [f64; 2]| v[0].is_finite() && v[1].is_finite();
-        if !finite(position) || !velocity.is_none_or(finite) || !angle.is_none_or(f64::is_finite) {
-            return Err("spawn: position, velocity and angle must be finite".to_owned());
+        let ok = |v: [f64; 2]| within(Vec2::new(v[0], v[1]));
+        if !ok(position) || !velocity.is_none_or(ok) || !angle.is_none_or(f64::is_finite) {
+            return Err(format!(
+                "spawn: position and velocity must be finite and within ±{MAX_INPUT_VALUE:e}, \
+                 the angle finite"
+            ));
+        }
+        if self.overflowed.is_some() {
+            return Err("the session overflowed: it steps no more".to_owned());
         }
         def.position = Vec2::new(position[0], position[1]);
         if let Some(v) = velocity {
@@ -165,12 +274,41 @@ impl<S: MessageSink> Session<S> {
         Ok(())
     }
 
-    /// Steps one frame and records it.
-    pub fn step(&mut self) -> Result<FrameOutput, LogError> {
+    /// Steps one frame and records it with its inputs. A step that overflows is not
+    /// recorded, nor are its inputs, and every later call fails the same way: the log ends
+    /// with the last good frame.
+    pub fn step(&mut self) -> Result<FrameOutput, StepError> {
+        if let Some((frame, what)) = &self.overflowed {
+            return Err(StepError::Overflow {
+                frame: *frame,
+                what: what.clone(),
+            });
+        }
         let out = self.sim.step();
+        if let Some(bad) = self.sim.first_non_finite() {
+            let what = crate::validate::describe(&self.sim, &bad);
+            self.unwritten.clear();
+            self.overflowed = Some((out.frame, what.clone()));
+            return Err(StepError::Overflow {
+                frame: out.frame,
+                what,
+            });
+        }
+        let t = out.frame.saturating_mul(self.recorder.dt_ns());
+        for (message, line) in std::mem::take(&mut self.unwritten) {
+            self.recorder.sink_mut().write(self.input, t, message)?;
+            if let (Some(line), Some(ch)) = (line, self.events) {
+                self.recorder.sink_mut().write(ch, t, line)?;
+            }
+        }
         self.recorder.record(&self.sim, &out)?;
         self.next = out.frame + 1;
         Ok(out)
+    }
+
+    /// The frame that overflowed and what did, if one did.
+    pub fn overflowed(&self) -> Option<(u64, &str)> {
+        self.overflowed.as_ref().map(|(f, w)| (*f, w.as_str()))
     }
 
     /// Sends live viewers the whole current state: both scenes and every body's frame (after
@@ -190,6 +328,11 @@ impl<S: MessageSink> Session<S> {
         &mut self.recorder
     }
 
+    /// A frame's length, ns (the log's clock).
+    pub fn dt_ns(&self) -> u64 {
+        self.recorder.dt_ns()
+    }
+
     /// The frame the next step makes.
     pub fn next_frame(&self) -> u64 {
         self.next
@@ -199,4 +342,21 @@ impl<S: MessageSink> Session<S> {
     pub fn into_sink(self) -> S {
         self.recorder.into_sink()
     }
+}
+
+/// Whether `v` is finite and within ±[`MAX_INPUT_VALUE`] on both axes.
+fn within(v: Vec2) -> bool {
+    v.is_finite() && v.abs().max_element() <= MAX_INPUT_VALUE
+}
+
+/// `[x, y]` in a short form that reads back the same (`1.7e308`, not 309 digits).
+fn vector(v: Vec2) -> String {
+    let number = |x: f64| {
+        if x != 0.0 && x.is_finite() && !(1e-4..1e6).contains(&x.abs()) {
+            format!("{x:e}")
+        } else {
+            format!("{x:?}")
+        }
+    };
+    format!("[{}, {}]", number(v.x), number(v.y))
 }

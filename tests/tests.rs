@@ -14,6 +14,7 @@ mod hostile;
 mod large_scenario;
 mod run_cli;
 mod seek;
+mod serve_bounds;
 mod serve_client;
 mod serve_session;
 mod serve_ws;

@@ -12,6 +12,7 @@ mod hub;
 mod protocol;
 mod server;
 mod services;
+mod serving;
 
 use std::net::SocketAddr;
 use std::path::{Path, PathBuf};
@@ -22,11 +23,11 @@ use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use ricochet_log::{ChannelId, LogError, LogWriter, MessageSink, Schema};
-use tokio_tungstenite::tungstenite::Message;
 
 use crate::out;
 use crate::session::{SCENARIO_ATTACHMENT, Session};
 use hub::{Hub, LiveSink};
+use serving::{Asker, Serving};
 
 /// Where `serve` listens unless told: what Foxglove's "Open connection" suggests.
 pub const DEFAULT_BIND: &str = "127.0.0.1:8765";
@@ -158,6 +159,12 @@ pub fn run(o: &Options) -> anyhow::Result<ExitCode> {
         Ok(s) => s,
         Err(code) => return Ok(code),
     };
+    // Every frame's log time must be a whole number of nanoseconds that fits in a u64.
+    let last = o.frames.unwrap_or(ricochet_sim::MAX_FRAMES);
+    if let Err(e) = scenario.world.last_time_ns(last) {
+        out::error(&format!("error: --frames {last}: {e}"));
+        return Ok(ExitCode::from(2));
+    }
     let addr: SocketAddr = match o.bind.parse() {
         Ok(a) => a,
         Err(e) => {
@@ -206,259 +213,98 @@ pub fn run(o: &Options) -> anyhow::Result<ExitCode> {
         "serving {} on ws://{local} (Foxglove: Open connection; layout foxglove/ricochet-layout.json); Ctrl-C stops",
         scenario.name
     ))?;
-    let mut serving = Serving {
-        session,
-        scenario,
-        text,
-        segment: 0,
-        inputs: Vec::new(),
-        speed: o.speed,
-        snapshots: Vec::new(),
-        recording: o.record.is_some(),
-    };
-    let frames = run_loop(&mut serving, &hub, o, &interrupted)?;
+    let mut serving = Serving::new(session, scenario, text, o);
+    let frames = run_loop(&mut serving, &hub, &interrupted)?;
+    let next = serving.session.next_frame();
+    let stepped = serving.stepped;
     finish(serving.session)?;
     let dropped = hub.lock().dropped;
+    let session = match next.checked_sub(1) {
+        Some(last) => format!("frames 0 to {last}"),
+        None => "no frame".to_owned(),
+    };
     out::note(&format!(
-        "served {frames} frames; {dropped} messages dropped for slow clients; {} s of CPU",
+        "served {session} ({stepped} steps in all, {frames} in real time, the rest by /step \
+         and seeks); {dropped} messages dropped for slow clients; {} s of CPU",
         cpu_seconds().map_or("?".to_owned(), |s| format!("{s:.2}"))
     ))?;
     Ok(ExitCode::SUCCESS)
 }
 
-/// What is being served: the session, its scenario (and the file's text), and which
-/// recording segment it writes.
-struct Serving {
-    session: Session<ServeSink>,
-    scenario: ricochet_sim::Scenario,
-    text: String,
-    segment: u32,
-    /// This session's inputs with their frames, for a seek back.
-    inputs: Vec<(u64, String)>,
-    /// Simulation seconds per wall second (`/speed`).
-    speed: f64,
-    /// Snapshots to seek back from, when not recording: every [`SNAPSHOT_EVERY`] frames, at
-    /// most [`MAX_SNAPSHOTS`] (then every other one is dropped, and they thin out).
-    snapshots: Vec<(u64, ricochet_sim::Simulation)>,
-    /// Whether the session is recorded (then seeks back start from frame 0).
-    recording: bool,
-}
-
-/// Frames between two snapshots of a session that is not recorded.
-pub const SNAPSHOT_EVERY: u64 = 600;
-/// Snapshots kept at most: their memory is bounded whatever the session's length.
-pub const MAX_SNAPSHOTS: usize = 16;
-
-impl Serving {
-    /// Carries out a service call; the JSON response, or why it failed.
-    fn command(
-        &mut self,
-        command: services::Command,
-        hub: &Hub,
-        o: &Options,
-        paused: &mut bool,
-    ) -> anyhow::Result<Result<String, String>> {
-        let mut recording = None;
-        match command {
-            services::Command::Pause => *paused = true,
-            services::Command::Play => *paused = false,
-            services::Command::Step(n) => {
-                *paused = true;
-                for _ in 0..n {
-                    self.frame(hub)?;
-                }
-            }
-            services::Command::Reset | services::Command::Load(_) => {
-                if let services::Command::Load(path) = command {
-                    match crate::load::load_text(Some(Path::new(&path))) {
-                        Ok((scenario, text)) => (self.scenario, self.text) = (scenario, text),
-                        Err(_) => {
-                            return Ok(Err(format!(
-                                "{path}: not a scenario that loads (see the server's log)"
-                            )));
-                        }
-                    }
-                }
-                recording = self.restart(hub, o)?;
-                self.inputs.clear();
-                self.snapshots.clear();
-                self.refresh()?;
-            }
-            services::Command::Speed(x) => self.speed = x,
-            services::Command::Seek(target) => {
-                let next = self.session.next_frame();
-                if target < next {
-                    self.inputs.retain(|(f, _)| *f < target);
-                    self.snapshots.retain(|(f, _)| *f <= target);
-                    match self.snapshots.last() {
-                        // Not recording: from the latest snapshot at or before `target`.
-                        Some((_, snapshot)) if o.record.is_none() => {
-                            let sink = ServeSink {
-                                live: LiveSink::new(hub.clone()),
-                                file: None,
-                                muted: false,
-                            };
-                            self.session = Session::resume(snapshot.clone(), sink, true)?;
-                        }
-                        // Recording (the new file must hold the session from frame 0, to
-                        // replay on its own), or no snapshot: from frame 0.
-                        _ => recording = self.restart(hub, o)?,
-                    }
-                }
-                self.session.recorder().sink_mut().muted = true;
-                let inputs = std::mem::take(&mut self.inputs);
-                let from = self.session.next_frame();
-                let mut pending = inputs.iter().filter(|(f, _)| *f >= from).peekable();
-                while self.session.next_frame() < target {
-                    let at = self.session.next_frame();
-                    while let Some((_, text)) = pending.next_if(|(f, _)| *f == at) {
-                        let _ = self.session.input(text)?;
-                    }
-                    self.step()?;
-                }
-                self.inputs = inputs;
-                self.session.recorder().sink_mut().muted = false;
-                self.refresh()?;
-            }
-        }
-        let mut response = serde_json::json!({
-            "frame": self.session.next_frame(),
-            "paused": *paused,
-        });
-        if let Some(file) = recording {
-            response["recording"] = serde_json::Value::String(file);
-        }
-        Ok(Ok(response.to_string()))
-    }
-
-    /// A new session of the current scenario from frame 0 (a new recording segment);
-    /// returns the new recording's file.
-    fn restart(&mut self, hub: &Hub, o: &Options) -> anyhow::Result<Option<String>> {
-        self.segment += u32::from(o.record.is_some());
-        let next = start(&self.scenario, &self.text, hub, o.record, self.segment)?;
-        finish(std::mem::replace(&mut self.session, next))?;
-        Ok(o.record
-            .map(|p| segment(p, self.segment).display().to_string()))
-    }
-
-    /// The clients are sent the whole current state (after a reset, load or seek).
-    fn refresh(&mut self) -> anyhow::Result<()> {
-        self.session.refresh_live()?;
-        Ok(())
-    }
-
-    /// One frame: the clients' inputs, then the step.
-    fn frame(&mut self, hub: &Hub) -> anyhow::Result<()> {
-        let dt_ns = self.session.recorder().dt_ns();
-        let (inputs, resend) = {
-            let mut s = hub.lock();
-            (
-                std::mem::take(&mut s.inputs),
-                std::mem::take(&mut s.transforms_wanted),
-            )
-        };
-        for (client, text) in inputs {
-            self.inputs.push((self.session.next_frame(), text.clone()));
-            if let Err(why) = self.session.input(&text)? {
-                hub.lock().tell(client, 2, &format!("input refused: {why}"));
-            }
-        }
-        if resend {
-            self.session.recorder().resend_transforms();
-        }
-        let t = self.session.next_frame().saturating_mul(dt_ns);
-        hub.lock().broadcast(&Message::binary(protocol::time(t)));
-        self.step()
-    }
-
-    /// Steps the session, keeping a snapshot every [`SNAPSHOT_EVERY`] frames.
-    fn step(&mut self) -> anyhow::Result<()> {
-        let out = self.session.step()?;
-        if self.session.sim().first_non_finite().is_some() {
-            anyhow::bail!("frame {}: a value overflowed; stopping", out.frame);
-        }
-        let next = self.session.next_frame();
-        if !self.recording && next.is_multiple_of(SNAPSHOT_EVERY) {
-            self.snapshots.push((next, self.session.sim().clone()));
-            if self.snapshots.len() > MAX_SNAPSHOTS {
-                let mut k = 0;
-                self.snapshots.retain(|_| {
-                    k += 1;
-                    k % 2 == 0
-                });
-            }
-        }
-        Ok(())
-    }
-}
-
 /// Steps on the real-time schedule until stopped, taking the clients' inputs at each frame
-/// boundary and their service calls between frames; returns the frames stepped.
-fn run_loop(
-    serving: &mut Serving,
-    hub: &Hub,
-    o: &Options,
-    interrupted: &AtomicBool,
-) -> anyhow::Result<u64> {
+/// boundary and their service calls between frames, running a seek or a step in slices;
+/// returns the real-time frames stepped.
+fn run_loop(serving: &mut Serving, hub: &Hub, interrupted: &AtomicBool) -> anyhow::Result<u64> {
     // The schedule: frame `anchor.1 + n` starts at `anchor.0 + n * step`; moved when stepping
     // pauses, resumes, or starts over.
     let mut anchor = (Instant::now(), 0u64);
     let mut frames = 0u64;
-    let mut paused = o.paused;
     let mut lateness = Lateness::default();
-    if paused {
+    if serving.paused {
         // Frame 0 for the clients to see while paused.
         serving.frame(hub)?;
         frames += 1;
     }
-    while !interrupted.load(Ordering::SeqCst) && o.frames.is_none_or(|n| frames <= n) {
+    while !interrupted.load(Ordering::SeqCst) && serving.session.next_frame() <= serving.last {
         let calls = std::mem::take(&mut hub.lock().calls);
         for (client, call) in calls {
-            let result = match services::parse(call.service, &call.payload) {
-                Ok(command) => serving.command(command, hub, o, &mut paused)?,
-                Err(why) => Err(why),
+            let result = match (serving.busy(), services::parse(call.service, &call.payload)) {
+                (Some(busy), _) => Some(Err(busy)),
+                (None, Ok(command)) => {
+                    let asker = Asker::Call {
+                        client,
+                        service: call.service,
+                        call: call.call,
+                    };
+                    serving.command(command, hub, asker)?
+                }
+                (None, Err(why)) => Some(Err(why)),
             };
-            hub.lock().answer(client, call.service, call.call, result);
+            if let Some(result) = result {
+                hub.lock().answer(client, call.service, call.call, result);
+            }
             anchor = (Instant::now(), frames);
         }
         let requests = std::mem::take(&mut hub.lock().playback);
         for (client, request) in requests {
-            // Foxglove's timeline: seek (to the frame at or before the time), speed, play or
-            // pause; every client is told the state that results.
-            let mut sought = false;
-            if let Some(ns) = request.seek {
-                let dt_ns = serving.session.recorder().dt_ns().max(1);
-                // Shown: the frame at or before the time (so the next one is after it).
-                let command = services::Command::Seek(ns / dt_ns + 1);
-                if let Err(why) = serving.command(command, hub, o, &mut paused)? {
-                    hub.lock().tell(client, 2, &why);
-                }
-                sought = true;
+            if let Some(busy) = serving.busy() {
+                hub.lock().tell(client, 1, &busy);
+                continue;
             }
+            // Foxglove's timeline: speed, seek (to the frame at or before the time), play or
+            // pause; every client is told the state that results.
             let speed = f64::from(request.speed);
             if speed.is_finite() && (0.01..=100.0).contains(&speed) {
                 serving.speed = speed;
             }
-            paused = !request.play;
             anchor = (Instant::now(), frames);
-            let t = serving
-                .session
-                .next_frame()
-                .saturating_sub(1)
-                .saturating_mul(serving.session.recorder().dt_ns());
-            let state = protocol::playback_state(
-                request.play,
-                t,
-                serving.speed as f32,
-                sought,
-                &request.request_id,
-            );
-            hub.lock().playback_state(state);
+            if let Some(ns) = request.seek {
+                let dt_ns = serving.session.dt_ns().max(1);
+                // Shown: the frame at or before the time (so the next one is after it).
+                let target = (ns / dt_ns).saturating_add(1);
+                let asker = Asker::Playback {
+                    play: request.play,
+                    request_id: request.request_id.clone(),
+                };
+                match serving.seek(target, hub, asker)? {
+                    Ok(()) => continue,
+                    Err(why) => hub.lock().tell(client, 2, &why),
+                }
+            }
+            if !request.play || serving.session.overflowed().is_none() {
+                serving.paused = !request.play;
+            }
+            serving.playback_state(hub, request.seek.is_some(), &request.request_id);
         }
-        if paused {
+        if serving.running.is_some() {
+            serving.slice(hub)?;
+            anchor = (Instant::now(), frames);
+            continue;
+        }
+        if serving.paused {
             // A viewer that subscribes to /tf while nothing steps gets the state at once.
             if std::mem::take(&mut hub.lock().transforms_wanted) {
-                serving.refresh()?;
+                serving.session.refresh_live()?;
             }
             std::thread::sleep(Duration::from_millis(5));
             anchor = (Instant::now(), frames);

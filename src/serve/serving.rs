@@ -1,0 +1,503 @@
+//! What `ricochet serve` serves: the session, the inputs kept for a seek back, the
+//! snapshots, and the seek or `/step` under way, which runs in slices between which the loop
+//! answers its clients, reports progress and notices SIGTERM.
+//!
+//! Bounds, whatever the clients do:
+//! - no frame past the session's last (`--frames`, else [`ricochet_sim::MAX_FRAMES`]) is
+//!   stepped, by real time, `/step`, `/seek` or the timeline alike;
+//! - the inputs kept for seeks back are the accepted ones, at most
+//!   [`MAX_KEPT_INPUT_BYTES`]; a refused input changes nothing, so a seek back that steps
+//!   the session again refuses nothing and needs none of them (the new recording doesn't
+//!   hold them, and so replays on its own);
+//! - a seek back while recording writes the segment's file again from frame 0 (the branch
+//!   left is dropped, as its inputs are): a seek never adds a file, and at most
+//!   [`MAX_SEGMENTS`] files are written (`/reset` and `/load` start one each).
+
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+use ricochet_sim::{Scenario, Simulation};
+use tokio_tungstenite::tungstenite::Message;
+
+use super::hub::{Hub, LiveSink};
+use super::{ServeSink, finish, protocol, segment, services, start};
+use crate::session::Session;
+
+/// Frames between two snapshots of a session that is not recorded.
+pub const SNAPSHOT_EVERY: u64 = 600;
+/// Snapshots kept at most: their memory is bounded whatever the session's length.
+pub const MAX_SNAPSHOTS: usize = 16;
+/// The inputs kept for seeks back, at most, bytes (each input's text and 32 bytes): past
+/// it, inputs are no longer kept, and a seek back can reach only the frame of the first one
+/// that was not.
+pub const MAX_KEPT_INPUT_BYTES: usize = 64 << 20;
+/// Recording files a server writes at most (`/reset` and `/load` each start one).
+pub const MAX_SEGMENTS: u32 = 1000;
+/// A seek or a `/step` runs at most this long before the loop looks at its clients again.
+const SLICE: Duration = Duration::from_millis(50);
+/// How often a long seek or step tells the clients how far it got.
+const PROGRESS_EVERY: Duration = Duration::from_millis(500);
+
+/// The inputs of a session that were accepted, with their frames, in order: what a seek
+/// back steps again.
+#[derive(Default)]
+struct KeptInputs {
+    list: Vec<(u64, String)>,
+    bytes: usize,
+    /// The frame of the first accepted input that was not kept (the budget was spent).
+    unkept_from: Option<u64>,
+}
+
+impl KeptInputs {
+    fn keep(&mut self, frame: u64, text: String) {
+        let cost = text.len() + 32;
+        if self.unkept_from.is_some() || self.bytes + cost > MAX_KEPT_INPUT_BYTES {
+            self.unkept_from.get_or_insert(frame);
+            return;
+        }
+        self.bytes += cost;
+        self.list.push((frame, text));
+    }
+
+    /// Forgets the inputs of frame `frame` and after.
+    fn truncate(&mut self, frame: u64) {
+        self.list.retain(|(f, _)| *f < frame);
+        self.bytes = self.list.iter().map(|(_, t)| t.len() + 32).sum();
+        if self.unkept_from.is_some_and(|u| u >= frame) {
+            self.unkept_from = None;
+        }
+    }
+}
+
+/// Who asked for a seek or step, to be answered when it is done.
+pub enum Asker {
+    /// A service call.
+    Call {
+        /// The client.
+        client: u64,
+        /// The service.
+        service: u32,
+        /// The call's id.
+        call: u32,
+    },
+    /// Foxglove's timeline (`playbackControl`): every client gets the playback state.
+    Playback {
+        /// Play after the seek (else pause).
+        play: bool,
+        /// The request's id.
+        request_id: String,
+    },
+}
+
+/// A seek or `/step` under way.
+pub struct Running {
+    /// The next frame when it is done.
+    target: u64,
+    /// A `/step`: each frame takes the clients' inputs and is sent live. A seek: the kept
+    /// inputs, muted.
+    live: bool,
+    /// The next kept input to apply (a seek).
+    cursor: usize,
+    asker: Asker,
+    /// The recording file a seek back writes again, for the answer.
+    recording: Option<String>,
+    progress_at: Instant,
+}
+
+/// What is being served.
+pub struct Serving {
+    pub session: Session<ServeSink>,
+    pub scenario: Scenario,
+    pub text: String,
+    segment: u32,
+    kept: KeptInputs,
+    /// Simulation seconds per wall second (`/speed`).
+    pub speed: f64,
+    /// Snapshots to seek back from, when not recording: every [`SNAPSHOT_EVERY`] frames, at
+    /// most [`MAX_SNAPSHOTS`] (then every other one is dropped, and they thin out).
+    snapshots: Vec<(u64, Simulation)>,
+    pub paused: bool,
+    /// The last frame the session may step.
+    pub last: u64,
+    /// What sets [`Serving::last`], for messages.
+    last_why: &'static str,
+    record: Option<PathBuf>,
+    /// The seek or step under way.
+    pub running: Option<Running>,
+    /// Frames stepped in all (seeks' and steps' included).
+    pub stepped: u64,
+}
+
+impl Serving {
+    /// Serves `session` of `scenario` (the file's `text`), stepping at most to frame
+    /// `frames` (`None`: [`ricochet_sim::MAX_FRAMES`]).
+    pub fn new(
+        session: Session<ServeSink>,
+        scenario: Scenario,
+        text: String,
+        o: &super::Options,
+    ) -> Serving {
+        Serving {
+            session,
+            scenario,
+            text,
+            segment: 0,
+            kept: KeptInputs::default(),
+            speed: o.speed,
+            snapshots: Vec::new(),
+            paused: o.paused,
+            last: o.frames.unwrap_or(ricochet_sim::MAX_FRAMES),
+            last_why: if o.frames.is_some() {
+                "--frames"
+            } else {
+                "the most a log holds"
+            },
+            record: o.record.map(std::path::Path::to_path_buf),
+            running: None,
+            stepped: 0,
+        }
+    }
+
+    /// Why the session can't step (it overflowed), for a client.
+    fn halted(&self) -> Option<String> {
+        self.session.overflowed().map(|(frame, what)| {
+            let good = match frame.checked_sub(1) {
+                Some(f) => format!("frame {f}"),
+                None => "no frame".to_owned(),
+            };
+            let kept = if self.record.is_some() {
+                format!(" (the recording holds {good} and those before)")
+            } else {
+                String::new()
+            };
+            format!(
+                "frame {frame}: {what}; the simulation overflowed. The session is paused at \
+                 {good}{kept}: /seek back, /reset or /load go on"
+            )
+        })
+    }
+
+    /// Carries out a service call (from `asker`); the JSON response, or why it failed, or
+    /// `None` when the answer comes when a seek or step is done.
+    pub fn command(
+        &mut self,
+        command: services::Command,
+        hub: &Hub,
+        asker: Asker,
+    ) -> anyhow::Result<Option<Result<String, String>>> {
+        let mut recording = None;
+        match command {
+            services::Command::Pause => self.paused = true,
+            services::Command::Play => {
+                if let Some(why) = self.halted() {
+                    return Ok(Some(Err(why)));
+                }
+                self.paused = false;
+            }
+            services::Command::Step(n) => {
+                if let Some(why) = self.halted() {
+                    return Ok(Some(Err(why)));
+                }
+                let next = self.session.next_frame();
+                let end = next.saturating_add(n);
+                if end > self.last.saturating_add(1) {
+                    return Ok(Some(Err(format!(
+                        "frames: the session ends at frame {} ({}); at most {} more",
+                        self.last,
+                        self.last_why,
+                        (self.last + 1).saturating_sub(next)
+                    ))));
+                }
+                self.paused = true;
+                self.begin(end, true, asker, None);
+                return Ok(None);
+            }
+            services::Command::Reset | services::Command::Load(_) => {
+                if self.record.is_some() && self.segment + 1 >= MAX_SEGMENTS {
+                    return Ok(Some(Err(format!(
+                        "the recording has {MAX_SEGMENTS} files, the most a server writes: \
+                         restart the server to record more"
+                    ))));
+                }
+                if let services::Command::Load(path) = command {
+                    match crate::load::load_text(Some(std::path::Path::new(&path))) {
+                        Ok((scenario, text)) => (self.scenario, self.text) = (scenario, text),
+                        Err(_) => {
+                            return Ok(Some(Err(format!(
+                                "{path}: not a scenario that loads (see the server's log)"
+                            ))));
+                        }
+                    }
+                }
+                recording = self.restart(hub, true)?;
+                self.kept = KeptInputs::default();
+                self.snapshots.clear();
+                self.session.refresh_live()?;
+            }
+            services::Command::Speed(x) => self.speed = x,
+            services::Command::Seek(target) => {
+                return match self.seek(target, hub, asker)? {
+                    Ok(()) => Ok(None),
+                    Err(why) => Ok(Some(Err(why))),
+                };
+            }
+        }
+        Ok(Some(Ok(self.response(recording))))
+    }
+
+    /// `{"frame": F, "paused": P}`, with `"recording"` if a file was (re)started.
+    fn response(&self, recording: Option<String>) -> String {
+        let mut response = serde_json::json!({
+            "frame": self.session.next_frame(),
+            "paused": self.paused,
+        });
+        if let Some(file) = recording {
+            response["recording"] = serde_json::Value::String(file);
+        }
+        response.to_string()
+    }
+
+    /// Starts a seek to `target` (the next frame once there), or says why it can't be:
+    /// every seek, a service's or the timeline's, is checked here.
+    pub fn seek(&mut self, target: u64, hub: &Hub, asker: Asker) -> anyhow::Result<Result<(), String>> {
+        if target > self.last {
+            return Ok(Err(format!(
+                "frame {target} is past the session's last frame, {} ({})",
+                self.last, self.last_why
+            )));
+        }
+        let next = self.session.next_frame();
+        let halted = self.halted();
+        if let Some(why) = &halted
+            && target > next
+        {
+            return Ok(Err(why.clone()));
+        }
+        let mut recording = None;
+        if target < next || halted.is_some() {
+            if let Some(u) = self.kept.unkept_from
+                && target > u
+            {
+                return Ok(Err(format!(
+                    "frame {target}: a seek back reaches frame {u} at most: the inputs since \
+                     were not kept (at most {} MiB of inputs are)",
+                    MAX_KEPT_INPUT_BYTES >> 20
+                )));
+            }
+            self.kept.truncate(target);
+            self.snapshots.retain(|(f, _)| *f <= target);
+            match self.snapshots.last() {
+                // Not recording: from the latest snapshot at or before `target`.
+                Some((_, snapshot)) if self.record.is_none() => {
+                    let sink = ServeSink {
+                        live: LiveSink::new(hub.clone()),
+                        file: None,
+                        muted: false,
+                    };
+                    self.session = Session::resume(snapshot.clone(), sink, true)?;
+                }
+                // Recording (the file must hold the session from frame 0, to replay on its
+                // own: it is written again), or no snapshot: from frame 0.
+                _ => recording = self.restart(hub, false)?,
+            }
+        }
+        let from = self.session.next_frame();
+        let cursor = self.kept.list.partition_point(|(f, _)| *f < from);
+        self.begin(target, false, asker, recording);
+        if let Some(r) = &mut self.running {
+            r.cursor = cursor;
+        }
+        Ok(Ok(()))
+    }
+
+    fn begin(&mut self, target: u64, live: bool, asker: Asker, recording: Option<String>) {
+        self.session.recorder().sink_mut().muted = !live;
+        self.running = Some(Running {
+            target,
+            live,
+            cursor: 0,
+            asker,
+            recording,
+            progress_at: Instant::now() + PROGRESS_EVERY,
+        });
+    }
+
+    /// Goes on with the seek or step under way for one slice; answers its asker when it is
+    /// done.
+    pub fn slice(&mut self, hub: &Hub) -> anyhow::Result<()> {
+        let Some(mut run) = self.running.take() else {
+            return Ok(());
+        };
+        let until = Instant::now() + SLICE;
+        let mut failed = None;
+        while self.session.next_frame() < run.target {
+            let ok = if run.live {
+                self.frame(hub)?
+            } else {
+                let at = self.session.next_frame();
+                while let Some((f, text)) = self.kept.list.get(run.cursor)
+                    && *f == at
+                {
+                    let _ = self.session.input(text)?;
+                    run.cursor += 1;
+                }
+                self.step(hub)?
+            };
+            if !ok {
+                failed = self.halted();
+                break;
+            }
+            if Instant::now() >= until {
+                break;
+            }
+        }
+        let at = self.session.next_frame();
+        if failed.is_none() && at < run.target {
+            if Instant::now() >= run.progress_at {
+                run.progress_at = Instant::now() + PROGRESS_EVERY;
+                let what = if run.live { "stepping" } else { "seeking" };
+                let text = format!("{what} to frame {}: at frame {at}", run.target);
+                broadcast_status(hub, 0, &text);
+            }
+            self.running = Some(run);
+            return Ok(());
+        }
+        self.session.recorder().sink_mut().muted = false;
+        if !run.live {
+            self.session.refresh_live()?;
+        }
+        match run.asker {
+            Asker::Call {
+                client,
+                service,
+                call,
+            } => {
+                let result = match failed {
+                    Some(why) => Err(why),
+                    None => Ok(self.response(run.recording)),
+                };
+                hub.lock().answer(client, service, call, result);
+            }
+            Asker::Playback { play, request_id } => {
+                if failed.is_none() {
+                    self.paused = !play;
+                }
+                self.playback_state(hub, true, &request_id);
+            }
+        }
+        Ok(())
+    }
+
+    /// Tells every client the playback state.
+    pub fn playback_state(&self, hub: &Hub, sought: bool, request_id: &str) {
+        let t = self
+            .session
+            .next_frame()
+            .saturating_sub(1)
+            .saturating_mul(self.session.dt_ns());
+        let state =
+            protocol::playback_state(!self.paused, t, self.speed as f32, sought, request_id);
+        hub.lock().playback_state(state);
+    }
+
+    /// A new session of the current scenario from frame 0: in a new recording file, or
+    /// (a seek back) writing the current one again; the file, if recording.
+    fn restart(&mut self, hub: &Hub, new_file: bool) -> anyhow::Result<Option<String>> {
+        if new_file && self.record.is_some() {
+            self.segment += 1;
+        }
+        let next = start(
+            &self.scenario,
+            &self.text,
+            hub,
+            self.record.as_deref(),
+            self.segment,
+        )?;
+        let old = std::mem::replace(&mut self.session, next);
+        if new_file {
+            finish(old)?;
+        }
+        // Else the old recording's temporary file is removed with it: the new one holds the
+        // session as it now stands.
+        Ok(self
+            .record
+            .as_deref()
+            .map(|p| segment(p, self.segment).display().to_string()))
+    }
+
+    /// One frame: the clients' inputs, then the step; false if it overflowed.
+    pub fn frame(&mut self, hub: &Hub) -> anyhow::Result<bool> {
+        let dt_ns = self.session.recorder().dt_ns();
+        let (inputs, resend) = {
+            let mut s = hub.lock();
+            (
+                std::mem::take(&mut s.inputs),
+                std::mem::take(&mut s.transforms_wanted),
+            )
+        };
+        for (client, text) in inputs {
+            let at = self.session.next_frame();
+            match self.session.input(&text)? {
+                Ok(()) => self.kept.keep(at, text),
+                Err(why) => hub.lock().tell(client, 2, &format!("input refused: {why}")),
+            }
+        }
+        if resend {
+            self.session.recorder().resend_transforms();
+        }
+        let t = self.session.next_frame().saturating_mul(dt_ns);
+        hub.lock().broadcast(&Message::binary(protocol::time(t)));
+        self.step(hub)
+    }
+
+    /// Steps the session, keeping a snapshot every [`SNAPSHOT_EVERY`] frames; false if the
+    /// step overflowed (then the session is paused at its last good frame and every client
+    /// told).
+    fn step(&mut self, hub: &Hub) -> anyhow::Result<bool> {
+        match self.session.step() {
+            Ok(_) => {}
+            Err(crate::session::StepError::Overflow { .. }) => {
+                self.paused = true;
+                let why = self.halted().unwrap_or_default();
+                crate::out::note(&format!("error: {why}"))?;
+                broadcast_status(hub, 2, &why);
+                return Ok(false);
+            }
+            Err(e) => return Err(e.into()),
+        }
+        self.stepped += 1;
+        let next = self.session.next_frame();
+        if self.record.is_none() && next.is_multiple_of(SNAPSHOT_EVERY) {
+            self.snapshots.push((next, self.session.sim().clone()));
+            if self.snapshots.len() > MAX_SNAPSHOTS {
+                let mut k = 0;
+                self.snapshots.retain(|_| {
+                    k += 1;
+                    k % 2 == 0
+                });
+            }
+        }
+        Ok(true)
+    }
+
+    /// Refuses a call or a timeline request while a seek or step is under way.
+    pub fn busy(&self) -> Option<String> {
+        self.running.as_ref().map(|r| {
+            format!(
+                "busy: {} to frame {} (at frame {}); ask again when it is done",
+                if r.live { "stepping" } else { "seeking" },
+                r.target,
+                self.session.next_frame()
+            )
+        })
+    }
+}
+
+/// A status message for every client (0 info, 1 warning, 2 error).
+fn broadcast_status(hub: &Hub, level: u8, text: &str) {
+    let status = protocol::ServerMessage::Status {
+        level,
+        message: text,
+    };
+    hub.lock().broadcast(&Message::text(status.json()));
+}

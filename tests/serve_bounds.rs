@@ -1,0 +1,486 @@
+//! `ricochet serve` under hostile inputs and service calls (issue 20, part 2): inputs
+//! checked as a scenario file is, an overflow that pauses the session instead of killing
+//! the server, seeks bounded (`--frames` and a log's last frame) and run in slices that
+//! report progress and yield to SIGTERM, seeks back that add no file, and refused inputs
+//! that cost no memory. Loopback only, a few clients, every wait bounded.
+
+use std::path::Path;
+use std::process::Command;
+use std::time::{Duration, Instant};
+
+use futures_util::SinkExt;
+use serde_json::Value;
+use tokio_tungstenite::tungstenite::Message;
+
+use crate::serve_client::*;
+
+/// Advertises `/input` (JSON) as the client's channel 5.
+async fn advertise_input(ws: &mut Ws) {
+    let advertise = serde_json::json!({"op": "advertise", "channels": [
+        {"id": 5, "topic": "/input", "encoding": "json", "schemaName": "ricochet.Input"}]});
+    ws.send(Message::text(advertise.to_string())).await.unwrap();
+}
+
+/// Publishes `text` on the client's channel 5.
+async fn publish(ws: &mut Ws, text: &str) {
+    let mut data = vec![1u8];
+    data.extend_from_slice(&5u32.to_le_bytes());
+    data.extend_from_slice(text.as_bytes());
+    ws.send(Message::binary(data)).await.unwrap();
+}
+
+/// The next status message's (level, text).
+async fn next_status(ws: &mut Ws) -> (u64, String) {
+    loop {
+        let v = next_json(ws).await;
+        if v["op"] == "status" {
+            return (
+                v["level"].as_u64().unwrap(),
+                v["message"].as_str().unwrap().to_owned(),
+            );
+        }
+    }
+}
+
+/// Sends a call to service `name` without waiting for its answer.
+async fn send_call(ws: &mut Ws, services: &Value, name: &str, call: u32, request: &str) {
+    let service = services["services"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|s| s["name"] == name)
+        .unwrap_or_else(|| panic!("a service {name}"))["id"]
+        .as_u64()
+        .unwrap() as u32;
+    let mut data = vec![2u8];
+    data.extend_from_slice(&service.to_le_bytes());
+    data.extend_from_slice(&call.to_le_bytes());
+    data.extend_from_slice(&4u32.to_le_bytes());
+    data.extend_from_slice(b"json");
+    data.extend_from_slice(request.as_bytes());
+    ws.send(Message::binary(data)).await.unwrap();
+}
+
+/// Calls service `name`; its answer (the response, or the failure's message) and the
+/// status messages that came before it.
+async fn call_with_statuses(
+    ws: &mut Ws,
+    services: &Value,
+    name: &str,
+    call: u32,
+    request: &str,
+) -> (Result<Value, String>, Vec<(u64, String)>) {
+    use futures_util::StreamExt;
+    send_call(ws, services, name, call, request).await;
+    let mut statuses = Vec::new();
+    loop {
+        let m = tokio::time::timeout(Duration::from_secs(10), ws.next())
+            .await
+            .expect("an answer within 10 s")
+            .unwrap()
+            .unwrap();
+        match m {
+            Message::Binary(b) if b[0] == 3 => {
+                assert_eq!(u32::from_le_bytes(b[5..9].try_into().unwrap()), call);
+                return (Ok(serde_json::from_slice(&b[17..]).unwrap()), statuses);
+            }
+            Message::Text(t) => {
+                let v: Value = serde_json::from_str(t.as_str()).unwrap();
+                if v["op"] == "serviceCallFailure" {
+                    return (Err(v["message"].as_str().unwrap().to_owned()), statuses);
+                }
+                if v["op"] == "status" {
+                    let text = v["message"].as_str().unwrap().to_owned();
+                    statuses.push((v["level"].as_u64().unwrap(), text));
+                }
+            }
+            _ => {}
+        }
+    }
+}
+
+/// Connects, returning the socket and the services' advertisement.
+async fn open(server: &Server, subprotocol: &str) -> (Ws, Value) {
+    let (mut ws, _) = connect(&server.url, subprotocol).await.unwrap();
+    loop {
+        let v = any_json(&mut ws).await;
+        if v["op"] == "advertiseServices" {
+            return (ws, v);
+        }
+    }
+}
+
+/// SIGTERM, then the exit status, waiting at most `limit`.
+fn terminate(server: &mut Server, limit: Duration) -> std::process::ExitStatus {
+    let pid = server.child.id().to_string();
+    assert!(
+        Command::new("kill")
+            .args(["-TERM", &pid])
+            .status()
+            .unwrap()
+            .success()
+    );
+    let asked = Instant::now();
+    loop {
+        if let Some(status) = server.child.try_wait().unwrap() {
+            return status;
+        }
+        assert!(
+            asked.elapsed() < limit,
+            "the server still runs {limit:?} after SIGTERM"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+/// `ricochet replay` of `log` gives the same bytes; the frames it holds (`/stats`).
+fn replays_byte_for_byte(log: &Path) -> usize {
+    let replayed = log.with_extension("replay.mcap");
+    let o = Command::new(env!("CARGO_BIN_EXE_ricochet"))
+        .args([
+            "replay",
+            log.to_str().unwrap(),
+            "-o",
+            replayed.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        std::fs::read(log).unwrap() == std::fs::read(&replayed).unwrap(),
+        "byte-identical"
+    );
+    ricochet_log::read_log_file(log)
+        .unwrap()
+        .iter()
+        .filter(|m| m.topic == "/stats")
+        .count()
+}
+
+/// Issue 20: `{"action":"apply_impulse","body":"ship","impulse":[1.7e308,0]}` twice killed
+/// the server ("frame 738: a value overflowed"), and its recording was deleted. Such inputs
+/// are now refused with a status, as a scenario file's ±1e15 would be; the session goes on
+/// and its recording replays.
+#[test]
+fn an_overflowing_impulse_is_refused_and_the_recording_replays() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("s.mcap");
+    let scenario = crate::util::root().join("scenarios/asteroids.toml");
+    let mut server = serve(&[
+        scenario.to_str().unwrap(),
+        "--paused",
+        "--record",
+        out.to_str().unwrap(),
+    ]);
+    runtime().block_on(async {
+        let (mut ws, services) = open(&server, "foxglove.websocket.v1").await;
+        advertise_input(&mut ws).await;
+        let huge = r#"{"action":"apply_impulse","body":"ship","impulse":[1.7e308,0]}"#;
+        let refused = [
+            huge,
+            huge,
+            r#"{"action":"set_velocity","body":"ship","velocity":[0,-2e15]}"#,
+            r#"{"action":"set_force","body":"ship","force":[1e300,0]}"#,
+            r#"{"action":"spawn","template":"asteroid_small","position":[1e16,0]}"#,
+            r#"{"action":"spawn","template":"asteroid_small","position":[0,0],"velocity":[0,1e200]}"#,
+        ];
+        for text in refused {
+            publish(&mut ws, text).await;
+            tokio::time::sleep(Duration::from_millis(20)).await;
+        }
+        // Within the limits: accepted.
+        publish(
+            &mut ws,
+            r#"{"action":"apply_impulse","body":"ship","impulse":[3,0]}"#,
+        )
+        .await;
+        tokio::time::sleep(Duration::from_millis(50)).await;
+        let (stepped, statuses) =
+            call_with_statuses(&mut ws, &services, "/step", 1, r#"{"frames": 5}"#).await;
+        assert_eq!(stepped.unwrap()["frame"], 6);
+        assert_eq!(statuses.len(), refused.len(), "{statuses:?}");
+        for (level, text) in &statuses {
+            assert_eq!(*level, 2, "{text}");
+        }
+        for (i, want) in [
+            "apply_impulse: [1.7e308, 0.0] beyond ±1e15",
+            "apply_impulse: [1.7e308, 0.0] beyond ±1e15",
+            "set_velocity: [0.0, -2e15] beyond ±1e15",
+            "set_force: [1e300, 0.0] beyond ±1e15",
+            "spawn: position and velocity must be finite and within ±1e15",
+            "spawn: position and velocity must be finite and within ±1e15",
+        ]
+        .iter()
+        .enumerate()
+        {
+            assert!(statuses[i].1.contains(want), "{want:?} in {:?}", statuses[i]);
+        }
+        let more = call(&mut ws, &services, "/step", 2, r#"{"frames": 3}"#).await;
+        assert_eq!(more.unwrap()["frame"], 9, "the server goes on");
+    });
+    assert!(terminate(&mut server, Duration::from_secs(10)).success());
+    assert_eq!(replays_byte_for_byte(&out), 9, "frames 0 to 8");
+    let log = ricochet_log::read_log_file(&out).unwrap();
+    let inputs = log.iter().filter(|m| m.topic == "/input").count();
+    assert_eq!(inputs, 7, "every input recorded, refused ones too");
+}
+
+/// A scenario whose body overflows after some frames, whatever the inputs (gravity 1e308):
+/// the frame `ricochet run` stops at, from its message ("frame N: ...").
+fn overflowing_scenario(dir: &Path) -> (std::path::PathBuf, u64) {
+    let scenario = dir.join("overflow.toml");
+    std::fs::write(
+        &scenario,
+        "layers = [\"a\"]\nframes = 1000\nworld.gravity = [0, -1e308]\n[[bodies]]\nname = \
+         \"rock\"\nlayer = \"a\"\nshape = { kind = \"circle\", radius = 1 }\n",
+    )
+    .unwrap();
+    let log = dir.join("run.mcap");
+    let o = crate::util::ricochet(
+        &["run", scenario.to_str().unwrap(), "-o", log.to_str().unwrap()],
+        b"",
+    );
+    let stderr = String::from_utf8_lossy(&o.stderr).into_owned();
+    assert_eq!(o.status.code(), Some(1), "{stderr}");
+    let frame = stderr
+        .split("error: frame ")
+        .nth(1)
+        .and_then(|r| r.split(':').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("the overflowing frame in {stderr}"));
+    assert!(frame > 5, "{stderr}");
+    (scenario, frame)
+}
+
+/// Issue 20: whatever still overflows mid-session, the server stays up: it pauses the
+/// session at its last good frame, tells every client, refuses to step on, and its
+/// recording holds frames 0 to N-1, complete, replaying byte for byte (as `run` leaves
+/// its log). A seek back steps again from frame 0 and the session goes on.
+#[test]
+fn an_overflow_pauses_the_session_at_its_last_good_frame_and_the_server_stays_up() {
+    let dir = tempfile::tempdir().unwrap();
+    let (scenario, bad) = overflowing_scenario(dir.path());
+    for seek_back in [false, true] {
+        let out = dir.path().join(format!("session-{seek_back}.mcap"));
+        let mut server = serve(&[
+            scenario.to_str().unwrap(),
+            "--paused",
+            "--record",
+            out.to_str().unwrap(),
+        ]);
+        runtime().block_on(async {
+            let (mut ws, services) = open(&server, "foxglove.websocket.v1").await;
+            let (mut other, _) = open(&server, "foxglove.websocket.v1").await;
+            let failed = call(&mut ws, &services, "/step", 1, r#"{"frames": 2000}"#)
+                .await
+                .unwrap_err();
+            let want = format!("frame {bad}: body rock #0:0 has a non-finite");
+            assert!(failed.contains(&want), "{want:?} in {failed}");
+            assert!(
+                failed.contains(&format!("paused at frame {}", bad - 1)),
+                "{failed}"
+            );
+            let (level, told) = next_status(&mut other).await;
+            assert_eq!(level, 2);
+            assert!(told.contains(&want), "every client is told: {told}");
+            for (id, service, request) in [(2, "/step", "{}"), (3, "/play", "{}")] {
+                let again = call(&mut ws, &services, service, id, request).await;
+                assert!(again.unwrap_err().contains("overflowed"), "{service}");
+            }
+            if seek_back {
+                let back = call(&mut ws, &services, "/seek", 4, r#"{"frame": 3}"#).await;
+                assert_eq!(back.unwrap()["frame"], 3);
+                let on = call(&mut ws, &services, "/step", 5, r#"{"frames": 2}"#).await;
+                assert_eq!(on.unwrap()["frame"], 5);
+            }
+        });
+        assert!(terminate(&mut server, Duration::from_secs(10)).success());
+        let frames = if seek_back { 5 } else { bad as usize };
+        assert_eq!(replays_byte_for_byte(&out), frames, "seek back: {seek_back}");
+    }
+}
+
+/// Issue 20: `serve --frames 100` did not bound `/step` or `/seek` (the recording held
+/// 8,000 frames, "served 1 frames"), and a timeline seek to 2^64 - 1 ns became 1.1e12
+/// frames, past `MAX_FRAMES`. Every path now checks the session's last frame; the server
+/// stops when it is stepped, and says how many frames it served.
+#[test]
+fn frames_bounds_steps_and_seeks_of_every_kind() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("s.mcap");
+    let mut server = serve(&[
+        "--paused",
+        "--frames",
+        "100",
+        "--record",
+        out.to_str().unwrap(),
+    ]);
+    runtime().block_on(async {
+        let (mut ws, services) = open(&server, "foxglove.sdk.v1").await;
+        let step = call(&mut ws, &services, "/step", 1, r#"{"frames": 8000}"#).await;
+        let why = step.unwrap_err();
+        assert!(why.contains("ends at frame 100 (--frames)"), "{why}");
+        let seek = call(&mut ws, &services, "/seek", 2, r#"{"frame": 8000}"#).await;
+        let why = seek.unwrap_err();
+        assert!(why.contains("past the session's last frame, 100"), "{why}");
+        let seek = call(&mut ws, &services, "/seek", 3, r#"{"frame": 100000001}"#).await;
+        assert!(seek.unwrap_err().contains("past"));
+        // The timeline: pause, seeking to u64::MAX ns.
+        let mut data = vec![3u8, 1];
+        data.extend_from_slice(&1.0f32.to_le_bytes());
+        data.push(1);
+        data.extend_from_slice(&u64::MAX.to_le_bytes());
+        data.extend_from_slice(&1u32.to_le_bytes());
+        data.extend_from_slice(b"z");
+        ws.send(Message::binary(data)).await.unwrap();
+        let (level, why) = next_status(&mut ws).await;
+        assert_eq!(level, 2);
+        assert!(why.contains("past the session's last frame, 100"), "{why}");
+        let (_, _, _, id) = playback_state(&mut ws).await;
+        assert_eq!(id, "z", "the timeline still gets its state");
+        let to = call(&mut ws, &services, "/seek", 4, r#"{"frame": 100}"#).await;
+        assert_eq!(to.unwrap()["frame"], 100);
+        let last = call(&mut ws, &services, "/step", 5, r#"{"frames": 2}"#).await;
+        assert!(last.unwrap_err().contains("at most 1 more"));
+        // The last frame: the server stops by itself.
+        send_call(&mut ws, &services, "/step", 6, "{}").await;
+    });
+    let started = Instant::now();
+    let status = loop {
+        if let Some(s) = server.child.try_wait().unwrap() {
+            break s;
+        }
+        assert!(started.elapsed() < Duration::from_secs(10), "stops at frame 100");
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    assert!(status.success());
+    assert_eq!(replays_byte_for_byte(&out), 101, "frames 0 to 100");
+    std::thread::sleep(Duration::from_millis(100));
+    let lines = server.lines.lock().unwrap().join("\n");
+    assert!(lines.contains("served frames 0 to 100"), "{lines}");
+}
+
+/// Issue 20: `/seek {"frame": 100000000}` ran all at once: no answer, nothing for the other
+/// clients, SIGTERM ignored, the recording growing. It now runs in slices: the other
+/// clients get its progress (and a "busy" answer to their calls), and SIGTERM finishes the
+/// recording, complete up to where the seek got.
+#[test]
+fn a_long_seek_runs_in_slices_reports_progress_and_yields_to_sigterm() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("s.mcap");
+    let mut server = serve(&["--paused", "--record", out.to_str().unwrap()]);
+    runtime().block_on(async {
+        let (mut ws, services) = open(&server, "foxglove.websocket.v1").await;
+        let (mut other, _) = open(&server, "foxglove.websocket.v1").await;
+        let mut data = vec![2u8];
+        data.extend_from_slice(&6u32.to_le_bytes()); // `/seek`
+        data.extend_from_slice(&1u32.to_le_bytes());
+        data.extend_from_slice(&4u32.to_le_bytes());
+        data.extend_from_slice(br#"json{"frame": 100000000}"#);
+        assert_eq!(
+            services["services"][5]["name"], "/seek",
+            "service 6 is /seek"
+        );
+        ws.send(Message::binary(data)).await.unwrap();
+        let (level, progress) = next_status(&mut other).await;
+        assert_eq!(level, 0);
+        assert!(
+            progress.starts_with("seeking to frame 100000000: at frame "),
+            "{progress}"
+        );
+        let busy = call(&mut other, &services, "/pause", 2, "{}").await;
+        assert!(busy.unwrap_err().starts_with("busy: seeking"));
+        let (_, later) = next_status(&mut other).await;
+        assert!(later.starts_with("seeking to frame 100000000"), "{later}");
+    });
+    assert!(terminate(&mut server, Duration::from_secs(5)).success());
+    let frames = replays_byte_for_byte(&out);
+    assert!(frames > 1, "the frames the seek made: {frames}");
+}
+
+/// Issue 20: every seek back while recording wrote a whole copy of the session (40
+/// seek-backs, 40 files). A seek back now writes the segment's file again: one file,
+/// holding the session as it stands, replaying on its own.
+#[test]
+fn seeks_back_while_recording_add_no_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("s.mcap");
+    let mut server = serve(&["--paused", "--record", out.to_str().unwrap()]);
+    runtime().block_on(async {
+        let (mut ws, services) = open(&server, "foxglove.websocket.v1").await;
+        let to = call(&mut ws, &services, "/seek", 1, r#"{"frame": 1000}"#).await;
+        assert_eq!(to.unwrap()["frame"], 1000);
+        for k in 0..10u32 {
+            let back = call(&mut ws, &services, "/seek", 10 + 2 * k, r#"{"frame": 400}"#)
+                .await
+                .unwrap();
+            assert_eq!(back["frame"], 400);
+            assert!(back["recording"].as_str().unwrap().ends_with("s.mcap"));
+            let on = call(&mut ws, &services, "/seek", 11 + 2 * k, r#"{"frame": 1000}"#).await;
+            assert_eq!(on.unwrap()["frame"], 1000);
+        }
+        // One temporary file being written, nothing else.
+        let names: Vec<String> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        assert_eq!(names.len(), 1, "{names:?}");
+        assert!(names[0].ends_with(".tmp"), "{names:?}");
+    });
+    assert!(terminate(&mut server, Duration::from_secs(10)).success());
+    let names: Vec<String> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(names, ["s.mcap"]);
+    assert_eq!(replays_byte_for_byte(&out), 1000, "frames 0 to 999");
+}
+
+/// The resident memory of process `pid`, bytes (Linux).
+fn rss(pid: u32) -> u64 {
+    let status = std::fs::read_to_string(format!("/proc/{pid}/status")).unwrap();
+    let kb: u64 = status
+        .lines()
+        .find_map(|l| l.strip_prefix("VmRSS:"))
+        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse().ok())
+        .unwrap();
+    kb * 1024
+}
+
+/// Issue 20: every input, refused ones too, was kept for seeks (one client at the rate
+/// limit: 8 to 207 MB in 25 s). A refused input changes nothing, so it is no longer kept:
+/// 4,000 refused inputs of 4 KB (16 MB) leave the server's memory where it was.
+#[test]
+fn refused_inputs_are_not_kept() {
+    let server = serve(&["--speed", "1"]);
+    let pid = server.child.id();
+    runtime().block_on(async {
+        let (mut ws, _) = open(&server, "foxglove.websocket.v1").await;
+        advertise_input(&mut ws).await;
+        let mut text = r#"{"action": "fire", "body": "nobody"}"#.to_owned();
+        text.push_str(&" ".repeat(4000));
+        // Warm up (the allocator's arenas, the socket's buffers), then measure.
+        for _ in 0..10 {
+            for _ in 0..100 {
+                publish(&mut ws, &text).await;
+            }
+            tokio::time::sleep(Duration::from_millis(60)).await;
+        }
+        tokio::time::sleep(Duration::from_millis(300)).await;
+        let before = rss(pid);
+        // 2,000 a second at most are taken (the rate limit).
+        for _ in 0..40 {
+            for _ in 0..100 {
+                publish(&mut ws, &text).await;
+            }
+            tokio::time::sleep(Duration::from_millis(60)).await;
+        }
+        tokio::time::sleep(Duration::from_millis(300)).await;
+        let grown = rss(pid).saturating_sub(before);
+        assert!(
+            grown < 6 << 20,
+            "{} MB more after 16 MB of refused inputs",
+            grown >> 20
+        );
+    });
+}
