@@ -110,10 +110,13 @@ enum Command {
         /// Simulation seconds per wall-clock second.
         #[arg(long, default_value_t = 1.0, value_name = "X")]
         speed: f64,
-        /// Stop after this many frames after frame 0 (default: run until stopped).
+        /// Stop after this many frames after frame 0 (default: run until stopped). No /step
+        /// or seek goes past frame N either (without it: 100,000,000, the most a log holds).
         #[arg(long, value_name = "N")]
         frames: Option<u64>,
-        /// Also record the session to this MCAP file, as `run` writes one.
+        /// Also record the session to this MCAP file, as `run` writes one. Disk: each file
+        /// holds one session, at most frames 0 to --frames; a seek back writes it again (it
+        /// adds no file); /reset and /load start a new one, OUT-1.mcap, ... (at most 1,000).
         #[arg(long, value_name = "OUT.mcap")]
         record: Option<PathBuf>,
         /// Start paused: frame 0 is shown; the /play or /step service goes on.

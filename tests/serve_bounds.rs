@@ -237,7 +237,12 @@ fn overflowing_scenario(dir: &Path) -> (std::path::PathBuf, u64) {
     .unwrap();
     let log = dir.join("run.mcap");
     let o = crate::util::ricochet(
-        &["run", scenario.to_str().unwrap(), "-o", log.to_str().unwrap()],
+        &[
+            "run",
+            scenario.to_str().unwrap(),
+            "-o",
+            log.to_str().unwrap(),
+        ],
         b"",
     );
     let stderr = String::from_utf8_lossy(&o.stderr).into_owned();
@@ -296,7 +301,11 @@ fn an_overflow_pauses_the_session_at_its_last_good_frame_and_the_server_stays_up
         });
         assert!(terminate(&mut server, Duration::from_secs(10)).success());
         let frames = if seek_back { 5 } else { bad as usize };
-        assert_eq!(replays_byte_for_byte(&out), frames, "seek back: {seek_back}");
+        assert_eq!(
+            replays_byte_for_byte(&out),
+            frames,
+            "seek back: {seek_back}"
+        );
     }
 }
 
@@ -350,7 +359,10 @@ fn frames_bounds_steps_and_seeks_of_every_kind() {
         if let Some(s) = server.child.try_wait().unwrap() {
             break s;
         }
-        assert!(started.elapsed() < Duration::from_secs(10), "stops at frame 100");
+        assert!(
+            started.elapsed() < Duration::from_secs(10),
+            "stops at frame 100"
+        );
         std::thread::sleep(Duration::from_millis(20));
     };
     assert!(status.success());
@@ -416,7 +428,14 @@ fn seeks_back_while_recording_add_no_file() {
                 .unwrap();
             assert_eq!(back["frame"], 400);
             assert!(back["recording"].as_str().unwrap().ends_with("s.mcap"));
-            let on = call(&mut ws, &services, "/seek", 11 + 2 * k, r#"{"frame": 1000}"#).await;
+            let on = call(
+                &mut ws,
+                &services,
+                "/seek",
+                11 + 2 * k,
+                r#"{"frame": 1000}"#,
+            )
+            .await;
             assert_eq!(on.unwrap()["frame"], 1000);
         }
         // One temporary file being written, nothing else.

@@ -213,7 +213,11 @@ fn services_pause_step_seek_and_reset_and_each_recording_segment_replays() {
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
         .collect();
     files.sort();
-    assert_eq!(files, ["session-1.mcap", "session.mcap"], "no file per seek");
+    assert_eq!(
+        files,
+        ["session-1.mcap", "session.mcap"],
+        "no file per seek"
+    );
     for file in ["session.mcap", "session-1.mcap"] {
         let recorded = dir.path().join(file);
         let replayed = dir.path().join(format!("{file}.replay"));

@@ -5,14 +5,22 @@
 //! |---|---|---|
 //! | `/pause` | `{}` | stops stepping (the clients still get the last state) |
 //! | `/play` | `{}` | steps again, in real time from now |
-//! | `/step` | `{"frames": N}` (default 1, at most 10,000) | pauses, then steps N frames at once |
-//! | `/reset` | `{}` | the scenario again from frame 0; a recording goes on in a new file |
+//! | `/step` | `{"frames": N}` (default 1, at most 10,000) | pauses, then steps N frames as fast as it can |
+//! | `/reset` | `{}` | the scenario again from frame 0; a recording goes on in a new file (at most 1,000 files) |
 //! | `/load` | `{"scenario": "scenarios/level.toml"}` | another scenario file (a relative path, below the server's directory), from frame 0, likewise |
-//! | `/seek` | `{"frame": N}` | to frame N: forward by stepping at once, back by stepping again from the latest snapshot before N with the inputs since (recording: from frame 0, and the recording goes on in a new file that holds frames 0 to N too, so it replays on its own) |
+//! | `/seek` | `{"frame": N}` | to frame N: forward by stepping as fast as it can, back by stepping again from the latest snapshot before N with the inputs since (recording: from frame 0, writing the recording's file again, so that it holds the session as it now stands and replays on its own) |
 //! | `/speed` | `{"speed": X}` | simulation seconds per wall second, from now (0.01 to 100) |
 //!
 //! Every response is `{"frame": F, "paused": P}` (the next frame, and whether stepping is
-//! paused), with `"recording": "FILE"` after a reset or load that started a new file.
+//! paused), with `"recording": "FILE"` after a reset or load that started a new file, or a
+//! seek back that writes one again.
+//!
+//! No `/step` or `/seek` (nor a timeline seek) goes past the session's last frame
+//! (`--frames`, else 100,000,000), and a step or seek runs in slices: meanwhile every client
+//! gets its progress (a status every 0.5 s), calls are answered "busy", and SIGTERM stops it
+//! and finishes the recording. After an overflow the session is paused at its last good
+//! frame: `/play`, `/step` and seeks forward are refused until a seek back, `/reset` or
+//! `/load`.
 
 use serde::Deserialize;
 

@@ -259,7 +259,12 @@ impl Serving {
 
     /// Starts a seek to `target` (the next frame once there), or says why it can't be:
     /// every seek, a service's or the timeline's, is checked here.
-    pub fn seek(&mut self, target: u64, hub: &Hub, asker: Asker) -> anyhow::Result<Result<(), String>> {
+    pub fn seek(
+        &mut self,
+        target: u64,
+        hub: &Hub,
+        asker: Asker,
+    ) -> anyhow::Result<Result<(), String>> {
         if target > self.last {
             return Ok(Err(format!(
                 "frame {target} is past the session's last frame, {} ({})",
