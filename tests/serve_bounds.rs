@@ -503,3 +503,51 @@ fn refused_inputs_are_not_kept() {
         );
     });
 }
+
+/// A reset or a load while recording starts a file: at most 1,000 of them (the disk a
+/// server writes is bounded), then a located refusal; the server goes on.
+#[test]
+fn resets_while_recording_stop_at_1000_files() {
+    use futures_util::StreamExt;
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("s.mcap");
+    let mut server = serve(&["--paused", "--record", out.to_str().unwrap()]);
+    runtime().block_on(async {
+        let (mut ws, services) = open(&server, "foxglove.websocket.v1").await;
+        // 1,000 resets in batches (at most 64 calls wait at once), answers counted.
+        let (mut ok, mut refused) = (0u32, Vec::new());
+        for batch in 0..20u32 {
+            for k in 0..50 {
+                send_call(&mut ws, &services, "/reset", batch * 50 + k, "{}").await;
+            }
+            let mut answers = 0;
+            while answers < 50 {
+                let m = tokio::time::timeout(Duration::from_secs(10), ws.next())
+                    .await
+                    .expect("an answer within 10 s")
+                    .unwrap()
+                    .unwrap();
+                match m {
+                    Message::Binary(b) if b[0] == 3 => (ok, answers) = (ok + 1, answers + 1),
+                    Message::Text(t) => {
+                        let v: Value = serde_json::from_str(t.as_str()).unwrap();
+                        if v["op"] == "serviceCallFailure" {
+                            refused.push(v["message"].as_str().unwrap().to_owned());
+                            answers += 1;
+                        }
+                    }
+                    _ => {}
+                }
+            }
+        }
+        assert_eq!(ok, 999, "segments 1 to 999 after s.mcap");
+        assert_eq!(refused.len(), 1, "{refused:?}");
+        assert!(refused[0].contains("1000 files, the most a server writes"));
+        let on = call(&mut ws, &services, "/step", 5000, "{}").await;
+        assert_eq!(on.unwrap()["frame"], 1);
+    });
+    assert!(terminate(&mut server, Duration::from_secs(10)).success());
+    let files = std::fs::read_dir(dir.path()).unwrap().count();
+    assert_eq!(files, 1000);
+    assert_eq!(replays_byte_for_byte(&dir.path().join("s-999.mcap")), 1);
+}

@@ -506,3 +506,36 @@ fn broadcast_status(hub: &Hub, level: u8, text: &str) {
     };
     hub.lock().broadcast(&Message::text(status.json()));
 }
+
+#[cfg(test)]
+mod tests {
+    use super::{KeptInputs, MAX_KEPT_INPUT_BYTES};
+
+    /// The inputs kept for seeks stop at their budget, from a frame on, and a seek back to
+    /// that frame or before spends it again.
+    #[test]
+    fn kept_inputs_stop_at_their_budget_and_a_seek_back_frees_it() {
+        let mut kept = KeptInputs::default();
+        let text = "x".repeat(4064); // 4,096 bytes with the 32 of bookkeeping
+        let fit = MAX_KEPT_INPUT_BYTES / 4096;
+        for i in 0..fit as u64 + 10 {
+            kept.keep(i / 100, text.clone());
+        }
+        assert_eq!(kept.list.len(), fit);
+        assert_eq!(kept.bytes, MAX_KEPT_INPUT_BYTES);
+        let first_unkept = fit as u64 / 100;
+        assert_eq!(kept.unkept_from, Some(first_unkept));
+        // A later input that would fit is not kept either: the inputs must run unbroken.
+        kept.truncate(first_unkept + 1);
+        assert_eq!(kept.unkept_from, Some(first_unkept));
+        kept.truncate(first_unkept);
+        assert_eq!(kept.unkept_from, None);
+        assert_eq!(kept.list.len(), first_unkept as usize * 100);
+        assert_eq!(kept.bytes, kept.list.len() * 4096);
+        kept.keep(first_unkept, "y".to_owned());
+        assert_eq!(
+            kept.list.last().map(|(f, t)| (*f, t.as_str())),
+            Some((first_unkept, "y"))
+        );
+    }
+}
