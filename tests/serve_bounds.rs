@@ -281,10 +281,12 @@ fn an_overflow_pauses_the_session_at_its_last_good_frame_and_the_server_stays_up
                 .unwrap_err();
             let want = format!("frame {bad}: body rock #0:0 has a non-finite");
             assert!(failed.contains(&want), "{want:?} in {failed}");
-            assert!(
-                failed.contains(&format!("paused at frame {}", bad - 1)),
-                "{failed}"
+            let paused = format!(
+                "paused at frame {} (the recording holds frames 0 to {})",
+                bad - 1,
+                bad - 1
             );
+            assert!(failed.contains(&paused), "{paused:?} in {failed}");
             let (level, told) = next_status(&mut other).await;
             assert_eq!(level, 2);
             assert!(told.contains(&want), "every client is told: {told}");

@@ -269,6 +269,7 @@ fn run_loop(serving: &mut Serving, hub: &Hub, interrupted: &AtomicBool) -> anyho
         for (client, request) in requests {
             if let Some(busy) = serving.busy() {
                 hub.lock().tell(client, 1, &busy);
+                serving.playback_state(hub, false, &request.request_id);
                 continue;
             }
             // Foxglove's timeline: speed, seek (to the frame at or before the time), play or

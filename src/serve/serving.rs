@@ -161,12 +161,12 @@ impl Serving {
     /// Why the session can't step (it overflowed), for a client.
     fn halted(&self) -> Option<String> {
         self.session.overflowed().map(|(frame, what)| {
-            let good = match frame.checked_sub(1) {
-                Some(f) => format!("frame {f}"),
-                None => "no frame".to_owned(),
+            let (good, kept) = match frame.checked_sub(1) {
+                Some(f) => (format!("frame {f}"), format!("frames 0 to {f}")),
+                None => ("no frame".to_owned(), "no frame".to_owned()),
             };
             let kept = if self.record.is_some() {
-                format!(" (the recording holds {good} and those before)")
+                format!(" (the recording holds {kept})")
             } else {
                 String::new()
             };
