@@ -9,6 +9,7 @@
 //! runtime of its own thread (`server.rs`); the two share the [`hub::Hub`].
 
 mod hub;
+mod load_path;
 mod protocol;
 mod server;
 mod services;
@@ -270,13 +271,9 @@ impl Serving {
             }
             services::Command::Reset | services::Command::Load(_) => {
                 if let services::Command::Load(path) = command {
-                    match crate::load::load_text(Some(Path::new(&path))) {
+                    match load_path::load(&path) {
                         Ok((scenario, text)) => (self.scenario, self.text) = (scenario, text),
-                        Err(_) => {
-                            return Ok(Err(format!(
-                                "{path}: not a scenario that loads (see the server's log)"
-                            )));
-                        }
+                        Err(why) => return Ok(Err(why)),
                     }
                 }
                 recording = self.restart(hub, o)?;
