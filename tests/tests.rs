@@ -15,6 +15,7 @@ mod large_scenario;
 mod run_cli;
 mod seek;
 mod serve_client;
+mod serve_hostile;
 mod serve_load;
 mod serve_session;
 mod serve_ws;
