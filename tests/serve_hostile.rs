@@ -1,15 +1,38 @@
 //! `ricochet serve` under hostile connections (issue 20), on loopback, bounded in count and
-//! time: half-open sockets under a file-descriptor limit.
+//! time: half-open sockets under a file-descriptor limit, a client advertising past the
+//! cap, a client that never reads on a scene of thousands of bodies (the server's RSS stays
+//! under its stated bound).
 
 use std::io::{Read, Write};
 use std::net::TcpStream;
 use std::process::Command;
 use std::time::{Duration, Instant};
 
+use futures_util::SinkExt;
+use prost::Message as _;
+use ricochet_log::messages::ricochet::Stats;
+use serde_json::Value;
+use tokio_tungstenite::tungstenite::Message;
+
 use crate::serve_client::*;
+
+/// The server's per-client byte budget and its room for answers (src/serve/hub.rs).
+const CLIENT_BUDGET: u64 = 8 << 20;
+const ANSWER_ROOM: u64 = 1 << 20;
 
 fn port(url: &str) -> u16 {
     url.rsplit(':').next().unwrap().parse().unwrap()
+}
+
+/// A field of /proc/PID/status, in kB.
+fn status_kb(pid: u32, field: &str) -> u64 {
+    let status = std::fs::read_to_string(format!("/proc/{pid}/status")).unwrap();
+    status
+        .lines()
+        .find_map(|l| l.strip_prefix(field))
+        .and_then(|rest| rest.split_whitespace().next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("{field} in /proc/{pid}/status"))
 }
 
 /// User plus system CPU seconds of a process, from /proc/PID/stat.
@@ -89,4 +112,110 @@ fn half_open_sockets_neither_spin_the_server_nor_lock_out_a_real_client() {
         .filter(|closed| !closed)
         .count();
     assert_eq!(open, 0, "half-open sockets still open 8 s on");
+}
+
+// Issue 20: `advertise` had no cap (13 M client channels took 200 MB more).
+#[test]
+fn advertising_past_the_cap_is_refused_and_the_client_told() {
+    let server = serve(&["--paused"]);
+    runtime().block_on(async {
+        let (mut ws, _) = connect(&server.url, "foxglove.websocket.v1").await.unwrap();
+        let _ = next_json(&mut ws).await;
+        let _ = next_json(&mut ws).await;
+        let channels: Vec<Value> = (0..300)
+            .map(|i| serde_json::json!({"id": i, "topic": format!("/t{i}"), "encoding": "json", "schemaName": "x"}))
+            .collect();
+        let advertise = serde_json::json!({"op": "advertise", "channels": channels});
+        ws.send(Message::text(advertise.to_string())).await.unwrap();
+        let status = tokio::time::timeout(Duration::from_secs(3), next_json(&mut ws))
+            .await
+            .expect("a status within 3 s");
+        assert_eq!(status["op"], "status", "{status}");
+        let message = status["message"].as_str().unwrap();
+        assert!(
+            message.contains("channel 256 refused") && message.contains("at most 256"),
+            "{message}"
+        );
+        // The 256 taken still work: an input on one of them is refused only for its topic.
+        let mut data = vec![1u8];
+        data.extend_from_slice(&5u32.to_le_bytes());
+        data.extend_from_slice(b"{}");
+        ws.send(Message::binary(data)).await.unwrap();
+        let status = next_json(&mut ws).await;
+        assert!(
+            status["message"]
+                .as_str()
+                .unwrap()
+                .contains("not an advertised /input channel"),
+            "{status}"
+        );
+    });
+}
+
+/// A scene of `n` circles drifting apart on a layer that collides with nothing: every frame
+/// sends every body on /bodies and /tf.
+fn drifting_scene(n: usize) -> String {
+    let mut text = String::from("hz = 60\nframes = 100000\nlayers = [\"dust\"]\n");
+    for i in 0..n {
+        let (x, y) = ((i % 100) as f64 * 3.0, (i / 100) as f64 * 3.0);
+        text.push_str(&format!(
+            "[[bodies]]\nname = \"d{i}\"\nlayer = \"dust\"\nshape = {{ kind = \"circle\", radius = 1 }}\nposition = [{x}, {y}]\nvelocity = [0.5, 0.25]\n"
+        ));
+    }
+    text
+}
+
+// Issue 20: the queue counted messages, not bytes: four clients that never read, on a
+// 5,000-body scene, took 1.2 GB.
+#[test]
+fn a_client_that_never_reads_keeps_the_server_within_its_byte_budget() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("dust.toml");
+    std::fs::write(&scene, drifting_scene(3000)).unwrap();
+    let server = serve(&[scene.to_str().unwrap(), "--speed", "4"]);
+    let pid = server.child.id();
+    runtime().block_on(async {
+        // A good client reads /stats all along; the server's resident size with it is the
+        // base.
+        let (mut good, _) = connect(&server.url, "foxglove.websocket.v1").await.unwrap();
+        let _ = next_json(&mut good).await;
+        let channels = next_json(&mut good).await;
+        subscribe_to(&mut good, &channels, "/stats", 1).await;
+        for _ in 0..30 {
+            next_data(&mut good).await;
+        }
+        let base = status_kb(pid, "VmRSS:");
+        // The slow client subscribes to everything, then never reads again.
+        let (mut slow, _) = connect(&server.url, "foxglove.websocket.v1").await.unwrap();
+        let _ = next_json(&mut slow).await;
+        let all: Vec<Value> = channels["channels"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .enumerate()
+            .map(|(i, c)| serde_json::json!({"id": i, "channelId": c["id"]}))
+            .collect();
+        let subscribe = serde_json::json!({"op": "subscribe", "subscriptions": all});
+        slow.send(Message::text(subscribe.to_string()))
+            .await
+            .unwrap();
+        // 600 frames: enough for the old message-counted queue (4,096 messages, 9 a frame)
+        // to fill with hundreds of megabytes.
+        let mut last = 0;
+        let mut peak = base;
+        while last < 600 {
+            let (_, _, payload) = next_data(&mut good).await;
+            let frame = Stats::decode(payload.as_slice()).unwrap().frame;
+            assert!(frame == last + 1 || last == 0, "{last} then {frame}");
+            last = frame;
+            peak = peak.max(status_kb(pid, "VmRSS:"));
+        }
+        // Its queue (the budget, and room for answers), the message being written, and the
+        // allocator's slack: 32 MiB in all over the base.
+        let bound_kb = (CLIENT_BUDGET + ANSWER_ROOM) / 1024 + 23 * 1024;
+        let grew = peak.saturating_sub(base);
+        eprintln!("RSS base {base} kB, peak {peak} kB, grew {grew} kB (bound {bound_kb} kB)");
+        assert!(grew < bound_kb, "RSS grew {grew} kB, over {bound_kb} kB");
+        drop(slow);
+    });
 }

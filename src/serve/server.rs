@@ -13,12 +13,12 @@ use std::time::Duration;
 
 use futures_util::{SinkExt, StreamExt};
 use tokio::net::{TcpListener, TcpStream};
-use tokio::sync::{mpsc, oneshot};
+use tokio::sync::oneshot;
 use tokio_tungstenite::tungstenite::Message;
 use tokio_tungstenite::tungstenite::handshake::server::{ErrorResponse, Request, Response};
 use tokio_tungstenite::tungstenite::http::{HeaderValue, StatusCode};
 
-use super::hub::{CLIENT_QUEUE, Hub};
+use super::hub::{Hub, client_queue};
 use super::protocol::{self, ClientMessage, ServerMessage};
 
 /// Clients served at once; more are refused (HTTP 503).
@@ -134,7 +134,7 @@ async fn client(
         )),
     };
     let (mut out, mut incoming) = ws.split();
-    let (queue, mut pending) = mpsc::channel::<Message>(CLIENT_QUEUE);
+    let (queue, mut pending) = client_queue();
     let admitted = {
         let mut s = hub.lock();
         (s.client_count() < MAX_CLIENTS).then(|| {
@@ -185,13 +185,13 @@ async fn client(
                     Some(Ok(Message::Text(text))) => {
                         if let Err(why) = handle(&hub, id, text.as_str()) {
                             let status = ServerMessage::Status { level: 2, message: &why };
-                            let _ = queue.try_send(Message::text(status.json()));
+                            let _ = queue.answer(Message::text(status.json()));
                         }
                     }
                     Some(Ok(Message::Binary(data))) => {
                         if let Err(why) = publish(&hub, id, &data, &mut limit) {
                             let status = ServerMessage::Status { level: 2, message: &why };
-                            let _ = queue.try_send(Message::text(status.json()));
+                            let _ = queue.answer(Message::text(status.json()));
                         }
                     }
                     Some(Ok(_)) => {}
@@ -219,7 +219,7 @@ fn handle(hub: &Hub, client: u64, text: &str) -> Result<(), String> {
         ClientMessage::Unsubscribe { subscription_ids } => s.unsubscribe(client, &subscription_ids),
         ClientMessage::Advertise { channels } => {
             for c in channels {
-                s.advertise(client, c.id, &c.topic, &c.encoding);
+                s.advertise(client, c.id, &c.topic, &c.encoding)?;
             }
         }
         ClientMessage::Unadvertise { channel_ids } => s.unadvertise(client, &channel_ids),
