@@ -32,9 +32,15 @@ impl Drop for Server {
 }
 
 pub(crate) fn serve(args: &[&str]) -> Server {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_ricochet"))
-        .args(["serve", "--bind", "127.0.0.1:0"])
-        .args(args)
+    let mut command = Command::new(env!("CARGO_BIN_EXE_ricochet"));
+    command.args(["serve", "--bind", "127.0.0.1:0"]).args(args);
+    serve_with(command)
+}
+
+/// A server started by `command` (a `ricochet serve` on 127.0.0.1:0, maybe through a shell
+/// that limits it, or in another directory).
+pub(crate) fn serve_with(mut command: Command) -> Server {
+    let mut child = command
         .stderr(Stdio::piped())
         .stdout(Stdio::null())
         .spawn()

@@ -16,6 +16,8 @@ mod run_cli;
 mod seek;
 mod serve_bounds;
 mod serve_client;
+mod serve_hostile;
+mod serve_load;
 mod serve_session;
 mod serve_ws;
 mod stress;

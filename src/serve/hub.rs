@@ -2,11 +2,14 @@
 //! subscribed to, shared between the simulation thread (which publishes every frame's
 //! messages) and the WebSocket tasks (which add and drop clients and subscriptions).
 //!
-//! Publishing never waits on a client: each has a bounded queue; when it is full the
-//! message is dropped for that client (counted, and the client is told once by a status
-//! message when it catches up). The simulation and the recording never lose a frame.
+//! Publishing never waits on a client: each has a queue bounded in bytes
+//! ([`CLIENT_BUDGET`]); a message that does not fit is dropped whole for that client
+//! (counted, and the client is told once by a status message when it catches up, and sent
+//! the latest `/scene` again if it missed one). The simulation and the recording never
+//! lose a frame.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard};
 
 use ricochet_log::{ChannelId, LogError, MessageSink, Schema};
@@ -15,8 +18,105 @@ use tokio_tungstenite::tungstenite::Message;
 
 use super::protocol::{self, Channel};
 
-/// Messages queued for one client before new ones are dropped for it.
-pub const CLIENT_QUEUE: usize = 4096;
+/// Bytes of messages queued for one client before new ones are dropped for it: 8 MiB, a
+/// few frames of a scene of thousands of bodies (a 3,000-body frame is about 0.3 MB). A
+/// message larger than the budget is queued only when the queue is empty, so a client holds
+/// at most `max(CLIENT_BUDGET, its largest message)` (plus the one being written).
+///
+/// Dropping whole messages, not disconnecting: each message on a channel is whole (a pose
+/// set, a stats record, a scene), so a viewer that missed some shows the next ones right;
+/// a stall of a second (a tab in the background) should not cost the connection. The
+/// latched `/scene` is sent again when it catches up.
+pub const CLIENT_BUDGET: usize = 8 << 20;
+
+/// Room beyond the budget for the server's answers (status, service responses, playback
+/// states: small, and a client waits for them), so they are not lost with the data.
+const ANSWER_ROOM: usize = 1 << 20;
+
+/// What one queued message is counted as beyond its payload: the queue's slot and the
+/// message's allocation (so a flood of tiny messages is bounded too).
+const MESSAGE_OVERHEAD: usize = 64;
+
+/// A client's outgoing queue: unbounded in count, bounded in bytes by [`CLIENT_BUDGET`]
+/// (the connection's task gives the bytes back as it writes each message).
+#[derive(Clone)]
+pub struct ClientQueue {
+    sender: mpsc::UnboundedSender<Message>,
+    queued: Arc<AtomicUsize>,
+}
+
+/// The connection's end of a [`ClientQueue`].
+pub struct ClientQueueReceiver {
+    receiver: mpsc::UnboundedReceiver<Message>,
+    queued: Arc<AtomicUsize>,
+}
+
+/// A new queue for one client.
+pub fn client_queue() -> (ClientQueue, ClientQueueReceiver) {
+    let (sender, receiver) = mpsc::unbounded_channel();
+    let queued = Arc::new(AtomicUsize::new(0));
+    (
+        ClientQueue {
+            sender,
+            queued: Arc::clone(&queued),
+        },
+        ClientQueueReceiver { receiver, queued },
+    )
+}
+
+/// The bytes a message is counted as.
+fn weight(message: &Message) -> usize {
+    message.len() + MESSAGE_OVERHEAD
+}
+
+impl ClientQueue {
+    /// Queues a data message if it fits the budget; `false` if it was dropped.
+    pub fn offer(&self, message: Message) -> bool {
+        self.offer_within(message, CLIENT_BUDGET)
+    }
+
+    /// Queues one of the server's answers (status, service response, playback state), which
+    /// may use [`ANSWER_ROOM`] beyond the budget; `false` if it was dropped.
+    pub fn answer(&self, message: Message) -> bool {
+        self.offer_within(message, CLIENT_BUDGET + ANSWER_ROOM)
+    }
+
+    fn offer_within(&self, message: Message, budget: usize) -> bool {
+        let weight = weight(&message);
+        // Producers hold the hub's lock, but for the client's own task (its statuses): two
+        // may pass the check at once, so a queue may exceed its budget by one message.
+        let queued = self.queued.load(Ordering::Acquire);
+        if queued > 0 && queued + weight > budget {
+            return false;
+        }
+        self.queued.fetch_add(weight, Ordering::AcqRel);
+        if self.sender.send(message).is_err() {
+            self.queued.fetch_sub(weight, Ordering::AcqRel);
+            return false;
+        }
+        true
+    }
+
+    /// Bytes queued now.
+    pub fn queued(&self) -> usize {
+        self.queued.load(Ordering::Acquire)
+    }
+}
+
+impl ClientQueueReceiver {
+    /// The next message to write (its bytes are given back to the budget), `None` once
+    /// every sender is gone.
+    pub async fn recv(&mut self) -> Option<Message> {
+        let message = self.receiver.recv().await?;
+        self.queued.fetch_sub(weight(&message), Ordering::AcqRel);
+        Some(message)
+    }
+}
+
+/// Channels one client may advertise (`clientPublish`): Foxglove's panels advertise a few
+/// (the 3D panel's click tools, a Publish panel each); more are refused with a status, so
+/// their memory is bounded.
+pub const MAX_CLIENT_CHANNELS: usize = 256;
 
 /// Topics whose last message is sent again to a client that subscribes: each is a whole
 /// state (`/scene` and `/scene/static` are sent only when their bodies change).
@@ -27,13 +127,15 @@ pub const MAX_PENDING_INPUTS: usize = 10_000;
 
 /// One connected client.
 struct Client {
-    queue: mpsc::Sender<Message>,
+    queue: ClientQueue,
     /// Its channels, by its id: those on `/input` in JSON.
     publishes: BTreeMap<u32, bool>,
     /// By channel id: the client's subscription id.
     subscriptions: BTreeMap<u32, u32>,
     /// Messages dropped since it was last told.
     dropped: u64,
+    /// Latched channels whose message was dropped for it: sent again when it catches up.
+    stale: BTreeSet<u32>,
 }
 
 /// Everything the simulation thread and the connections share.
@@ -79,7 +181,7 @@ impl Shared {
     }
 
     /// A new client with its outgoing queue; returns its id.
-    pub fn connect(&mut self, queue: mpsc::Sender<Message>) -> u64 {
+    pub fn connect(&mut self, queue: ClientQueue) -> u64 {
         let id = self.next_client;
         self.next_client += 1;
         self.clients.insert(
@@ -89,6 +191,7 @@ impl Shared {
                 publishes: BTreeMap::new(),
                 subscriptions: BTreeMap::new(),
                 dropped: 0,
+                stale: BTreeSet::new(),
             },
         );
         id
@@ -128,8 +231,9 @@ impl Shared {
             c.subscriptions.insert(channel, subscription);
             if let Some((time, payload)) = latched {
                 let data = protocol::message_data(subscription, time, &payload);
-                if c.queue.try_send(Message::binary(data)).is_err() {
+                if !c.queue.offer(Message::binary(data)) {
                     c.dropped += 1;
+                    c.stale.insert(channel);
                 }
             }
         }
@@ -138,12 +242,26 @@ impl Shared {
 
     /// `client` will publish on its channel `id`. Any channel may be advertised (Foxglove's
     /// 3D panel advertises its click tools' topics); only messages on `/input` in JSON are
-    /// taken, others are refused when they come.
-    pub fn advertise(&mut self, client: u64, id: u32, topic: &str, encoding: &str) {
+    /// taken, others are refused when they come. Past [`MAX_CLIENT_CHANNELS`] a new channel
+    /// is refused (an error for the client's status).
+    pub fn advertise(
+        &mut self,
+        client: u64,
+        id: u32,
+        topic: &str,
+        encoding: &str,
+    ) -> Result<(), String> {
         let input = topic == "/input" && encoding == "json";
         if let Some(c) = self.clients.get_mut(&client) {
+            if c.publishes.len() >= MAX_CLIENT_CHANNELS && !c.publishes.contains_key(&id) {
+                return Err(format!(
+                    "advertise: channel {id} refused, a client may advertise at most \
+                     {MAX_CLIENT_CHANNELS} channels (unadvertise some first)"
+                ));
+            }
             c.publishes.insert(id, input);
         }
+        Ok(())
     }
 
     /// `client` stops publishing on `ids`.
@@ -190,7 +308,12 @@ impl Shared {
 
     /// Sends the playback state to every client.
     pub fn playback_state(&mut self, state: Vec<u8>) {
-        self.broadcast(&Message::binary(state));
+        let state = Message::binary(state);
+        for c in self.clients.values_mut() {
+            if !c.queue.answer(state.clone()) {
+                c.dropped += 1;
+            }
+        }
     }
 
     /// Answers `client`'s call: its JSON response, or why it failed.
@@ -209,7 +332,7 @@ impl Shared {
                 .json(),
             ),
         };
-        let _ = c.queue.try_send(message);
+        let _ = c.queue.answer(message);
     }
 
     /// Tells `client` something (a status message), if it is still there.
@@ -219,7 +342,7 @@ impl Shared {
                 level,
                 message: text,
             };
-            let _ = c.queue.try_send(Message::text(status.json()));
+            let _ = c.queue.answer(Message::text(status.json()));
         }
     }
 
@@ -233,7 +356,7 @@ impl Shared {
     /// Sends `data` to every client (the time, a status), dropping it for full queues.
     pub fn broadcast(&mut self, data: &Message) {
         for c in self.clients.values_mut() {
-            if c.queue.try_send(data.clone()).is_err() {
+            if !c.queue.offer(data.clone()) {
                 c.dropped += 1;
             }
         }
@@ -242,16 +365,29 @@ impl Shared {
     /// Publishes a message on `channel` to its subscribers.
     fn publish(&mut self, channel: u32, time_ns: u64, payload: Vec<u8>) {
         let mut dropped = 0;
+        let latched = self
+            .channels
+            .iter()
+            .any(|c| c.id == channel && LATCHED.contains(&c.topic.as_str()));
         for c in self.clients.values_mut() {
             let Some(&sub) = c.subscriptions.get(&channel) else {
                 continue;
             };
             let data = Message::binary(protocol::message_data(sub, time_ns, &payload));
-            if c.queue.try_send(data).is_err() {
+            if !c.queue.offer(data) {
                 c.dropped += 1;
                 dropped += 1;
-            } else if c.dropped > 0 {
-                // It caught up: say how much it missed.
+                if latched {
+                    c.stale.insert(channel);
+                }
+                continue;
+            }
+            if latched {
+                c.stale.remove(&channel);
+            }
+            // It caught up (half its budget free): say how much it missed, and send again
+            // the latest state of the latched channels it missed.
+            if c.dropped > 0 && c.queue.queued() < CLIENT_BUDGET / 2 {
                 let text = format!(
                     "this client was too slow: {} messages were dropped for it",
                     c.dropped
@@ -260,16 +396,23 @@ impl Shared {
                     level: 1,
                     message: &text,
                 };
-                if c.queue.try_send(Message::text(status.json())).is_ok() {
+                if c.queue.answer(Message::text(status.json())) {
                     c.dropped = 0;
+                }
+                for stale in std::mem::take(&mut c.stale) {
+                    let (Some(&sub), Some((time, payload))) =
+                        (c.subscriptions.get(&stale), self.latched.get(&stale))
+                    else {
+                        continue;
+                    };
+                    let data = protocol::message_data(sub, *time, payload);
+                    if !c.queue.offer(Message::binary(data)) {
+                        c.stale.insert(stale);
+                    }
                 }
             }
         }
         self.dropped += dropped;
-        let latched = self
-            .channels
-            .iter()
-            .any(|c| c.id == channel && LATCHED.contains(&c.topic.as_str()));
         if latched {
             self.latched.insert(channel, (time_ns, payload));
         }

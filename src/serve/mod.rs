@@ -9,6 +9,7 @@
 //! runtime of its own thread (`server.rs`); the two share the [`hub::Hub`].
 
 mod hub;
+mod load_path;
 mod protocol;
 mod server;
 mod services;

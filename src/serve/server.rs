@@ -1,17 +1,24 @@
 //! The WebSocket side of `ricochet serve`: accepts connections on a tokio runtime of its own
 //! (one thread), negotiates `foxglove.websocket.v1` or `foxglove.sdk.v1`, sends the server
 //! info and the channels, and runs each client: its subscriptions in, its queue out.
+//!
+//! A connection costs memory and a file descriptor from its first byte, so the handshakes
+//! are bounded too: at most [`MAX_PENDING_HANDSHAKES`] at once (a new one evicts the
+//! oldest, so sockets that stop mid-request never lock out a real client), each at most
+//! [`HANDSHAKE_TIMEOUT`]. Running out of file descriptors backs the accept loop off.
 
+use std::collections::VecDeque;
 use std::net::SocketAddr;
+use std::time::Duration;
 
 use futures_util::{SinkExt, StreamExt};
 use tokio::net::{TcpListener, TcpStream};
-use tokio::sync::mpsc;
+use tokio::sync::oneshot;
 use tokio_tungstenite::tungstenite::Message;
 use tokio_tungstenite::tungstenite::handshake::server::{ErrorResponse, Request, Response};
 use tokio_tungstenite::tungstenite::http::{HeaderValue, StatusCode};
 
-use super::hub::{CLIENT_QUEUE, Hub};
+use super::hub::{Hub, client_queue};
 use super::protocol::{self, ClientMessage, ServerMessage};
 
 /// Clients served at once; more are refused (HTTP 503).
@@ -20,15 +27,52 @@ pub const MAX_CLIENTS: usize = 64;
 /// bytes).
 const MAX_CLIENT_MESSAGE: usize = 64 * 1024;
 
+/// Handshakes under way at once (each holds a socket and at most tungstenite's 64 KiB of
+/// request); a connection past them evicts the oldest.
+pub const MAX_PENDING_HANDSHAKES: usize = 32;
+/// How long a handshake may take from the connection (a browser on a LAN takes
+/// milliseconds).
+pub const HANDSHAKE_TIMEOUT: Duration = Duration::from_secs(5);
+/// The pause after a failed accept (out of file descriptors, mostly): the listener stays
+/// readable then, so retrying at once would spin.
+const ACCEPT_BACKOFF: Duration = Duration::from_millis(100);
+
 /// Accepts connections on `listener` until the runtime stops.
 pub async fn accept(listener: TcpListener, hub: Hub, session: String) {
+    // The handshakes under way, oldest first: dropping one's sender evicts it; a finished
+    // one has dropped its receiver.
+    let mut pending: VecDeque<oneshot::Sender<()>> = VecDeque::new();
+    let mut failing = false;
     loop {
-        let Ok((stream, peer)) = listener.accept().await else {
-            continue;
+        let (stream, peer) = match listener.accept().await {
+            Ok(accepted) => accepted,
+            Err(e) => {
+                if !failing {
+                    tracing_note(&format!("serve: accepting a connection: {e}"));
+                }
+                failing = true;
+                pending.retain(|p| !p.is_closed());
+                // Out of descriptors, mostly: the oldest handshake gives its back (its task
+                // closes the socket when it runs next); with none, the clients hold them
+                // all, and only waiting helps.
+                if pending.pop_front().is_some() {
+                    tokio::task::yield_now().await;
+                } else {
+                    tokio::time::sleep(ACCEPT_BACKOFF).await;
+                }
+                continue;
+            }
         };
+        failing = false;
+        pending.retain(|p| !p.is_closed());
+        if pending.len() >= MAX_PENDING_HANDSHAKES {
+            pending.pop_front();
+        }
+        let (evict, evicted) = oneshot::channel();
+        pending.push_back(evict);
         let (hub, session) = (hub.clone(), session.clone());
         tokio::spawn(async move {
-            if let Err(e) = client(stream, peer, hub, &session).await {
+            if let Err(e) = client(stream, peer, hub, &session, evicted).await {
                 tracing_note(&format!("serve: client {peer}: {e}"));
             }
         });
@@ -71,15 +115,26 @@ async fn client(
     peer: SocketAddr,
     hub: Hub,
     session: &str,
+    evicted: oneshot::Receiver<()>,
 ) -> Result<(), String> {
     let config = tokio_tungstenite::tungstenite::protocol::WebSocketConfig::default()
         .max_message_size(Some(MAX_CLIENT_MESSAGE))
         .max_frame_size(Some(MAX_CLIENT_MESSAGE));
-    let ws = tokio_tungstenite::accept_hdr_async_with_config(stream, negotiate, Some(config))
-        .await
-        .map_err(|e| format!("handshake: {e}"))?;
+    let handshake =
+        tokio_tungstenite::accept_hdr_async_with_config(stream, negotiate, Some(config));
+    let ws = tokio::select! {
+        done = tokio::time::timeout(HANDSHAKE_TIMEOUT, handshake) => match done {
+            Ok(ws) => ws.map_err(|e| format!("handshake: {e}"))?,
+            Err(_) => return Err(format!(
+                "handshake: not finished within {} s, closed", HANDSHAKE_TIMEOUT.as_secs()
+            )),
+        },
+        _ = evicted => return Err(format!(
+            "handshake: closed unfinished, {MAX_PENDING_HANDSHAKES} newer connections came"
+        )),
+    };
     let (mut out, mut incoming) = ws.split();
-    let (queue, mut pending) = mpsc::channel::<Message>(CLIENT_QUEUE);
+    let (queue, mut pending) = client_queue();
     let admitted = {
         let mut s = hub.lock();
         (s.client_count() < MAX_CLIENTS).then(|| {
@@ -130,13 +185,13 @@ async fn client(
                     Some(Ok(Message::Text(text))) => {
                         if let Err(why) = handle(&hub, id, text.as_str()) {
                             let status = ServerMessage::Status { level: 2, message: &why };
-                            let _ = queue.try_send(Message::text(status.json()));
+                            let _ = queue.answer(Message::text(status.json()));
                         }
                     }
                     Some(Ok(Message::Binary(data))) => {
                         if let Err(why) = publish(&hub, id, &data, &mut limit) {
                             let status = ServerMessage::Status { level: 2, message: &why };
-                            let _ = queue.try_send(Message::text(status.json()));
+                            let _ = queue.answer(Message::text(status.json()));
                         }
                     }
                     Some(Ok(_)) => {}
@@ -164,7 +219,7 @@ fn handle(hub: &Hub, client: u64, text: &str) -> Result<(), String> {
         ClientMessage::Unsubscribe { subscription_ids } => s.unsubscribe(client, &subscription_ids),
         ClientMessage::Advertise { channels } => {
             for c in channels {
-                s.advertise(client, c.id, &c.topic, &c.encoding);
+                s.advertise(client, c.id, &c.topic, &c.encoding)?;
             }
         }
         ClientMessage::Unadvertise { channel_ids } => s.unadvertise(client, &channel_ids),

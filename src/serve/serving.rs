@@ -220,13 +220,9 @@ impl Serving {
                     ))));
                 }
                 if let services::Command::Load(path) = command {
-                    match crate::load::load_text(Some(std::path::Path::new(&path))) {
+                    match super::load_path::load(&path) {
                         Ok((scenario, text)) => (self.scenario, self.text) = (scenario, text),
-                        Err(_) => {
-                            return Ok(Some(Err(format!(
-                                "{path}: not a scenario that loads (see the server's log)"
-                            ))));
-                        }
+                        Err(why) => return Ok(Some(Err(why))),
                     }
                 }
                 recording = self.restart(hub, true)?;
