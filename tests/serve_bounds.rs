@@ -15,14 +15,14 @@ use tokio_tungstenite::tungstenite::Message;
 use crate::serve_client::*;
 
 /// Advertises `/input` (JSON) as the client's channel 5.
-async fn advertise_input(ws: &mut Ws) {
+pub(crate) async fn advertise_input(ws: &mut Ws) {
     let advertise = serde_json::json!({"op": "advertise", "channels": [
         {"id": 5, "topic": "/input", "encoding": "json", "schemaName": "ricochet.Input"}]});
     ws.send(Message::text(advertise.to_string())).await.unwrap();
 }
 
 /// Publishes `text` on the client's channel 5.
-async fn publish(ws: &mut Ws, text: &str) {
+pub(crate) async fn publish(ws: &mut Ws, text: &str) {
     let mut data = vec![1u8];
     data.extend_from_slice(&5u32.to_le_bytes());
     data.extend_from_slice(text.as_bytes());
@@ -30,7 +30,7 @@ async fn publish(ws: &mut Ws, text: &str) {
 }
 
 /// The next status message's (level, text).
-async fn next_status(ws: &mut Ws) -> (u64, String) {
+pub(crate) async fn next_status(ws: &mut Ws) -> (u64, String) {
     loop {
         let v = next_json(ws).await;
         if v["op"] == "status" {
@@ -100,7 +100,7 @@ async fn call_with_statuses(
 }
 
 /// Connects, returning the socket and the services' advertisement.
-async fn open(server: &Server, subprotocol: &str) -> (Ws, Value) {
+pub(crate) async fn open(server: &Server, subprotocol: &str) -> (Ws, Value) {
     let (mut ws, _) = connect(&server.url, subprotocol).await.unwrap();
     loop {
         let v = any_json(&mut ws).await;
@@ -111,7 +111,7 @@ async fn open(server: &Server, subprotocol: &str) -> (Ws, Value) {
 }
 
 /// SIGTERM, then the exit status, waiting at most `limit`.
-fn terminate(server: &mut Server, limit: Duration) -> std::process::ExitStatus {
+pub(crate) fn terminate(server: &mut Server, limit: Duration) -> std::process::ExitStatus {
     let pid = server.child.id().to_string();
     assert!(
         Command::new("kill")
@@ -134,7 +134,7 @@ fn terminate(server: &mut Server, limit: Duration) -> std::process::ExitStatus {
 }
 
 /// `ricochet replay` of `log` gives the same bytes; the frames it holds (`/stats`).
-fn replays_byte_for_byte(log: &Path) -> usize {
+pub(crate) fn replays_byte_for_byte(log: &Path) -> usize {
     let replayed = log.with_extension("replay.mcap");
     let o = Command::new(env!("CARGO_BIN_EXE_ricochet"))
         .args([

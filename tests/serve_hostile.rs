@@ -17,15 +17,15 @@ use tokio_tungstenite::tungstenite::Message;
 use crate::serve_client::*;
 
 /// The server's per-client byte budget and its room for answers (src/serve/hub.rs).
-const CLIENT_BUDGET: u64 = 8 << 20;
-const ANSWER_ROOM: u64 = 1 << 20;
+pub(crate) const CLIENT_BUDGET: u64 = 8 << 20;
+pub(crate) const ANSWER_ROOM: u64 = 1 << 20;
 
-fn port(url: &str) -> u16 {
+pub(crate) fn port(url: &str) -> u16 {
     url.rsplit(':').next().unwrap().parse().unwrap()
 }
 
 /// A field of /proc/PID/status, in kB.
-fn status_kb(pid: u32, field: &str) -> u64 {
+pub(crate) fn status_kb(pid: u32, field: &str) -> u64 {
     let status = std::fs::read_to_string(format!("/proc/{pid}/status")).unwrap();
     status
         .lines()
@@ -154,7 +154,7 @@ fn advertising_past_the_cap_is_refused_and_the_client_told() {
 
 /// A scene of `n` circles drifting apart on a layer that collides with nothing: every frame
 /// sends every body on /bodies and /tf.
-fn drifting_scene(n: usize) -> String {
+pub(crate) fn drifting_scene(n: usize) -> String {
     let mut text = String::from("hz = 60\nframes = 100000\nlayers = [\"dust\"]\n");
     for i in 0..n {
         let (x, y) = ((i % 100) as f64 * 3.0, (i / 100) as f64 * 3.0);

@@ -19,6 +19,7 @@ mod serve_client;
 mod serve_hostile;
 mod serve_load;
 mod serve_session;
+mod serve_siege;
 mod serve_ws;
 mod stress;
 mod threads;
