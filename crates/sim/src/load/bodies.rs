@@ -4,7 +4,7 @@
 use std::collections::BTreeMap;
 use std::ops::Range;
 
-use crate::def::{BodyDef, BodyKind, Controller, Layers, Split};
+use crate::def::{BodyDef, BodyKind, Controller, Layers, MAX_MASS, MIN_MASS, Split};
 use crate::load::context::{Ctx, ScenarioError, finite, unknown, vec2, within_world};
 use crate::load::file::{BodyFile, ControllerFile, SplitFile};
 
@@ -98,17 +98,30 @@ pub(crate) fn references(
     span: Range<usize>,
     field: &str,
 ) -> Result<(), ScenarioError> {
-    if let Some(ControllerFile::Ship { bullet, .. }) = &b.controller
-        && !templates.contains_key(bullet)
-    {
-        return Err(unknown(
-            ctx,
-            span,
-            format!("{field}.controller.bullet"),
-            "template",
-            bullet,
-            templates.keys(),
-        ));
+    if let Some(ControllerFile::Ship { bullet, .. }) = &b.controller {
+        let Some(t) = templates.get(bullet) else {
+            return Err(unknown(
+                ctx,
+                span,
+                format!("{field}.controller.bullet"),
+                "template",
+                bullet,
+                templates.keys(),
+            ));
+        };
+        // A bullet leaves at the ship's velocity plus `bullet_speed`; a static one never
+        // moves, so that velocity would be dropped without a word.
+        if t.kind == BodyKind::Static {
+            return Err(ctx.err(
+                span,
+                format!("{field}.controller.bullet"),
+                format!(
+                    "template \"{bullet}\" is static: a static bullet never moves, so its \
+                     velocity (the ship's plus bullet_speed) would be dropped: give the \
+                     template `kind = \"dynamic\"` (or \"kinematic\")"
+                ),
+            ));
+        }
     }
     for (i, s) in b.split.iter().flatten().enumerate() {
         if !templates.contains_key(&s.template) {
@@ -190,6 +203,16 @@ pub(crate) fn body_def(
     let mass = num("mass", b.mass.unwrap_or(1.0))?;
     if mass <= 0.0 {
         return Err(fail("mass", format!("must be greater than 0, got {mass}")));
+    }
+    if !(MIN_MASS..=MAX_MASS).contains(&mass) {
+        return Err(fail(
+            "mass",
+            format!(
+                "{mass:e} is outside {MIN_MASS:e} to {MAX_MASS:e}, the masses Ricochet \
+                 accepts (a heavier body's kinetic energy overflows, a lighter one's \
+                 velocity after a push)"
+            ),
+        ));
     }
     let lifetime = match b.lifetime {
         None => None,
