@@ -304,7 +304,23 @@ fn issue_20_limits_are_named_with_their_location() {
     case(
         "wider-than-wrap-world",
         "19:1",
-        &["bodies[1].shape", "reaches 5.5 along x and 5.5 along y", "10 x 10"],
+        &[
+            "bodies[1].shape",
+            "reaches 5.5 along x and 5.5 along y",
+            "10 x 10",
+        ],
+    );
+    // Was: every digit of -5e29 (30 of them), and 309 of 1e308: numbers are quoted in
+    // their shortest round-trip form, scientific past 1e16.
+    case(
+        "huge-clockwise-polygon",
+        "4:29",
+        &["bodies[0].shape.vertices", "(signed area -5e29)"],
+    );
+    case(
+        "huge-turn-input",
+        "2:53",
+        &["script[0].input", "between -1 and 1, got 1e308\n"],
     );
     // A template only the script spawns, in a world 100 wide but 10 tall: the box's centre
     // (4.5 away, it turns with the body) plus its half height 1 is 5.5 up.

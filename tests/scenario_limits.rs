@@ -45,7 +45,9 @@ fn a_kinetic_energy_past_f64_stops_the_run_with_the_frames_before() {
         let v: serde_json::Value = serde_json::from_str(line).unwrap();
         let ke = &v["data"]["kinetic_energy"];
         // The JSON form of a non-finite double is a string ("Infinity").
-        let ke = ke.as_f64().unwrap_or_else(|| panic!("not a finite number: {line}"));
+        let ke = ke
+            .as_f64()
+            .unwrap_or_else(|| panic!("not a finite number: {line}"));
         assert!(ke.is_finite() && ke > 0.0, "{line}");
         frames += 1;
     }
@@ -66,7 +68,10 @@ fn a_body_may_reach_exactly_half_a_wrap_world() {
         ("{ kind = \"circle\", radius = 5.000001 }", false),
         ("{ kind = \"aabb\", half_extents = [5, 0.5] }", true),
         ("{ kind = \"obb\", half_extents = [5, 0.5] }", false),
-        ("{ kind = \"circle\", radius = 1, center = [4.5, 0] }", false),
+        (
+            "{ kind = \"circle\", radius = 1, center = [4.5, 0] }",
+            false,
+        ),
     ] {
         let (_dir, path) = scenario(&format!("{world}shape = {shape}\n"));
         let o = ricochet(&["check", &path], b"");

@@ -45,7 +45,7 @@ pub enum ControlError {
     },
     /// A value passed for a body is not finite or beyond the coordinates Ricochet accepts.
     #[error(
-        "{field}: must be finite and within ±{}",
+        "{field}: must be finite and within ±{:e}",
         ricochet_geom::MAX_COORDINATE
     )]
     OutOfRange {

@@ -1,7 +1,7 @@
 //! Validated definitions: what a scenario file loads into (Box2D's `b2WorldDef` and
 //! `b2BodyDef`), each with a `Default`.
 
-use ricochet_geom::{Primitive, Rot, Shape, Vec2};
+use ricochet_geom::{Number, Primitive, Rot, Shape, Vec2};
 
 /// Index of a layer in [`Layers::names`].
 pub type LayerId = u8;
@@ -433,12 +433,16 @@ pub enum RunLengthError {
     #[error("must be 0 to {MAX_FRAMES} frames, got {0}")]
     TooManyFrames(u64),
     /// The timestep is below half a nanosecond: every frame would be logged at time 0.
-    #[error("a timestep of {0:e} s rounds to 0 ns; logs count time in whole nanoseconds")]
+    #[error(
+        "a timestep of {} s rounds to 0 ns; logs count time in whole nanoseconds",
+        Number(*.0)
+    )]
     StepRoundsToZero(f64),
     /// The last frame's time is past `u64::MAX` nanoseconds (about 584 years).
     #[error(
-        "frame {frames} at {dt:e} s per step is past the last time a log can hold \
-         (2^64 ns, about 584 years)"
+        "frame {frames} at {} s per step is past the last time a log can hold \
+         (2^64 ns, about 584 years)",
+        Number(*.dt)
     )]
     TooLong {
         /// Frames after frame 0.

@@ -7,6 +7,7 @@ use std::ops::Range;
 use crate::def::{BodyDef, BodyKind, Controller, Layers, MAX_MASS, MIN_MASS, Split};
 use crate::load::context::{Ctx, ScenarioError, finite, unknown, vec2, within_world};
 use crate::load::file::{BodyFile, ControllerFile, SplitFile};
+use ricochet_geom::{Number, Numbers};
 
 /// The most bodies that destroying one body can create through its split chain (its
 /// children, their children when destroyed, and so on). Asteroids' big → 2 medium → 4 small
@@ -151,7 +152,10 @@ pub(crate) fn body_def(
         if finite(v) {
             Ok(v)
         } else {
-            Err(fail(f, format!("must be a finite number, got {v}")))
+            Err(fail(
+                f,
+                format!("must be a finite number, got {}", Number(v)),
+            ))
         }
     };
     let pair = |f: &str, v: [f64; 2]| {
@@ -160,7 +164,7 @@ pub(crate) fn body_def(
         } else {
             Err(fail(
                 f,
-                format!("must be finite numbers, got [{}, {}]", v[0], v[1]),
+                format!("must be finite numbers, got {}", Numbers(v)),
             ))
         }
     };
@@ -202,15 +206,19 @@ pub(crate) fn body_def(
     };
     let mass = num("mass", b.mass.unwrap_or(1.0))?;
     if mass <= 0.0 {
-        return Err(fail("mass", format!("must be greater than 0, got {mass}")));
+        return Err(fail(
+            "mass",
+            format!("must be greater than 0, got {}", Number(mass)),
+        ));
     }
     if !(MIN_MASS..=MAX_MASS).contains(&mass) {
         return Err(fail(
             "mass",
             format!(
-                "{mass:e} is outside {MIN_MASS:e} to {MAX_MASS:e}, the masses Ricochet \
+                "{} is outside {MIN_MASS:e} to {MAX_MASS:e}, the masses Ricochet \
                  accepts (a heavier body's kinetic energy overflows, a lighter one's \
-                 velocity after a push)"
+                 velocity after a push)",
+                Number(mass)
             ),
         ));
     }
@@ -246,7 +254,8 @@ pub(crate) fn body_def(
                     return Err(fail(
                         "controller.muzzle",
                         format!(
-                            "{m:e} is beyond ±{:e}, the largest coordinate Ricochet accepts",
+                            "{} is beyond ±{:e}, the largest coordinate Ricochet accepts",
+                            Number(m),
                             ricochet_geom::MAX_COORDINATE
                         ),
                     ));

@@ -20,6 +20,7 @@ use chunks::split_bodies;
 pub use context::ScenarioError;
 use context::{Ctx, unknown};
 use file::{BodyFile, BodyTable, ScenarioFile};
+use ricochet_geom::Number;
 use script::script;
 use std::ops::Range;
 use toml::Spanned;
@@ -36,7 +37,10 @@ fn oversized(world: &crate::WorldDef, def: &crate::BodyDef) -> Option<String> {
          angle), more than half the {} x {} wrap-around world: a body in a wrapping world \
          must reach at most half its width and height, so that the wrap seam meets its \
          deepest image (make the shape smaller or the world larger)",
-        reach.x, reach.y, size.x, size.y
+        Number(reach.x),
+        Number(reach.y),
+        Number(size.x),
+        Number(size.y)
     ))
 }
 
