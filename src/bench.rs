@@ -14,7 +14,7 @@ use anyhow::{Context, bail};
 
 use crate::{files, out};
 use ricochet_scenes::bench::{DEFAULT_SCENES, Scene};
-use ricochet_study::bench::{Row, report, run_scene};
+use ricochet_study::bench::{MAX_FRAMES, Row, report, run_scene};
 
 /// Set in the environment of the process that runs one scene (`run` starts one per scene):
 /// it runs the scenes in-process and prints each result as a JSON line. Set it yourself to
@@ -47,7 +47,8 @@ fn run_child(name: &str, frames: u64) -> anyhow::Result<Row> {
 /// Runs the named scenes (or [`DEFAULT_SCENES`]), `frames` timed frames each, prints the
 /// table, writes the CSV. Each scene runs in its own process (see [`CHILD_ENV`]). Exit code
 /// 0 when every scene's contact sets agree with both rapier's and Box2D's, 1 when one does
-/// not, 2 for an unknown scene name or a zero frame count.
+/// not, 2 for an unknown scene name, a count past [`ricochet_scenes::bench::MAX_COUNT`], or a
+/// frame count of 0 or past [`MAX_FRAMES`].
 pub fn run(scenes: &[String], frames: u64, csv: Option<&Path>) -> anyhow::Result<ExitCode> {
     let names: Vec<String> = if scenes.is_empty() {
         DEFAULT_SCENES.iter().map(|s| (*s).to_owned()).collect()
@@ -66,6 +67,13 @@ pub fn run(scenes: &[String], frames: u64, csv: Option<&Path>) -> anyhow::Result
     }
     if frames == 0 {
         out::error("error: --frames must be at least 1");
+        return Ok(ExitCode::from(2));
+    }
+    if frames > MAX_FRAMES {
+        out::error(&format!(
+            "error: --frames must be at most {MAX_FRAMES} (a scene keeps every frame's \
+             timings), got {frames}"
+        ));
         return Ok(ExitCode::from(2));
     }
     if let Some(path) = csv {

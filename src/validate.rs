@@ -70,12 +70,11 @@ pub fn describe(sim: &Simulation, bad: &NonFinite) -> String {
     let w = sim.world();
     let name = w.index_of(bad.body).map_or("?", |i| w.name(i));
     format!(
-        "body {} #{} has a non-finite {} [{}, {}]",
+        "body {} #{} has a non-finite {} {}",
         crate::out::escape_controls(name),
         bad.body,
         bad.field,
-        bad.value[0],
-        bad.value[1]
+        ricochet_geom::Numbers(bad.value)
     )
 }
 

@@ -278,6 +278,59 @@ fn a_field_the_kind_ignores_is_named_with_what_to_write() {
     );
 }
 
+/// Issue #20's small ones and its bodies larger than the world: each was accepted (exit 0)
+/// before, and silently wrong.
+#[test]
+fn issue_20_limits_are_named_with_their_location() {
+    // Was: /stats.kinetic_energy = Infinity (0.5 * 1e300 * 1000^2), exit 0.
+    case(
+        "mass-too-large",
+        "7:1",
+        &["bodies[0].mass", "1e300", "outside 1e-12 to 1e15"],
+    );
+    // Was: the bullet appeared at rest, its velocity (ship's + bullet_speed) dropped.
+    case(
+        "static-bullet",
+        "12:58",
+        &[
+            "bodies[0].controller.bullet",
+            "template \"bullet\" is static",
+            "kind = \"dynamic\"",
+        ],
+    );
+    // The capsule reaches 5.5 from its origin (end a, 5 away, plus the radius 0.5): at some
+    // angle it spans 11 across the 10-wide world, so an image two world sizes away could
+    // touch a body the seam never tests there.
+    case(
+        "wider-than-wrap-world",
+        "19:1",
+        &[
+            "bodies[1].shape",
+            "reaches 5.5 along x and 5.5 along y",
+            "10 x 10",
+        ],
+    );
+    // Was: every digit of -5e29 (30 of them), and 309 of 1e308: numbers are quoted in
+    // their shortest round-trip form, scientific past 1e16.
+    case(
+        "huge-clockwise-polygon",
+        "4:29",
+        &["bodies[0].shape.vertices", "(signed area -5e29)"],
+    );
+    case(
+        "huge-turn-input",
+        "2:53",
+        &["script[0].input", "between -1 and 1, got 1e308\n"],
+    );
+    // A template only the script spawns, in a world 100 wide but 10 tall: the box's centre
+    // (4.5 away, it turns with the body) plus its half height 1 is 5.5 up.
+    case(
+        "template-wider-than-wrap-world",
+        "8:1",
+        &["templates.pair.shape", "5.5 along y", "100 x 10"],
+    );
+}
+
 #[test]
 fn every_bad_scenario_file_has_a_case() {
     let mut files: Vec<String> = std::fs::read_dir(crate::util::data("bad-scenarios"))

@@ -86,3 +86,30 @@ fn the_documented_command_names_known_scenes() {
     assert_eq!(o.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("--frames must be at least 1"), "{stderr}");
 }
+
+/// Issue #20: `bench rain-4294967296` aborted with an out-of-memory backtrace and
+/// `bench asteroids-18446744073709551615` grew by 600 MB/s until killed; `--frames` near
+/// `u64::MAX` panicked reserving the timings. Each is bad input now (exit 2) naming the
+/// scene and the cap, before anything is built; `--help` states both caps.
+#[test]
+fn counts_and_frames_past_the_caps_are_bad_input() {
+    for scene in ["rain-4294967296", "asteroids-18446744073709551615"] {
+        let o = ricochet(&["bench", scene, "--frames", "1"], b"");
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{scene}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{stderr}");
+        assert!(stderr.contains(&format!("scene \"{scene}\"")), "{stderr}");
+        assert!(stderr.contains("more than 1000000"), "{stderr}");
+    }
+    let o = ricochet(
+        &["bench", "asteroids-10", "--frames", "18446744073709551615"],
+        b"",
+    );
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("at most 1000000"), "{stderr}");
+    let help = ricochet(&["bench", "--help"], b"");
+    let help = String::from_utf8_lossy(&help.stdout);
+    assert!(help.contains("from 1 to 1000000"), "{help}");
+    assert!(help.contains("at most 1000000"), "{help}");
+}

@@ -13,6 +13,7 @@ mod golden;
 mod hostile;
 mod large_scenario;
 mod run_cli;
+mod scenario_limits;
 mod seek;
 mod serve_bounds;
 mod serve_client;

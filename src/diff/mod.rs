@@ -372,7 +372,8 @@ pub fn run(
 ) -> anyhow::Result<ExitCode> {
     if !(tolerance.is_finite() && tolerance >= 0.0) {
         out::error(&format!(
-            "error: --tolerance must be a finite number >= 0, got {tolerance}"
+            "error: --tolerance must be a finite number >= 0, got {}",
+            ricochet_geom::Number(tolerance)
         ));
         return Ok(ExitCode::from(2));
     }

@@ -80,6 +80,13 @@ impl Line {
     fn still(&self) -> bool {
         self.step == [0.0; 3]
     }
+
+    /// Whether every pose it predicts up to [`HORIZON`] frames after `frame` is finite (a
+    /// line is straight, so its two ends decide): a body near `f64::MAX` would otherwise
+    /// be predicted at infinity while its own pose is still finite.
+    fn finite_ahead(&self, frame: u64) -> bool {
+        self.at(frame + HORIZON).iter().all(|x| x.is_finite())
+    }
 }
 
 /// A body's motion as `/tf` has described it so far.
@@ -136,7 +143,7 @@ impl Motion {
             self.future = None;
         }
         match self.line {
-            Some(line) if near(p, line.at(frame)) => {
+            Some(line) if near(p, line.at(frame)) && line.finite_ahead(frame) => {
                 if self.future.is_none() && !line.still() {
                     self.predict(&line, frame, out);
                 }
@@ -157,7 +164,8 @@ impl Motion {
                     pose: last,
                     step,
                 };
-                let steady = near(p, line.at(frame)) && line.spacing().is_some();
+                let steady =
+                    near(p, line.at(frame)) && line.spacing().is_some() && line.finite_ahead(frame);
                 if steady {
                     // The pose at `frame - 1` was sent exactly: the line starts there.
                     if due {
@@ -209,5 +217,42 @@ impl Motion {
         let at = frame + line.spacing().unwrap_or(1);
         out.push((at, line.at(at)));
         self.future = Some(at);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Motion, Sample};
+    use ricochet_geom::Vec2;
+
+    /// Issue #20: no logged value may be non-finite. A body moving `1e307` a frame is finite
+    /// up to frame 17 (1.7e308 < f64::MAX), but a line's prediction 60 frames ahead passes
+    /// f64::MAX from its first frame on; `/tf` sends exact poses instead.
+    #[test]
+    fn a_line_predicting_past_f64_sends_exact_poses() {
+        let mut out: Vec<Sample> = Vec::new();
+        let mut m = Motion::appear(0, Vec2::ZERO, 0.0, false, &mut out);
+        for frame in 1..=17u64 {
+            m.frame(frame, Vec2::new(frame as f64 * 1e307, 0.0), 0.0, &mut out);
+        }
+        for (frame, pose) in &out {
+            assert!(
+                pose.iter().all(|x| x.is_finite()),
+                "frame {frame}: {pose:?}"
+            );
+        }
+        // Every frame from 1 on is sent exactly, as for any motion that is not a line.
+        assert_eq!(out.len(), 18);
+    }
+
+    /// The guard changes nothing for an ordinary line: one prediction, 60 frames ahead.
+    #[test]
+    fn an_ordinary_line_is_still_predicted() {
+        let mut out: Vec<Sample> = Vec::new();
+        let mut m = Motion::appear(0, Vec2::ZERO, 0.0, false, &mut out);
+        for frame in 1..=5u64 {
+            m.frame(frame, Vec2::new(frame as f64, 0.0), 0.0, &mut out);
+        }
+        assert!(out.iter().any(|(f, _)| *f == 62), "{out:?}");
     }
 }

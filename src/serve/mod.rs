@@ -152,7 +152,7 @@ pub fn run(o: &Options) -> anyhow::Result<ExitCode> {
     if !(o.speed.is_finite() && o.speed > 0.0) {
         out::error(&format!(
             "error: --speed must be a positive number, got {}",
-            o.speed
+            ricochet_geom::Number(o.speed)
         ));
         return Ok(ExitCode::from(2));
     }

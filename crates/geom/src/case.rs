@@ -100,8 +100,9 @@ fn body(def: &BodyDef, name: &str) -> Result<CaseBody, (String, String)> {
             return Err((
                 format!("{name}.position[{i}]"),
                 format!(
-                    "must be a finite number within ±{:e}, got {v}",
-                    crate::MAX_COORDINATE
+                    "must be a finite number within ±{:e}, got {}",
+                    crate::MAX_COORDINATE,
+                    crate::Number(*v)
                 ),
             ));
         }

@@ -48,6 +48,7 @@ mod contact;
 mod cores;
 mod def;
 mod math;
+mod number;
 mod placed;
 mod shape;
 mod toi;
@@ -58,6 +59,7 @@ pub use collide::{contact, contact_placed, overlaps, overlaps_placed, pair_name}
 pub use contact::Contact;
 pub use def::ShapeDef;
 pub use math::{Pose, Rot, Vec2};
+pub use number::{Number, Numbers};
 pub use placed::{
     PlacedAabb, PlacedCapsule, PlacedCircle, PlacedObb, PlacedPolygon, PlacedPrimitive, place,
 };

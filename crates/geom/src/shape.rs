@@ -1,6 +1,7 @@
 //! The shapes a body can carry, in local coordinates, validated on construction.
 
 use crate::math::{Vec2, cross};
+use crate::number::Number;
 
 /// The most vertices a polygon may have (Box2D's limit too). Fixed so that a polygon is `Copy`
 /// and the narrow phase never allocates.
@@ -50,13 +51,16 @@ fn finite(field: &str, v: f64) -> Result<f64, ShapeError> {
     if !v.is_finite() {
         return Err(ShapeError::new(
             field,
-            format!("must be a finite number, got {v}"),
+            format!("must be a finite number, got {}", Number(v)),
         ));
     }
     if v.abs() > MAX_COORDINATE {
         return Err(ShapeError::new(
             field,
-            format!("{v:?} is beyond ±{MAX_COORDINATE:e}, the largest coordinate Ricochet accepts"),
+            format!(
+                "{} is beyond ±{MAX_COORDINATE:e}, the largest coordinate Ricochet accepts",
+                Number(v)
+            ),
         ));
     }
     Ok(v)
@@ -73,13 +77,16 @@ fn positive(field: &str, v: f64) -> Result<f64, ShapeError> {
     if v <= 0.0 {
         return Err(ShapeError::new(
             field,
-            format!("must be greater than 0, got {v}"),
+            format!("must be greater than 0, got {}", Number(v)),
         ));
     }
     if v < MIN_SIZE {
         return Err(ShapeError::new(
             field,
-            format!("{v:?} is below {MIN_SIZE:e}, the smallest size Ricochet accepts"),
+            format!(
+                "{} is below {MIN_SIZE:e}, the smallest size Ricochet accepts",
+                Number(v)
+            ),
         ));
     }
     Ok(v)
@@ -158,7 +165,7 @@ impl Polygon {
                 "vertices",
                 format!(
                     "polygon is clockwise or flat (signed area {}); list the vertices counter-clockwise",
-                    twice_area / 2.0
+                    Number(twice_area / 2.0)
                 ),
             ));
         }

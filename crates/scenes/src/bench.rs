@@ -33,6 +33,12 @@ const BULLET_SPEED: f64 = 60.0;
 /// Vertical distance between two platformer floors.
 const FLOOR_SPACING: f64 = 5.0;
 
+/// The largest count a scene name may ask for (`N`, `T` or `A`): the largest scene
+/// BENCHMARKS.md runs has a million tiles, and a million bodies take about 1.6 GB in the
+/// bench's three engines (about 1.2 KB a body at the peak, Ricochet 700 bytes), so a count
+/// past it is a typo, not a benchmark. `bench rain-4294967296` used to abort out of memory.
+pub const MAX_COUNT: usize = 1_000_000;
+
 /// A built-in scene and its size, parsed from its name.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Scene {
@@ -68,17 +74,36 @@ impl std::fmt::Display for SceneNameError {
 impl std::error::Error for SceneNameError {}
 
 impl Scene {
-    /// Parses `asteroids-N`, `platformer-T-A` or `rain-N` (counts at least 1, `_` allowed
-    /// between digits).
+    /// Parses `asteroids-N`, `platformer-T-A` or `rain-N` (counts from 1 to [`MAX_COUNT`],
+    /// `_` allowed between digits).
+    ///
+    /// # Errors
+    /// Not one of the three forms, or a count that is not a whole number from 1 to
+    /// [`MAX_COUNT`]; the message names the scene.
     pub fn parse(name: &str) -> Result<Scene, SceneNameError> {
         let count = |s: &str| -> Result<usize, SceneNameError> {
-            let n: usize = s.replace('_', "").parse().map_err(|e| {
-                SceneNameError(format!("scene {name:?}: {s:?} is not a count: {e}"))
+            let digits = s.replace('_', "");
+            // Any run of digits is a count, too large or not: the cap is the problem then.
+            let too_large = || {
+                SceneNameError(format!(
+                    "scene {name:?}: {s} is more than {MAX_COUNT}, the largest count a bench \
+                     scene may have"
+                ))
+            };
+            let n: usize = digits.parse().map_err(|e| {
+                if !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit()) {
+                    too_large()
+                } else {
+                    SceneNameError(format!("scene {name:?}: {s:?} is not a count: {e}"))
+                }
             })?;
             if n == 0 {
                 return Err(SceneNameError(format!(
                     "scene {name:?}: counts must be at least 1"
                 )));
+            }
+            if n > MAX_COUNT {
+                return Err(too_large());
             }
             Ok(n)
         };
@@ -404,6 +429,28 @@ mod tests {
             "snow-5",
         ] {
             assert!(Scene::parse(bad).is_err(), "{bad}");
+        }
+    }
+
+    /// Issue #20: `rain-4294967296` aborted out of memory and
+    /// `asteroids-18446744073709551615` grew until killed; past a `usize` it was "not a
+    /// count". Every count past the cap is refused by name, the cap itself accepted.
+    #[test]
+    fn counts_past_the_cap_are_refused_naming_the_scene_and_the_cap() {
+        assert_eq!(
+            Scene::parse("rain-1_000_000").unwrap(),
+            Scene::Rain { shapes: 1_000_000 }
+        );
+        for bad in [
+            "rain-1000001",
+            "rain-4294967296",
+            "asteroids-18446744073709551615",
+            "asteroids-99999999999999999999999",
+            "platformer-10-1000001",
+        ] {
+            let e = Scene::parse(bad).unwrap_err().to_string();
+            assert!(e.contains(&format!("{bad:?}")), "{e}");
+            assert!(e.contains("more than 1000000"), "{e}");
         }
     }
 

@@ -22,9 +22,10 @@ use crate::scenario::Scenario;
 pub struct NonFinite {
     /// The body (the lowest id with a non-finite field).
     pub body: Entity,
-    /// `position`, `velocity`, `angle` or `angular_velocity`.
+    /// `position`, `velocity`, `angle`, `angular_velocity`, or `kinetic_energy` (the
+    /// body at which the frame's `/stats.kinetic_energy` sum overflowed).
     pub field: &'static str,
-    /// The value (`[x, y]` as written, or `[angle, 0]`).
+    /// The value (`[x, y]` as written, `[angle, 0]`, or `[sum so far, 0]`).
     pub value: [f64; 2],
 }
 
@@ -44,7 +45,7 @@ pub enum ControlError {
     },
     /// A value passed for a body is not finite or beyond the coordinates Ricochet accepts.
     #[error(
-        "{field}: must be finite and within ±{}",
+        "{field}: must be finite and within ±{:e}",
         ricochet_geom::MAX_COORDINATE
     )]
     OutOfRange {
@@ -120,6 +121,12 @@ impl Simulation {
     }
 
     /// Creates a body now; it takes the lowest free id.
+    ///
+    /// The definition is trusted as given: what a scenario file's loader refuses (a mass
+    /// outside `MIN_MASS..=MAX_MASS`, a body wider or taller than a wrap world, see
+    /// [`crate::WorldBounds::oversized`]) is not refused here, since refusing would change
+    /// this signature. A game that builds definitions from untrusted data checks them
+    /// first.
     pub fn spawn(&mut self, def: &BodyDef) -> Entity {
         let e = self.world.spawn(def);
         self.world.refresh_active();
@@ -251,11 +258,24 @@ impl Simulation {
     }
 
     /// The first moving body, in id order, whose position, velocity, angle or angular
-    /// velocity is not finite, if any. Static bodies never change, and every value a body
-    /// starts with is checked finite, so only moving bodies are looked at (one pass over
-    /// them: call it after each step when a run must stop at the first overflow).
+    /// velocity is not finite, if any; else the body at which the kinetic energy the step
+    /// reports (`FrameStats::kinetic_energy`) overflows, if it does. Static bodies never
+    /// change, and every value a body starts with is checked finite, so only moving bodies
+    /// are looked at (call it after each step when a run must stop at the first overflow:
+    /// then every value a log holds is finite).
     #[must_use]
     pub fn first_non_finite(&self) -> Option<NonFinite> {
+        let w = &self.world;
+        self.first_non_finite_state().or_else(|| {
+            w.kinetic_energy_overflow().map(|i| NonFinite {
+                body: w.entity[i],
+                field: "kinetic_energy",
+                value: [w.kinetic_energy(), 0.0],
+            })
+        })
+    }
+
+    fn first_non_finite_state(&self) -> Option<NonFinite> {
         let w = &self.world;
         w.movers().iter().find_map(|&i| {
             let i = i as usize;

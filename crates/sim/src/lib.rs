@@ -79,8 +79,8 @@ mod world;
 pub use action::{Action, Event, ScriptAction};
 pub use control::{ControlError, NonFinite};
 pub use def::{
-    ActiveRegion, BodyDef, BodyKind, Controller, Doomed, LayerId, Layers, MAX_FRAMES, Response,
-    RunLengthError, Split, WorldBounds, WorldDef,
+    ActiveRegion, BodyDef, BodyKind, Controller, Doomed, LayerId, Layers, MAX_FRAMES, MAX_MASS,
+    MIN_MASS, Response, RunLengthError, Split, WorldBounds, WorldDef, shape_reach,
 };
 pub use entity::{Entity, EntityAllocator};
 pub use event::{FireOutcome, GameEvent, JumpOutcome, Removal, ScriptInput};

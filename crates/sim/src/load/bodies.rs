@@ -4,9 +4,10 @@
 use std::collections::BTreeMap;
 use std::ops::Range;
 
-use crate::def::{BodyDef, BodyKind, Controller, Layers, Split};
+use crate::def::{BodyDef, BodyKind, Controller, Layers, MAX_MASS, MIN_MASS, Split};
 use crate::load::context::{Ctx, ScenarioError, finite, unknown, vec2, within_world};
 use crate::load::file::{BodyFile, ControllerFile, SplitFile};
+use ricochet_geom::{Number, Numbers};
 
 /// The most bodies that destroying one body can create through its split chain (its
 /// children, their children when destroyed, and so on). Asteroids' big → 2 medium → 4 small
@@ -98,17 +99,30 @@ pub(crate) fn references(
     span: Range<usize>,
     field: &str,
 ) -> Result<(), ScenarioError> {
-    if let Some(ControllerFile::Ship { bullet, .. }) = &b.controller
-        && !templates.contains_key(bullet)
-    {
-        return Err(unknown(
-            ctx,
-            span,
-            format!("{field}.controller.bullet"),
-            "template",
-            bullet,
-            templates.keys(),
-        ));
+    if let Some(ControllerFile::Ship { bullet, .. }) = &b.controller {
+        let Some(t) = templates.get(bullet) else {
+            return Err(unknown(
+                ctx,
+                span,
+                format!("{field}.controller.bullet"),
+                "template",
+                bullet,
+                templates.keys(),
+            ));
+        };
+        // A bullet leaves at the ship's velocity plus `bullet_speed`; a static one never
+        // moves, so that velocity would be dropped without a word.
+        if t.kind == BodyKind::Static {
+            return Err(ctx.err(
+                span,
+                format!("{field}.controller.bullet"),
+                format!(
+                    "template \"{bullet}\" is static: a static bullet never moves, so its \
+                     velocity (the ship's plus bullet_speed) would be dropped: give the \
+                     template `kind = \"dynamic\"` (or \"kinematic\")"
+                ),
+            ));
+        }
     }
     for (i, s) in b.split.iter().flatten().enumerate() {
         if !templates.contains_key(&s.template) {
@@ -138,7 +152,10 @@ pub(crate) fn body_def(
         if finite(v) {
             Ok(v)
         } else {
-            Err(fail(f, format!("must be a finite number, got {v}")))
+            Err(fail(
+                f,
+                format!("must be a finite number, got {}", Number(v)),
+            ))
         }
     };
     let pair = |f: &str, v: [f64; 2]| {
@@ -147,7 +164,7 @@ pub(crate) fn body_def(
         } else {
             Err(fail(
                 f,
-                format!("must be finite numbers, got [{}, {}]", v[0], v[1]),
+                format!("must be finite numbers, got {}", Numbers(v)),
             ))
         }
     };
@@ -189,7 +206,21 @@ pub(crate) fn body_def(
     };
     let mass = num("mass", b.mass.unwrap_or(1.0))?;
     if mass <= 0.0 {
-        return Err(fail("mass", format!("must be greater than 0, got {mass}")));
+        return Err(fail(
+            "mass",
+            format!("must be greater than 0, got {}", Number(mass)),
+        ));
+    }
+    if !(MIN_MASS..=MAX_MASS).contains(&mass) {
+        return Err(fail(
+            "mass",
+            format!(
+                "{} is outside {MIN_MASS:e} to {MAX_MASS:e}, the masses Ricochet \
+                 accepts (a heavier body's kinetic energy overflows, a lighter one's \
+                 velocity after a push)",
+                Number(mass)
+            ),
+        ));
     }
     let lifetime = match b.lifetime {
         None => None,
@@ -223,7 +254,8 @@ pub(crate) fn body_def(
                     return Err(fail(
                         "controller.muzzle",
                         format!(
-                            "{m:e} is beyond ±{:e}, the largest coordinate Ricochet accepts",
+                            "{} is beyond ±{:e}, the largest coordinate Ricochet accepts",
+                            Number(m),
                             ricochet_geom::MAX_COORDINATE
                         ),
                     ));

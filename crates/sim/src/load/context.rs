@@ -183,9 +183,8 @@ pub(crate) fn within_world(
         return Err(fail(
             "position",
             format!(
-                "[{:?}, {:?}] is beyond ±{:e}, the largest coordinate Ricochet accepts",
-                p.x,
-                p.y,
+                "{} is beyond ±{:e}, the largest coordinate Ricochet accepts",
+                ricochet_geom::Numbers([p.x, p.y]),
                 ricochet_geom::MAX_COORDINATE
             ),
         ));

@@ -20,10 +20,29 @@ use chunks::split_bodies;
 pub use context::ScenarioError;
 use context::{Ctx, unknown};
 use file::{BodyFile, BodyTable, ScenarioFile};
+use ricochet_geom::Number;
 use script::script;
 use std::ops::Range;
 use toml::Spanned;
 use world::world_settings;
+
+/// The problem with `def` in a wrapping world it is too large for
+/// ([`crate::WorldBounds::oversized`]), if any.
+fn oversized(world: &crate::WorldDef, def: &crate::BodyDef) -> Option<String> {
+    let bounds = world.bounds?;
+    let reach = bounds.oversized(&def.shape)?;
+    let size = bounds.size();
+    Some(format!(
+        "the shape reaches {} along x and {} along y from the body's position (at some \
+         angle), more than half the {} x {} wrap-around world: a body in a wrapping world \
+         must reach at most half its width and height, so that the wrap seam meets its \
+         deepest image (make the shape smaller or the world larger)",
+        Number(reach.x),
+        Number(reach.y),
+        Number(size.x),
+        Number(size.y)
+    ))
+}
 
 /// Parses and checks a scenario. `file` is only used in error messages.
 pub fn load_scenario(text: &str, file: &str) -> Result<Scenario, ScenarioError> {
@@ -90,6 +109,11 @@ fn load(text: &str, file: &str, chunked: bool) -> Result<Scenario, ScenarioError
         let def = body_def(&ctx, &world.layers, t.get_ref(), t.span(), &field, name)?;
         if let Some((f, problem)) = ignored_field(def.kind, t.get_ref(), t.get_ref()) {
             return Err(ctx.err(t.span(), format!("{field}.{f}"), problem));
+        }
+        // Every template: a script's spawn, a ship's bullet, a split, and a live input's
+        // spawn in `serve` may create its body.
+        if let Some(problem) = oversized(&world, &def) {
+            return Err(ctx.err(t.span(), format!("{field}.shape"), problem));
         }
         templates.insert(name.clone(), def);
     }
@@ -159,6 +183,9 @@ fn load(text: &str, file: &str, chunked: bool) -> Result<Scenario, ScenarioError
         )?;
         if let Some((f, problem)) = ignored_field(def.kind, &merged, b.get_ref()) {
             return Err(ctx.err(b.span(), format!("{field}.{f}"), problem));
+        }
+        if let Some(problem) = oversized(&world, &def) {
+            return Err(ctx.err(b.span(), format!("{field}.shape"), problem));
         }
         bodies.push(def);
     }

@@ -7,6 +7,7 @@ use crate::def::{BodyDef, BodyKind};
 use crate::load::bodies::{names_sorted, shared_name};
 use crate::load::context::{Ctx, ScenarioError, finite, unknown, vec2, within_world};
 use crate::load::file::{ActionFile, EventFile, ScenarioFile};
+use ricochet_geom::Number;
 
 pub(crate) fn script(
     ctx: &Ctx<'_>,
@@ -79,7 +80,10 @@ pub(crate) fn script(
             if finite(x) && (-1.0..=1.0).contains(&x) {
                 Ok(x)
             } else {
-                Err(fail("input", format!("must be between -1 and 1, got {x}")))
+                Err(fail(
+                    "input",
+                    format!("must be between -1 and 1, got {}", Number(x)),
+                ))
             }
         };
         let action = match action {

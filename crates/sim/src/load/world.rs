@@ -8,6 +8,7 @@ use crate::def::{
 };
 use crate::load::context::{Ctx, ScenarioError, finite, unknown, vec2};
 use crate::load::file::ScenarioFile;
+use ricochet_geom::{Number, Numbers};
 
 fn timestep(ctx: &Ctx<'_>, raw: &ScenarioFile) -> Result<f64, ScenarioError> {
     match (&raw.hz, &raw.dt) {
@@ -18,7 +19,7 @@ fn timestep(ctx: &Ctx<'_>, raw: &ScenarioFile) -> Result<f64, ScenarioError> {
                 return Err(ctx.err(
                     h.span(),
                     "hz",
-                    format!("must be a finite number > 0, got {v}"),
+                    format!("must be a finite number > 0, got {}", Number(v)),
                 ));
             }
             Ok(1.0 / v)
@@ -29,7 +30,7 @@ fn timestep(ctx: &Ctx<'_>, raw: &ScenarioFile) -> Result<f64, ScenarioError> {
                 return Err(ctx.err(
                     d.span(),
                     "dt",
-                    format!("must be a finite number of seconds > 0, got {v}"),
+                    format!("must be a finite number of seconds > 0, got {}", Number(v)),
                 ));
             }
             Ok(v)
@@ -242,8 +243,8 @@ pub(crate) fn world_settings(
                 r.half_extents.span(),
                 "world.active_region.half_extents",
                 format!(
-                    "must be finite numbers > 0 on both axes, got [{}, {}]",
-                    h[0], h[1]
+                    "must be finite numbers > 0 on both axes, got {}",
+                    Numbers(h)
                 ),
             ));
         }

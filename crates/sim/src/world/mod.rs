@@ -575,6 +575,23 @@ impl World {
             .sum()
     }
 
+    /// The first dynamic body (world index, in [`World::kinetic_energy`]'s order) at which
+    /// that sum stops being finite, if it does: every velocity can be finite while `m v²`
+    /// overflows (a velocity past 1e154, or two bodies near `f64::MAX` each).
+    #[must_use]
+    pub(crate) fn kinetic_energy_overflow(&self) -> Option<usize> {
+        let mut sum = 0.0;
+        self.movers
+            .iter()
+            .map(|&i| i as usize)
+            .filter(|&i| self.kind[i] == BodyKind::Dynamic)
+            .find(|&i| {
+                let r = self.row[i] as usize;
+                sum += 0.5 * self.rows.mass[r] * self.rows.velocity[r].length_squared();
+                !sum.is_finite()
+            })
+    }
+
     /// The heap bytes the world holds: every column's capacity, the shape and name tables,
     /// the rows and the id allocator. An honest count of what it keeps, not of what the
     /// allocator adds around it.

@@ -149,7 +149,13 @@ fn durations(ms: &[f64]) -> Vec<Duration> {
         .collect()
 }
 
-/// Runs one scene: all three engines, `frames` timed frames after frame 0.
+/// The most timed frames a scene may run: each frame keeps seven timings (8 bytes each) for
+/// the medians, so a million frames hold 56 MB, and take hours on the largest scenes.
+/// `bench asteroids-10 --frames 18446744073709551615` used to panic reserving them.
+pub const MAX_FRAMES: u64 = 1_000_000;
+
+/// Runs one scene: all three engines, `frames` timed frames after frame 0 (at most
+/// [`MAX_FRAMES`]).
 /// `name` is the scene's name as asked (it names the row); `progress` hears what the run is
 /// doing (`NAME: N bodies, F frames`, the setup time, a note every 30 s).
 pub fn run_scene(
@@ -158,6 +164,10 @@ pub fn run_scene(
     frames: u64,
     mut progress: impl FnMut(&str),
 ) -> anyhow::Result<Row> {
+    anyhow::ensure!(
+        (1..=MAX_FRAMES).contains(&frames),
+        "{name}: --frames must be 1 to {MAX_FRAMES}, got {frames}"
+    );
     reset_peak();
     let setup = Instant::now();
     let scenario = scene.build(frames);

@@ -6,4 +6,4 @@
 pub mod measure;
 pub mod report;
 
-pub use measure::{Row, run_scene};
+pub use measure::{MAX_FRAMES, Row, run_scene};
