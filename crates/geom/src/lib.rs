@@ -8,7 +8,8 @@
 //! point) for every pairing.
 //!
 //! **Never:** does I/O, keeps state between calls, reads the clock, allocates in the narrow
-//! phase, or uses platform trigonometry (all `sin`/`cos` go through `libm`, so results are the
+//! phase (but for a pair of compounds with more than 64 part pairs: their parts' boxes, to
+//! cull them), or uses platform trigonometry (all `sin`/`cos` go through `libm`, so results are the
 //! same bits on every machine). It knows nothing about bodies, layers, time or responses: those
 //! belong to the simulation crate.
 //!
@@ -62,8 +63,8 @@ pub use placed::{
     PlacedAabb, PlacedCapsule, PlacedCircle, PlacedObb, PlacedPolygon, PlacedPrimitive, place,
 };
 pub use shape::{
-    Aabb, Capsule, Circle, Compound, MAX_COORDINATE, MAX_POLYGON_VERTICES, MIN_SIZE, Obb, Polygon,
-    Primitive, Shape, ShapeError, ShapeKind,
+    Aabb, Capsule, Circle, Compound, MAX_COMPOUND_PARTS, MAX_COORDINATE, MAX_POLYGON_VERTICES,
+    MIN_SIZE, Obb, Polygon, Primitive, Shape, ShapeError, ShapeKind,
 };
 pub use toi::{Impact, Sweep, time_of_impact};
 
