@@ -267,8 +267,10 @@ enum Command {
     ///
     /// Prints {"id", "overlap", "depth", "normal", "point"} per pair. depth > 0 is the
     /// penetration; depth <= 0 is minus the distance. The normal points from a to b: moving
-    /// b by depth * normal separates the pair. Bad input, an unknown key included, is
-    /// reported by case id and field, with exit code 2, and nothing is printed to stdout.
+    /// b by depth * normal separates the pair. Bad input (an unknown key, a key given twice,
+    /// a wrong type) is reported by case id, line and field, with exit code 2, and nothing
+    /// is printed to stdout. The input is streamed: at most 4 MiB a case, ids of at most 256
+    /// bytes, compounds of at most 1024 parts; the first 20 errors are printed, then a count.
     ///
     /// Example: ricochet collide tests/data/collision-cases.json | head -3
     Collide {

@@ -14,7 +14,8 @@ use crate::out;
 use crate::session::{SCENARIO_ATTACHMENT, Session};
 
 /// Replays `log` into `output` (default: `NAME.replay.mcap` beside it). Exit code 0 when the
-/// replay is byte-identical to the recording, 1 when not, 2 when `log` is no session.
+/// replay is byte-identical to the recording, 1 when not, 2 when `log` is no session (no
+/// scenario attachment, or more than one).
 pub fn run(log: &Path, output: Option<PathBuf>) -> anyhow::Result<ExitCode> {
     let file = match LogFile::open(log) {
         Ok(f) => f,
@@ -23,6 +24,19 @@ pub fn run(log: &Path, output: Option<PathBuf>) -> anyhow::Result<ExitCode> {
             return Ok(ExitCode::from(2));
         }
     };
+    // A session carries the one scenario it was played from: with two, which one the
+    // recording shows is unknown, and replaying either could pass or fail falsely.
+    let scenarios = file
+        .attachment_names()
+        .filter(|n| *n == SCENARIO_ATTACHMENT)
+        .count();
+    if scenarios > 1 {
+        out::error(&format!(
+            "error: {}: {scenarios} {SCENARIO_ATTACHMENT} attachments: a session recorded by              `ricochet serve --record` carries exactly one, so which one it was played from              is unknown",
+            log.display()
+        ));
+        return Ok(ExitCode::from(2));
+    }
     let Some(text) = file.attachment(SCENARIO_ATTACHMENT)? else {
         out::error(&format!(
             "error: {}: no {SCENARIO_ATTACHMENT} attachment: not a session recorded by \

@@ -7,6 +7,7 @@ mod bench_cli;
 mod channel_schemas;
 mod collide_cli;
 mod collision_cases;
+mod damaged_logs;
 mod dump_cli;
 mod fuzz_corpus;
 mod golden;

@@ -158,6 +158,9 @@ fn diff_topic(
                 count.messages_a += 1;
                 count.messages_b += 1;
                 if x.bytes() == y.bytes() {
+                    // Equal, but only if each decodes with its own log's schema.
+                    ma.check(&x)?;
+                    mb.check(&y)?;
                     continue;
                 }
                 let later = best.is_some_and(|b| (x.log_time(), rank(topic)) > b);
@@ -284,6 +287,10 @@ fn lockstep(
         }
         if x.bytes() != y.bytes() {
             group.push((rank(x.topic()), x, y));
+        } else {
+            // Equal, but only if each decodes with its own log's schema.
+            ma.check(&x)?;
+            mb.check(&y)?;
         }
     }
     resolve(&mut group, &mut counts, &mut first, &mut ma, &mut mb)?;
@@ -295,8 +302,91 @@ fn lockstep(
     }))
 }
 
+/// How a topic's channels are encoded in a log: message encoding, schema name, schema
+/// encoding and schema bytes of each, in channel id order.
+fn encodings<'a>(log: &'a LogFile, topic: &str) -> Vec<(&'a str, &'a str, &'a str, &'a [u8])> {
+    log.channels()
+        .filter(|c| c.topic == topic)
+        .map(|c| {
+            (
+                c.message_encoding.as_str(),
+                c.schema_name.as_str(),
+                c.schema_encoding.as_str(),
+                c.schema_data.as_slice(),
+            )
+        })
+        .collect()
+}
+
+/// The first topic, in report order, whose schema differs between the two logs (its name,
+/// encoding or bytes): equal bytes read through different schemas are different messages,
+/// so this is a difference before any message's.
+fn schema_difference(a: &LogFile, b: &LogFile) -> Option<Divergence> {
+    let both: BTreeSet<&str> = a
+        .channels()
+        .map(|c| c.topic.as_str())
+        .filter(|t| b.channels().any(|c| c.topic == *t))
+        .collect();
+    let mut ordered: Vec<&str> = both.into_iter().collect();
+    ordered.sort_by_key(|t| (rank(t), *t));
+    ordered.into_iter().find_map(|topic| {
+        let (ea, eb) = (encodings(a, topic), encodings(b, topic));
+        if ea == eb {
+            return None;
+        }
+        let describe = |e: &[(&str, &str, &str, &[u8])], other: &[(&str, &str, &str, &[u8])]| {
+            let parts: Vec<String> = e
+                .iter()
+                .enumerate()
+                .map(|(i, (message, name, encoding, data))| {
+                    let mut text = format!(
+                        "{} ({message} messages, {encoding} schema of {} bytes)",
+                        out::escape_controls(name),
+                        data.len()
+                    );
+                    // Same name and size: say where the bytes part.
+                    if let Some((.., o)) = other.get(i)
+                        && o.len() == data.len()
+                        && let Some(at) = data.iter().zip(o.iter()).position(|(x, y)| x != y)
+                    {
+                        text += &format!(", differing from byte {at}");
+                    }
+                    text
+                })
+                .collect();
+            parts.join("; ")
+        };
+        Some(Divergence {
+            topic: topic.to_owned(),
+            time_ns: 0,
+            frame: None,
+            body: None,
+            field: "schema".to_owned(),
+            a: describe(&ea, &eb),
+            b: describe(&eb, &ea),
+        })
+    })
+}
+
 /// Compares two logs, streaming them topic by topic: memory does not grow with their length.
+/// A schema that differs between them is the first difference; every message found equal
+/// decodes with its own log's schema (a corrupt log's error otherwise).
 pub fn diff_files(
+    a: &LogFile,
+    b: &LogFile,
+    tol: f64,
+    only: Option<&str>,
+) -> Result<Report, DiffError> {
+    let mut report = diff_messages(a, b, tol, only)?;
+    if let Some(d) = schema_difference(a, b).filter(|d| only.is_none_or(|t| t == d.topic)) {
+        report.equal = false;
+        report.first = Some(d);
+    }
+    Ok(report)
+}
+
+/// The messages of two logs compared, in one pass or topic by topic.
+fn diff_messages(
     a: &LogFile,
     b: &LogFile,
     tol: f64,
@@ -427,7 +517,11 @@ pub fn render(report: &Report, a: &Path, b: &Path) -> String {
                 || format!("t = {} ns", d.time_ns),
                 |f| format!("frame {f} (t = {:.6} s)", d.time_ns as f64 * 1e-9),
             );
-            s += &format!("first difference: {frame}, topic {}", d.topic);
+            if d.field == "schema" {
+                s += &format!("first difference: the schema of topic {}", d.topic);
+            } else {
+                s += &format!("first difference: {frame}, topic {}", d.topic);
+            }
             match &d.body {
                 Some(pair) if pair.starts_with("pair ") => s += &format!(", {pair}"),
                 Some(body) => s += &format!(", body {body}"),

@@ -81,6 +81,10 @@ impl ShapeDef {
     pub fn to_shape(&self) -> Result<Shape, ShapeError> {
         match self {
             ShapeDef::Compound { parts } => {
+                // Counted before any part is checked: a huge list is refused at once.
+                if parts.len() > crate::MAX_COMPOUND_PARTS {
+                    return Err(crate::shape::too_many_parts(parts.len()));
+                }
                 let mut out = Vec::with_capacity(parts.len());
                 for (i, part) in parts.iter().enumerate() {
                     let p = part

@@ -7,9 +7,12 @@
 //! [`overlaps`] and a full [`contact`] (signed depth, unit normal from `a` to `b`, a contact
 //! point) for every pairing.
 //!
-//! **Never:** does I/O, keeps state between calls, reads the clock, allocates in the narrow
-//! phase, or uses platform trigonometry (all `sin`/`cos` go through `libm`, so results are the
-//! same bits on every machine). It knows nothing about bodies, layers, time or responses: those
+//! **Never:** does I/O (a case file is read from a reader its caller opened, through
+//! [`CaseReader`]), keeps state between calls, reads the clock, allocates in the narrow phase
+//! (but for a pair of compounds with more than 64 part pairs: their parts' boxes, to cull
+//! them), or uses platform trigonometry (all `sin`/`cos` go through `libm`, so results are
+//! the same bits on every machine). It knows nothing about bodies, layers, time or responses:
+//! those
 //! belong to the simulation crate.
 //!
 //! # Number type: `f64`
@@ -43,6 +46,7 @@
 
 mod bounds;
 mod case;
+mod case_reader;
 mod collide;
 mod contact;
 mod cores;
@@ -54,7 +58,8 @@ mod shape;
 mod toi;
 
 pub use bounds::Bounds;
-pub use case::{Case, CaseBody, CaseError, parse_case_file};
+pub use case::{Case, CaseBody, CaseError, MAX_ID_BYTES, MAX_QUOTED, parse_case, parse_case_file};
+pub use case_reader::{CaseReader, MAX_CASE_BYTES};
 pub use collide::{contact, contact_placed, overlaps, overlaps_placed, pair_name};
 pub use contact::Contact;
 pub use def::ShapeDef;
@@ -64,8 +69,8 @@ pub use placed::{
     PlacedAabb, PlacedCapsule, PlacedCircle, PlacedObb, PlacedPolygon, PlacedPrimitive, place,
 };
 pub use shape::{
-    Aabb, Capsule, Circle, Compound, MAX_COORDINATE, MAX_POLYGON_VERTICES, MIN_SIZE, Obb, Polygon,
-    Primitive, Shape, ShapeError, ShapeKind,
+    Aabb, Capsule, Circle, Compound, MAX_COMPOUND_PARTS, MAX_COORDINATE, MAX_POLYGON_VERTICES,
+    MIN_SIZE, Obb, Polygon, Primitive, Shape, ShapeError, ShapeKind,
 };
 pub use toi::{Impact, Sweep, time_of_impact};
 

@@ -1,7 +1,8 @@
 //! Time of impact: the first moment two shapes moving in straight lines come within a hair
 //! of touching.
 
-use crate::{Contact, Pose, Shape, Vec2, contact};
+use crate::collide::compound;
+use crate::{Bounds, Contact, Pose, Primitive, Shape, Vec2, contact};
 
 /// How close the search must get, relative to the smaller shape's size.
 const TOI_TOLERANCE: f64 = 1e-9;
@@ -66,19 +67,31 @@ pub fn time_of_impact(a: &Shape, sweep_a: &Sweep, b: &Shape, sweep_b: &Sweep) ->
         )
     };
     let mut first: Option<f64> = None;
-    for pa in a.primitives() {
-        for pb in b.primitives() {
-            let (part_a, part_b) = (Shape::Primitive(*pa), Shape::Primitive(*pb));
-            let gap = |t: f64| {
-                let (pa, pb) = poses(t);
-                -contact(&part_a, &pa, &part_b, &pb).depth
-            };
-            if let Some(t) = first_touch(gap, speed, tol)
-                && first.is_none_or(|f| t < f)
-            {
-                first = Some(t);
+    let mut search = |pa: &Primitive, pb: &Primitive| {
+        let (part_a, part_b) = (Shape::Primitive(*pa), Shape::Primitive(*pb));
+        let gap = |t: f64| {
+            let (pa, pb) = poses(t);
+            -contact(&part_a, &pa, &part_b, &pb).depth
+        };
+        if let Some(t) = first_touch(gap, speed, tol)
+            && first.is_none_or(|f| t < f)
+        {
+            first = Some(t);
+        }
+    };
+    let (parts_a, parts_b) = (a.primitives(), b.primitives());
+    if parts_a.len() * parts_b.len() <= compound::ALL_PAIRS {
+        for pa in parts_a {
+            for pb in parts_b {
+                search(pa, pb);
             }
         }
+    } else {
+        // Part pairs whose swept boxes stay apart by more than the tolerance never come
+        // within it: only the others are searched (the earliest touch is the same).
+        let (ba, bb) = (swept(parts_a, sweep_a, sa), swept(parts_b, sweep_b, sa));
+        let reach = tol + compound::margin(&ba, &bb);
+        compound::near_pairs(&ba, &bb, reach, |i, j| search(&parts_a[i], &parts_b[j]));
     }
     let t = first?;
     let (pose_a, pose_b) = poses(t);
@@ -88,6 +101,19 @@ pub fn time_of_impact(a: &Shape, sweep_a: &Sweep, b: &Shape, sweep_b: &Sweep) ->
         pose_a,
         pose_b,
     })
+}
+
+/// The box each part of a shape sweeps over the step (the union of its boxes at both ends:
+/// it moves on a line at a fixed angle), relative to `origin`.
+fn swept(parts: &[Primitive], sweep: &Sweep, origin: Vec2) -> Vec<Bounds> {
+    parts
+        .iter()
+        .map(|p| {
+            let part = Shape::Primitive(*p);
+            let at = |position: Vec2| part.bounds(&Pose::new(position - origin, sweep.angle));
+            at(sweep.start).union(at(sweep.end))
+        })
+        .collect()
 }
 
 /// The first `t` in `[0, 1]` with `gap(t) <= tol`, for a convex `gap` that changes at most

@@ -25,9 +25,26 @@ fn options() -> SerializeOptions {
 impl Decoder {
     /// The payload of `message` as JSON, or why it is not what its channel says.
     pub(crate) fn decode(&mut self, message: &mcap::Message<'_>) -> Result<Value, String> {
+        match self.parse(message)? {
+            Parsed::Json(value) => Ok(value),
+            Parsed::Protobuf(name, decoded) => decoded
+                .serialize_with_options(serde_json::value::Serializer, &options())
+                .map_err(|e| format!("{name}: {e}")),
+        }
+    }
+
+    /// Whether `message` decodes with its channel's schema, without building its JSON: what
+    /// a comparison that finds two payloads byte-identical still has to know.
+    pub(crate) fn check(&mut self, message: &mcap::Message<'_>) -> Result<(), String> {
+        self.parse(message).map(|_| ())
+    }
+
+    fn parse(&mut self, message: &mcap::Message<'_>) -> Result<Parsed, String> {
         let channel = &message.channel;
         match channel.message_encoding.as_str() {
-            "json" => serde_json::from_slice(&message.data).map_err(|e| format!("not JSON: {e}")),
+            "json" => serde_json::from_slice(&message.data)
+                .map(Parsed::Json)
+                .map_err(|e| format!("not JSON: {e}")),
             "protobuf" => {
                 let schema = channel
                     .schema
@@ -36,23 +53,30 @@ impl Decoder {
                 let descriptor = self
                     .descriptors
                     .entry(schema.id)
-                    .or_insert_with(|| {
-                        let pool = DescriptorPool::decode(schema.data.as_ref())
-                            .map_err(|e| format!("schema {}: {e}", schema.name))?;
-                        pool.get_message_by_name(&schema.name).ok_or_else(|| {
-                            format!("schema {}: its descriptor does not define it", schema.name)
-                        })
-                    })
+                    .or_insert_with(|| descriptor(&schema.name, &schema.data))
                     .clone()?;
-                let decoded = DynamicMessage::decode(descriptor, message.data.as_ref())
-                    .map_err(|e| format!("not a {} message: {e}", schema.name))?;
-                decoded
-                    .serialize_with_options(serde_json::value::Serializer, &options())
-                    .map_err(|e| format!("{}: {e}", schema.name))
+                DynamicMessage::decode(descriptor, message.data.as_ref())
+                    .map(|m| Parsed::Protobuf(schema.name.clone(), m))
+                    .map_err(|e| format!("not a {} message: {e}", schema.name))
             }
             other => Err(format!(
                 "message encoding {other:?} is neither json nor protobuf"
             )),
         }
     }
+}
+
+/// A payload decoded, before it becomes JSON.
+enum Parsed {
+    Json(Value),
+    /// The schema's name and the message.
+    Protobuf(String, DynamicMessage),
+}
+
+/// The message type `name` from the FileDescriptorSet `data` (a protobuf channel's schema),
+/// or why the schema can't decode anything.
+pub(crate) fn descriptor(name: &str, data: &[u8]) -> Result<MessageDescriptor, String> {
+    let pool = DescriptorPool::decode(data).map_err(|e| format!("schema {name}: {e}"))?;
+    pool.get_message_by_name(name)
+        .ok_or_else(|| format!("schema {name}: its descriptor does not define it"))
 }

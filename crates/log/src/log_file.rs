@@ -12,7 +12,7 @@ use mcap::read::Summary;
 use mcap::sans_io::{LinearReaderOptions, SummaryReadEvent, SummaryReader, SummaryReaderOptions};
 
 use crate::LogError;
-use crate::decode::Decoder;
+use crate::decode::{Decoder, descriptor};
 use crate::reader::{
     FOOTER_LEN, Footer, LogMessage, RECORD_LIMIT, at, check_magic, classify, corrupt, decode,
     truncated,
@@ -49,6 +49,8 @@ pub struct ChannelInfo {
     pub schema_name: String,
     /// Encoding of the schema (`jsonschema`), or empty without one.
     pub schema_encoding: String,
+    /// The schema's data (for protobuf, its FileDescriptorSet), or empty without one.
+    pub schema_data: Vec<u8>,
     /// Encoding of the messages (`json`).
     pub message_encoding: String,
     /// How many messages the channel holds, by the summary's statistics.
@@ -156,17 +158,36 @@ impl LogFile {
             .ok_or_else(|| corrupt("no statistics record; a finished log always has one"))?;
         let mut channels = BTreeMap::new();
         for (id, channel) in &summary.channels {
-            let (schema_name, schema_encoding) = channel
+            let (schema_name, schema_encoding, schema_data) = channel
                 .schema
                 .as_ref()
-                .map(|s| (s.name.clone(), s.encoding.clone()))
+                .map(|s| (s.name.clone(), s.encoding.clone(), s.data.to_vec()))
                 .unwrap_or_default();
+            // A protobuf channel's messages are only as readable as its schema: one that
+            // does not decode, or does not define the type it names, damages every message
+            // (checked here, not at the first message, so that a reader that compares bytes
+            // without decoding them can't take the channel as sound).
+            if channel.message_encoding == "protobuf" {
+                let why = if channel.schema.is_none() {
+                    Some("a protobuf channel without a schema".to_owned())
+                } else if schema_encoding != "protobuf" {
+                    Some(format!(
+                        "protobuf messages with a {schema_encoding:?} schema, not a protobuf one"
+                    ))
+                } else {
+                    descriptor(&schema_name, &schema_data).err()
+                };
+                if let Some(why) = why {
+                    return Err(corrupt(&format!("channel {}: {why}", channel.topic)));
+                }
+            }
             channels.insert(
                 *id,
                 ChannelInfo {
                     topic: channel.topic.clone(),
                     schema_name,
                     schema_encoding,
+                    schema_data,
                     message_encoding: channel.message_encoding.clone(),
                     messages: stats.channel_message_counts.get(id).copied().unwrap_or(0),
                 },
@@ -200,7 +221,13 @@ impl LogFile {
         })
     }
 
-    /// The data of the attachment named `name`, if the log has one; its CRC checked.
+    /// The names of its attachments, in the order the summary indexes them (a name may
+    /// come more than once).
+    pub fn attachment_names(&self) -> impl Iterator<Item = &str> {
+        self.attachments.iter().map(|a| a.0.as_str())
+    }
+
+    /// The data of the first attachment named `name`, if the log has one; its CRC checked.
     pub fn attachment(&self, name: &str) -> Result<Option<Vec<u8>>, LogError> {
         let Some(&(_, offset, length)) = self.attachments.iter().find(|a| a.0 == name) else {
             return Ok(None);
@@ -357,6 +384,18 @@ impl Messages {
             }
         }
         None
+    }
+
+    /// Checks that a message [`next_raw`](Self::next_raw) yielded decodes with its channel's
+    /// schema, without building its JSON (a corrupt log's error if not).
+    pub fn check(&mut self, raw: &RawMessage) -> Result<(), LogError> {
+        self.decoder.check(&raw.inner).map_err(|error| {
+            self.done = true;
+            at(&self.path)(corrupt(&format!(
+                "message {} on {}: {error}",
+                raw.inner.sequence, raw.inner.channel.topic
+            )))
+        })
     }
 
     /// Decodes a message [`next_raw`](Self::next_raw) yielded.

@@ -13,6 +13,7 @@ pub(crate) mod circle_capsule;
 pub(crate) mod circle_circle;
 pub(crate) mod circle_obb;
 pub(crate) mod circle_polygon;
+pub(crate) mod compound;
 pub(crate) mod obb_capsule;
 pub(crate) mod obb_obb;
 pub(crate) mod obb_polygon;
@@ -20,7 +21,7 @@ pub(crate) mod polygon_polygon;
 
 use crate::contact::Contact;
 use crate::math::Pose;
-use crate::placed::{PlacedPrimitive, place_with};
+use crate::placed::PlacedPrimitive;
 use crate::shape::{Shape, ShapeKind};
 
 use aabb_aabb::*;
@@ -106,28 +107,18 @@ pub fn overlaps_placed(a: &PlacedPrimitive, b: &PlacedPrimitive) -> bool {
 /// `pose_a`, so accuracy does not depend on the distance from the world origin; the returned
 /// point is in world coordinates.
 ///
-/// For a compound, every part of one shape is tested against every part of the other and the
-/// deepest contact is returned (the nearest when none overlaps). The distance between two
-/// compounds is exact; for overlapping compounds the deepest part pair is what Box2D and
-/// rapier resolve too, though the union's true minimum translation may be longer.
+/// For a compound, the deepest contact of a part of one shape with a part of the other is
+/// returned (the nearest when none overlaps; the first in part order among equals). Only
+/// the part pairs near each other are tested, culled by their bounds, with the same answer
+/// as testing every pair. The distance between two compounds is exact; for overlapping
+/// compounds the deepest part pair is what Box2D and rapier resolve too, though the union's
+/// true minimum translation may be longer.
 #[must_use]
 pub fn contact(a: &Shape, pose_a: &Pose, b: &Shape, pose_b: &Pose) -> Contact {
     let origin = pose_a.position;
-    let (rot_a, rot_b) = (a.rotation(pose_a.angle), b.rotation(pose_b.angle));
-    let offset_b = pose_b.position - origin;
-    let mut best: Option<Contact> = None;
-    for pa in a.primitives() {
-        let pa = place_with(pa, glam::DVec2::ZERO, rot_a, pose_a.angle);
-        for pb in b.primitives() {
-            let pb = place_with(pb, offset_b, rot_b, pose_b.angle);
-            let c = contact_placed(&pa, &pb);
-            if best.is_none_or(|best| c.depth > best.depth) {
-                best = Some(c);
-            }
-        }
-    }
+    let (sa, sb) = sides(a, pose_a, b, pose_b);
     // Shapes always have at least one primitive (validated on construction).
-    best.map_or(
+    compound::deepest(sa, sb).map_or(
         Contact {
             depth: f64::NEG_INFINITY,
             normal: glam::DVec2::Y,
@@ -140,15 +131,27 @@ pub fn contact(a: &Shape, pose_a: &Pose, b: &Shape, pose_b: &Pose) -> Contact {
 /// Whether two shapes at two poses overlap: any part of one with any part of the other.
 #[must_use]
 pub fn overlaps(a: &Shape, pose_a: &Pose, b: &Shape, pose_b: &Pose) -> bool {
-    let origin = pose_a.position;
-    let (rot_a, rot_b) = (a.rotation(pose_a.angle), b.rotation(pose_b.angle));
-    let offset_b = pose_b.position - origin;
-    a.primitives().iter().any(|pa| {
-        let pa = place_with(pa, glam::DVec2::ZERO, rot_a, pose_a.angle);
-        b.primitives()
-            .iter()
-            .any(|pb| overlaps_placed(&pa, &place_with(pb, offset_b, rot_b, pose_b.angle)))
-    })
+    let (sa, sb) = sides(a, pose_a, b, pose_b);
+    compound::any_overlap(sa, sb)
+}
+
+/// The two shapes of a pair, placed in the frame centred on `pose_a`.
+fn sides<'s>(
+    a: &'s Shape,
+    pose_a: &Pose,
+    b: &'s Shape,
+    pose_b: &Pose,
+) -> (compound::Side<'s>, compound::Side<'s>) {
+    let side = |s: &'s Shape, pose: &Pose, position| compound::Side {
+        parts: s.primitives(),
+        position,
+        rot: s.rotation(pose.angle),
+        angle: pose.angle,
+    };
+    (
+        side(a, pose_a, glam::DVec2::ZERO),
+        side(b, pose_b, pose_b.position - pose_a.position),
+    )
 }
 
 /// The name of a pairing as the shared cases spell it, in canonical order
