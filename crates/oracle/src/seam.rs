@@ -4,6 +4,12 @@
 //! image as `pose_b`, and takes the deepest translation (the earliest touch for a swept
 //! pair), the first in the offsets' order (the direct one first) on a tie. The referee
 //! gives rapier a collider for each image, and checks the choice with parry.
+//!
+//! What the logged poses show is the rule: the referee judges a pair with both bodies
+//! wrapped into the world first (its own wrap of each pose, [`Seam::wrapped`]), however far
+//! out Ricochet's detect poses are. Inside the world a body sticks out by at most half its
+//! width, so the translations by `-1, 0, 1` sizes reach every overlap of a body narrower
+//! than the world.
 
 use ricochet_geom::{Bounds, Pose, Shape, Vec2};
 use ricochet_sim::{Scenario, WorldBounds};
@@ -16,16 +22,37 @@ use crate::convert::depth;
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) struct Seam {
     offsets: Vec<Vec2>,
+    /// The world's bounds when it wraps.
+    bounds: Option<WorldBounds>,
 }
 
 impl Seam {
     /// The seam of `scenario`'s world.
     pub(crate) fn new(scenario: &Scenario) -> Seam {
-        let offsets = match scenario.world.bounds {
-            Some(b @ WorldBounds { wrap: true, .. }) => b.image_offsets().to_vec(),
-            _ => vec![Vec2::ZERO],
+        let bounds = scenario.world.bounds.filter(|b| b.wrap);
+        let offsets = match bounds {
+            Some(b) => b.image_offsets().to_vec(),
+            None => vec![Vec2::ZERO],
         };
-        Seam { offsets }
+        Seam { offsets, bounds }
+    }
+
+    /// `pose` with its position wrapped into the world, `[min, max)` on each axis (the pose
+    /// itself in a world that does not wrap, or already inside).
+    pub(crate) fn wrapped(&self, pose: &Pose) -> Pose {
+        let Some(b) = self.bounds else {
+            return *pose;
+        };
+        let mut p = pose.position;
+        for axis in 0..2 {
+            let (lo, hi) = (b.min[axis], b.max[axis]);
+            if p[axis] < lo || p[axis] >= hi {
+                // The remainder is exact; only adding `lo` back rounds, possibly onto `hi`.
+                let q = lo + (p[axis] - lo).rem_euclid(hi - lo);
+                p[axis] = if q < hi { q } else { lo };
+            }
+        }
+        Pose::new(p, pose.angle)
     }
 
     /// The translations, direct first.
@@ -46,9 +73,9 @@ impl Seam {
             .find(|&o| moved(pose, o) == *image)
     }
 
-    /// Parry's depth of `a` and `b` at each translation of `b`: the deepest, and its
-    /// offset (the first on a tie; `-inf` at the direct one when all are further apart
-    /// than `prediction`).
+    /// Parry's depth of `a` and `b`, both [wrapped](Seam::wrapped) into the world, at each
+    /// translation of `b`: the deepest, and its offset (the first on a tie; `-inf` at the
+    /// direct one when all are further apart than `prediction`).
     pub(crate) fn deepest(
         &self,
         a: &Shape,
@@ -57,6 +84,7 @@ impl Seam {
         pb: &Pose,
         prediction: f64,
     ) -> Result<(f64, Vec2), OracleError> {
+        let (pa, pb) = (&self.wrapped(pa), &self.wrapped(pb));
         let mut best = (f64::NEG_INFINITY, Vec2::ZERO);
         for &o in &self.offsets {
             if o != Vec2::ZERO && !near(a, pa, b, &moved(pb, o), prediction) {

@@ -34,7 +34,9 @@
 //! In a wrapping world, pairs also meet through the seam (`wrap.rs`): a pair with an image
 //! is tested directly and with `b` translated by whole world sizes next to `a`; the deepest
 //! contact (the earliest touch) wins, the direct one on a tie, and is logged with `b`'s
-//! image as `pose_b`. Responses are the same (a push moves the real bodies).
+//! image as `pose_b`. Responses are the same (a push moves the real bodies). A body that
+//! ended its motion half the world's size or more outside it is wrapped in first
+//! (`wrap::bring_in`), so the images reach every contact whatever the speed.
 
 use ricochet_geom::{Contact, Pose, Sweep, Vec2, contact, time_of_impact};
 
@@ -48,7 +50,7 @@ use crate::stages::push::separate_along_normal;
 use crate::stages::remove::remove;
 use crate::stages::separate::is_box;
 use crate::stages::sweep_normal;
-use crate::stages::wrap::Seam;
+use crate::stages::wrap::{self, Seam};
 use crate::stages::{SLOP, StageCtx};
 use crate::world::World;
 
@@ -258,6 +260,10 @@ pub(crate) fn run(
 ) {
     let def = ctx.def;
     let layers = &def.layers;
+    if let Some(b) = def.bounds.filter(|b| b.wrap) {
+        // Before the poses are taken: the pass, and its referee, see the bodies wrapped.
+        wrap::bring_in(&b, ctx.world);
+    }
     if capture_poses {
         let w = &ctx.world;
         ctx.out.detect_poses = Some((0..w.len()).map(|i| (w.entity[i], w.pose(i))).collect());

@@ -25,9 +25,19 @@
 //! contact, and its logged `pose_b`, are in `a`'s coordinates: `pose_b` is `b`'s image.
 //! Swept pairs take the earliest touch the same way.
 //!
-//! Offsets are whole world sizes `-1, 0, 1` on each axis: a body further than a world size
-//! out of the bounds (only a static body, or a body placed there, can be) meets no image
-//! beyond those.
+//! **Far out.** Offsets are whole world sizes `-1, 0, 1` on each axis. They are enough when
+//! every body's bounds stick out of the world by less than half its size: an image two
+//! sizes away would need `reach_a + reach_b >= size`. A moving body can end its motion any
+//! number of sizes out (200 units a frame in a 100-unit world, or placed there), so before
+//! the pass [`bring_in`] wraps every active body whose bounds stick out by half the size or
+//! more, on that axis, into the world (the `bounds` stage's exact wrap, [`wrap_coordinate`]),
+//! and moves its frame's start by the same whole sizes (its motion over the frame, which
+//! swept tests follow, is unchanged). Bodies less far out are left to the images, so a
+//! body that just crossed an edge is tested where it was before. The contacts of any scene
+//! at any speed are then those of the same scene with every body wrapped into the world
+//! first. Not covered: a static body placed half the world's size or more outside (statics
+//! are never moved), and the straight-line path of a swept pair longer than the world,
+//! which is cast at the same three translations per axis only.
 
 use ricochet_geom::{Bounds, Vec2};
 
@@ -68,6 +78,44 @@ pub(crate) struct Seam {
     /// Moving bodies (places in the entries) outside the guessed edges.
     candidates: Vec<u32>,
     found: Vec<(u32, u32)>,
+}
+
+/// `p` wrapped into `[min, max)` on one axis (`size = max - min`). `rem_euclid` is exact
+/// (an IEEE remainder), so wrapping is deterministic and lands in one step from any
+/// distance.
+pub(crate) fn wrap_coordinate(p: f64, min: f64, max: f64, size: f64) -> f64 {
+    let q = min + (p - min).rem_euclid(size);
+    // -tiny.rem_euclid(size) can round up to size itself.
+    if q >= max { min } else { q }
+}
+
+/// Wraps into the world, before `detect`'s pass, each active body whose bounds stick out
+/// of it by half its size or more on an axis (see the module docs: the images then reach
+/// every contact). Such a body is wrapped on that axis only, and its frame's start moved by
+/// the same whole world sizes.
+pub(crate) fn bring_in(world: &WorldBounds, w: &mut World) {
+    let size = world.size();
+    let half = size * 0.5;
+    for k in 0..w.active().len() {
+        let i = w.active()[k] as usize;
+        let p = w.position[i];
+        let outside = |axis: usize| p[axis] < world.min[axis] || p[axis] >= world.max[axis];
+        // A body centred in the world sticks out by at most half its width, less than half
+        // the world's (a body wider than the world is refused at load).
+        if !outside(0) && !outside(1) {
+            continue;
+        }
+        let r = reach(world, &w.bounds(i));
+        let mut q = p;
+        for axis in 0..2 {
+            if outside(axis) && r[axis] >= half[axis] {
+                q[axis] = wrap_coordinate(p[axis], world.min[axis], world.max[axis], size[axis]);
+            }
+        }
+        if q != p {
+            w.wrap_to(i, q);
+        }
+    }
 }
 
 /// How far `b` sticks out of the world on each axis (`>= 0`).
