@@ -107,7 +107,11 @@ fn a_disc_two_world_widths_a_frame_keeps_its_contact_and_validate_passes() {
     let dir = tempfile::tempdir().unwrap();
     let log = dir.path().join("w.mcap");
     let log = log.to_str().unwrap();
-    assert!(ricochet(&["run", scenario, "-o", log], b"").status.success());
+    assert!(
+        ricochet(&["run", scenario, "-o", log], b"")
+            .status
+            .success()
+    );
     let o = ricochet(&["dump", log, "--topic", "/contacts"], b"");
     assert!(o.status.success());
     let mut depths = Vec::new();

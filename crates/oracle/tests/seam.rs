@@ -160,7 +160,13 @@ fn a_contact_missed_two_world_widths_out_is_caught() {
     let s = scene(
         100.0,
         &[
-            ("ship", SHIP, 5.0, Vec2::new(5.0, 50.0), Vec2::new(12000.0, 0.0)),
+            (
+                "ship",
+                SHIP,
+                5.0,
+                Vec2::new(5.0, 50.0),
+                Vec2::new(12000.0, 0.0),
+            ),
             ("rock", ROCK, 5.0, Vec2::new(8.0, 50.0), Vec2::ZERO),
         ],
     );
@@ -178,7 +184,9 @@ fn a_contact_missed_two_world_widths_out_is_caught() {
     let r = referee.check_frame(&sim, &out);
     assert_eq!(r.mismatches, 1, "{:#?}", r.details);
     assert!(
-        r.details.iter().any(|d| d.contains("Ricochet logged no contact")),
+        r.details
+            .iter()
+            .any(|d| d.contains("Ricochet logged no contact")),
         "{:#?}",
         r.details
     );
