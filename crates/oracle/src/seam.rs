@@ -60,6 +60,52 @@ impl Seam {
         &self.offsets
     }
 
+    /// The translations of `b` a swept pair is cast at, direct first, then by `x` steps and
+    /// `y` steps ascending: [`Seam::offsets`] while the two paths' bounds (`path_a`, widened
+    /// by the caller, and `path_b`) meet within one world size on each axis, else every
+    /// whole-size translation at which they meet (a path longer than the world passes
+    /// several images). More than [`MAX_PATH_IMAGES`] is an error: not refereed.
+    pub(crate) fn along(&self, path_a: &Bounds, path_b: &Bounds) -> Result<Vec<Vec2>, OracleError> {
+        let Some(world) = self.bounds else {
+            return Ok(self.offsets.clone());
+        };
+        let size = world.size();
+        // Steps `k` with `path_b + k size` meeting `path_a` on each axis.
+        let steps = |axis: usize| {
+            let first = ((path_a.min[axis] - path_b.max[axis]) / size[axis]).ceil();
+            let last = ((path_a.max[axis] - path_b.min[axis]) / size[axis]).floor();
+            (first, last)
+        };
+        let ((x0, x1), (y0, y1)) = (steps(0), steps(1));
+        if x0 >= -1.0 && x1 <= 1.0 && y0 >= -1.0 && y1 <= 1.0 {
+            return Ok(self.offsets.clone());
+        }
+        let n = (x1 - x0 + 1.0).max(0.0) * (y1 - y0 + 1.0).max(0.0);
+        if n > MAX_PATH_IMAGES as f64 {
+            return Err(OracleError::Unsupported(format!(
+                "a swept path through {n:e} world images (more than {MAX_PATH_IMAGES})"
+            )));
+        }
+        let mut out = vec![Vec2::ZERO];
+        let mut kx = x0;
+        while kx <= x1 {
+            let mut ky = y0;
+            while ky <= y1 {
+                if kx != 0.0 || ky != 0.0 {
+                    out.push(Vec2::new(kx * size.x, ky * size.y));
+                }
+                ky += 1.0;
+            }
+            kx += 1.0;
+        }
+        Ok(out)
+    }
+
+    /// The world's size when it wraps.
+    pub(crate) fn size(&self) -> Option<Vec2> {
+        self.bounds.map(|b| b.size())
+    }
+
     /// Whether the world wraps.
     pub(crate) fn wraps(&self) -> bool {
         self.offsets.len() > 1
@@ -98,6 +144,10 @@ impl Seam {
         Ok(best)
     }
 }
+
+/// The most translations the referee casts one swept pair at (a path through more world
+/// images is reported, not refereed): a 256 x 256 block of world sizes.
+pub(crate) const MAX_PATH_IMAGES: usize = 1 << 16;
 
 /// `pose` translated by `offset` (the pose itself for the direct one), as Ricochet
 /// translates it.

@@ -198,3 +198,52 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn a_bullet_two_and_a_half_world_widths_a_frame_hits_the_first_rock_on_its_path() {
+    // 250 units a frame from x = 5: the bullet (radius 0.2) meets the rock (radius 1) at
+    // x = 60 when its centre reaches 58.8, at t = (58.8 - 5) / 250 of frame 1, on its
+    // first lap; its path passes the rock twice more.
+    let mut l = layers(
+        &["bullet", "rock"],
+        &[(0, 1, Response::Destroy(ricochet_sim::Doomed::Both))],
+    );
+    l.set_fast(0);
+    let w = WorldDef {
+        layers: l,
+        ..world(Vec2::ZERO, Vec2::splat(100.0))
+    };
+    let bodies = vec![
+        ricochet_scenes::moving_body(
+            "bullet",
+            0,
+            Shape::circle(0.2).unwrap(),
+            Vec2::new(5.0, 50.0),
+            Vec2::new(15000.0, 0.0),
+        ),
+        ricochet_scenes::moving_body(
+            "rock",
+            1,
+            Shape::circle(1.0).unwrap(),
+            Vec2::new(60.0, 50.0),
+            Vec2::ZERO,
+        ),
+    ];
+    let mut sim = Simulation::new(&scenario("bullet", w, bodies, 2));
+    assert!(sim.step().contacts.is_empty());
+    let out = sim.step();
+    assert_eq!(out.contacts.len(), 1, "{:?}", out.contacts);
+    let c = &out.contacts[0];
+    let end = out
+        .removed
+        .iter()
+        .find(|r| r.name == "bullet")
+        .unwrap()
+        .pose;
+    // Where the bullet was at the touch, as a fraction of its 250-unit motion.
+    let start = end.position.x - 250.0;
+    let t = (c.pose_a.position.x - start) / 250.0;
+    assert!((t - (58.8 - 5.0) / 250.0).abs() < 1e-9, "t = {t}, {c:?}");
+    assert!((c.pose_b.position.x - c.pose_a.position.x - 1.2).abs() < 1e-9);
+    assert_eq!(out.removed.len(), 2);
+}

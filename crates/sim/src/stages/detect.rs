@@ -421,6 +421,8 @@ fn run_swept(
         poses: (Pose, Pose),
     }
     let mut hits = Vec::new();
+    let wrap = ctx.def.bounds.filter(|b| b.wrap);
+    let (mut offsets, mut path) = (Vec::new(), Vec::new());
     for &(i, j) in swept {
         ctx.out.stats.narrow_tests += 1;
         let w = &ctx.world;
@@ -431,8 +433,26 @@ fn run_swept(
             angle: w.angle[k],
         };
         let mut first = time_of_impact(w.shape(i), &sweep(i), w.shape(j), &sweep(j));
-        // Through the seam: `b`'s images next to `a`, the earliest (the first on a tie).
-        for offset in seam.offsets(i, j) {
+        // Through the seam: `b`'s images next to `a`, the earliest (the first on a tie);
+        // along a path longer than the world, every image it meets.
+        offsets.clear();
+        let at_start = |k: usize| {
+            let s = sweep(k);
+            (
+                w.shape(k).bounds(&Pose::new(s.start, s.angle)),
+                s.end - s.start,
+            )
+        };
+        let far = wrap.is_some_and(|b| {
+            let ((ba, da), (bb, db)) = (at_start(i), at_start(j));
+            wrap::path_offsets(&b, (&ba, da), (&bb, db), &mut path)
+        });
+        if far {
+            offsets.extend_from_slice(&path);
+        } else {
+            offsets.extend(seam.offsets(i, j));
+        }
+        for &offset in &offsets {
             ctx.out.stats.narrow_tests += 1;
             let image = Sweep {
                 start: w.start_position(j) + offset,
