@@ -247,3 +247,145 @@ fn a_bullet_two_and_a_half_world_widths_a_frame_hits_the_first_rock_on_its_path(
     assert!((c.pose_b.position.x - c.pose_a.position.x - 1.2).abs() < 1e-9);
     assert_eq!(out.removed.len(), 2);
 }
+
+/// The earliest touch of `a` moving `da` from `pa` and `b` moving `db` from `pb` (both
+/// inside the world), over every translation of `b` by whole world sizes whose centre
+/// passes within the two bounding radii of `a`'s along the relative path.
+#[allow(
+    clippy::too_many_arguments,
+    reason = "two bodies' shapes, starts and motions"
+)]
+fn earliest_touch(
+    (a, ra, pa, da): (&Shape, f64, Vec2, Vec2),
+    (b, rb, pb, db): (&Shape, f64, Vec2, Vec2),
+    angles: (f64, f64),
+    size: Vec2,
+) -> Option<f64> {
+    let d = db - da;
+    let reach = ra + rb + 1e-6 * size.max_element();
+    // Relative centre of the image at `o`: `pb + o - pa + t d`, t in [0, 1].
+    let span = |axis: usize| {
+        let (lo, hi) = (
+            (pa[axis] - pb[axis] - d[axis].max(0.0) - reach) / size[axis],
+            (pa[axis] - pb[axis] - d[axis].min(0.0) + reach) / size[axis],
+        );
+        (lo.floor() as i64, hi.ceil() as i64)
+    };
+    let (xs, ys) = (span(0), span(1));
+    let mut best: Option<f64> = None;
+    for kx in xs.0..=xs.1 {
+        for ky in ys.0..=ys.1 {
+            let o = Vec2::new(kx as f64 * size.x, ky as f64 * size.y);
+            let c = pb + o - pa;
+            let t = if d == Vec2::ZERO {
+                0.0
+            } else {
+                (-c.dot(d) / d.dot(d)).clamp(0.0, 1.0)
+            };
+            if (c + d * t).length() > reach {
+                continue;
+            }
+            let sweep = |p: Vec2, m: Vec2, angle: f64| ricochet_geom::Sweep {
+                start: p,
+                end: p + m,
+                angle,
+            };
+            let hit = ricochet_geom::time_of_impact(
+                a,
+                &sweep(pa, da, angles.0),
+                b,
+                &sweep(pb + o, db, angles.1),
+            );
+            if let Some(h) = hit
+                && best.is_none_or(|t| h.t < t)
+            {
+                best = Some(h.t);
+            }
+        }
+    }
+    best
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
+
+    #[test]
+    fn swept_hits_at_any_speed_are_those_of_the_scene_wrapped_into_the_world(
+        min in (-300.0..300.0f64, -300.0..300.0f64),
+        size in (10.0..150.0f64, 10.0..150.0f64),
+        bullets in prop::collection::vec(
+            (0.005..0.05f64, (-5.0..6.0f64, -5.0..6.0f64), (-100.0..100.0f64, -100.0..100.0f64)),
+            1..4,
+        ),
+        rocks in prop::collection::vec(
+            (0.02..0.3f64, (0.0..1.0f64, 0.0..1.0f64), (-0.5..0.5f64, -0.5..0.5f64), prop::bool::ANY),
+            1..4,
+        ),
+    ) {
+        let (min, size) = (Vec2::new(min.0, min.1), Vec2::new(size.0, size.1));
+        let hz = 60.0;
+        let mut l = layers(&["bullet", "rock"], &[(0, 1, Response::Report)]);
+        l.set_fast(0);
+        let w = WorldDef { layers: l, ..world(min, size) };
+        let place = |f: (f64, f64)| min + Vec2::new(f.0, f.1) * size;
+        let speed = |v: (f64, f64)| Vec2::new(v.0, v.1) * size * hz;
+        let mut bodies = Vec::new();
+        // Bullets first: each swept pair's `a` is the bullet, the body that moves.
+        for (k, &(r, at, v)) in bullets.iter().enumerate() {
+            let r = r * size.min_element();
+            let v = speed(v).max(Vec2::splat(1e-3));
+            bodies.push(ricochet_scenes::moving_body(&format!("bullet{k}"), 0, Shape::circle(r).unwrap(), place(at), v));
+        }
+        for (k, &(r, at, v, round)) in rocks.iter().enumerate() {
+            let r = r * size.min_element();
+            let shape = if round {
+                Shape::circle(r).unwrap()
+            } else {
+                let v = [(1.0, 0.1), (0.3, 0.95), (-0.8, 0.6), (-0.9, -0.5), (0.2, -1.0)];
+                Shape::polygon(&v.map(|(x, y)| Vec2::new(x * r, y * r))).unwrap()
+            };
+            bodies.push(ricochet_scenes::moving_body(&format!("rock{k}"), 1, shape, place(at), speed(v)));
+        }
+        let frames = 4;
+        let mut sim = Simulation::new(&scenario("bullets", w, bodies, frames));
+        let dt = sim.dt();
+        sim.step();
+        for _ in 1..=frames {
+            let out = sim.step();
+            let w = sim.world();
+            let radius = |k: usize| {
+                let b = w.shape(k).bounds(&Pose::new(Vec2::ZERO, w.angle[k]));
+                b.min.abs().max(b.max.abs()).length()
+            };
+            for i in 0..bullets.len() {
+                for j in bullets.len()..w.len() {
+                    let (ma, mb) = (w.velocity(i) * dt, w.velocity(j) * dt);
+                    let start = |k: usize| wrapped(w.start_position(k), min, size);
+                    let expected = earliest_touch(
+                        (w.shape(i), radius(i), start(i), ma),
+                        (w.shape(j), radius(j), start(j), mb),
+                        (w.angle[i], w.angle[j]),
+                        size,
+                    );
+                    let logged = out.contacts.iter().find(|c| {
+                        (w.index_of(c.a), w.index_of(c.b)) == (Some(i), Some(j))
+                    });
+                    // The logged touch's moment along the bullet's own motion.
+                    let t = logged.map(|c| {
+                        (c.pose_a.position - w.start_position(i)).dot(ma) / ma.dot(ma)
+                    });
+                    match (t, expected) {
+                        (Some(t), Some(e)) => prop_assert!(
+                            (t - e).abs() <= 1e-6,
+                            "frame {}: pair {i} {j} touched at t = {t}, wrapped at {e}", out.frame
+                        ),
+                        (t, e) => prop_assert!(
+                            t.is_none() && e.is_none(),
+                            "frame {}: pair {i} {j} logged at {t:?}, wrapped at {e:?}", out.frame
+                        ),
+                    }
+                }
+            }
+        }
+    }
+}
