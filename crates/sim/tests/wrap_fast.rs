@@ -251,10 +251,6 @@ fn a_bullet_two_and_a_half_world_widths_a_frame_hits_the_first_rock_on_its_path(
 /// The earliest touch of `a` moving `da` from `pa` and `b` moving `db` from `pb` (both
 /// inside the world), over every translation of `b` by whole world sizes whose centre
 /// passes within the two bounding radii of `a`'s along the relative path.
-#[allow(
-    clippy::too_many_arguments,
-    reason = "two bodies' shapes, starts and motions"
-)]
 fn earliest_touch(
     (a, ra, pa, da): (&Shape, f64, Vec2, Vec2),
     (b, rb, pb, db): (&Shape, f64, Vec2, Vec2),
