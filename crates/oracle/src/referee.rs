@@ -434,8 +434,9 @@ impl Referee {
 
     /// The pairs rapier's broad and narrow phase find penetrating (`dist < 0`) with every
     /// body's collider at its detect pose, layers filtering as Ricochet's matrix does. In a
-    /// wrapping world every body also has a collider at each of its images, and a pair of a
-    /// body and another's image counts as the pair.
+    /// wrapping world every pose is first wrapped into the world (what the log shows), every
+    /// body also has a collider at each of its images, and a pair of a body and another's
+    /// image counts as the pair.
     fn rapier_pairs(
         &self,
         sim: &Simulation,
@@ -449,8 +450,9 @@ impl Referee {
         let n = offsets.len();
         for (k, (e, pose)) in poses.iter().enumerate() {
             let b = body(sim, out, *e).ok_or(OracleError::Conversion("unknown body"))?;
+            let pose = self.seam.wrapped(pose);
             for (m, &o) in offsets.iter().enumerate() {
-                let (p, shape) = place(b.shape, &moved(pose, o), Vec2::ZERO)?;
+                let (p, shape) = place(b.shape, &moved(&pose, o), Vec2::ZERO)?;
                 let builder = ColliderBuilder::new(shape)
                     .position(p)
                     .active_collision_types(ActiveCollisionTypes::all());

@@ -95,14 +95,23 @@ impl Referee {
         if let Some(i) = sim.world().index_of(e) {
             return Some(sim.world().start_position(i));
         }
+        let removed = out.removed.iter().find(|r| r.entity == e);
         if let Some((frame, positions)) = &self.previous
             && *frame + 1 == out.frame
-            && let Some(p) = positions.get(&e)
+            && let Some(&p) = positions.get(&e)
         {
-            return Some(*p);
+            // A body that ended its motion far out of a wrapping world was wrapped in
+            // before detect, its start moved by the same whole world sizes: the sizes that
+            // bring the start nearest `detect - velocity dt`.
+            return Some(match (self.seam.size(), removed) {
+                (Some(size), Some(r)) => {
+                    let k = (detect.position - r.velocity * sim.dt() - p) / size;
+                    p + k.round() * size
+                }
+                _ => p,
+            });
         }
-        let removed = out.removed.iter().find(|r| r.entity == e)?;
-        Some(detect.position - removed.velocity * sim.dt())
+        Some(detect.position - removed?.velocity * sim.dt())
     }
 
     /// Part 3: swept pairs. Every pair Ricochet would test by time of impact is cast by
@@ -397,9 +406,11 @@ impl Referee {
                 .union(s.bounds(&Pose::new(p.position + d, p.angle)))
         };
         let path_a = widened(swept(a.shape, &start.0, motion.0), 2.0 * gap);
+        let path_b = swept(b.shape, &start.1, motion.1);
+        let offsets = self.seam.along(&path_a, &path_b)?;
         let mut touch: Option<(f64, Vec2)> = None;
         let mut graze: Option<(f64, Vec2)> = None;
-        for &o in self.seam.offsets() {
+        for &o in &offsets {
             let sb = moved(&start.1, o);
             if o != Vec2::ZERO && !path_a.overlaps(&swept(b.shape, &sb, motion.1)) {
                 continue;

@@ -150,3 +150,81 @@ fn a_swept_hit_through_the_seam_is_parrys_first_touch() {
     assert!(r.mismatches >= 1, "{r:#?}");
     assert!(r.details[0].contains("shape cast touches"), "{r:#?}");
 }
+
+/// Issue 20: a disc two world widths a frame was seen by `detect` at x = 205, where the
+/// images one width either way meet nothing, so no contact was logged, while the logged
+/// pose (wrapped, x = 5) overlaps the still disc at x = 8 by 7. The referee judges the
+/// poses wrapped into the world, so the missing contact is a mismatch.
+#[test]
+fn a_contact_missed_two_world_widths_out_is_caught() {
+    let s = scene(
+        100.0,
+        &[
+            (
+                "ship",
+                SHIP,
+                5.0,
+                Vec2::new(5.0, 50.0),
+                Vec2::new(12000.0, 0.0),
+            ),
+            ("rock", ROCK, 5.0, Vec2::new(8.0, 50.0), Vec2::ZERO),
+        ],
+    );
+    let (sim, mut out, [mut referee, mut other]) = frame(&s, 1);
+    assert_eq!(out.contacts.len(), 1, "{:?}", out.contacts);
+    assert_eq!(other.check_frame(&sim, &out).mismatches, 0);
+    // What the old `detect` did: the disc two widths out, nothing found.
+    let ship = sim.world().entity[sim.world().find("ship").unwrap()];
+    let poses = out.detect_poses.as_mut().unwrap();
+    let pose = poses.iter_mut().find(|(e, _)| *e == ship).unwrap();
+    assert_eq!(pose.1.position, Vec2::new(5.0, 50.0));
+    pose.1.position.x = 205.0;
+    out.contacts.clear();
+    out.events.clear();
+    let r = referee.check_frame(&sim, &out);
+    assert_eq!(r.mismatches, 1, "{:#?}", r.details);
+    assert!(
+        r.details
+            .iter()
+            .any(|d| d.contains("Ricochet logged no contact")),
+        "{:#?}",
+        r.details
+    );
+}
+
+/// Issue 20, swept: a bullet 250 units a frame in a 100-wide world meets the rock at x = 60
+/// on its first lap (t = 0.2152). Cast at one world size either way only, the first touch
+/// found was on the second lap (t = 0.6152, the rock's image at x = -40 with the start
+/// moved to -195): the referee casts every image along the path, so that record is caught.
+#[test]
+fn a_swept_hit_on_a_later_lap_of_a_path_longer_than_the_world_is_caught() {
+    let s = scene(
+        100.0,
+        &[
+            (
+                "bullet",
+                BULLET,
+                0.2,
+                Vec2::new(5.0, 50.0),
+                Vec2::new(15000.0, 0.0),
+            ),
+            ("rock", ROCK, 1.0, Vec2::new(60.0, 50.0), Vec2::ZERO),
+        ],
+    );
+    let (sim, out, [mut honest, mut referee]) = frame(&s, 1);
+    assert_eq!(out.contacts.len(), 1);
+    assert_eq!(out.contacts[0].phase, Phase::Swept);
+    let r = honest.check_frame(&sim, &out);
+    assert_eq!(r.mismatches, 0, "{:#?}", r.details);
+    assert_eq!(r.swept_confirmed, 1, "{r:#?}");
+    // The second lap's touch, as the images one size either way found it.
+    let mut late = out.clone();
+    let c = &mut late.contacts[0];
+    let shift = Vec2::new(100.0, 0.0);
+    c.pose_a.position += shift;
+    c.pose_b.position += shift;
+    c.point += shift;
+    assert!((c.pose_b.position.x + 40.0).abs() < 1e-9, "{c:?}");
+    let r = referee.check_frame(&sim, &late);
+    assert!(r.mismatches >= 1, "{r:#?}");
+}

@@ -4,6 +4,7 @@ use crate::def::WorldDef;
 use crate::event::Removal;
 use crate::stages::StageCtx;
 use crate::stages::remove::remove;
+use crate::stages::wrap::wrap_coordinate;
 
 /// Whether the world has bounds.
 pub(crate) fn has_work(def: &WorldDef) -> bool {
@@ -25,12 +26,7 @@ pub(crate) fn run(ctx: &mut StageCtx) {
         for axis in 0..2 {
             if p[axis] < b.min[axis] || p[axis] >= b.max[axis] {
                 if b.wrap {
-                    // rem_euclid is exact (IEEE remainder), so wrapping is deterministic.
-                    p[axis] = b.min[axis] + (p[axis] - b.min[axis]).rem_euclid(size[axis]);
-                    if p[axis] >= b.max[axis] {
-                        // -tiny.rem_euclid(size) can round up to size itself.
-                        p[axis] = b.min[axis];
-                    }
+                    p[axis] = wrap_coordinate(p[axis], b.min[axis], b.max[axis], size[axis]);
                 } else if !gone.contains(&w.entity[i]) {
                     gone.push(w.entity[i]);
                 }

@@ -34,7 +34,9 @@
 //! In a wrapping world, pairs also meet through the seam (`wrap.rs`): a pair with an image
 //! is tested directly and with `b` translated by whole world sizes next to `a`; the deepest
 //! contact (the earliest touch) wins, the direct one on a tie, and is logged with `b`'s
-//! image as `pose_b`. Responses are the same (a push moves the real bodies).
+//! image as `pose_b`. Responses are the same (a push moves the real bodies). A body that
+//! ended its motion half the world's size or more outside it is wrapped in first
+//! (`wrap::bring_in`), so the images reach every contact whatever the speed.
 
 use ricochet_geom::{Contact, Pose, Sweep, Vec2, contact, time_of_impact};
 
@@ -48,7 +50,7 @@ use crate::stages::push::separate_along_normal;
 use crate::stages::remove::remove;
 use crate::stages::separate::is_box;
 use crate::stages::sweep_normal;
-use crate::stages::wrap::Seam;
+use crate::stages::wrap::{self, Seam};
 use crate::stages::{SLOP, StageCtx};
 use crate::world::World;
 
@@ -258,6 +260,10 @@ pub(crate) fn run(
 ) {
     let def = ctx.def;
     let layers = &def.layers;
+    if let Some(b) = def.bounds.filter(|b| b.wrap) {
+        // Before the poses are taken: the pass, and its referee, see the bodies wrapped.
+        wrap::bring_in(&b, ctx.world);
+    }
     if capture_poses {
         let w = &ctx.world;
         ctx.out.detect_poses = Some((0..w.len()).map(|i| (w.entity[i], w.pose(i))).collect());
@@ -415,6 +421,8 @@ fn run_swept(
         poses: (Pose, Pose),
     }
     let mut hits = Vec::new();
+    let wrap = ctx.def.bounds.filter(|b| b.wrap);
+    let (mut offsets, mut path) = (Vec::new(), Vec::new());
     for &(i, j) in swept {
         ctx.out.stats.narrow_tests += 1;
         let w = &ctx.world;
@@ -425,8 +433,26 @@ fn run_swept(
             angle: w.angle[k],
         };
         let mut first = time_of_impact(w.shape(i), &sweep(i), w.shape(j), &sweep(j));
-        // Through the seam: `b`'s images next to `a`, the earliest (the first on a tie).
-        for offset in seam.offsets(i, j) {
+        // Through the seam: `b`'s images next to `a`, the earliest (the first on a tie);
+        // along a path longer than the world, every image it meets.
+        offsets.clear();
+        let at_start = |k: usize| {
+            let s = sweep(k);
+            (
+                w.shape(k).bounds(&Pose::new(s.start, s.angle)),
+                s.end - s.start,
+            )
+        };
+        let far = wrap.is_some_and(|b| {
+            let ((ba, da), (bb, db)) = (at_start(i), at_start(j));
+            wrap::path_offsets(&b, (&ba, da), (&bb, db), &mut path)
+        });
+        if far {
+            offsets.extend_from_slice(&path);
+        } else {
+            offsets.extend(seam.offsets(i, j));
+        }
+        for &offset in &offsets {
             ctx.out.stats.narrow_tests += 1;
             let image = Sweep {
                 start: w.start_position(j) + offset,

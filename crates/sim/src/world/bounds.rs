@@ -86,6 +86,18 @@ impl World {
         }
     }
 
+    /// Moves moving body `i` to `position`, whole world sizes from where it is, and its
+    /// frame's start by the same: the wrap seam brings a body far out of a wrapping world
+    /// back in before `detect`, its motion over the frame unchanged.
+    pub(crate) fn wrap_to(&mut self, i: usize, position: Vec2) {
+        let shift = position - self.position[i];
+        self.position[i] = position;
+        let r = self.row[i];
+        if r != NO_ROW {
+            self.rows.start_position[r as usize] += shift;
+        }
+    }
+
     /// Body `i`'s entity as one number, ordered as entities are: the broad phase's key.
     pub(crate) fn key(&self, i: usize) -> u64 {
         let e = self.entity[i];
