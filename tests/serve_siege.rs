@@ -135,5 +135,8 @@ fn a_recorded_session_under_every_hostile_client_serves_a_good_one_within_its_me
     assert!(grew < bound_kb, "RSS grew {grew} kB, over {bound_kb} kB");
     assert!(terminate(&mut server, Duration::from_secs(5)).success());
     let frames = replays_byte_for_byte(&out);
-    assert!(frames > 430, "the recording holds every frame served: {frames}");
+    assert!(
+        frames > 430,
+        "the recording holds every frame served: {frames}"
+    );
 }
