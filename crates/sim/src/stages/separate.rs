@@ -173,7 +173,7 @@ fn overlap(a: &Bounds, b: &Bounds, axis: usize) -> f64 {
 /// The dense index of the static body of rank `s` among the static bodies: `s` plus the
 /// moving bodies before it. `movers` are the moving bodies' dense indices, ascending, so
 /// mover `k` has `movers[k] - k` static bodies before it (a non-decreasing count).
-fn static_index(movers: &[u32], s: u32) -> u32 {
+pub(crate) fn static_index(movers: &[u32], s: u32) -> u32 {
     // Usually every static body comes first (a level's tiles before its actors).
     if movers.first().is_none_or(|&m| m > s) {
         return s;
