@@ -38,12 +38,13 @@ fn a_pair_sees_the_push_of_an_earlier_pair_in_the_same_pass() {
         sim.set_threads(threads);
         let out = sim.step();
         // (a, b): depth 0.5, b (the only dynamic body) moves out by all of it, to x = 2.
-        // (b, c): then depth 2 - (3 - 2) = 1, each moves half: b to 1.5, c to 3.5. Tested at
-        // the poses the pass started from, it would be depth 0.5: b 1.75, c 3.25.
+        // (b, c): then depth 2 - (3 - 2) = 1. Statics win (`push.rs`): b is flush on the
+        // static a, so it stays at 2 and c takes the whole depth, to 4. Tested at the poses
+        // the pass started from, it would be depth 0.5 (c to 3.5).
         let depths: Vec<f64> = out.contacts.iter().map(|c| c.depth).collect();
         assert_eq!(depths, [0.5, 1.0], "{threads} threads");
         let w = sim.world();
         let x = |name: &str| w.position[w.find(name).unwrap()].x;
-        assert_eq!((x("b"), x("c")), (1.5, 3.5), "{threads} threads");
+        assert_eq!((x("b"), x("c")), (2.0, 4.0), "{threads} threads");
     }
 }

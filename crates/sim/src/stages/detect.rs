@@ -17,7 +17,8 @@
 //! - `report`: the contact is logged and a `contact` event raised;
 //! - `destroy`: the doomed bodies are removed after the pass (children of a split spawned);
 //! - `separate`: the dynamic body is pushed out along the normal by the depth (two dynamic
-//!   bodies half each), and its velocity into the other is removed.
+//!   bodies half each, clipped by the static bodies: `push.rs`), and its velocity into the
+//!   other is removed.
 //!
 //! A sleeping body that touches an awake one wakes up (from the next frame on).
 //!
@@ -46,7 +47,7 @@ use crate::entity::Entity;
 use crate::event::{GameEvent, Removal};
 use crate::output::{ContactRecord, Phase};
 use crate::parallel::Workers;
-use crate::stages::push::separate_along_normal;
+use crate::stages::push::{Statics, separate_along_normal};
 use crate::stages::remove::remove;
 use crate::stages::separate::is_box;
 use crate::stages::sweep_normal;
@@ -92,6 +93,8 @@ pub(crate) struct DetectState {
     /// Per body, all false between passes (only the `moved` ones are set, then cleared).
     pushed: Vec<bool>,
     moved: Vec<usize>,
+    /// The static bodies that clip pushes between dynamic bodies (`push.rs`).
+    push_statics: Statics,
 }
 
 impl DetectState {
@@ -118,6 +121,7 @@ impl DetectState {
             contacts: Vec::new(),
             pushed: Vec::new(),
             moved: Vec::new(),
+            push_statics: Statics::default(),
         }
     }
 }
@@ -367,7 +371,7 @@ pub(crate) fn run(
         woken.extend([i, j].into_iter().filter(|&k| w.asleep(k)));
         respond(
             ctx,
-            &mut doomed,
+            (&mut doomed, &mut st.push_statics),
             (i, j),
             response,
             Phase::All,
@@ -390,7 +394,14 @@ pub(crate) fn run(
         }
     }
     st.tests = per_layer_pair;
-    run_swept(ctx, &mut doomed, &swept, &st.seam, &mut woken);
+    run_swept(
+        ctx,
+        &mut st.push_statics,
+        &mut doomed,
+        &swept,
+        &st.seam,
+        &mut woken,
+    );
     for i in woken {
         ctx.world.wake(i);
     }
@@ -407,6 +418,7 @@ pub(crate) fn run(
 /// first rock on its path and no other, however fast it goes.
 fn run_swept(
     ctx: &mut StageCtx,
+    push_statics: &mut Statics,
     doomed: &mut Vec<(Entity, Entity)>,
     swept: &[(usize, usize)],
     seam: &Seam,
@@ -505,7 +517,7 @@ fn run_swept(
         let before = doomed.len();
         respond(
             ctx,
-            doomed,
+            (doomed, push_statics),
             hit.pair,
             response,
             Phase::Swept,
@@ -518,10 +530,11 @@ fn run_swept(
     }
 }
 
-/// Records a contact and applies its response.
+/// Records a contact and applies its response: a `destroy` adds to `doomed`, a `separate`
+/// between two dynamic bodies is clipped by `push_statics` (`push.rs`).
 fn respond(
     ctx: &mut StageCtx,
-    doomed: &mut Vec<(Entity, Entity)>,
+    (doomed, push_statics): (&mut Vec<(Entity, Entity)>, &mut Statics),
     (i, j): (usize, usize),
     response: Response,
     phase: Phase,
@@ -547,7 +560,8 @@ fn respond(
             }
         }
         Response::Separate => {
-            resolved = separate_along_normal(ctx.world, i, j, c.normal, c.depth);
+            let statics = Some((push_statics, &ctx.def.layers));
+            resolved = separate_along_normal(ctx.world, statics, (i, j), c.normal, c.depth);
             ctx.out.events.push(GameEvent::PushedApart {
                 a: ea,
                 b: eb,

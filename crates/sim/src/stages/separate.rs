@@ -8,7 +8,8 @@
 //! or dynamic box that pushed it as the carrier the box rides next frame; a box that a
 //! kinematic body pushed or carried and that is left overlapping a wall raises `crush`
 //! (riders: `stages/carry.rs`). Dynamic boxes settle lowest (leftmost) first, and a settled
-//! box is solid to the rest, so stacks resolve bottom-up in one pass. Only boxes (a single
+//! box is solid to the rest, so stacks resolve bottom-up in one pass. Statics win: a push out
+//! of another dynamic box never moves a box into a static one (`statics_win`). Only boxes (a single
 //! AABB) are resolved per axis; every other shape in a `separate` pair is pushed along the
 //! contact normal by the `detect` stage.
 //!
@@ -173,7 +174,7 @@ fn overlap(a: &Bounds, b: &Bounds, axis: usize) -> f64 {
 /// The dense index of the static body of rank `s` among the static bodies: `s` plus the
 /// moving bodies before it. `movers` are the moving bodies' dense indices, ascending, so
 /// mover `k` has `movers[k] - k` static bodies before it (a non-decreasing count).
-fn static_index(movers: &[u32], s: u32) -> u32 {
+pub(crate) fn static_index(movers: &[u32], s: u32) -> u32 {
     // Usually every static body comes first (a level's tiles before its actors).
     if movers.first().is_none_or(|&m| m > s) {
         return s;
@@ -346,7 +347,10 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
                 if overlap(&bi, &bj, 0) <= SLOP || overlap(&bi, &bj, 1) <= SLOP {
                     continue;
                 }
-                let by = push_out(&bi, &bj, axis);
+                let mut by = push_out(&bi, &bj, axis);
+                if o.moving && w.kind[j] == BodyKind::Dynamic {
+                    by = statics_win(&st.statics, (w, layers), (i, &bi, &bj), axis, by);
+                }
                 push = Some((j, w.position[i][axis] + by, by, false));
             }
             let Some((j, to, by, after)) = push else {
@@ -417,6 +421,75 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
     st.woken = woken;
     // The log's convention: a pass's contacts sorted by (a, b).
     out.contacts[first..].sort_by_key(|c| (c.a, c.b));
+}
+
+/// Statics win: the push `by` along `axis` that moves box `i` (bounds `bi`) out of the
+/// dynamic box `bj` by the smaller overlap, unless a static box is in its way; then out of
+/// `bj`'s other side if that way is clear, else as far as the first static box lets it go
+/// (flush on it, still overlapping `bj`: a push from another dynamic body never moves a box
+/// into a static one, as along the normal, `push.rs`).
+fn statics_win(
+    statics: &FixedGrid,
+    (w, layers): (&World, &Layers),
+    (i, bi, bj): (usize, &Bounds, &Bounds),
+    axis: usize,
+    by: f64,
+) -> f64 {
+    let allowed = clear_way(statics, (w, layers), (i, bi), axis, by);
+    if allowed.to_bits() == by.to_bits() {
+        return by;
+    }
+    let other_way = if by < 0.0 {
+        bj.max[axis] - bi.min[axis]
+    } else {
+        -(bi.max[axis] - bj.min[axis])
+    };
+    if clear_way(statics, (w, layers), (i, bi), axis, other_way).to_bits() == other_way.to_bits() {
+        return other_way;
+    }
+    allowed
+}
+
+/// How much of the move `by` along `axis` box `i` (bounds `bi`) can make before it meets a
+/// static box it `separate`s from: one ahead of it, overlapping its span on the other axis
+/// by more than [`SLOP`] (a static box it overlaps now is not in its way: the pass pushes it
+/// out of that one at its turn).
+fn clear_way(
+    statics: &FixedGrid,
+    (w, layers): (&World, &Layers),
+    (i, bi): (usize, &Bounds),
+    axis: usize,
+    by: f64,
+) -> f64 {
+    let other = 1 - axis;
+    let mut path = *bi;
+    if by < 0.0 {
+        path.min[axis] += by;
+    } else {
+        path.max[axis] += by;
+    }
+    let mut allowed = by;
+    statics.query(&path, |_, b, layer| {
+        if layers.response(w.layer[i], layer) != Response::Separate || overlap(bi, b, other) <= SLOP
+        {
+            return;
+        }
+        let gap = if by < 0.0 {
+            bi.min[axis] - b.max[axis]
+        } else {
+            b.min[axis] - bi.max[axis]
+        };
+        if gap < -SLOP {
+            return;
+        }
+        let room = gap.max(0.0);
+        allowed = if by < 0.0 {
+            allowed.max(-room)
+        } else {
+            allowed.min(room)
+        };
+    });
+    allowed
 }
 
 /// The coordinate along `axis` that puts box `i` (bounds `bi`) flush against the sweep's

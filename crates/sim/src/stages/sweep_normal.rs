@@ -83,7 +83,8 @@ pub(crate) fn apply(ctx: &mut StageCtx, (i, j): (usize, usize), impact: &Impact)
     } else {
         (impact.contact.normal, 0.0)
     };
-    separate_along_normal(w, i, j, normal, depth);
+    // One dynamic body against a static or kinematic one: no push between dynamic bodies.
+    separate_along_normal(w, None, (i, j), normal, depth);
     let resolved = w.position[d] - end;
     let (ea, eb) = (w.entity[i], w.entity[j]);
     ctx.out.events.push(GameEvent::PushedApart {
