@@ -4,8 +4,9 @@
 //! playback states).
 
 use std::io::{BufRead, BufReader};
+use std::path::Path;
 use std::process::{Child, Command, Stdio};
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use futures_util::{SinkExt, StreamExt};
 use prost::Message as _;
@@ -103,6 +104,20 @@ pub(crate) async fn subscribe_to(ws: &mut Ws, channels: &Value, topic: &str, id:
     ws.send(Message::text(subscribe.to_string())).await.unwrap();
 }
 
+/// Subscribes `ws` to every channel of the `advertise` message `channels` (subscription `i`
+/// for the `i`-th).
+pub(crate) async fn subscribe_all(ws: &mut Ws, channels: &Value) {
+    let all: Vec<Value> = channels["channels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .enumerate()
+        .map(|(i, c)| serde_json::json!({"id": i, "channelId": c["id"]}))
+        .collect();
+    let subscribe = serde_json::json!({"op": "subscribe", "subscriptions": all});
+    ws.send(Message::text(subscribe.to_string())).await.unwrap();
+}
+
 /// The next JSON message, but for the services' advertisement (see [`services`]).
 pub(crate) async fn next_json(ws: &mut Ws) -> Value {
     loop {
@@ -159,21 +174,7 @@ pub(crate) async fn call(
     call: u32,
     request: &str,
 ) -> Result<Value, String> {
-    let service = services["services"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|s| s["name"] == name)
-        .unwrap_or_else(|| panic!("a service {name}"))["id"]
-        .as_u64()
-        .unwrap() as u32;
-    let mut data = vec![2u8];
-    data.extend_from_slice(&service.to_le_bytes());
-    data.extend_from_slice(&call.to_le_bytes());
-    data.extend_from_slice(&4u32.to_le_bytes());
-    data.extend_from_slice(b"json");
-    data.extend_from_slice(request.as_bytes());
-    ws.send(Message::binary(data)).await.unwrap();
+    send_call(ws, services, name, call, request).await;
     loop {
         let m = tokio::time::timeout(Duration::from_secs(10), ws.next())
             .await
@@ -219,20 +220,7 @@ pub(crate) async fn playback_state(ws: &mut Ws) -> (u8, u64, u8, String) {
 /// The `/stats` message of the next frame stepped (`/step` of 1), decoded (it may come
 /// before the call's answer).
 pub(crate) async fn step_stats(ws: &mut Ws, services: &Value, call_id: u32) -> Stats {
-    let service = services["services"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|s| s["name"] == "/step")
-        .unwrap()["id"]
-        .as_u64()
-        .unwrap() as u32;
-    let mut data = vec![2u8];
-    data.extend_from_slice(&service.to_le_bytes());
-    data.extend_from_slice(&call_id.to_le_bytes());
-    data.extend_from_slice(&4u32.to_le_bytes());
-    data.extend_from_slice(b"json{\"frames\": 1}");
-    ws.send(Message::binary(data)).await.unwrap();
+    send_call(ws, services, "/step", call_id, r#"{"frames": 1}"#).await;
     let (mut stepped, mut frame) = (Vec::new(), None);
     loop {
         let m = tokio::time::timeout(Duration::from_secs(10), ws.next())
@@ -256,4 +244,147 @@ pub(crate) async fn step_stats(ws: &mut Ws, services: &Value, call_id: u32) -> S
             return stats.clone();
         }
     }
+}
+
+/// Advertises `/input` (JSON) as the client's channel 5.
+pub(crate) async fn advertise_input(ws: &mut Ws) {
+    let advertise = serde_json::json!({"op": "advertise", "channels": [
+        {"id": 5, "topic": "/input", "encoding": "json", "schemaName": "ricochet.Input"}]});
+    ws.send(Message::text(advertise.to_string())).await.unwrap();
+}
+
+/// Publishes `text` on the client's channel 5.
+pub(crate) async fn publish(ws: &mut Ws, text: &str) {
+    let mut data = vec![1u8];
+    data.extend_from_slice(&5u32.to_le_bytes());
+    data.extend_from_slice(text.as_bytes());
+    ws.send(Message::binary(data)).await.unwrap();
+}
+
+/// The next status message's (level, text).
+pub(crate) async fn next_status(ws: &mut Ws) -> (u64, String) {
+    loop {
+        let v = next_json(ws).await;
+        if v["op"] == "status" {
+            return (
+                v["level"].as_u64().unwrap(),
+                v["message"].as_str().unwrap().to_owned(),
+            );
+        }
+    }
+}
+
+/// Sends a call to service `name` without waiting for its answer.
+pub(crate) async fn send_call(ws: &mut Ws, services: &Value, name: &str, call: u32, request: &str) {
+    let service = services["services"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|s| s["name"] == name)
+        .unwrap_or_else(|| panic!("a service {name}"))["id"]
+        .as_u64()
+        .unwrap() as u32;
+    let mut data = vec![2u8];
+    data.extend_from_slice(&service.to_le_bytes());
+    data.extend_from_slice(&call.to_le_bytes());
+    data.extend_from_slice(&4u32.to_le_bytes());
+    data.extend_from_slice(b"json");
+    data.extend_from_slice(request.as_bytes());
+    ws.send(Message::binary(data)).await.unwrap();
+}
+
+/// Calls service `name`; its answer (the response, or the failure's message) and the
+/// status messages that came before it.
+pub(crate) async fn call_with_statuses(
+    ws: &mut Ws,
+    services: &Value,
+    name: &str,
+    call: u32,
+    request: &str,
+) -> (Result<Value, String>, Vec<(u64, String)>) {
+    use futures_util::StreamExt;
+    send_call(ws, services, name, call, request).await;
+    let mut statuses = Vec::new();
+    loop {
+        let m = tokio::time::timeout(Duration::from_secs(10), ws.next())
+            .await
+            .expect("an answer within 10 s")
+            .unwrap()
+            .unwrap();
+        match m {
+            Message::Binary(b) if b[0] == 3 => {
+                assert_eq!(u32::from_le_bytes(b[5..9].try_into().unwrap()), call);
+                return (Ok(serde_json::from_slice(&b[17..]).unwrap()), statuses);
+            }
+            Message::Text(t) => {
+                let v: Value = serde_json::from_str(t.as_str()).unwrap();
+                if v["op"] == "serviceCallFailure" {
+                    return (Err(v["message"].as_str().unwrap().to_owned()), statuses);
+                }
+                if v["op"] == "status" {
+                    let text = v["message"].as_str().unwrap().to_owned();
+                    statuses.push((v["level"].as_u64().unwrap(), text));
+                }
+            }
+            _ => {}
+        }
+    }
+}
+
+/// Connects, returning the socket and the services' advertisement.
+pub(crate) async fn open(server: &Server, subprotocol: &str) -> (Ws, Value) {
+    let (mut ws, _) = connect(&server.url, subprotocol).await.unwrap();
+    loop {
+        let v = any_json(&mut ws).await;
+        if v["op"] == "advertiseServices" {
+            return (ws, v);
+        }
+    }
+}
+
+/// SIGTERM, then the exit status, waiting at most `limit`.
+pub(crate) fn terminate(server: &mut Server, limit: Duration) -> std::process::ExitStatus {
+    let pid = server.child.id().to_string();
+    assert!(
+        Command::new("kill")
+            .args(["-TERM", &pid])
+            .status()
+            .unwrap()
+            .success()
+    );
+    let asked = Instant::now();
+    loop {
+        if let Some(status) = server.child.try_wait().unwrap() {
+            return status;
+        }
+        assert!(
+            asked.elapsed() < limit,
+            "the server still runs {limit:?} after SIGTERM"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+/// `ricochet replay` of `log` gives the same bytes; the frames it holds (`/stats`).
+pub(crate) fn replays_byte_for_byte(log: &Path) -> usize {
+    let replayed = log.with_extension("replay.mcap");
+    let o = Command::new(env!("CARGO_BIN_EXE_ricochet"))
+        .args([
+            "replay",
+            log.to_str().unwrap(),
+            "-o",
+            replayed.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        std::fs::read(log).unwrap() == std::fs::read(&replayed).unwrap(),
+        "byte-identical"
+    );
+    ricochet_log::read_log_file(log)
+        .unwrap()
+        .iter()
+        .filter(|m| m.topic == "/stats")
+        .count()
 }

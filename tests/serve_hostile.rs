@@ -191,17 +191,7 @@ fn a_client_that_never_reads_keeps_the_server_within_its_byte_budget() {
         // The slow client subscribes to everything, then never reads again.
         let (mut slow, _) = connect(&server.url, "foxglove.websocket.v1").await.unwrap();
         let _ = next_json(&mut slow).await;
-        let all: Vec<Value> = channels["channels"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .enumerate()
-            .map(|(i, c)| serde_json::json!({"id": i, "channelId": c["id"]}))
-            .collect();
-        let subscribe = serde_json::json!({"op": "subscribe", "subscriptions": all});
-        slow.send(Message::text(subscribe.to_string()))
-            .await
-            .unwrap();
+        subscribe_all(&mut slow, &channels).await;
         // 600 frames: enough for the old message-counted queue (4,096 messages, 9 a frame)
         // to fill with hundreds of megabytes.
         let mut last = 0;

@@ -11,10 +11,8 @@ use std::time::Duration;
 use futures_util::SinkExt;
 use prost::Message as _;
 use ricochet_log::messages::ricochet::Stats;
-use serde_json::Value;
 use tokio_tungstenite::tungstenite::Message;
 
-use crate::serve_bounds::{advertise_input, open, publish, replays_byte_for_byte, terminate};
 use crate::serve_client::*;
 use crate::serve_hostile::{ANSWER_ROOM, CLIENT_BUDGET, drifting_scene, port, status_kb};
 
@@ -70,17 +68,7 @@ fn a_recorded_session_under_every_hostile_client_serves_a_good_one_within_its_me
         // A client that subscribes to every channel and never reads again.
         let (mut slow, _) = connect(&server.url, "foxglove.websocket.v1").await.unwrap();
         let _ = next_json(&mut slow).await;
-        let all: Vec<Value> = channels["channels"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .enumerate()
-            .map(|(i, c)| serde_json::json!({"id": i, "channelId": c["id"]}))
-            .collect();
-        let subscribe = serde_json::json!({"op": "subscribe", "subscriptions": all});
-        slow.send(Message::text(subscribe.to_string()))
-            .await
-            .unwrap();
+        subscribe_all(&mut slow, &channels).await;
 
         // 150 sockets that send half a handshake and stop.
         let port = port(&server.url);

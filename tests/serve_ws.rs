@@ -11,7 +11,6 @@ use std::time::Duration;
 use futures_util::SinkExt;
 use prost::Message as _;
 use ricochet_log::messages::ricochet::Stats;
-use serde_json::Value;
 use tokio_tungstenite::tungstenite::Message;
 
 use crate::serve_client::*;
@@ -169,17 +168,7 @@ fn a_client_that_never_reads_loses_messages_and_nobody_else_does() {
         let (mut slow, _) = connect(&server.url, "foxglove.websocket.v1").await.unwrap();
         let _ = next_json(&mut slow).await;
         let channels = next_json(&mut slow).await;
-        let all: Vec<Value> = channels["channels"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .enumerate()
-            .map(|(i, c)| serde_json::json!({"id": i, "channelId": c["id"]}))
-            .collect();
-        let subscribe = serde_json::json!({"op": "subscribe", "subscriptions": all});
-        slow.send(Message::text(subscribe.to_string()))
-            .await
-            .unwrap();
+        subscribe_all(&mut slow, &channels).await;
         // A good client reads /stats all along: every frame, none missing.
         let (mut good, _) = connect(&server.url, "foxglove.websocket.v1").await.unwrap();
         let _ = next_json(&mut good).await;
