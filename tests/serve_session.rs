@@ -101,21 +101,7 @@ fn inputs_from_a_client_are_applied_recorded_and_replayed_byte_for_byte() {
                 && m.data["message"].as_str().unwrap().contains("thrust on")),
         "the thrust was applied"
     );
-    let replayed = dir.path().join("replayed.mcap");
-    let o = Command::new(env!("CARGO_BIN_EXE_ricochet"))
-        .args([
-            "replay",
-            out.to_str().unwrap(),
-            "-o",
-            replayed.to_str().unwrap(),
-        ])
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    assert!(
-        std::fs::read(&out).unwrap() == std::fs::read(&replayed).unwrap(),
-        "byte-identical"
-    );
+    replays_byte_for_byte(&out);
 }
 
 #[test]
@@ -219,22 +205,7 @@ fn services_pause_step_seek_and_reset_and_each_recording_segment_replays() {
         "no file per seek"
     );
     for file in ["session.mcap", "session-1.mcap"] {
-        let recorded = dir.path().join(file);
-        let replayed = dir.path().join(format!("{file}.replay"));
-        let o = Command::new(env!("CARGO_BIN_EXE_ricochet"))
-            .args([
-                "replay",
-                recorded.to_str().unwrap(),
-                "-o",
-                replayed.to_str().unwrap(),
-            ])
-            .output()
-            .unwrap();
-        assert!(
-            o.status.success(),
-            "{file}: {}",
-            String::from_utf8_lossy(&o.stderr)
-        );
+        replays_byte_for_byte(&dir.path().join(file));
     }
 }
 
