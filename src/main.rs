@@ -99,6 +99,13 @@ enum Command {
     /// and foxglove.sdk.v1 (current Foxglove). A slow client loses messages (and is told),
     /// never the simulation or the recording. Ctrl-C or SIGTERM stops, finishing --record.
     ///
+    /// Bounds, whatever clients do: at most 64 clients, each with an 8 MiB queue (+1 MiB for
+    /// answers), 256 advertised channels and 2,000 inputs a second of at most 4 KB; inputs
+    /// within ±1e15 (one that would overflow the state is refused); 32 handshakes under way,
+    /// 5 s each; 64 MiB of inputs kept for seeks back; /load reads a regular file below the
+    /// server's directory of at most 16 MiB. A frame that still overflows pauses the session
+    /// at its last good frame, the recording complete up to there.
+    ///
     /// Example: ricochet serve scenarios/platformer.toml --record session.mcap
     Serve {
         /// The scenario file (TOML). Default: the built-in Asteroids demo.
