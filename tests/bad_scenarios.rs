@@ -322,6 +322,13 @@ fn issue_20_limits_are_named_with_their_location() {
         "2:53",
         &["script[0].input", "between -1 and 1, got 1e308\n"],
     );
+    // Was: accepted, and the run overflowed at frame 1. The script's values are held to
+    // the ±1e15 a body's and a live input's are.
+    case(
+        "huge-script-impulse",
+        "2:62",
+        &["script[0].impulse", "[1.7e308, 0] is beyond ±1e15"],
+    );
     // A template only the script spawns, in a world 100 wide but 10 tall: the box's centre
     // (4.5 away, it turns with the body) plus its half height 1 is 5.5 up.
     case(

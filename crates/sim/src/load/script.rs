@@ -69,11 +69,27 @@ pub(crate) fn script(
                 action,
             })
         };
+        // As strict as a body's values and a live input's (src/session.rs): finite, and
+        // within the coordinates the geometry accepts.
         let v = |f: &str, v: [f64; 2]| {
-            if v.iter().all(|x| finite(*x)) {
-                Ok(vec2(v))
-            } else {
+            if !v.iter().all(|x| finite(*x)) {
                 Err(fail(f, "must be finite numbers".to_owned()))
+            } else if v.iter().any(|x| x.abs() > ricochet_geom::MAX_COORDINATE) {
+                Err(fail(
+                    f,
+                    format!(
+                        "{} is beyond ±{:e}, the largest {} Ricochet accepts",
+                        ricochet_geom::Numbers(v),
+                        ricochet_geom::MAX_COORDINATE,
+                        if f == "position" {
+                            "coordinate"
+                        } else {
+                            "value"
+                        }
+                    ),
+                ))
+            } else {
+                Ok(vec2(v))
             }
         };
         let input = |x: f64| {
