@@ -44,6 +44,23 @@ fn run_child(name: &str, frames: u64) -> anyhow::Result<Row> {
     };
     serde_json::from_str(line).with_context(|| format!("{name}: reading the benchmark result"))
 }
+/// Exit code 2, after saying why, for a `--frames` of 0 or past [`MAX_FRAMES`] (`bench`
+/// keeps every frame's timings, `bench --record` every frame's log).
+pub fn bad_frames(frames: u64) -> anyhow::Result<Option<ExitCode>> {
+    if frames == 0 {
+        out::error("error: --frames must be at least 1");
+        return Ok(Some(ExitCode::from(2)));
+    }
+    if frames > MAX_FRAMES {
+        out::error(&format!(
+            "error: --frames must be at most {MAX_FRAMES} (a scene keeps every frame's \
+             timings, or with --record its log), got {frames}"
+        ));
+        return Ok(Some(ExitCode::from(2)));
+    }
+    Ok(None)
+}
+
 /// Runs the named scenes (or [`DEFAULT_SCENES`]), `frames` timed frames each, prints the
 /// table, writes the CSV. Each scene runs in its own process (see [`CHILD_ENV`]). Exit code
 /// 0 when every scene's contact sets agree with both rapier's and Box2D's, 1 when one does
@@ -65,16 +82,8 @@ pub fn run(scenes: &[String], frames: u64, csv: Option<&Path>) -> anyhow::Result
             }
         }
     }
-    if frames == 0 {
-        out::error("error: --frames must be at least 1");
-        return Ok(ExitCode::from(2));
-    }
-    if frames > MAX_FRAMES {
-        out::error(&format!(
-            "error: --frames must be at most {MAX_FRAMES} (a scene keeps every frame's \
-             timings), got {frames}"
-        ));
-        return Ok(ExitCode::from(2));
+    if let Some(code) = bad_frames(frames)? {
+        return Ok(code);
     }
     if let Some(path) = csv {
         files::check_writable(path)?;

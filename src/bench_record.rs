@@ -82,6 +82,9 @@ fn measure(name: &str, scene: Scene, frames: u64, dir: &Path) -> anyhow::Result<
 /// Runs `--record` on the named scenes, `frames` frames each after frame 0; keeps the logs
 /// in `keep` if given (else in a temporary directory).
 pub fn run(scenes: &[String], frames: u64, keep: Option<&Path>) -> anyhow::Result<ExitCode> {
+    if let Some(code) = crate::bench::bad_frames(frames)? {
+        return Ok(code);
+    }
     let names: Vec<String> = if scenes.is_empty() {
         vec!["asteroids-10000".to_owned()]
     } else {

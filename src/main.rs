@@ -242,7 +242,7 @@ enum Command {
     Bench {
         /// Scenes to run (default: a small set).
         scenes: Vec<String>,
-        /// Frames per scene after frame 0 (at most 1000000: every frame's timings are kept).
+        /// Frames per scene after frame 0 (at most 1000000: every frame's timings, or with --record its log, are kept).
         #[arg(long, default_value_t = 100, value_name = "N")]
         frames: u64,
         /// Write the results as CSV here.

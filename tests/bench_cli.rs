@@ -101,13 +101,15 @@ fn counts_and_frames_past_the_caps_are_bad_input() {
         assert!(stderr.contains(&format!("scene \"{scene}\"")), "{stderr}");
         assert!(stderr.contains("more than 1000000"), "{stderr}");
     }
-    let o = ricochet(
-        &["bench", "asteroids-10", "--frames", "18446744073709551615"],
-        b"",
-    );
-    let stderr = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{stderr}");
-    assert!(stderr.contains("at most 1000000"), "{stderr}");
+    // `--record` too: it stepped and recorded until killed (a log of every frame).
+    for record in [&[][..], &["--record"][..]] {
+        let mut args = vec!["bench", "asteroids-10", "--frames", "18446744073709551615"];
+        args.extend_from_slice(record);
+        let o = ricochet(&args, b"");
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(stderr.contains("at most 1000000"), "{stderr}");
+    }
     let help = ricochet(&["bench", "--help"], b"");
     let help = String::from_utf8_lossy(&help.stdout);
     assert!(help.contains("from 1 to 1000000"), "{help}");
