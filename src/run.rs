@@ -155,10 +155,13 @@ pub fn run(
         .with_context(|| format!("finishing {}", output.display()))?;
     if let Some((frame, bad)) = overflow {
         out::error(&format!(
-            "error: frame {frame}: {}; the simulation overflowed. {} holds frames 0 to {}",
+            "error: frame {frame}: {}; the simulation overflowed. {} holds {}",
             crate::validate::describe(&sim, &bad),
             output.display(),
-            frame.saturating_sub(1)
+            match frame {
+                0 => "no frame".to_owned(),
+                f => format!("frames 0 to {}", f - 1),
+            }
         ));
         return Ok(ExitCode::from(1));
     }
