@@ -329,6 +329,21 @@ fn issue_20_limits_are_named_with_their_location() {
         "2:62",
         &["script[0].impulse", "[1.7e308, 0] is beyond ±1e15"],
     );
+    // A static body is never wrapped: two widths out it would be met only at its images one
+    // width away (at x = 15 and 35), never at x = 5 where the disc overlaps it.
+    case(
+        "static-outside-wrap-world",
+        "20:1",
+        &[
+            "bodies[1].position",
+            "[25, 5] is outside the wrap-around world",
+        ],
+    );
+    case(
+        "static-spawned-outside-wrap-world",
+        "2:61",
+        &["script[0].position", "[5, -25] is outside"],
+    );
     // A template only the script spawns, in a world 100 wide but 10 tall: the box's centre
     // (4.5 away, it turns with the body) plus its half height 1 is 5.5 up.
     case(

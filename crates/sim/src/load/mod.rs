@@ -20,11 +20,30 @@ use chunks::split_bodies;
 pub use context::ScenarioError;
 use context::{Ctx, unknown};
 use file::{BodyFile, BodyTable, ScenarioFile};
-use ricochet_geom::Number;
+use ricochet_geom::{Number, Numbers};
 use script::script;
 use std::ops::Range;
 use toml::Spanned;
 use world::world_settings;
+
+/// The problem with a static `def` placed outside a wrapping world, if any: a static body
+/// is never wrapped (it never moves), so one outside would be met only at its images one
+/// world size away, not where the rule "contacts are those of the scene wrapped into the
+/// world" puts it.
+pub(crate) fn static_outside(world: &crate::WorldDef, def: &crate::BodyDef) -> Option<String> {
+    let bounds = world.bounds?;
+    let p = def.position;
+    let inside = (0..2).all(|axis| bounds.min[axis] <= p[axis] && p[axis] <= bounds.max[axis]);
+    (bounds.wrap && def.kind == crate::BodyKind::Static && !inside).then(|| {
+        format!(
+            "{} is outside the wrap-around world {} to {}: a static body never moves, so \
+             it is never wrapped; place it inside the world",
+            Numbers([p.x, p.y]),
+            Numbers([bounds.min.x, bounds.min.y]),
+            Numbers([bounds.max.x, bounds.max.y])
+        )
+    })
+}
 
 /// The problem with `def` in a wrapping world it is too large for
 /// ([`crate::WorldBounds::oversized`]), if any.
@@ -187,6 +206,9 @@ fn load(text: &str, file: &str, chunked: bool) -> Result<Scenario, ScenarioError
         if let Some(problem) = oversized(&world, &def) {
             return Err(ctx.err(b.span(), format!("{field}.shape"), problem));
         }
+        if let Some(problem) = static_outside(&world, &def) {
+            return Err(ctx.err(b.span(), format!("{field}.position"), problem));
+        }
         bodies.push(def);
     }
     if let Some(r) = &raw.world.active_region {
@@ -212,7 +234,7 @@ fn load(text: &str, file: &str, chunked: bool) -> Result<Scenario, ScenarioError
             ));
         }
     }
-    let script = script(&ctx, &raw, &templates, &bodies, frames)?;
+    let script = script(&ctx, &raw, &world, &templates, &bodies, frames)?;
     Ok(Scenario {
         name: raw.name.clone().unwrap_or_else(|| {
             std::path::Path::new(file).file_stem().map_or_else(

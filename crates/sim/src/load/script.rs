@@ -12,6 +12,7 @@ use ricochet_geom::Number;
 pub(crate) fn script(
     ctx: &Ctx<'_>,
     raw: &ScenarioFile,
+    world: &crate::WorldDef,
     templates: &BTreeMap<String, BodyDef>,
     bodies: &[BodyDef],
     frames: u64,
@@ -125,6 +126,9 @@ pub(crate) fn script(
                     def.name = n.clone();
                 }
                 def.position = within_world(fail, v("position", *position)?)?;
+                if let Some(problem) = crate::load::static_outside(world, &def) {
+                    return Err(fail("position", problem));
+                }
                 if let Some(vel) = velocity {
                     if def.kind == BodyKind::Static {
                         return Err(fail(

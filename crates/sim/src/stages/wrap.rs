@@ -38,7 +38,8 @@
 //! first. A swept pair whose path over the frame reaches two or more world sizes (a bullet
 //! faster than the world a frame) is cast at every image its path meets instead
 //! ([`path_offsets`], at most [`MAX_PATH_IMAGES`]). Not covered: a static body placed half
-//! the world's size or more outside (statics are never moved).
+//! the world's size or more outside (statics are never moved; scenario files refuse a
+//! static body outside a wrapping world, a scene built in code is not checked).
 
 use ricochet_geom::{Bounds, Vec2};
 
