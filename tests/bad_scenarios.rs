@@ -344,6 +344,14 @@ fn issue_20_limits_are_named_with_their_location() {
         "2:61",
         &["script[0].position", "[5, -25] is outside"],
     );
+    case(
+        "static-split-child",
+        "16:12",
+        &[
+            "bodies[0].split[0].template",
+            "template \"debris\" is static",
+        ],
+    );
     // A template only the script spawns, in a world 100 wide but 10 tall: the box's centre
     // (4.5 away, it turns with the body) plus its half height 1 is 5.5 up.
     case(
@@ -351,6 +359,24 @@ fn issue_20_limits_are_named_with_their_location() {
         "8:1",
         &["templates.pair.shape", "5.5 along y", "100 x 10"],
     );
+}
+
+/// The other side of `static-split-child`: a static parent splitting into static debris
+/// with no split velocity drops nothing, so it loads.
+#[test]
+fn a_static_child_of_a_static_parent_without_velocity_loads() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("debris.toml");
+    std::fs::write(
+        &path,
+        "layers = [\"a\"]\n[templates.debris]\nlayer = \"a\"\nkind = \"static\"\nshape = \
+         { kind = \"circle\", radius = 0.5 }\n[[bodies]]\nname = \"wall\"\nlayer = \"a\"\n\
+         kind = \"static\"\nshape = { kind = \"circle\", radius = 1 }\nsplit = [{ template \
+         = \"debris\", offset = [1, 0] }]\n",
+    )
+    .unwrap();
+    let o = crate::util::ricochet(&["check", path.to_str().unwrap()], b"");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
 
 #[test]

@@ -125,7 +125,7 @@ pub(crate) fn references(
         }
     }
     for (i, s) in b.split.iter().flatten().enumerate() {
-        if !templates.contains_key(&s.template) {
+        let Some(t) = templates.get(&s.template) else {
             return Err(unknown(
                 ctx,
                 span,
@@ -133,6 +133,22 @@ pub(crate) fn references(
                 "template",
                 &s.template,
                 templates.keys(),
+            ));
+        };
+        // A child leaves at the parent's velocity plus the split's; a static child never
+        // moves, so that velocity would be dropped without a word, unless there is none (a
+        // static parent, no split velocity).
+        let static_parent = b.kind.as_deref() == Some("static");
+        if t.kind == BodyKind::Static && (!static_parent || s.velocity != [0.0, 0.0]) {
+            return Err(ctx.err(
+                span,
+                format!("{field}.split[{i}].template"),
+                format!(
+                    "template \"{}\" is static: a static child never moves, so its velocity \
+                     (the parent's plus the split's) would be dropped: give the template \
+                     `kind = \"dynamic\"` (or \"kinematic\")",
+                    s.template
+                ),
             ));
         }
     }
