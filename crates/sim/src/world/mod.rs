@@ -33,6 +33,7 @@ use crate::interned::{NameTable, ShapeTable, shape_key};
 use crate::scenario::TileRows;
 
 mod bounds;
+mod measures;
 mod rows;
 
 use bounds::LocalBounds;
@@ -529,101 +530,6 @@ impl World {
     #[must_use]
     pub fn pose(&self, i: usize) -> ricochet_geom::Pose {
         ricochet_geom::Pose::new(self.position[i], self.angle[i])
-    }
-
-    /// A 64-bit FNV-1a hash of every body's raw state bits in id order (entity, position,
-    /// angle, velocity, angular velocity), like Box2D's determinism test: any change of any
-    /// bit anywhere changes it.
-    #[must_use]
-    pub fn digest(&self) -> u64 {
-        const PRIME: u64 = 0x0000_0100_0000_01b3;
-        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-        let mut eat = |bits: u64| {
-            for byte in bits.to_le_bytes() {
-                h ^= u64::from(byte);
-                h = h.wrapping_mul(PRIME);
-            }
-        };
-        for i in 0..self.len() {
-            eat(u64::from(self.entity[i].index) << 32 | u64::from(self.entity[i].generation));
-            let (v, w) = (self.velocity(i), self.angular_velocity(i));
-            for x in [
-                self.position[i].x,
-                self.position[i].y,
-                self.angle[i],
-                v.x,
-                v.y,
-                w,
-            ] {
-                eat(x.to_bits());
-            }
-        }
-        h
-    }
-
-    /// Kinetic energy of the dynamic bodies, `sum(m v² / 2)` (translation only).
-    #[must_use]
-    pub fn kinetic_energy(&self) -> f64 {
-        self.movers
-            .iter()
-            .map(|&i| i as usize)
-            .filter(|&i| self.kind[i] == BodyKind::Dynamic)
-            .map(|i| {
-                let r = self.row[i] as usize;
-                0.5 * self.rows.mass[r] * self.rows.velocity[r].length_squared()
-            })
-            .sum()
-    }
-
-    /// The first dynamic body (world index, in [`World::kinetic_energy`]'s order) at which
-    /// that sum stops being finite, if it does: every velocity can be finite while `m v²`
-    /// overflows (a velocity past 1e154, or two bodies near `f64::MAX` each).
-    #[must_use]
-    pub(crate) fn kinetic_energy_overflow(&self) -> Option<usize> {
-        let mut sum = 0.0;
-        self.movers
-            .iter()
-            .map(|&i| i as usize)
-            .filter(|&i| self.kind[i] == BodyKind::Dynamic)
-            .find(|&i| {
-                let r = self.row[i] as usize;
-                sum += 0.5 * self.rows.mass[r] * self.rows.velocity[r].length_squared();
-                !sum.is_finite()
-            })
-    }
-
-    /// The heap bytes the world holds: every column's capacity, the shape and name tables,
-    /// the rows and the id allocator. An honest count of what it keeps, not of what the
-    /// allocator adds around it.
-    #[must_use]
-    pub fn heap_bytes(&self) -> usize {
-        fn cap<T>(v: &Vec<T>) -> usize {
-            v.capacity() * size_of::<T>()
-        }
-        let compound_parts: usize = (0..self.shapes_len())
-            .filter_map(|id| self.shapes.try_get(id))
-            .map(|(s, _)| match s {
-                Shape::Compound(c) => size_of_val(c.parts()),
-                Shape::Primitive(_) => 0,
-            })
-            .sum();
-        cap(&self.entity)
-            + cap(&self.layer)
-            + cap(&self.kind)
-            + cap(&self.position)
-            + cap(&self.angle)
-            + cap(&self.shape_id)
-            + cap(&self.name_id)
-            + cap(&self.row)
-            + self.shapes.heap_bytes()
-            + compound_parts
-            + self.names.heap_bytes(|k| k.len())
-            + self.rows.heap_bytes()
-            + cap(&self.movers)
-            + cap(&self.active)
-            + cap(&self.non_boxes)
-            + cap(&self.key)
-            + self.ids.heap_bytes()
     }
 
     /// How many ids the shape table has handed out (some may be free).
