@@ -367,7 +367,6 @@ fn refused_inputs_are_not_kept() {
 /// server writes is bounded), then a located refusal; the server goes on.
 #[test]
 fn resets_while_recording_stop_at_1000_files() {
-    use futures_util::StreamExt;
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("s.mcap");
     let mut server = serve(&["--paused", "--record", out.to_str().unwrap()]);
@@ -381,11 +380,7 @@ fn resets_while_recording_stop_at_1000_files() {
             }
             let mut answers = 0;
             while answers < 50 {
-                let m = tokio::time::timeout(Duration::from_secs(10), ws.next())
-                    .await
-                    .expect("an answer within 10 s")
-                    .unwrap()
-                    .unwrap();
+                let m = next_message(&mut ws).await;
                 match m {
                     Message::Binary(b) if b[0] == 3 => (ok, answers) = (ok + 1, answers + 1),
                     Message::Text(t) => {

@@ -130,11 +130,7 @@ pub(crate) async fn next_json(ws: &mut Ws) -> Value {
 
 pub(crate) async fn any_json(ws: &mut Ws) -> Value {
     loop {
-        let m = tokio::time::timeout(Duration::from_secs(10), ws.next())
-            .await
-            .expect("a message within 10 s")
-            .unwrap()
-            .unwrap();
+        let m = next_message(ws).await;
         if let Message::Text(t) = m {
             return serde_json::from_str(t.as_str()).unwrap();
         }
@@ -144,11 +140,7 @@ pub(crate) async fn any_json(ws: &mut Ws) -> Value {
 /// The next message on a subscription: (subscription, time, payload).
 pub(crate) async fn next_data(ws: &mut Ws) -> (u32, u64, Vec<u8>) {
     loop {
-        let m = tokio::time::timeout(Duration::from_secs(10), ws.next())
-            .await
-            .expect("a message within 10 s")
-            .unwrap()
-            .unwrap();
+        let m = next_message(ws).await;
         if let Message::Binary(b) = m
             && b[0] == 1
         {
@@ -157,6 +149,15 @@ pub(crate) async fn next_data(ws: &mut Ws) -> (u32, u64, Vec<u8>) {
             return (sub, time, b[13..].to_vec());
         }
     }
+}
+
+/// The next message on `ws`, waiting at most 10 s.
+pub(crate) async fn next_message(ws: &mut Ws) -> Message {
+    tokio::time::timeout(Duration::from_secs(10), ws.next())
+        .await
+        .expect("a message within 10 s")
+        .unwrap()
+        .unwrap()
 }
 
 pub(crate) fn runtime() -> tokio::runtime::Runtime {
@@ -174,28 +175,9 @@ pub(crate) async fn call(
     call: u32,
     request: &str,
 ) -> Result<Value, String> {
-    send_call(ws, services, name, call, request).await;
-    loop {
-        let m = tokio::time::timeout(Duration::from_secs(10), ws.next())
-            .await
-            .expect("an answer within 10 s")
-            .unwrap()
-            .unwrap();
-        match m {
-            Message::Binary(b) if b[0] == 3 => {
-                assert_eq!(u32::from_le_bytes(b[5..9].try_into().unwrap()), call);
-                assert_eq!(&b[13..17], b"json");
-                return Ok(serde_json::from_slice(&b[17..]).unwrap());
-            }
-            Message::Text(t) => {
-                let v: Value = serde_json::from_str(t.as_str()).unwrap();
-                if v["op"] == "serviceCallFailure" {
-                    return Err(v["message"].as_str().unwrap().to_owned());
-                }
-            }
-            _ => {}
-        }
-    }
+    call_with_statuses(ws, services, name, call, request)
+        .await
+        .0
 }
 
 /// The next playback state: (status, time, whether it sought, request id).
@@ -223,11 +205,7 @@ pub(crate) async fn step_stats(ws: &mut Ws, services: &Value, call_id: u32) -> S
     send_call(ws, services, "/step", call_id, r#"{"frames": 1}"#).await;
     let (mut stepped, mut frame) = (Vec::new(), None);
     loop {
-        let m = tokio::time::timeout(Duration::from_secs(10), ws.next())
-            .await
-            .expect("a message within 10 s")
-            .unwrap()
-            .unwrap();
+        let m = next_message(ws).await;
         if let Message::Binary(b) = m {
             match b[0] {
                 1 => stepped.push(Stats::decode(&b[13..]).unwrap()),
@@ -302,18 +280,14 @@ pub(crate) async fn call_with_statuses(
     call: u32,
     request: &str,
 ) -> (Result<Value, String>, Vec<(u64, String)>) {
-    use futures_util::StreamExt;
     send_call(ws, services, name, call, request).await;
     let mut statuses = Vec::new();
     loop {
-        let m = tokio::time::timeout(Duration::from_secs(10), ws.next())
-            .await
-            .expect("an answer within 10 s")
-            .unwrap()
-            .unwrap();
+        let m = next_message(ws).await;
         match m {
             Message::Binary(b) if b[0] == 3 => {
                 assert_eq!(u32::from_le_bytes(b[5..9].try_into().unwrap()), call);
+                assert_eq!(&b[13..17], b"json");
                 return (Ok(serde_json::from_slice(&b[17..]).unwrap()), statuses);
             }
             Message::Text(t) => {
