@@ -70,7 +70,7 @@ pub fn run(log: &Path, output: Option<PathBuf>) -> anyhow::Result<ExitCode> {
     let output = output.unwrap_or_else(|| log.with_extension("replay.mcap"));
     let mut writer = LogWriter::create(&output, crate::record::LIBRARY)?;
     writer.attach(SCENARIO_ATTACHMENT, "application/toml", text.as_bytes())?;
-    let mut session = Session::new(&scenario, writer, true)?;
+    let mut session = Session::new(&scenario, writer)?;
     let mut pending = inputs.iter().peekable();
     for _ in 0..frames {
         let next = session.next_frame();

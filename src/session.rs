@@ -95,9 +95,9 @@ pub struct Session<S: MessageSink> {
 }
 
 impl<S: MessageSink> Session<S> {
-    /// A session of `scenario` writing to `sink` (`live`: see [`Recorder::new`]).
-    pub fn new(scenario: &Scenario, sink: S, live: bool) -> Result<Session<S>, LogError> {
-        let mut recorder = Recorder::new(sink, scenario.world.dt, Channels::default(), live)?;
+    /// A session of `scenario` writing to `sink`.
+    pub fn new(scenario: &Scenario, sink: S) -> Result<Session<S>, LogError> {
+        let mut recorder = Recorder::new(sink, scenario.world.dt, Channels::default())?;
         let input = recorder
             .sink_mut()
             .add_protobuf_channel("/input", Schema::ricochet("ricochet.Input"))?;
@@ -115,8 +115,8 @@ impl<S: MessageSink> Session<S> {
 
     /// A session going on from `sim` (a snapshot), writing to a new `sink` from its next
     /// frame: the first frame written lists every body, as a first frame does.
-    pub fn resume(sim: Simulation, sink: S, live: bool) -> Result<Session<S>, LogError> {
-        let mut recorder = Recorder::new(sink, sim.dt(), Channels::default(), live)?;
+    pub fn resume(sim: Simulation, sink: S) -> Result<Session<S>, LogError> {
+        let mut recorder = Recorder::new(sink, sim.dt(), Channels::default())?;
         let input = recorder
             .sink_mut()
             .add_protobuf_channel("/input", Schema::ricochet("ricochet.Input"))?;
@@ -311,7 +311,7 @@ impl<S: MessageSink> Session<S> {
         self.overflowed.as_ref().map(|(f, w)| (*f, w.as_str()))
     }
 
-    /// Sends live viewers the whole current state: both scenes and every body's frame (after
+    /// Sends live viewers the whole current state: both scenes and the camera's frame (after
     /// a reset or a seek). Never recorded.
     pub fn refresh_live(&mut self) -> Result<(), LogError> {
         let frame = self.next.saturating_sub(1);

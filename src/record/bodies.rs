@@ -1,20 +1,14 @@
-//! What changed since the previous frame, body by body: the `/bodies` deltas, the `/tf`
-//! transforms to send and whether `/scene` must be sent whole again.
+//! What changed since the previous frame, body by body: the `/bodies` deltas and whether
+//! `/scene` or `/scene/static` must be sent again.
 //!
 //! `/bodies` leaves out what the integrator predicts (see `proto/ricochet.proto`): a position
 //! that is `previous + velocity * dt`, an angle that is `previous + angular_velocity * dt`,
 //! velocities that did not change. Values are compared by their bits, so a change of sign of
 //! a zero, or any NaN, is a change.
-//!
-//! `/tf` samples each body's frame as [`motion`](super::motion) decides.
 
 use ricochet_geom::{ShapeDef, Vec2};
-use ricochet_log::messages::fox::FrameTransform;
 use ricochet_log::messages::ricochet as pb;
 use ricochet_sim::{BodyKind, Entity, FrameOutput, Layers, RemovedBody, World};
-
-use super::motion::{Motion, Sample};
-use super::scene;
 
 /// `/bodies` lists every moving body in full every this many frames (and at frame 0).
 pub const KEYFRAME_INTERVAL: u64 = 60;
@@ -26,14 +20,6 @@ struct Known {
     angle: f64,
     velocity: Vec2,
     angular_velocity: f64,
-    /// Its frame's name, `body/index:generation`.
-    frame_id: String,
-    /// Its motion as `/tf` has described it.
-    motion: Motion,
-    /// Its frame stays upright (an AABB part): `/tf` sends no rotation.
-    upright: bool,
-    /// Its drawing depends on its angle: a turn redraws the scene.
-    drawn_with_angle: bool,
     /// A static body: drawn on `/scene/static`, and listed in `/bodies` only when it appears
     /// or changes (keyframes list the moving bodies).
     is_static: bool,
@@ -122,25 +108,16 @@ pub fn removed_message(r: &RemovedBody, layers: &Layers) -> pb::Body {
 pub struct Changes {
     /// `/bodies`.
     pub bodies: pb::Bodies,
-    /// `/tf`: the transforms of the bodies that appeared, or whose stretch of straight-line
-    /// motion ended.
-    pub transforms: Vec<FrameTransform>,
-    /// Every body's pose, when [`Tracker::resend_transforms`] asked: for live viewers only.
-    pub resent: Vec<FrameTransform>,
-    /// `/scene` (moving bodies) must be sent whole: one appeared or went, or one with an
-    /// AABB part turned.
+    /// `/scene` (moving bodies) must be sent again: one moved, turned, appeared or went
+    /// (or, when velocities are drawn, changed its velocity).
     pub scene_changed: bool,
-    /// `/scene/static` must be sent whole: a static body appeared, went, or turned.
+    /// `/scene/static` must be sent again: a static body appeared, went, moved or turned.
     pub static_changed: bool,
 }
 
 /// The last recorded state of every body, by slot.
 #[derive(Default)]
 pub struct Tracker {
-    /// For a live stream: `/tf` never predicts (see [`Motion::live`]).
-    live: bool,
-    /// The next frame sends every body's pose on `/tf`.
-    resend: bool,
     known: Vec<Option<Known>>,
     alive: usize,
     started: bool,
@@ -148,36 +125,17 @@ pub struct Tracker {
     frame: u64,
 }
 
-fn transforms_of(frame_id: &str, samples: &[Sample], dt_ns: u64, out: &mut Vec<FrameTransform>) {
-    for &(frame, [x, y, angle]) in samples {
-        let ts = ricochet_log::messages::timestamp(frame.saturating_mul(dt_ns));
-        out.push(scene::transform(frame_id, ts, Vec2::new(x, y), angle));
-    }
-}
-
 impl Tracker {
-    /// Sends every body's pose on `/tf` in the next frame.
-    pub fn resend_transforms(&mut self) {
-        self.resend = true;
-    }
-
-    /// A tracker for a file (`live` false) or a live stream.
-    pub fn new(live: bool) -> Tracker {
-        Tracker {
-            live,
-            ..Tracker::default()
-        }
-    }
-
-    /// The changes of frame `out.frame` (its world is `world`). `dt_ns` is the step.
+    /// The changes of frame `out.frame` (its world is `world`). `velocities_drawn`: the
+    /// scene shows each body's velocity, so a change of velocity redraws it.
     pub fn frame(
         &mut self,
         world: &World,
         out: &FrameOutput,
         layers: &Layers,
         dt: f64,
-        dt_ns: u64,
         want_bodies: bool,
+        velocities_drawn: bool,
     ) -> Changes {
         let frame = out.frame;
         let keyframe = !self.started || frame.is_multiple_of(KEYFRAME_INTERVAL);
@@ -192,9 +150,6 @@ impl Tracker {
         self.started = true;
         self.frame = frame;
         let mut bodies = Vec::new();
-        let mut transforms = Vec::new();
-        let mut samples = Vec::new();
-        let mut resent = Vec::new();
         for i in 0..world.len() {
             let e: Entity = world.entity[i];
             let (position, angle) = (world.position[i], world.angle[i]);
@@ -204,10 +159,7 @@ impl Tracker {
                 self.known.resize_with(slot + 1, || None);
             }
             let fresh = !matches!(&self.known[slot], Some(k) if k.generation == e.generation);
-            samples.clear();
             if fresh {
-                let upright = scene::upright(world.shape(i));
-                let frame_angle = if upright { 0.0 } else { angle };
                 if self.known[slot].is_none() {
                     self.alive += 1;
                 }
@@ -223,39 +175,25 @@ impl Tracker {
                     angle,
                     velocity,
                     angular_velocity,
-                    frame_id: scene::entity_id(e),
-                    motion: Motion::appear(frame, position, frame_angle, self.live, &mut samples),
-                    upright,
-                    drawn_with_angle: scene::drawing_depends_on_angle(world.shape(i)),
                     is_static,
                     seen: frame,
                 };
-                transforms_of(&k.frame_id, &samples, dt_ns, &mut transforms);
                 self.known[slot] = Some(k);
             }
             let Some(k) = self.known[slot].as_mut() else {
                 continue;
             };
             k.seen = frame;
-            if !fresh {
-                let frame_angle = if k.upright { 0.0 } else { angle };
-                k.motion.frame(frame, position, frame_angle, &mut samples);
-                if self.resend {
-                    let ts = ricochet_log::messages::timestamp(frame.saturating_mul(dt_ns));
-                    let pose = Vec2::new(position.x, position.y);
-                    resent.push(scene::transform(&k.frame_id, ts, pose, frame_angle));
-                }
-                transforms_of(&k.frame_id, &samples, dt_ns, &mut transforms);
-            }
-            if !fresh && k.drawn_with_angle && !same(angle, k.angle) {
+            let sped = !same2(k.velocity, velocity);
+            let spun = !same(k.angular_velocity, angular_velocity);
+            let moved = !same2(position, k.position) || !same(angle, k.angle);
+            if !fresh && (moved || (velocities_drawn && !k.is_static && (sped || spun))) {
                 *if k.is_static {
                     &mut static_changed
                 } else {
                     &mut scene_changed
                 } = true;
             }
-            let sped = !same2(k.velocity, velocity);
-            let spun = !same(k.angular_velocity, angular_velocity);
             // What a reader predicts: the integrator's step with this frame's velocities.
             let moved_as_predicted = same2(position, k.position + velocity * dt);
             let turned_as_predicted = same(angle, k.angle + angular_velocity * dt);
@@ -298,7 +236,6 @@ impl Tracker {
             k.velocity = velocity;
             k.angular_velocity = angular_velocity;
         }
-        self.resend = false;
         if self.alive != world.len() {
             // Some bodies went (removed, or despawned between frames): forget them.
             for slot in &mut self.known {
@@ -332,8 +269,6 @@ impl Tracker {
                 removed,
                 dt,
             },
-            transforms,
-            resent,
             scene_changed,
             static_changed,
         }

@@ -3,9 +3,9 @@
 //!
 //! | topic | schema | content |
 //! |---|---|---|
-//! | `/scene` | `foxglove.SceneUpdate` | every moving body, drawn in its own frame; sent whole when that set changes |
-//! | `/scene/static` | `foxglove.SceneUpdate` | every static body, the same way: sent whole when that set changes |
-//! | `/tf` | `foxglove.FrameTransforms` | each body's frame: every frame while its motion changes, one prediction per second on a straight line (Foxglove interpolates) |
+//! | `/scene` | `foxglove.SceneUpdate` | every moving body, in `world`: whole, in every frame one moved, appeared or went (`scene.rs`) |
+//! | `/scene/static` | `foxglove.SceneUpdate` | every static body, the same way: whole, when one appeared, went or moved |
+//! | `/tf` | `foxglove.FrameTransforms` | one frame, `view`, where the layout's camera looks: the focus body, or the world's centre |
 //! | `/scene/contacts` | `foxglove.SceneUpdate` | the frame's contact normals as arrows |
 //! | `/bodies` | `ricochet.Bodies` | exact body states: every body at keyframes, between them what the integrator does not predict |
 //! | `/contacts` | `ricochet.Contacts` | every contact, with the poses it was detected at |
@@ -17,15 +17,15 @@
 //! encoded and compressed on the log's writer thread.
 
 mod bodies;
-mod motion;
 pub mod scene;
 
 use std::path::Path;
 
+use ricochet_geom::Vec2;
 use ricochet_log::messages::fox::{FrameTransforms, Log, SceneUpdate, log};
 use ricochet_log::messages::{Schema, ricochet as pb, timestamp};
 use ricochet_log::{ChannelId, LogError, LogWriter, MessageSink, Threading};
-use ricochet_sim::{BodyKind, FrameOutput, Layers, Simulation};
+use ricochet_sim::{FrameOutput, Layers, Simulation};
 
 use crate::channels::Channels;
 use bodies::Tracker;
@@ -68,6 +68,11 @@ pub struct Recorder<S: MessageSink = LogWriter> {
     tracker: Tracker,
     /// The previous frame had contact arrows (so this one sends an empty set if it has none).
     arrows_shown: bool,
+    /// How bodies become entities, chosen at the first frame (from its body count).
+    style: Option<scene::Style>,
+    /// Where the camera's frame was last sent, and where it looks without a focus body or
+    /// world bounds (the centre of the bodies' extent at the first frame recorded).
+    view: Option<(Vec2, Vec2)>,
 }
 
 impl Recorder<LogWriter> {
@@ -80,7 +85,7 @@ impl Recorder<LogWriter> {
             Threading::Thread
         };
         let writer = LogWriter::create_with(path, LIBRARY, threading)?;
-        Recorder::new(writer, dt, channels, false)
+        Recorder::new(writer, dt, channels)
     }
 
     /// Writes the summary and index. Called after an interrupted run too.
@@ -90,10 +95,8 @@ impl Recorder<LogWriter> {
 }
 
 impl<S: MessageSink> Recorder<S> {
-    /// Adds the chosen channels to `sink`. `live`: for a stream watched as it runs, where
-    /// Foxglove can't read ahead, so `/tf` sends every body's pose in every frame it
-    /// changes, never a prediction.
-    pub fn new(mut w: S, dt: f64, channels: Channels, live: bool) -> Result<Recorder<S>, LogError> {
+    /// Adds the chosen channels to `sink`.
+    pub fn new(mut w: S, dt: f64, channels: Channels) -> Result<Recorder<S>, LogError> {
         let mut t = Topics::default();
         if channels.scene {
             t.scene = Some(w.add_protobuf_channel("/scene", Schema::foxglove::<SceneUpdate>())?);
@@ -124,8 +127,10 @@ impl<S: MessageSink> Recorder<S> {
             dt_ns: (dt * 1e9).round() as u64,
             dt,
             topics: t,
-            tracker: Tracker::new(live),
+            tracker: Tracker::default(),
             arrows_shown: false,
+            style: None,
+            view: None,
         })
     }
 
@@ -149,41 +154,44 @@ impl<S: MessageSink> Recorder<S> {
         self.dt_ns
     }
 
-    /// Sends live viewers the whole state at `frame`: `/scene/static`, `/scene` and every
-    /// body's frame on `/tf` (never recorded: see [`MessageSink::write_live`]).
+    /// Sends live viewers the whole scene at `frame`: `/scene/static`, `/scene` and the
+    /// camera's frame (never recorded: see [`MessageSink::write_live`]).
     pub fn refresh_live(&mut self, sim: &Simulation, frame: u64) -> Result<(), LogError> {
         let t = frame * self.dt_ns;
         let ts = timestamp(t);
-        let w = sim.world();
-        if let Some(ch) = self.topics.statics {
-            self.writer
-                .write_live(ch, t, scene::snapshot(drawings(w, true), ts))?;
-        }
-        if let Some(ch) = self.topics.scene {
-            self.writer
-                .write_live(ch, t, scene::snapshot(drawings(w, false), ts))?;
+        let (w, layers) = (sim.world(), &sim.scenario().world.layers);
+        let style = *self
+            .style
+            .get_or_insert_with(|| scene::Style::for_bodies(w.len()));
+        for (channel, statics) in [(self.topics.statics, true), (self.topics.scene, false)] {
+            if let Some(ch) = channel {
+                let message = scene::snapshot(w, layers, statics, style, ts);
+                self.writer.write_live(ch, t, message)?;
+            }
         }
         if let Some(ch) = self.topics.tf {
-            let transforms = (0..w.len())
-                .map(|i| {
-                    let angle = if scene::upright(w.shape(i)) {
-                        0.0
-                    } else {
-                        w.angle[i]
-                    };
-                    scene::transform(&scene::entity_id(w.entity[i]), ts, w.position[i], angle)
-                })
-                .collect();
+            let transforms = vec![scene::view_transform(ts, self.view_at(sim))];
             self.writer
                 .write_live(ch, t, FrameTransforms { transforms })?;
         }
         Ok(())
     }
 
-    /// Sends every body's pose on `/tf` in the next frame (a live viewer that just
-    /// subscribed knows none).
-    pub fn resend_transforms(&mut self) {
-        self.tracker.resend_transforms();
+    /// The centre of the bodies' extent at the first frame recorded: where the camera looks
+    /// without a focus body or world bounds.
+    fn fallback_view(&self, sim: &Simulation) -> Vec2 {
+        self.view.map_or_else(
+            || scene::extent_centre(sim.world()),
+            |(_, fallback)| fallback,
+        )
+    }
+
+    /// Where the camera looks now (see [`scene::view_position`]).
+    fn view_at(&self, sim: &Simulation) -> Vec2 {
+        let world = &sim.scenario().world;
+        let focus = world.active_region.as_ref().map(|a| a.focus.as_str());
+        let bounds = world.bounds.map(|b| (b.min, b.max));
+        scene::view_position(sim.world(), focus, bounds, self.fallback_view(sim))
     }
 
     /// Adds the `/validation` channel (`ricochet run --validate`).
@@ -226,33 +234,39 @@ impl<S: MessageSink> Recorder<S> {
         let layers = &sim.scenario().world.layers;
         let want_bodies = self.topics.bodies.is_some();
         if self.topics.scene.is_some() || want_bodies {
-            let mut changes = self
-                .tracker
-                .frame(w, out, layers, self.dt, self.dt_ns, want_bodies);
-            let drawings = |statics: bool| drawings(w, statics);
-            if let (Some(ch), true) = (self.topics.statics, changes.static_changed) {
-                self.writer
-                    .write(ch, t, scene::snapshot(drawings(true), ts))?;
+            let style = *self
+                .style
+                .get_or_insert_with(|| scene::Style::for_bodies(w.len()));
+            let mut changes = self.tracker.frame(
+                w,
+                out,
+                layers,
+                self.dt,
+                want_bodies,
+                style == scene::Style::PerBody,
+            );
+            for (channel, statics, changed) in [
+                (self.topics.statics, true, changes.static_changed),
+                (self.topics.scene, false, changes.scene_changed),
+            ] {
+                if let (Some(ch), true) = (channel, changed) {
+                    let message = scene::snapshot(w, layers, statics, style, ts);
+                    self.writer.write(ch, t, message)?;
+                }
             }
-            if let (Some(ch), true) = (self.topics.scene, changes.scene_changed) {
-                self.writer
-                    .write(ch, t, scene::snapshot(drawings(false), ts))?;
-            }
-            if let (Some(ch), false) = (self.topics.tf, changes.resent.is_empty()) {
-                // For a viewer that just subscribed: never recorded (a replay has no viewer).
-                let transforms = std::mem::take(&mut changes.resent);
-                self.writer
-                    .write_live(ch, t, FrameTransforms { transforms })?;
-            }
-            if let (Some(ch), false) = (self.topics.tf, changes.transforms.is_empty()) {
-                let transforms = std::mem::take(&mut changes.transforms);
-                self.writer.write(ch, t, FrameTransforms { transforms })?;
+            if let Some(ch) = self.topics.tf {
+                let at = self.view_at(sim);
+                if self.view.is_none_or(|(sent, _)| !same_point(sent, at)) {
+                    self.view = Some((at, self.fallback_view(sim)));
+                    let transforms = vec![scene::view_transform(ts, at)];
+                    self.writer.write(ch, t, FrameTransforms { transforms })?;
+                }
             }
             if let Some(ch) = self.topics.arrows
                 && (!out.contacts.is_empty() || self.arrows_shown)
             {
                 self.writer
-                    .write(ch, t, scene::contact_arrows(&out.contacts, ts))?;
+                    .write(ch, t, scene::contact_normals(&out.contacts, ts))?;
                 self.arrows_shown = !out.contacts.is_empty();
             }
             if let Some(ch) = self.topics.bodies {
@@ -284,21 +298,9 @@ impl<S: MessageSink> Recorder<S> {
     }
 }
 
-/// The bodies to draw: the static ones, or the moving ones.
-fn drawings(
-    w: &ricochet_sim::World,
-    statics: bool,
-) -> impl Iterator<Item = scene::BodyDrawing<'_>> {
-    (0..w.len())
-        .filter(move |&i| (w.kind[i] == BodyKind::Static) == statics)
-        .map(|i| scene::BodyDrawing {
-            entity: w.entity[i],
-            name: w.name(i),
-            shape: w.shape(i),
-            angle: w.angle[i],
-            layer: w.layer[i],
-            kind: w.kind[i],
-        })
+/// The same point, bit for bit.
+fn same_point(a: Vec2, b: Vec2) -> bool {
+    a.x.to_bits() == b.x.to_bits() && a.y.to_bits() == b.y.to_bits()
 }
 
 /// `/contacts`: every contact of the frame with the poses it was found at.

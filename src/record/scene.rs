@@ -1,39 +1,90 @@
-//! What Foxglove's 3D panel draws, built so that a seek shows every body at its exact pose
-//! while each frame costs only the poses that changed.
+//! What Foxglove's 3D panel draws: every body in the `world` frame, in few entities, so that
+//! a log of 10,000 bodies opens in seconds and a seek shows every body at its exact pose.
 //!
-//! Foxglove, on a seek, takes the last message of each topic at or before the new time, and
-//! it preloads every transform of the log. So:
-//! - every body has a coordinate frame of its own, `body/INDEX:GENERATION`, child of
-//!   `world`, moved on `/tf` (`foxglove.FrameTransforms`) as `motion.rs` decides. It turns
-//!   with the body, except for a body with an AABB part (which does not turn): its frame
-//!   stays upright and the entity draws the other parts turned;
-//! - `/scene` (`foxglove.SceneUpdate`) draws every body in its own frame, `frame_locked`
-//!   so it follows its frame; it is sent whole (a delete-all, then every body) when the set
-//!   of bodies changes, so its last message at any time is the whole scene then;
+//! What the viewer does (Lichtblick 1.10.8, measured with `../shared/viewer`):
+//! - on a seek to `t` it takes, per topic, the last message at or before `t`: not per
+//!   entity (an entity sent once and never again is gone after a seek);
+//! - it keeps a coordinate frame for every frame id it has seen and preloads every
+//!   transform of the log: 10,000 body frames froze it;
+//! - it draws the cubes and cylinders of one entity as one instanced batch.
+//!
+//! So:
+//! - `/scene` draws the moving bodies and `/scene/static` the static ones, each message whole
+//!   (a delete-all, then every entity of its topic): the last message of a topic at any time
+//!   is all of its bodies then. `/scene` is sent in a frame when a moving body moved,
+//!   turned, appeared or went, `/scene/static` when a static body did (usually once);
+//! - every entity is in `world`, its primitives placed at the bodies' poses: no frame per
+//!   body, no `/tf` for bodies;
+//! - [`Style::PerBody`] (scenes of at most [`PER_BODY_LIMIT`] bodies when recording starts):
+//!   each body is an entity `body/INDEX:GENERATION`, with its name, id, layer, kind and
+//!   velocity as `metadata`, which the 3D panel shows when the body is clicked;
+//! - [`Style::Batched`] (larger scenes): a layer's bodies, in id order, fill entities
+//!   `LAYER/K` of at most [`CHUNK_PRIMITIVES`] primitives each, so one entity stays a
+//!   bounded batch; its metadata names the layer, the body count and the first and last body
+//!   id, and the body at a point is found in `/bodies` (or with `ricochet dump`);
 //! - `/scene/contacts` draws the frame's contact normals as arrows in `world`: sent in every
 //!   frame that has contacts, and once, empty, after the last.
 //!
+//! Numbers are drawn at f32 precision (rounded to the nearest `f32`), the precision the
+//! viewer renders at: the bytes that would only say more than the screen can show are zero,
+//! and compress away. `/bodies` has the exact states.
+//!
 //! A body's shape is drawn filled: cubes for boxes, cylinders for circles, triangle fans for
-//! polygons and capsules.
+//! polygons and capsules (placed by the primitive's pose, the points in the body's frame).
 
-use ricochet_geom::{Primitive, Rot, Shape, Vec2};
+use ricochet_geom::{Number, Numbers, Primitive, Rot, Vec2};
 use ricochet_log::messages::fox::{
-    ArrowPrimitive, Color, CubePrimitive, CylinderPrimitive, FrameTransform, KeyValuePair, Point3,
+    Color, CubePrimitive, CylinderPrimitive, FrameTransform, KeyValuePair, LinePrimitive, Point3,
     Pose, Quaternion, SceneEntity, SceneEntityDeletion, SceneUpdate, Timestamp,
-    TriangleListPrimitive, Vector3, scene_entity_deletion,
+    TriangleListPrimitive, Vector3, line_primitive, scene_entity_deletion,
 };
-use ricochet_sim::{BodyKind, ContactRecord, Entity};
+use ricochet_sim::{BodyKind, ContactRecord, Entity, Layers, World};
 
 /// The root frame: world coordinates.
 pub const WORLD: &str = "world";
 
+/// The frame the shipped layout's camera follows: see [`view_position`].
+pub const VIEW: &str = "view";
+
+/// At most this many bodies when recording starts: each body is an entity of its own.
+pub const PER_BODY_LIMIT: usize = 1000;
+
+/// At most this many primitives in one batched entity (a compound body of more parts has an
+/// entity of its own; compounds have at most `MAX_COMPOUND_PARTS`, 1024, parts).
+pub const CHUNK_PRIMITIVES: usize = 1024;
+
 /// Thickness of drawn shapes along z.
 const DEPTH: f64 = 0.05;
 
-/// The scene entity id, and the coordinate frame, of a body: `body/index:generation`,
-/// stable for the body's life, and never another body's.
+/// How bodies become entities.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Style {
+    /// Each body an entity, with metadata: small scenes.
+    PerBody,
+    /// Each layer's bodies in entities of at most [`CHUNK_PRIMITIVES`] primitives.
+    Batched,
+}
+
+impl Style {
+    /// The style for a scene of `bodies` bodies.
+    pub fn for_bodies(bodies: usize) -> Style {
+        if bodies <= PER_BODY_LIMIT {
+            Style::PerBody
+        } else {
+            Style::Batched
+        }
+    }
+}
+
+/// The per-body entity id: `body/index:generation`, stable for the body's life, and never
+/// another body's.
 pub fn entity_id(entity: Entity) -> String {
     format!("body/{entity}")
+}
+
+/// `x` at f32 precision: see the module docs.
+fn r(x: f64) -> f64 {
+    f64::from(x as f32)
 }
 
 /// A colour per layer, from a fixed palette, dimmed for static bodies.
@@ -48,13 +99,22 @@ fn color(layer: u8, kind: BodyKind) -> Color {
         (0.40, 0.85, 0.80),
         (0.85, 0.85, 0.85),
     ];
-    let (r, g, b) = PALETTE[usize::from(layer) % PALETTE.len()];
+    let (cr, cg, cb) = PALETTE[usize::from(layer) % PALETTE.len()];
     let a = if kind == BodyKind::Static { 0.5 } else { 0.9 };
-    Color { r, g, b, a }
+    Color {
+        r: r(cr),
+        g: r(cg),
+        b: r(cb),
+        a: r(a),
+    }
 }
 
 fn vec3(x: f64, y: f64, z: f64) -> Option<Vector3> {
-    Some(Vector3 { x, y, z })
+    Some(Vector3 {
+        x: r(x),
+        y: r(y),
+        z: r(z),
+    })
 }
 
 /// A rotation by `yaw` about z.
@@ -63,166 +123,158 @@ fn yaw(angle: f64) -> Option<Quaternion> {
     Some(Quaternion {
         x: 0.0,
         y: 0.0,
-        z: s,
-        w: c,
+        z: r(s),
+        w: r(c),
     })
 }
 
-fn planar(x: f64, y: f64, angle: f64) -> Option<Pose> {
+fn planar(at: Vec2, angle: f64) -> Option<Pose> {
     Some(Pose {
-        position: vec3(x, y, 0.0),
+        position: vec3(at.x, at.y, 0.0),
         orientation: yaw(angle),
     })
 }
 
 fn p3(v: Vec2) -> Point3 {
     Point3 {
-        x: v.x,
-        y: v.y,
+        x: r(v.x),
+        y: r(v.y),
         z: 0.0,
     }
 }
 
-/// Points around a capsule's outline: a half circle at each end, 8 segments each.
-fn capsule_outline(a: Vec2, b: Vec2, r: f64) -> Vec<Point3> {
-    let d = b - a;
-    let base = if d == Vec2::ZERO {
-        0.0
-    } else {
-        libm::atan2(d.y, d.x)
-    };
-    let mut pts = Vec::with_capacity(18);
-    for (centre, start) in [
-        (b, base - std::f64::consts::FRAC_PI_2),
-        (a, base + std::f64::consts::FRAC_PI_2),
-    ] {
-        for k in 0..=8 {
-            let t = start + std::f64::consts::PI * f64::from(k) / 8.0;
-            let (s, c) = libm::sincos(t);
-            pts.push(p3(centre + Vec2::new(c, s) * r));
-        }
+/// Adds a convex outline, in world coordinates, to the entity's one triangle list (made in
+/// `color` if it has none yet): a fan of triangles from its first point.
+fn fill(entity: &mut SceneEntity, outline: impl Iterator<Item = Vec2>, color: Color) {
+    if entity.triangles.is_empty() {
+        entity.triangles.push(TriangleListPrimitive {
+            pose: planar(Vec2::ZERO, 0.0),
+            color: Some(color),
+            ..Default::default()
+        });
     }
-    pts
+    let list = &mut entity.triangles[0];
+    let first = list.points.len() as u32;
+    list.points.extend(outline.map(p3));
+    let n = list.points.len() as u32 - first;
+    list.indices
+        .extend((1..n.saturating_sub(1)).flat_map(|k| [first, first + k, first + k + 1]));
 }
 
-/// A convex outline, filled: a fan of triangles from its first point.
-fn filled(outline: Vec<Point3>, color: Color) -> TriangleListPrimitive {
-    let n = outline.len() as u32;
-    TriangleListPrimitive {
-        pose: planar(0.0, 0.0, 0.0),
-        points: outline,
-        color: Some(color),
-        colors: Vec::new(),
-        indices: (1..n.saturating_sub(1))
-            .flat_map(|k| [0, k, k + 1])
-            .collect(),
-    }
-}
-
-/// Adds the drawing of one primitive to `entity`, in its body's frame turned by `turn`: 0 for
-/// a body whose frame turns with it, its angle for an upright one (see [`upright`]).
-fn draw(entity: &mut SceneEntity, prim: &Primitive, turn: f64, color: Color) {
-    let rot = Rot::from_angle(turn);
-    let at = |v: Vec2| rot.apply(v);
+/// Adds the drawing of one primitive of a body at `at`, turned by `angle`, to `entity`, in
+/// world coordinates. An AABB part does not turn: only its centre turns with the body.
+/// Polygons and capsules join the entity's one triangle list (one batch for the viewer).
+fn draw(entity: &mut SceneEntity, prim: &Primitive, at: Vec2, angle: f64, color: Color) {
+    let rot = Rot::from_angle(angle);
+    let place = |v: Vec2| at + rot.apply(v);
     match prim {
-        Primitive::Circle(c) => {
-            let c0 = at(c.center);
-            entity.cylinders.push(CylinderPrimitive {
-                // Foxglove cylinders stand along z: lying in the XY plane needs no turn.
-                pose: planar(c0.x, c0.y, 0.0),
-                size: vec3(2.0 * c.radius, 2.0 * c.radius, DEPTH),
-                bottom_scale: 1.0,
-                top_scale: 1.0,
-                color: Some(color),
-            });
-        }
-        Primitive::Aabb(b) => {
-            // Only in an upright frame: an AABB does not turn with its body.
-            let c0 = at(b.center);
-            entity.cubes.push(CubePrimitive {
-                pose: planar(c0.x, c0.y, 0.0),
-                size: vec3(2.0 * b.half_extents.x, 2.0 * b.half_extents.y, DEPTH),
-                color: Some(color),
-            });
-        }
-        Primitive::Obb(b) => {
-            let c0 = at(b.center);
-            entity.cubes.push(CubePrimitive {
-                pose: planar(c0.x, c0.y, turn + b.angle),
-                size: vec3(2.0 * b.half_extents.x, 2.0 * b.half_extents.y, DEPTH),
-                color: Some(color),
-            });
-        }
+        Primitive::Circle(c) => entity.cylinders.push(CylinderPrimitive {
+            // Foxglove cylinders stand along z: lying in the XY plane needs no turn.
+            pose: planar(place(c.center), 0.0),
+            size: vec3(2.0 * c.radius, 2.0 * c.radius, DEPTH),
+            bottom_scale: 1.0,
+            top_scale: 1.0,
+            color: Some(color),
+        }),
+        Primitive::Aabb(b) => entity.cubes.push(CubePrimitive {
+            pose: planar(place(b.center), 0.0),
+            size: vec3(2.0 * b.half_extents.x, 2.0 * b.half_extents.y, DEPTH),
+            color: Some(color),
+        }),
+        Primitive::Obb(b) => entity.cubes.push(CubePrimitive {
+            pose: planar(place(b.center), angle + b.angle),
+            size: vec3(2.0 * b.half_extents.x, 2.0 * b.half_extents.y, DEPTH),
+            color: Some(color),
+        }),
+        // A capsule is its segment's rectangle and a disc at each end: primitives that the
+        // viewer draws as instanced batches, in fewer numbers than an outline.
         Primitive::Capsule(c) => {
-            // A capsule is convex: its outline fans into triangles like a polygon's.
-            entity
-                .triangles
-                .push(filled(capsule_outline(at(c.a), at(c.b), c.radius), color));
+            let (a, b) = (place(c.a), place(c.b));
+            let d = b - a;
+            let turn = if d == Vec2::ZERO {
+                0.0
+            } else {
+                libm::atan2(d.y, d.x)
+            };
+            entity.cubes.push(CubePrimitive {
+                pose: planar((a + b) * 0.5, turn),
+                size: vec3(d.length(), 2.0 * c.radius, DEPTH),
+                color: Some(color),
+            });
+            for end in [a, b] {
+                entity.cylinders.push(CylinderPrimitive {
+                    pose: planar(end, 0.0),
+                    size: vec3(2.0 * c.radius, 2.0 * c.radius, DEPTH),
+                    bottom_scale: 1.0,
+                    top_scale: 1.0,
+                    color: Some(color),
+                });
+            }
         }
-        Primitive::Polygon(p) => {
-            let pts = p.vertices().iter().map(|v| p3(at(*v))).collect();
-            entity.triangles.push(filled(pts, color));
-        }
+        Primitive::Polygon(p) => fill(entity, p.vertices().iter().map(|v| place(*v)), color),
     }
 }
 
-/// Whether a body's frame stays upright (its `/tf` rotation is none): a shape with an AABB
-/// part, which does not turn with its body. Its other parts are drawn turned by the body's
-/// angle in the entity itself.
-pub fn upright(shape: &Shape) -> bool {
-    shape
-        .primitives()
-        .iter()
-        .any(|p| matches!(p, Primitive::Aabb(_)))
+fn pair(key: &str, value: String) -> KeyValuePair {
+    KeyValuePair {
+        key: key.to_owned(),
+        value,
+    }
 }
 
-/// Whether drawing `shape` depends on the body's angle: in an upright frame, every part but a
-/// centred AABB turns with the body, so `/scene` is drawn again when such a body turns.
-pub fn drawing_depends_on_angle(shape: &Shape) -> bool {
-    upright(shape) && !matches!(shape.primitives(), [Primitive::Aabb(b)] if b.center == Vec2::ZERO)
+fn entity(id: String, ts: Timestamp, metadata: Vec<KeyValuePair>) -> SceneEntity {
+    SceneEntity {
+        timestamp: Some(ts),
+        frame_id: WORLD.to_owned(),
+        id,
+        lifetime: None,
+        frame_locked: false,
+        metadata,
+        ..Default::default()
+    }
 }
 
-/// One body as a scene entity in its own frame.
-pub struct BodyDrawing<'a> {
-    /// The body.
-    pub entity: Entity,
-    /// Its name (the entity's `name` metadata).
-    pub name: &'a str,
-    /// Its shape.
-    pub shape: &'a Shape,
-    /// Its angle (drawn into the entity only if its frame is [`upright`]).
-    pub angle: f64,
-    /// Its layer, for the colour.
-    pub layer: u8,
-    /// Static bodies are dimmed.
-    pub kind: BodyKind,
+fn kind_name(kind: BodyKind) -> &'static str {
+    match kind {
+        BodyKind::Static => "static",
+        BodyKind::Kinematic => "kinematic",
+        BodyKind::Dynamic => "dynamic",
+    }
 }
 
-/// The whole scene at time `ts`: a delete-all, then every body.
-pub fn snapshot<'a>(bodies: impl Iterator<Item = BodyDrawing<'a>>, ts: Timestamp) -> SceneUpdate {
-    let entities = bodies
-        .map(|b| {
-            let id = entity_id(b.entity);
-            let mut e = SceneEntity {
-                timestamp: Some(ts),
-                frame_id: id.clone(),
-                id,
-                lifetime: None,
-                frame_locked: true,
-                metadata: vec![KeyValuePair {
-                    key: "name".to_owned(),
-                    value: b.name.to_owned(),
-                }],
-                ..Default::default()
-            };
-            let color = color(b.layer, b.kind);
-            let turn = if upright(b.shape) { b.angle } else { 0.0 };
-            for prim in b.shape.primitives() {
-                draw(&mut e, prim, turn, color);
-            }
-            e
-        })
-        .collect();
+/// The whole of one topic at time `ts`: a delete-all, then the static bodies
+/// (`statics`) or the moving ones of `w`, as `style` says.
+pub fn snapshot(
+    w: &World,
+    layers: &Layers,
+    statics: bool,
+    style: Style,
+    ts: Timestamp,
+) -> SceneUpdate {
+    let chosen = (0..w.len()).filter(|&i| (w.kind[i] == BodyKind::Static) == statics);
+    let entities = match style {
+        Style::PerBody => chosen
+            .map(|i| {
+                let e = w.entity[i];
+                let mut metadata = vec![
+                    pair("name", w.name(i).to_owned()),
+                    pair("id", e.to_string()),
+                    pair("layer", layers.name(w.layer[i]).to_owned()),
+                    pair("kind", kind_name(w.kind[i]).to_owned()),
+                ];
+                if !statics {
+                    let v = w.velocity(i);
+                    metadata.push(pair("velocity", Numbers([v.x, v.y]).to_string()));
+                    let spin = Number(w.angular_velocity(i)).to_string();
+                    metadata.push(pair("angular_velocity", spin));
+                }
+                let mut drawn = entity(entity_id(e), ts, metadata);
+                draw_body(&mut drawn, w, i);
+                drawn
+            })
+            .collect(),
+        Style::Batched => batches(w, layers, chosen, ts),
+    };
     SceneUpdate {
         deletions: vec![SceneEntityDeletion {
             timestamp: Some(ts),
@@ -233,46 +285,173 @@ pub fn snapshot<'a>(bodies: impl Iterator<Item = BodyDrawing<'a>>, ts: Timestamp
     }
 }
 
-/// A body's frame at time `ts`: where it is and how it is turned.
-pub fn transform(frame: &str, ts: Timestamp, position: Vec2, angle: f64) -> FrameTransform {
-    FrameTransform {
-        timestamp: Some(ts),
-        parent_frame_id: WORLD.to_owned(),
-        child_frame_id: frame.to_owned(),
-        translation: vec3(position.x, position.y, 0.0),
-        rotation: yaw(angle),
+/// Adds body `i`'s primitives to `entity`.
+fn draw_body(entity: &mut SceneEntity, w: &World, i: usize) {
+    let color = color(w.layer[i], w.kind[i]);
+    for prim in w.shape(i).primitives() {
+        draw(entity, prim, w.position[i], w.angle[i], color);
     }
 }
 
-/// The contact normals of a frame: an arrow from each contact point along its normal, as
-/// long as the depth but at least 0.8 units (about 8 px at the layout's zoom).
-pub fn contact_arrows(contacts: &[ContactRecord], ts: Timestamp) -> SceneUpdate {
-    let arrows = contacts
+/// One layer's batched entities: those filled, and the one being filled.
+struct LayerBatches {
+    done: Vec<SceneEntity>,
+    open: Option<Batch>,
+}
+
+/// An entity being filled with a layer's bodies.
+struct Batch {
+    entity: SceneEntity,
+    first: Entity,
+    last: Entity,
+    bodies: usize,
+    /// Primitives (body parts) drawn in it so far.
+    parts: usize,
+}
+
+impl LayerBatches {
+    /// Closes the open batch, its metadata written.
+    fn close(&mut self, layer: &str) {
+        if let Some(mut b) = self.open.take() {
+            b.entity.metadata = vec![
+                pair("layer", layer.to_owned()),
+                pair("bodies", b.bodies.to_string()),
+                pair("first", b.first.to_string()),
+                pair("last", b.last.to_string()),
+            ];
+            self.done.push(b.entity);
+        }
+    }
+}
+
+/// The bodies `chosen` (in id order), each layer's in entities `LAYER/K` of at most
+/// [`CHUNK_PRIMITIVES`] primitives (a body is never split), by layer, then by `K`.
+fn batches(
+    w: &World,
+    layers: &Layers,
+    chosen: impl Iterator<Item = usize>,
+    ts: Timestamp,
+) -> Vec<SceneEntity> {
+    let names = layers.names();
+    let mut by_layer: Vec<LayerBatches> = names
         .iter()
-        .map(|c| ArrowPrimitive {
-            pose: Some(Pose {
-                position: vec3(c.point.x, c.point.y, DEPTH),
-                orientation: yaw(libm::atan2(c.normal.y, c.normal.x)),
-            }),
-            shaft_length: c.depth.max(0.8),
-            shaft_diameter: 0.12,
-            head_length: 0.35,
-            head_diameter: 0.3,
-            color: Some(Color {
-                r: 1.0,
-                g: 0.2,
-                b: 0.2,
-                a: 1.0,
-            }),
+        .map(|_| LayerBatches {
+            done: Vec::new(),
+            open: None,
         })
         .collect();
+    for i in chosen {
+        let layer = usize::from(w.layer[i]);
+        let parts = w.shape(i).primitives().len();
+        let l = &mut by_layer[layer];
+        if l.open
+            .as_ref()
+            .is_some_and(|b| b.parts + parts > CHUNK_PRIMITIVES)
+        {
+            l.close(&names[layer]);
+        }
+        let e = w.entity[i];
+        let next = l.done.len();
+        let b = l.open.get_or_insert_with(|| Batch {
+            entity: entity(format!("{}/{next}", names[layer]), ts, Vec::new()),
+            first: e,
+            last: e,
+            bodies: 0,
+            parts: 0,
+        });
+        draw_body(&mut b.entity, w, i);
+        b.last = e;
+        b.bodies += 1;
+        b.parts += parts;
+    }
+    let mut all = Vec::new();
+    for (layer, mut l) in by_layer.into_iter().enumerate() {
+        l.close(&names[layer]);
+        all.append(&mut l.done);
+    }
+    all
+}
+
+/// Where the layout's camera looks: the focus body of the scenario's active region while it
+/// is alive (the lowest id of that name), else the centre of the world's bounds, else
+/// `fallback` (the centre of the bodies' extent when recording started).
+pub fn view_position(
+    w: &World,
+    focus: Option<&str>,
+    bounds: Option<(Vec2, Vec2)>,
+    fallback: Vec2,
+) -> Vec2 {
+    if let Some(name) = focus
+        && let Some(i) = (0..w.len()).find(|&i| w.name(i) == name)
+    {
+        return w.position[i];
+    }
+    if let Some((min, max)) = bounds {
+        return (min + max) * 0.5;
+    }
+    fallback
+}
+
+/// The centre of the box holding every body's position (the origin with no bodies).
+pub fn extent_centre(w: &World) -> Vec2 {
+    if w.is_empty() {
+        return Vec2::ZERO;
+    }
+    let (mut lo, mut hi) = (w.position[0], w.position[0]);
+    for p in &w.position {
+        lo = Vec2::new(lo.x.min(p.x), lo.y.min(p.y));
+        hi = Vec2::new(hi.x.max(p.x), hi.y.max(p.y));
+    }
+    (lo + hi) * 0.5
+}
+
+/// The camera's frame at `ts`, child of `world`, upright.
+pub fn view_transform(ts: Timestamp, at: Vec2) -> FrameTransform {
+    FrameTransform {
+        timestamp: Some(ts),
+        parent_frame_id: WORLD.to_owned(),
+        child_frame_id: VIEW.to_owned(),
+        translation: vec3(at.x, at.y, 0.0),
+        rotation: yaw(0.0),
+    }
+}
+
+/// The contact normals of a frame: a red segment from each contact point along its normal,
+/// as long as the depth but at least 0.8 units (about 8 px at the layout's zoom), all in one
+/// line list (one batch for the viewer).
+pub fn contact_normals(contacts: &[ContactRecord], ts: Timestamp) -> SceneUpdate {
+    let points = contacts
+        .iter()
+        .flat_map(|c| {
+            let tip = c.point + c.normal * c.depth.max(0.8);
+            [c.point, tip].map(|p| Point3 {
+                z: r(DEPTH),
+                ..p3(p)
+            })
+        })
+        .collect();
+    let line = LinePrimitive {
+        r#type: line_primitive::Type::LineList as i32,
+        pose: planar(Vec2::ZERO, 0.0),
+        thickness: r(0.12),
+        scale_invariant: false,
+        points,
+        color: Some(Color {
+            r: 1.0,
+            g: r(0.2),
+            b: r(0.2),
+            a: 1.0,
+        }),
+        colors: Vec::new(),
+        indices: Vec::new(),
+    };
     SceneUpdate {
         deletions: Vec::new(),
         entities: vec![SceneEntity {
             timestamp: Some(ts),
             frame_id: WORLD.to_owned(),
             id: "contacts".to_owned(),
-            arrows,
+            lines: vec![line],
             ..Default::default()
         }],
     }

@@ -119,8 +119,9 @@ impl ClientQueueReceiver {
 pub const MAX_CLIENT_CHANNELS: usize = 256;
 
 /// Topics whose last message is sent again to a client that subscribes: each is a whole
-/// state (`/scene` and `/scene/static` are sent only when their bodies change).
-const LATCHED: [&str; 2] = ["/scene", "/scene/static"];
+/// state (`/scene` and `/scene/static` are sent only when their bodies change, `/tf`, the
+/// camera's frame, only when it moves).
+const LATCHED: [&str; 3] = ["/scene", "/scene/static", "/tf"];
 
 /// Inputs waiting for the next frame, from all clients, beyond which new ones are refused.
 pub const MAX_PENDING_INPUTS: usize = 10_000;
@@ -146,8 +147,6 @@ pub struct Shared {
     latched: BTreeMap<u32, (u64, Vec<u8>)>,
     clients: BTreeMap<u64, Client>,
     next_client: u64,
-    /// A client subscribed to `/tf`: the next frame sends every body's pose.
-    pub transforms_wanted: bool,
     /// Inputs in the order they came, with the client that sent each: the next frame takes
     /// them all.
     pub inputs: std::collections::VecDeque<(u64, String)>,
@@ -215,16 +214,8 @@ impl Shared {
         subscription: u32,
         channel: u32,
     ) -> Result<(), String> {
-        let Some(topic) = self
-            .channels
-            .iter()
-            .find(|c| c.id == channel)
-            .map(|c| c.topic.clone())
-        else {
+        if !self.channels.iter().any(|c| c.id == channel) {
             return Err(format!("no channel {channel}"));
-        };
-        if topic == "/tf" {
-            self.transforms_wanted = true;
         }
         let latched = self.latched.get(&channel).cloned();
         if let Some(c) = self.clients.get_mut(&client) {

@@ -119,7 +119,7 @@ fn start(
         file,
         muted: false,
     };
-    Ok(Session::new(scenario, sink, true)?)
+    Ok(Session::new(scenario, sink)?)
 }
 
 /// Finishes a session's recording, if it has one.
@@ -304,10 +304,6 @@ fn run_loop(serving: &mut Serving, hub: &Hub, interrupted: &AtomicBool) -> anyho
             continue;
         }
         if serving.paused {
-            // A viewer that subscribes to /tf while nothing steps gets the state at once.
-            if std::mem::take(&mut hub.lock().transforms_wanted) {
-                serving.session.refresh_live()?;
-            }
             std::thread::sleep(Duration::from_millis(5));
             anchor = (Instant::now(), frames);
             continue;

@@ -295,7 +295,7 @@ impl Serving {
                         file: None,
                         muted: false,
                     };
-                    self.session = Session::resume(snapshot.clone(), sink, true)?;
+                    self.session = Session::resume(snapshot.clone(), sink)?;
                 }
                 // Recording (the file must hold the session from frame 0, to replay on its
                 // own: it is written again), or no snapshot: from frame 0.
@@ -429,22 +429,13 @@ impl Serving {
     /// One frame: the clients' inputs, then the step; false if it overflowed.
     pub fn frame(&mut self, hub: &Hub) -> anyhow::Result<bool> {
         let dt_ns = self.session.recorder().dt_ns();
-        let (inputs, resend) = {
-            let mut s = hub.lock();
-            (
-                std::mem::take(&mut s.inputs),
-                std::mem::take(&mut s.transforms_wanted),
-            )
-        };
+        let inputs = std::mem::take(&mut hub.lock().inputs);
         for (client, text) in inputs {
             let at = self.session.next_frame();
             match self.session.input(&text)? {
                 Ok(()) => self.kept.keep(at, text),
                 Err(why) => hub.lock().tell(client, 2, &format!("input refused: {why}")),
             }
-        }
-        if resend {
-            self.session.recorder().resend_transforms();
         }
         let t = self.session.next_frame().saturating_mul(dt_ns);
         hub.lock().broadcast(&Message::binary(protocol::time(t)));
