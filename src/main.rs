@@ -53,8 +53,9 @@ enum Command {
     ///
     /// With no scenario, runs the built-in Asteroids demo (scenarios/asteroids.toml, embedded)
     /// into asteroids.mcap. The log is protobuf (official Foxglove schemas for what Foxglove
-    /// draws): /scene and /scene/static (foxglove.SceneUpdate: moving and static bodies, each
-    /// in its own frame), /tf (foxglove.FrameTransforms: those frames), /scene/contacts
+    /// draws): /scene and /scene/static (foxglove.SceneUpdate: moving and static bodies, in
+    /// the world frame, each message whole), /tf (foxglove.FrameTransforms: the `view` frame
+    /// the layout's camera follows), /scene/contacts
     /// (contact normals), /bodies (exact states: keyframes, then what the integrator does not
     /// predict), /contacts, /stats (for the Plot panel) and /events (foxglove.Log).
     /// Ctrl-C (SIGINT), SIGTERM and SIGHUP stop the run and still leave a complete, indexed
@@ -94,7 +95,7 @@ enum Command {
     /// With no scenario, serves the built-in Asteroids demo. In Foxglove (or Lichtblick):
     /// Open connection, Foxglove WebSocket, ws://localhost:8765, then import the layout
     /// foxglove/ricochet-layout.json. The channels are the log's (see `run`), the same
-    /// messages and schemas; /tf carries every moving body's pose every frame. Both
+    /// messages and schemas; a viewer that subscribes gets the last scene at once. Both
     /// subprotocols are accepted: foxglove.websocket.v1 (Lichtblick, @foxglove/ws-protocol)
     /// and foxglove.sdk.v1 (current Foxglove). A slow client loses messages (and is told),
     /// never the simulation or the recording. Ctrl-C or SIGTERM stops, finishing --record.

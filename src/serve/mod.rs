@@ -1,7 +1,7 @@
 //! `ricochet serve`: a scenario stepped in real time and streamed live over the Foxglove
-//! WebSocket protocol, the same messages and schemas as `ricochet run` writes (with `/tf`
-//! sent exactly every frame a body moves: a live viewer can't interpolate towards the
-//! future), optionally recorded to a file at the same time.
+//! WebSocket protocol, the same messages and schemas as `ricochet run` writes (a viewer that
+//! subscribes gets the last `/scene`, `/scene/static` and `/tf` at once: each is whole),
+//! optionally recorded to a file at the same time.
 //!
 //! The simulation runs on this thread, paced by a fixed-timestep schedule (frame `n` starts
 //! at `n * dt / speed` after the start: a late frame is not skipped, the next ones catch up);
