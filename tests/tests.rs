@@ -25,5 +25,6 @@ mod serve_siege;
 mod serve_ws;
 mod stress;
 mod threads;
+mod touch_log;
 mod util;
 mod validate_cli;

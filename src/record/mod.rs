@@ -242,6 +242,7 @@ impl<S: MessageSink> Recorder<S> {
                 out,
                 layers,
                 self.dt,
+                sim.scenario().world.gravity,
                 want_bodies,
                 style == scene::Style::PerBody,
             );

@@ -4,7 +4,8 @@
 //! it appears or changes), and between keyframes only
 //! what the integrator does not predict (see `proto/ricochet.proto`): an unlisted position is
 //! `previous + velocity * dt`, an unlisted angle `previous + angular_velocity * dt` (IEEE
-//! f64, multiply then add), unlisted velocities are unchanged. [`BodyStates`] applies the
+//! f64, multiply then add), unlisted velocities are unchanged, or, while a body is
+//! `falling`, `previous + gravity * dt`. [`BodyStates`] applies the
 //! messages in order and gives each frame as if it listed every body in full: what `ricochet
 //! diff`, the tests and any reader that wants whole frames need. Memory is one state per
 //! live body.
@@ -52,6 +53,7 @@ impl BodyStates {
             .and_then(Value::as_bool)
             .unwrap_or(false);
         let dt = number(message.get("dt"));
+        let gravity = pair(message.get("gravity"));
         if keyframe {
             // A keyframe lists every moving body; static ones are listed when they change.
             self.bodies
@@ -72,8 +74,15 @@ impl BodyStates {
         for (k, state) in &mut self.bodies {
             let delta = listed.get(k);
             let field = |name: &str| delta.and_then(|d| d.get(name)).filter(|v| present(v));
+            if let Some(f) = field("falling") {
+                state.insert("falling".to_owned(), f.clone());
+            }
             if let Some(v) = field("velocity") {
                 state.insert("velocity".to_owned(), v.clone());
+            } else if state.get("falling").and_then(Value::as_bool) == Some(true) {
+                let v = pair(state.get("velocity"));
+                let fell = json!([v[0] + gravity[0] * dt, v[1] + gravity[1] * dt]);
+                state.insert("velocity".to_owned(), fell);
             }
             if let Some(w) = field("angular_velocity") {
                 state.insert("angular_velocity".to_owned(), w.clone());
@@ -172,5 +181,37 @@ mod tests {
         let k =
             s.apply(&json!({"frame": 4, "keyframe": true, "dt": 0.5, "removed": [], "bodies": []}));
         assert!(k["bodies"].as_array().unwrap().is_empty() && s.is_empty());
+    }
+
+    /// A falling body's velocity advances by `gravity * dt` while it is unlisted, and holds
+    /// once `falling: false` is listed: g = [0, -8], dt = 0.25, so each step adds -2 to vy
+    /// and the position moves by the new velocity (semi-implicit Euler).
+    #[test]
+    fn a_falling_body_gains_gravity_each_unlisted_frame_until_it_stops_falling() {
+        let mut s = BodyStates::default();
+        let g = json!([0.0, -8.0]);
+        s.apply(&json!({"frame": 0, "keyframe": true, "dt": 0.25, "gravity": g, "bodies": [
+            {"id": 0, "generation": 0, "position": [0.0, 10.0], "angle": 0.0, "velocity": [1.0, 0.0], "angular_velocity": 0.0},
+        ]}));
+        // Frame 1 switches it to falling: vy = 0 - 2 = -2, y = 10 - 0.5, x = 0 + 0.25.
+        let f1 = s.apply(&json!({"frame": 1, "dt": 0.25, "gravity": g, "bodies": [
+            {"id": 0, "generation": 0, "falling": true},
+        ]}));
+        assert_eq!(f1["bodies"][0]["velocity"], json!([1.0, -2.0]));
+        assert_eq!(f1["bodies"][0]["position"], json!([0.25, 9.5]));
+        // Frame 2, unlisted: vy = -4, y = 9.5 - 1.
+        let f2 = s.apply(&json!({"frame": 2, "dt": 0.25, "gravity": g, "bodies": []}));
+        assert_eq!(f2["bodies"][0]["velocity"], json!([1.0, -4.0]));
+        assert_eq!(f2["bodies"][0]["position"], json!([0.5, 8.5]));
+        // Frame 3 lands: velocity [1, 0] listed, then `falling: false` holds it at frame 4.
+        s.apply(&json!({"frame": 3, "dt": 0.25, "gravity": g, "bodies": [
+            {"id": 0, "generation": 0, "velocity": [1.0, 0.0], "position": [0.75, 8.0]},
+        ]}));
+        s.apply(&json!({"frame": 4, "dt": 0.25, "gravity": g, "bodies": [
+            {"id": 0, "generation": 0, "falling": false},
+        ]}));
+        let f5 = s.apply(&json!({"frame": 5, "dt": 0.25, "gravity": g, "bodies": []}));
+        assert_eq!(f5["bodies"][0]["velocity"], json!([1.0, 0.0]));
+        assert_eq!(f5["bodies"][0]["position"], json!([1.25, 8.0]));
     }
 }
