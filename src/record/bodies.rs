@@ -8,7 +8,7 @@
 
 use ricochet_geom::{ShapeDef, Vec2};
 use ricochet_log::messages::ricochet as pb;
-use ricochet_sim::{BodyKind, Entity, FrameOutput, Layers, RemovedBody, World};
+use ricochet_sim::{BodyKind, Entity, FrameOutput, Layers, RemovedBody, World, WorldDef};
 
 /// `/bodies` lists every moving body in full every this many frames (and at frame 0).
 pub const KEYFRAME_INTERVAL: u64 = 60;
@@ -130,18 +130,18 @@ pub struct Tracker {
 }
 
 impl Tracker {
-    /// The changes of frame `out.frame` (its world is `world`). `velocities_drawn`: the
-    /// scene shows each body's velocity, so a change of velocity redraws it.
+    /// The changes of frame `out.frame` (its world is `world`, its settings `def`).
+    /// `velocities_drawn`: the scene shows each body's velocity, so a change of velocity
+    /// redraws it.
     pub fn frame(
         &mut self,
         world: &World,
         out: &FrameOutput,
-        layers: &Layers,
-        dt: f64,
-        gravity: Vec2,
+        def: &WorldDef,
         want_bodies: bool,
         velocities_drawn: bool,
     ) -> Changes {
+        let (layers, dt, gravity) = (&def.layers, def.dt, def.gravity);
         let frame = out.frame;
         let keyframe = !self.started || frame.is_multiple_of(KEYFRAME_INTERVAL);
         let (mut scene_changed, mut static_changed) = (!self.started, !self.started);

@@ -240,9 +240,7 @@ impl<S: MessageSink> Recorder<S> {
             let mut changes = self.tracker.frame(
                 w,
                 out,
-                layers,
-                self.dt,
-                sim.scenario().world.gravity,
+                &sim.scenario().world,
                 want_bodies,
                 style == scene::Style::PerBody,
             );
