@@ -47,7 +47,7 @@ pub const WORLD: &str = "world";
 pub const VIEW: &str = "view";
 
 /// At most this many bodies when recording starts: each body is an entity of its own.
-pub const PER_BODY_LIMIT: usize = 1000;
+pub const PER_BODY_LIMIT: usize = 256;
 
 /// At most this many primitives in one batched entity (a compound body of more parts has an
 /// entity of its own; compounds have at most `MAX_COMPOUND_PARTS`, 1024, parts).
