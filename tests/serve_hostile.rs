@@ -155,8 +155,8 @@ fn advertising_past_the_cap_is_refused_and_the_client_told() {
     });
 }
 
-/// A scene of `n` circles drifting apart on a layer that collides with nothing: every frame
-/// sends every body on /bodies and /tf.
+/// A scene of `n` circles drifting on a layer that collides with nothing: every frame sends
+/// the whole /scene (every body moved; per-layer batches above 1000 bodies).
 pub(crate) fn drifting_scene(n: usize) -> String {
     let mut text = String::from("hz = 60\nframes = 100000\nlayers = [\"dust\"]\n");
     for i in 0..n {

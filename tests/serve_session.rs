@@ -26,8 +26,8 @@ fn inputs_from_a_client_are_applied_recorded_and_replayed_byte_for_byte() {
                 .unwrap()
                 .contains(&"clientPublish".into())
         );
-        // Subscribing to /tf makes the server send every pose again, to this viewer only:
-        // the recording (and so the replay) never sees it.
+        // Subscribing to /tf (latched: this viewer gets the camera's last frame at once)
+        // writes nothing: the recording (and so the replay) never sees it.
         let channels = next_json(&mut ws).await;
         subscribe_to(&mut ws, &channels, "/tf", 1).await;
         let advertise = serde_json::json!({"op": "advertise", "channels": [
@@ -226,6 +226,88 @@ fn paused_serves_frame_0_and_steps_only_when_asked() {
             (stepped["frame"].as_u64(), stepped["paused"].as_bool()),
             (Some(3), Some(true))
         );
+    });
+}
+
+/// The raw payloads of `topic` in a log, by log time.
+fn payloads(log: &std::path::Path, topic: &str) -> Vec<(u64, Vec<u8>)> {
+    let bytes = std::fs::read(log).unwrap();
+    let messages = mcap::MessageStream::new(&bytes)
+        .unwrap()
+        .map(Result::unwrap);
+    let ours = messages.filter(|m| m.channel.topic == topic);
+    ours.map(|m| (m.log_time, m.data.into_owned())).collect()
+}
+
+/// Subscribes to the three latched topics: the last message of each comes at once, and
+/// nothing else while paused. Their (time, payload), in that order.
+async fn latched(ws: &mut Ws, channels: &Value) -> Vec<(u64, Vec<u8>)> {
+    for (id, topic) in [(1, "/scene"), (2, "/scene/static"), (3, "/tf")] {
+        subscribe_to(ws, channels, topic, id).await;
+    }
+    let mut got = std::collections::BTreeMap::new();
+    while got.len() < 3 {
+        let (sub, time, payload) = next_data(ws).await;
+        assert!(
+            got.insert(sub, (time, payload)).is_none(),
+            "subscription {sub} twice"
+        );
+    }
+    let more = tokio::time::timeout(Duration::from_millis(300), next_data(ws)).await;
+    assert!(more.is_err(), "more data while paused");
+    got.into_values().collect()
+}
+
+#[test]
+fn a_client_that_subscribes_while_paused_gets_the_whole_scene_at_once() {
+    // The scene as `ricochet run` records it: frame 0, then frame 3.
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = crate::util::root().join("scenarios/platformer.toml");
+    let straight = dir.path().join("straight.mcap");
+    let args = ["run", scenario.to_str().unwrap(), "--frames", "3", "-o"];
+    let o = crate::util::ricochet(&[&args[..], &[straight.to_str().unwrap()]].concat(), b"");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let recorded: Vec<Vec<(u64, Vec<u8>)>> = ["/scene", "/scene/static", "/tf"]
+        .iter()
+        .map(|topic| payloads(&straight, topic))
+        .collect();
+    // Platformer's static tiles are sent once (frame 0), as is the camera's frame (the
+    // centre of the world's bounds); its moving bodies every frame.
+    assert_eq!(recorded[1].len(), 1, "/scene/static once");
+    assert_eq!(recorded[2].len(), 1, "/tf once");
+    assert_eq!(recorded[0].len(), 4, "/scene every frame");
+    let server = serve(&[scenario.to_str().unwrap(), "--paused"]);
+    runtime().block_on(async {
+        let (mut ws, _) = connect(&server.url, "foxglove.websocket.v1").await.unwrap();
+        let _ = any_json(&mut ws).await;
+        let channels = any_json(&mut ws).await;
+        let services = any_json(&mut ws).await;
+        tokio::time::sleep(Duration::from_millis(300)).await;
+        let first = latched(&mut ws, &channels).await;
+        let want = [&recorded[0][0], &recorded[1][0], &recorded[2][0]];
+        for (topic, (got, want)) in ["/scene", "/scene/static", "/tf"]
+            .iter()
+            .zip(first.iter().zip(want))
+        {
+            assert!(got == want, "{topic}: frame 0's, as recorded");
+        }
+        // Three frames on, a new viewer gets frame 3's moving bodies, and the static ones
+        // and the camera's frame as they have been since frame 0.
+        let stepped = call(&mut ws, &services, "/step", 4, r#"{"frames": 3}"#)
+            .await
+            .unwrap();
+        assert_eq!(stepped["frame"], 4, "frames 1 to 3 stepped: 4 is next");
+        let (mut late, _) = connect(&server.url, "foxglove.websocket.v1").await.unwrap();
+        let _ = any_json(&mut late).await;
+        let channels = any_json(&mut late).await;
+        let now = latched(&mut late, &channels).await;
+        let want = [&recorded[0][3], &recorded[1][0], &recorded[2][0]];
+        for (topic, (got, want)) in ["/scene", "/scene/static", "/tf"]
+            .iter()
+            .zip(now.iter().zip(want))
+        {
+            assert!(got == want, "{topic}: the last sent, as recorded");
+        }
     });
 }
 

@@ -32,34 +32,38 @@ section's, each chunk's, the summary's), and every message is decoded with
   Bodies are unique by `(id, generation)` (one per id at a time, a reused id has a later
   generation, a removed body never returns), no body vanishes without being listed in
   `removed`, and `/stats.bodies` counts the live bodies.
-- `/tf` against `/bodies`, as Foxglove shows it: every transform is a body's frame
-  `body/ID:GENERATION` in `world`, planar (z = 0, a unit quaternion about z), stamped at a
-  frame's time (a multiple of `dt_ns`), never before its message's `log_time` (it may be
-  after: a prediction), the first one at the frame the body appeared; one stamped at its
-  message's own time (an exact pose) has the body's `/bodies` position at that frame to the
-  bit. Then at EVERY frame and for every live body, Foxglove's lookup of its frame at that
-  frame's time, from the transform messages logged at or before it (Lichtblick never reads
-  preloaded messages ahead of the time shown; a later transform with the same timestamp
-  replaces the earlier): the transform stamped then, else the position lerped and the
-  rotation slerped between the transforms before and after, gl-matrix style; before the
-  first or after the last, that one. It must be the body's `/bodies` pose: x and y within
-  1e-9 of max(1, |value|), the angle within 1e-9 rad modulo a turn (0 for a body with an AABB part, whose frame stays
-  upright). `/tf` sends a body on
-  a straight line only as a prediction ahead, overwritten when the motion changes, so
-  this fails if a prediction is wrong and not overwritten in time, or turns too far to
-  slerp.
-- `/scene` and `/scene/static` together draw exactly the live bodies at every frame, each once, in its own frame, with
-  its `/bodies` name.
+- `/scene` (moving bodies) and `/scene/static` (static ones), as Foxglove shows them after a
+  seek (the last message of each TOPIC at or before the time: so each message is whole):
+  every message is a delete-all stamped at its time, then the entities of its topic, each
+  in `world`, not `frame_locked`, stamped then, with no lifetime, only cubes, cylinders and
+  one triangle list, every number an f32. Both are sent at frame 0. With at most 1000
+  bodies at frame 0, each live body is one entity `body/ID:GENERATION` on the topic of its
+  kind, with metadata `name`, `id`, `layer`, `kind` (`static`, or `dynamic`/`kinematic`)
+  and, moving, `velocity` and `angular_velocity` equal to `/bodies`' to the bit; with more,
+  each topic's entities are `LAYER/0`, `LAYER/1`, ..., a layer's together and in order,
+  holding in order exactly that layer's live bodies in id order, as many as fit in 1024
+  body parts (never more, and the next would not fit), with metadata `layer`, `bodies`,
+  `first` and `last`. In both, every primitive is where the body's shape is at its
+  `/bodies` pose, within f32 rounding (4 f32 epsilons of max(1, |value|)): a circle a
+  cylinder at its centre, an AABB an upright cube, an OBB a cube turned by the body's angle
+  plus its own, a capsule a cube along its segment and a cylinder at each end, polygons
+  fans in the one triangle list in world coordinates. A frame without a message of a topic
+  has exactly the bodies of the topic's last message, none moved or turned (to the bit;
+  per body, none with another velocity): what a seek shows then is that frame.
+- `/tf`: one transform a message, the camera's frame `view` in `world`, upright, at f32
+  precision, stamped at its time; sent at frame 0, then only when it moves.
+- `/scene/contacts`: one entity `contacts` in `world`, with one `LINE_LIST` of 2 points per
+  contact of that frame's `/contacts` (its point, and the point plus the normal times
+  max(depth, 0.8)), sent in every frame with contacts and in the frame after the last
+  (empty), in no other.
 - `/contacts` and `/stats` agree on the number of contacts.
 
 Prints one line per log, then `check_mcap: N passed, N failed`; exits 1 on any problem,
 naming it.
 """
 
-import bisect
 import importlib
 import math
-import re
 import struct
 import sys
 import zlib
@@ -85,14 +89,12 @@ EXPECTED = {
 OPTIONAL = {"/validation": "ricochet.Validation", "/input": "ricochet.Input"}
 PER_FRAME = ("/bodies", "/contacts", "/stats")
 WORLD = "world"
-BODY_FRAME = re.compile(r"body/(\d+):(\d+)")
-# A /tf transform's rotation is a unit quaternion (within f64 rounding of sin² + cos²).
-UNIT_TOLERANCE = 1e-12
-# Foxglove's interpolated pose against /bodies: relative to max(1, |value|) for x and y,
-# absolute (radians, modulo a turn) for the angle.
-POSE_TOLERANCE = 1e-9
-# gl-matrix quat.slerp: below this 1 - cos, a plain lerp.
-SLERP_EPSILON = 1e-6
+# The recorder's scene styles: an entity per body up to this many bodies at frame 0, above
+# that per-layer batches of at most CHUNK_PARTS body parts.
+PER_BODY_LIMIT = 1000
+CHUNK_PARTS = 1024
+# Drawings are at f32 precision: within a few f32 roundings of max(1, |value|).
+F32_TOLERANCE = 4 * 2.0**-23
 
 
 class Problem(Exception):
@@ -197,15 +199,144 @@ def ts_ns(t):
     return t.seconds * 1_000_000_000 + t.nanos
 
 
-def has_aabb(shape):
-    """Whether a `ricochet.Shape` has an AABB part."""
-    kind = shape.WhichOneof("kind")
-    return kind == "aabb" or (kind == "compound" and any(has_aabb(p) for p in shape.compound.parts))
+def f32(x):
+    """`x` rounded to the nearest f32 (None if it has none: beyond the f32 range)."""
+    try:
+        return struct.unpack("<f", struct.pack("<f", x))[0]
+    except OverflowError:
+        return None
+
+
+DEPTH = f32(0.05)
+
+
+def is_f32(x):
+    return f32(x) == x
+
+
+def close(got, want):
+    return abs(got - want) <= F32_TOLERANCE * max(1.0, abs(got), abs(want))
+
+
+def close_angle(got, want):
+    return abs(math.remainder(got - want, math.tau)) <= F32_TOLERANCE * max(1.0, abs(want))
+
+
+def shape_parts(shape):
+    """The primitives of a `ricochet.Shape`, in order."""
+    if shape.WhichOneof("kind") == "compound":
+        return [q for p in shape.compound.parts for q in shape_parts(p)]
+    return [shape]
+
+
+def number_text(x):
+    """A number as `ricochet_geom::Number` writes it, read back (None if it is not one)."""
+    try:
+        return float(x)
+    except ValueError:
+        return None
+
+
+def numbers_text(s):
+    """`[x, y]` as `ricochet_geom::Numbers` writes it, read back."""
+    if not (s.startswith("[") and s.endswith("]")) or s.count(", ") != 1:
+        return None
+    xs = [number_text(v) for v in s[1:-1].split(", ")]
+    return None if None in xs else xs
+
+
+def planar(pose, what):
+    """(x, y, yaw) of a `foxglove.Pose`; a Problem unless it is in the plane (z = 0, a unit
+    quaternion about z) at f32 precision."""
+    p, q = pose.position, pose.orientation
+    numbers = (p.x, p.y, p.z, q.x, q.y, q.z, q.w)
+    if p.z != 0.0 or q.x != 0.0 or q.y != 0.0 or not close(q.z * q.z + q.w * q.w, 1.0):
+        raise Problem(f"{what}: pose ({p.x}, {p.y}, {p.z}) turned ({q.x}, {q.y}, {q.z}, {q.w}): not in the plane")
+    if not all(is_f32(x) for x in numbers):
+        raise Problem(f"{what}: pose {numbers} not at f32 precision")
+    return p.x, p.y, 2.0 * math.atan2(q.z, q.w)
+
+
+def drawing(bodies):
+    """What the bodies (`[((id, generation), state)]`, in order) make in one entity: the
+    cubes and the cylinders, each `(x, y, yaw or None for any, width, height, whose)`, and
+    the triangle list's points, its indices and whose polygon starts at each point."""
+    cubes, cylinders, points, indices, owners = [], [], [], [], []
+    for (i, g), b in bodies:
+        (x, y), a = b["position"], b["angle"]
+        s, c = math.sin(a), math.cos(a)
+
+        def at(px, py):
+            return x + (c * px - s * py), y + (s * px + c * py)
+
+        for n, p in enumerate(shape_parts(b["shape"])):
+            whose = f"body {i}:{g} part {n}"
+            kind = p.WhichOneof("kind")
+            if kind == "circle":
+                r = p.circle.radius
+                cylinders.append((*at(*p.circle.center), 0.0, 2 * r, 2 * r, whose))
+            elif kind in ("aabb", "obb"):
+                box = getattr(p, kind)
+                turn = 0.0 if kind == "aabb" else a + box.angle
+                w, h = 2 * box.half_extents[0], 2 * box.half_extents[1]
+                cubes.append((*at(*box.center), turn, w, h, whose))
+            elif kind == "capsule":
+                (ax, ay), (bx, by), r = at(*p.capsule.a), at(*p.capsule.b), p.capsule.radius
+                length = math.hypot(bx - ax, by - ay)
+                turn = math.atan2(by - ay, bx - ax) if length > 0 else None
+                cubes.append(((ax + bx) / 2, (ay + by) / 2, turn, length, 2 * r, f"{whose} (capsule's segment)"))
+                cylinders.append((ax, ay, 0.0, 2 * r, 2 * r, f"{whose} (capsule end a)"))
+                cylinders.append((bx, by, 0.0, 2 * r, 2 * r, f"{whose} (capsule end b)"))
+            elif kind == "polygon":
+                v = p.polygon.vertices
+                first, count = len(points), len(v) // 2
+                owners.append((first, whose))
+                points += [at(v[2 * k], v[2 * k + 1]) for k in range(count)]
+                indices += [j for k in range(1, count - 1) for j in (first, first + k, first + k + 1)]
+            else:
+                raise Problem(f"{whose}: a shape of kind {kind}")
+    return cubes, cylinders, points, indices, owners
+
+
+def compare_drawing(e, bodies, what):
+    """Raises Problem unless entity `e` draws `bodies` (in order) where their shapes are."""
+    cubes, cylinders, points, indices, owners = drawing(bodies)
+    for name, got, want in (("cubes", e.cubes, cubes), ("cylinders", e.cylinders, cylinders)):
+        if len(got) != len(want):
+            raise Problem(f"{what}: {len(got)} {name}, its bodies' shapes make {len(want)}")
+        for k, (prim, (x, y, turn, w, h, whose)) in enumerate(zip(got, want)):
+            px, py, yaw = planar(prim.pose, f"{what}: {name}[{k}] ({whose})")
+            size = prim.size
+            if not all(is_f32(v) for v in (size.x, size.y, size.z)):
+                raise Problem(f"{what}: {name}[{k}] ({whose}): size not at f32 precision")
+            if not (close(px, x) and close(py, y) and (turn is None or close_angle(yaw, turn))
+                    and close(size.x, w) and close(size.y, h) and size.z == DEPTH):
+                raise Problem(f"{what}: {name}[{k}] ({whose}) drawn at ({px!r}, {py!r}) turned {yaw!r}, of size ({size.x!r}, {size.y!r}, {size.z!r}); "
+                              f"its shape at ({x!r}, {y!r}) turned {turn!r}, of size ({w!r}, {h!r})")
+    if len(e.triangles) != (1 if points else 0):
+        raise Problem(f"{what}: {len(e.triangles)} triangle lists, its bodies have {len(owners)} polygons")
+    if not points:
+        return
+    tl = e.triangles[0]
+    if planar(tl.pose, f"{what}: the triangle list") != (0.0, 0.0, 0.0):
+        raise Problem(f"{what}: the triangle list is not in world coordinates")
+    if len(tl.points) != len(points) or list(tl.indices) != indices or tl.colors:
+        raise Problem(f"{what}: a triangle list of {len(tl.points)} points, indices {list(tl.indices)[:12]}...; "
+                      f"its polygons {len(points)} points, as fans {indices[:12]}...")
+    for k, (p, (x, y)) in enumerate(zip(tl.points, points)):
+        if not (is_f32(p.x) and is_f32(p.y) and p.z == 0.0 and close(p.x, x) and close(p.y, y)):
+            first, whose = max(o for o in owners if o[0] <= k)
+            raise Problem(f"{what}: {whose} vertex {k - first} drawn at ({p.x!r}, {p.y!r}, {p.z!r}), its shape at ({x!r}, {y!r})")
+
+
+def check_color(c, what):
+    if not all(is_f32(v) for v in (c.r, c.g, c.b, c.a)):
+        raise Problem(f"{what}: colour ({c.r}, {c.g}, {c.b}, {c.a}) not at f32 precision")
 
 
 class Bodies:
     """Every body's full state, rebuilt from `/bodies` keyframes and deltas as `BodyStates`
-    (crates/log/src/bodies.rs) does, and every body's pose at every frame it was alive."""
+    (crates/log/src/bodies.rs) does."""
 
     # Carried only when a body is listed in full (it appears, or a keyframe).
     FIXED = ("name", "layer", "shape", "static")
@@ -216,8 +347,6 @@ class Bodies:
         self.retired = set()
         self.generation = {}  # id -> latest generation seen
         self.dt = None
-        # (id, generation) -> (first frame alive, [(x, y, angle) at each frame since])
-        self.history = {}
 
     def apply(self, m, frame):
         """Applies frame `frame`'s message."""
@@ -318,7 +447,6 @@ class Bodies:
                     raise Problem(f"/bodies frame {frame}: id {b.id} reused with generation {b.generation}, after {last}")
                 if (b.id, last) in live:
                     raise Problem(f"/bodies frame {frame}: body {k} appears while {(b.id, last)} is alive")
-                self.history[k] = (frame, [])
             elif m.keyframe:
                 for f in self.FIXED:
                     if getattr(b, f) != before[k][f]:
@@ -331,70 +459,7 @@ class Bodies:
         for k in removed:
             self.retired.add(k)
             self.generation[k[0]] = max(self.generation.get(k[0], k[1]), k[1])
-        for k, s in live.items():
-            # A body with an AABB part (which does not turn) has an upright frame.
-            angle = 0.0 if has_aabb(s["shape"]) else s["angle"]
-            self.history[k][1].append((*s["position"], angle))
         self.live = live
-
-
-def slerp_yaw(a, b, f):
-    """gl-matrix `quat.slerp(a, b, f)` of two quaternions (x, y, z, w), as a yaw."""
-    cos = sum(p * q for p, q in zip(a, b))
-    if cos < 0.0:
-        cos, b = -cos, tuple(-q for q in b)
-    if 1.0 - cos > SLERP_EPSILON:
-        omega = math.acos(cos)
-        s = math.sin(omega)
-        s0, s1 = math.sin((1.0 - f) * omega) / s, math.sin(f * omega) / s
-    else:
-        s0, s1 = 1.0 - f, f
-    z = s0 * a[2] + s1 * b[2]
-    w = s0 * a[3] + s1 * b[3]
-    return 2.0 * math.atan2(z, w)
-
-
-class Transform:
-    """One `/tf` transform of a body's frame."""
-
-    __slots__ = ("stamp", "log_time", "x", "y", "q")
-
-    def __init__(self, tf, log_time):
-        self.stamp = ts_ns(tf.timestamp)
-        self.log_time = log_time
-        self.x, self.y = tf.translation.x, tf.translation.y
-        r = tf.rotation
-        self.q = (r.x, r.y, r.z, r.w)
-
-    def pose(self):
-        return self.x, self.y, 2.0 * math.atan2(self.q[2], self.q[3])
-
-
-def foxglove_pose(transforms, stamps, t):
-    """The pose Foxglove's 3D panel gives a frame at `t` from the transforms it holds
-    (`stamps` their sorted timestamps): the one stamped `t`; between two, the translation
-    lerped and the rotation slerped; before the first or after the last, that one. Also
-    the indices of the transforms used."""
-    i = bisect.bisect_left(stamps, t)
-    if i < len(stamps) and stamps[i] == t:
-        return transforms[i].pose(), (i, i)
-    if i == 0:
-        return transforms[0].pose(), (0, 0)
-    if i == len(stamps):
-        return transforms[-1].pose(), (i - 1, i - 1)
-    a, b = transforms[i - 1], transforms[i]
-    f = (t - a.stamp) / (b.stamp - a.stamp)
-    x = a.x + f * (b.x - a.x)  # gl-matrix vec3.lerp
-    y = a.y + f * (b.y - a.y)
-    return (x, y, slerp_yaw(a.q, b.q, f)), (i - 1, i)
-
-
-def pose_error(got, want):
-    """(x and y error relative to max(1, |value|), angle error modulo a turn); NaN counts
-    as infinitely wrong."""
-    ex = max(abs(g - w) / max(1.0, abs(w)) for g, w in zip(got[:2], want[:2]))
-    ea = abs(math.remainder(got[2] - want[2], math.tau))
-    return tuple(e if e == e else math.inf for e in (ex, ea))
 
 
 def round_ns(seconds):
@@ -411,9 +476,13 @@ class Log:
         self.dt_ns = None
         self.frames = 0
         self.bodies = Bodies()
-        self.tf = {}  # child frame -> [Transform], in file order
-        self.tf_summary = ""
-        self.scenes = {}  # topic -> the entities of its last message, by id
+        self.batched = None  # the scene style, chosen at frame 0
+        # topic -> the bodies its last message drew: (id, generation) -> the bits of their
+        # pose (and velocities), and the frame it was sent at
+        self.drawn = {}
+        self.views = 0  # /tf messages
+        self.view = None  # the last one's (x, y)
+        self.contacts_shown = False  # the last /scene/contacts drew some
         self.validation = False
         self.validation_mismatches = 0
 
@@ -471,12 +540,12 @@ class Log:
             for c in summary.channels.values():
                 if stats.channel_message_counts.get(c.id, 0) != self.counts[c.topic]:
                     raise Problem(f"{c.topic}: read {self.counts[c.topic]} messages, the summary says {stats.channel_message_counts.get(c.id, 0)}")
-        self.check_tf()
         total = sum(self.counts.values())
         per_topic = ", ".join(f"{t} {self.counts[t]}" for t in list(EXPECTED) + list(OPTIONAL) if t in EXPECTED or t in self.counts)
         extra = f" ({self.validation_mismatches} mismatches)" if self.validation else ""
         return (f"ok, CRCs checked, {self.frames} frames of {self.dt_ns or 0} ns, {len(self.bodies.live)} bodies at the end, "
-                f"{total} messages: {per_topic}{extra}; {self.tf_summary}")
+                f"{total} messages: {per_topic}{extra}; "
+                f"scene {'batched' if self.batched else 'per body'}, /tf {self.views} views")
 
     def frame(self, t, msgs):
         """Checks the messages logged at time `t`: one frame's."""
@@ -499,131 +568,180 @@ class Log:
         if frame == 1 and round_ns(self.bodies.dt) != dt:
             raise Problem(f"frames {dt} ns apart, /bodies.dt {self.bodies.dt!r} s rounds to {round_ns(self.bodies.dt)} ns")
         live = self.bodies.live
-        names = {f"body/{i}:{g}": (i, g) for i, g in live}
         stats = msgs["/stats"][0]
         if stats.bodies != len(live):
             raise Problem(f"/stats frame {frame}: {stats.bodies} bodies, /bodies rebuilds {len(live)}")
         contacts = len(msgs["/contacts"][0].contacts)
         if stats.contacts != contacts:
             raise Problem(f"/stats frame {frame}: {stats.contacts} contacts, /contacts lists {contacts}")
-        # /tf: kept (preloaded, as Foxglove does) and checked against /bodies at the end.
-        for m in msgs.get("/tf", []):
-            if not m.transforms:
-                raise Problem(f"/tf frame {frame}: an empty message")
-            for tf in m.transforms:
-                name = tf.child_frame_id
-                if tf.parent_frame_id != WORLD:
-                    raise Problem(f"/tf frame {frame}: {name} has parent {tf.parent_frame_id!r}, not {WORLD!r}")
-                if not BODY_FRAME.fullmatch(name):
-                    raise Problem(f"/tf frame {frame}: a transform of {name!r}, not a body's frame body/ID:GENERATION")
-                tr, q = tf.translation, tf.rotation
-                if tr.z != 0.0 or q.x != 0.0 or q.y != 0.0 or not abs(q.z * q.z + q.w * q.w - 1.0) <= UNIT_TOLERANCE:
-                    raise Problem(f"/tf frame {frame}: {name} at ({tr.x!r}, {tr.y!r}, {tr.z!r}) turned ({q.x}, {q.y}, {q.z}, {q.w}): not planar (z = 0, a unit yaw quaternion)")
-                x = Transform(tf, t)
-                if x.stamp < t:
-                    raise Problem(f"/tf frame {frame}: {name} stamped {x.stamp} ns, before its message ({t} ns)")
-                self.tf.setdefault(name, []).append(x)
-        # /scene and /scene/static: the last message of each is the whole of its bodies
-        # (moving, static), every one in its own frame.
+        if frame == 0:
+            self.batched = len(live) > PER_BODY_LIMIT
         for topic in ("/scene", "/scene/static"):
-            for s in msgs.get(topic, []):
-                if [d.type for d in s.deletions] != [1] or ts_ns(s.deletions[0].timestamp) != t:
-                    raise Problem(f"{topic} frame {frame}: not a delete-all at {t} ns, then the scene")
-                scene = {}
-                for e in s.entities:
-                    if e.id in scene or e.frame_id != e.id or not e.frame_locked or ts_ns(e.timestamp) != t:
-                        raise Problem(f"{topic} frame {frame}: entity {e.id} (frame {e.frame_id}, locked {e.frame_locked}) is not a body drawn once in its own frame at {t} ns")
-                    names_meta = [kv.value for kv in e.metadata if kv.key == "name"]
-                    if e.id in names and names_meta != [live[names[e.id]]["name"]]:
-                        raise Problem(f"{topic} frame {frame}: entity {e.id} named {names_meta}, /bodies names it {live[names[e.id]]['name']!r}")
-                    if e.id in names and live[names[e.id]]["static"] != (topic == "/scene/static"):
-                        raise Problem(f"{topic} frame {frame}: entity {e.id} is drawn on the wrong topic for its kind")
-                    scene[e.id] = e
-                self.scenes[topic] = scene
-        drawn = [i for scene in self.scenes.values() for i in scene]
-        if len(drawn) != len(set(drawn)):
-            raise Problem(f"/scene at frame {frame}: a body drawn on both /scene and /scene/static")
-        drawn = set(drawn)
-        if drawn != set(names):
-            raise Problem(f"/scene at frame {frame}: draws {sorted(drawn - set(names))[:5]}, not live bodies; does not draw {sorted(set(names) - drawn)[:5]}")
-        for s in msgs.get("/scene/contacts", []):
-            if any(ts_ns(e.timestamp) != t or e.frame_id != WORLD for e in s.entities):
-                raise Problem(f"/scene/contacts frame {frame}: an entity not at {t} ns in {WORLD!r}")
+            sent = msgs.get(topic, [])
+            if len(sent) > 1 or (frame == 0 and not sent):
+                raise Problem(f"{topic} frame {frame}: {len(sent)} messages, expected at most one (one at frame 0)")
+            ours = sorted((k, b) for k, b in live.items() if b["static"] == (topic == "/scene/static"))
+            if sent:
+                self.check_scene(topic, frame, t, sent[0], ours)
+            self.check_unmoved(topic, frame, ours, sent)
+        for m in msgs.get("/tf", []):
+            self.check_view(frame, t, m)
+        if frame == 0 and self.views == 0:
+            raise Problem("/tf frame 0: no view frame")
+        self.check_contacts(frame, t, msgs["/contacts"][0].contacts, msgs.get("/scene/contacts", []))
         for e in msgs.get("/events", []):
             if ts_ns(e.timestamp) != t:
                 raise Problem(f"/events frame {frame}: stamped {ts_ns(e.timestamp)} ns at {t} ns")
 
-    def check_tf(self):
-        """Every body's frame, as Foxglove shows it from the `/tf` messages logged by then,
-        against `/bodies` at every frame the body is alive."""
-        dt_ns = self.dt_ns or 0
-        last = (self.frames - 1) * dt_ns
-        history = self.bodies.history
-        frame_ids = {f"body/{i}:{g}": (i, g) for i, g in history}
-        strays = sorted(set(self.tf) - set(frame_ids))
-        if strays:
-            raise Problem(f"/tf: transforms of {strays[:5]}, never a body in /bodies")
+    def pose_bits(self, b, velocities):
+        """The bits a scene shows of a body: its pose, and its velocities if shown."""
+        shown = (*b["position"], b["angle"])
+        if velocities:
+            shown += (*b["velocity"], b["angular_velocity"])
+        return bits(*shown)
 
-        def at(stamp):
-            return stamp // dt_ns if dt_ns else 0
+    def check_unmoved(self, topic, frame, ours, sent):
+        """After a frame's `topic` (sent, or not): what its last message drew is the frame's."""
+        velocities = not self.batched and topic == "/scene"
+        now = {k: self.pose_bits(b, velocities) for k, b in ours}
+        if sent:
+            self.drawn[topic] = (frame, now)
+            return
+        at, drawn = self.drawn[topic]
+        if drawn != now:
+            went = sorted(set(drawn) - set(now))[:5]
+            came = sorted(set(now) - set(drawn))[:5]
+            moved = sorted(k for k in set(now) & set(drawn) if now[k] != drawn[k])[:5]
+            raise Problem(f"{topic} frame {frame}: not sent, so a seek shows frame {at}'s bodies; since then {went} went, {came} came, {moved} moved, turned or changed velocity")
 
-        worst = [0.0, 0.0]
-        checked = bad = 0
-        off = []  # (frame, body frame, what is wrong): the first of each body
-        for name, k in frame_ids.items():
-            first, poses = history[k]
-            gone = first + len(poses) - 1  # the last frame it is alive
-            sent = self.tf.get(name, [])  # in file order: by log time
-            if not sent:
-                raise Problem(f"/tf: no transform of {name}, alive at frames {first} to {gone}")
-            for x in sent:
-                f = at(x.stamp)
-                if x.stamp != f * dt_ns:
-                    raise Problem(f"/tf: {name} stamped {x.stamp} ns (sent at {x.log_time} ns), not a frame's time (a multiple of {dt_ns} ns)")
-                if x.stamp == x.log_time:  # an exact pose: the body's position, to the bit
-                    if not first <= f <= gone:
-                        raise Problem(f"/tf: {name} at frame {f}, alive only at frames {first} to {gone}")
-                    want = poses[f - first]
-                    if bits(x.x, x.y) != bits(*want[:2]):
-                        raise Problem(f"/tf: {name} at frame {f} at ({x.x!r}, {x.y!r}), /bodies rebuilds ({want[0]!r}, {want[1]!r})")
-            if sent[0].stamp != first * dt_ns:
-                raise Problem(f"/tf: the first transform of {name} is at frame {at(sent[0].stamp)}, it appeared at frame {first}")
-            # What Foxglove holds at each frame: the transforms logged by then, by stamp.
-            held, stamps, read = {}, [], 0
-            for i, want in enumerate(poses):
-                frame = first + i
-                t = frame * dt_ns
-                while read < len(sent) and sent[read].log_time <= t:
-                    x = sent[read]
-                    if x.stamp not in held:
-                        bisect.insort(stamps, x.stamp)
-                    held[x.stamp] = x
-                    read += 1
-                tfs = [held[st] for st in stamps]
-                got, (a, b) = foxglove_pose(tfs, stamps, t)
-                ex, ea = pose_error(got, want)
-                checked += 1
-                worst = [max(worst[0], ex), max(worst[1], ea)]
-                if not (ex <= POSE_TOLERANCE and ea <= POSE_TOLERANCE):
-                    bad += 1
-                    if off and off[-1][1] == name:
-                        continue  # the first of each body is enough
-                    if a == b and stamps[a] == t:
-                        how = "its transform stamped then"
-                    elif a == b:
-                        side = "before its first" if stamps[a] > t else "after its last"
-                        how = f"{side} transform, at frame {at(stamps[a])}, held"
-                    else:
-                        how = f"interpolated between its transforms at frames {at(stamps[a])} and {at(stamps[b])}"
-                    g = ", ".join(f"{v!r}" for v in got)
-                    w = ", ".join(f"{v!r}" for v in want)
-                    off.append((frame, name, f"shown at (x, y, angle) ({g}), {how}; /bodies has ({w}): off by {ex:.3g} relative, {ea:.3g} rad"))
-        if off:
-            frame, name, what = min(off)
-            raise Problem(f"/tf: {bad} body-frames of {len(off)} bodies not shown where /bodies has them; the first, at frame {frame} ({frame * dt_ns} ns): {name} {what}")
-        n = sum(len(v) for v in self.tf.values())
-        self.tf_summary = (f"/tf: {n} transforms give {checked} body-frames, "
-                           f"worst {worst[0]:.1e} (position, relative), {worst[1]:.1e} rad")
+    def check_scene(self, topic, frame, t, s, ours):
+        """One whole `/scene` or `/scene/static` message: exactly the bodies `ours` (in id order)."""
+        where = f"{topic} frame {frame}"
+        if len(s.deletions) != 1 or s.deletions[0].type != 1 or s.deletions[0].id or ts_ns(s.deletions[0].timestamp) != t:
+            raise Problem(f"{where}: not one delete-all at {t} ns, then the scene")
+        ids = [e.id for e in s.entities]
+        if len(ids) != len(set(ids)):
+            raise Problem(f"{where}: an entity twice")
+        for e in s.entities:
+            what = f"{where}: entity {e.id}"
+            if e.frame_id != WORLD or e.frame_locked or ts_ns(e.timestamp) != t or e.HasField("lifetime"):
+                raise Problem(f"{what} (frame {e.frame_id}, locked {e.frame_locked}, lifetime {e.HasField('lifetime')}) is not drawn in {WORLD!r} at {t} ns for ever")
+            if e.arrows or e.spheres or e.lines or e.texts or e.models:
+                raise Problem(f"{what}: draws more than cubes, cylinders and triangles")
+            for prim in (*e.cubes, *e.cylinders, *e.triangles):
+                check_color(prim.color, what)
+        if self.batched:
+            self.check_batches(where, s.entities, ours)
+            return
+        entities = {e.id: e for e in s.entities}
+        want = {f"body/{i}:{g}": ((i, g), b) for (i, g), b in ours}
+        if set(entities) != set(want):
+            raise Problem(f"{where}: draws {sorted(set(entities) - set(want))[:5]}, not live bodies of this topic; does not draw {sorted(set(want) - set(entities))[:5]}")
+        for name, ((i, g), b) in want.items():
+            e = entities[name]
+            meta = [(kv.key, kv.value) for kv in e.metadata]
+            head = [("name", b["name"]), ("id", f"{i}:{g}"), ("layer", b["layer"])]
+            keys = ["name", "id", "layer", "kind"] + ([] if b["static"] else ["velocity", "angular_velocity"])
+            ok = [k for k, _ in meta] == keys and meta[:3] == head
+            if ok:
+                kind = meta[3][1]
+                ok = kind == "static" if b["static"] else kind in ("dynamic", "kinematic")
+            if ok and not b["static"]:
+                v, w = numbers_text(meta[4][1]), number_text(meta[5][1])
+                ok = v is not None and w is not None and bits(*v, w) == bits(*b["velocity"], b["angular_velocity"])
+            if not ok:
+                raise Problem(f"{where}: entity {name} has metadata {meta}; /bodies: {head}, static {b['static']}, velocity {b['velocity']}, angular velocity {b['angular_velocity']!r}")
+            compare_drawing(e, [((i, g), b)], f"{where}: entity {name}")
+
+    def check_batches(self, where, entities, ours):
+        """Batched: each layer's bodies of `ours` in entities `LAYER/0`, `LAYER/1`, ... in order."""
+        by_layer = {}
+        for k, b in ours:
+            by_layer.setdefault(b["layer"], []).append((k, b))
+        done, current = set(), None
+        held = 0  # bodies of the current layer drawn so far
+        for e in entities:
+            layer, slash, n = e.id.rpartition("/")
+            if not slash or layer not in by_layer or not n.isdigit():
+                raise Problem(f"{where}: entity {e.id!r}, not a batch LAYER/K of a layer with bodies on this topic")
+            if layer != current:
+                if current is not None and held != len(by_layer[current]):
+                    raise Problem(f"{where}: layer {current}'s batches hold {held} of its {len(by_layer[current])} bodies")
+                if layer in done:
+                    raise Problem(f"{where}: layer {layer}'s batches are not together")
+                done.add(layer)
+                current, held, k = layer, 0, 0
+            if n != str(k):
+                raise Problem(f"{where}: entity {e.id} where {layer}/{k} was due")
+            k += 1
+            bodies = by_layer[layer]
+            meta = [(kv.key, kv.value) for kv in e.metadata]
+            count = int(meta[1][1]) if len(meta) == 4 and meta[1][0] == "bodies" and meta[1][1].isdigit() else 0
+            mine = bodies[held:held + count]
+            if count == 0 or len(mine) != count:
+                raise Problem(f"{where}: entity {e.id} has metadata {meta}, with {len(bodies) - held} bodies of {layer} left")
+            name = lambda kb: f"{kb[0][0]}:{kb[0][1]}"
+            want = [("layer", layer), ("bodies", str(count)), ("first", name(mine[0])), ("last", name(mine[-1]))]
+            if meta != want:
+                raise Problem(f"{where}: entity {e.id} has metadata {meta}, the bodies it holds {want}")
+            parts = sum(len(shape_parts(b["shape"])) for _, b in mine)
+            if parts > CHUNK_PARTS:
+                raise Problem(f"{where}: entity {e.id} holds {parts} body parts, over {CHUNK_PARTS}")
+            if held + count < len(bodies) and parts + len(shape_parts(bodies[held + count][1]["shape"])) <= CHUNK_PARTS:
+                raise Problem(f"{where}: entity {e.id} holds {parts} body parts and the next body would fit")
+            compare_drawing(e, mine, f"{where}: entity {e.id}")
+            held += count
+        if current is not None and held != len(by_layer[current]):
+            raise Problem(f"{where}: layer {current}'s batches hold {held} of its {len(by_layer[current])} bodies")
+        if done != set(by_layer):
+            raise Problem(f"{where}: no batch of layers {sorted(set(by_layer) - done)}")
+
+    def check_view(self, frame, t, m):
+        """A `/tf` message: the camera's frame, sent only when it moves."""
+        if len(m.transforms) != 1:
+            raise Problem(f"/tf frame {frame}: {len(m.transforms)} transforms, expected the view frame alone")
+        tf = m.transforms[0]
+        tr, q = tf.translation, tf.rotation
+        if tf.parent_frame_id != WORLD or tf.child_frame_id != "view" or ts_ns(tf.timestamp) != t:
+            raise Problem(f"/tf frame {frame}: {tf.child_frame_id!r} in {tf.parent_frame_id!r} at {ts_ns(tf.timestamp)} ns, expected 'view' in {WORLD!r} at {t} ns")
+        if tr.z != 0.0 or (q.x, q.y, q.z, q.w) != (0.0, 0.0, 0.0, 1.0) or not (is_f32(tr.x) and is_f32(tr.y)):
+            raise Problem(f"/tf frame {frame}: view at ({tr.x!r}, {tr.y!r}, {tr.z!r}) turned ({q.x}, {q.y}, {q.z}, {q.w}): not upright in the plane at f32 precision")
+        if self.view == (tr.x, tr.y):
+            raise Problem(f"/tf frame {frame}: the view sent again where it was")
+        self.view = (tr.x, tr.y)
+        self.views += 1
+
+    def check_contacts(self, frame, t, contacts, sent):
+        """`/scene/contacts`: the frame's contact normals in one line list."""
+        due = bool(contacts) or self.contacts_shown
+        if len(sent) != (1 if due else 0):
+            raise Problem(f"/scene/contacts frame {frame}: {len(sent)} messages with {len(contacts)} contacts (the frame before had {'some' if self.contacts_shown else 'none'})")
+        self.contacts_shown = bool(contacts)
+        if not sent:
+            return
+        s = sent[0]
+        where = f"/scene/contacts frame {frame}"
+        e = s.entities[0] if len(s.entities) == 1 else None
+        if s.deletions or e is None or e.id != "contacts" or e.frame_id != WORLD or e.frame_locked or ts_ns(e.timestamp) != t or e.HasField("lifetime"):
+            raise Problem(f"{where}: not one entity 'contacts' in {WORLD!r} at {t} ns")
+        if e.arrows or e.cubes or e.spheres or e.cylinders or e.triangles or e.texts or e.models or len(e.lines) != 1:
+            raise Problem(f"{where}: not one line list")
+        line = e.lines[0]
+        if line.type != 2 or planar(line.pose, where) != (0.0, 0.0, 0.0) or line.indices or line.colors:
+            raise Problem(f"{where}: not a LINE_LIST of plain points in world coordinates")
+        check_color(line.color, where)
+        if not is_f32(line.thickness):
+            raise Problem(f"{where}: thickness {line.thickness!r} not at f32 precision")
+        want = []
+        for c in contacts:
+            (x, y), (nx, ny), d = c.point, c.normal, max(c.depth, 0.8)
+            want += [(x, y), (x + nx * d, y + ny * d)]
+        if len(line.points) != len(want):
+            raise Problem(f"{where}: {len(line.points)} points for {len(contacts)} contacts")
+        for k, (p, (x, y)) in enumerate(zip(line.points, want)):
+            if not (is_f32(p.x) and is_f32(p.y) and p.z == DEPTH and close(p.x, x) and close(p.y, y)):
+                end = "point" if k % 2 == 0 else "normal's tip"
+                raise Problem(f"{where}: contact {k // 2}'s {end} drawn at ({p.x!r}, {p.y!r}, {p.z!r}), /contacts has ({x!r}, {y!r})")
 
 
 def check(path):
