@@ -65,7 +65,7 @@ const TOL: f64 = 4.0 * f32::EPSILON as f64;
 /// At most this many bodies at frame 0: an entity per body (`scene::PER_BODY_LIMIT`).
 const PER_BODY_LIMIT: usize = 1000;
 
-/// At most this many body parts in one batched entity (`scene::CHUNK_PRIMITIVES`).
+/// At most this many body parts in one batched entity (`scene::CHUNK_PARTS`).
 const CHUNK_PARTS: usize = 1024;
 
 /// The thickness of drawn shapes along z, at f32 precision.

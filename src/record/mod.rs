@@ -6,7 +6,7 @@
 //! | `/scene` | `foxglove.SceneUpdate` | every moving body, in `world`: whole, in every frame one moved, appeared or went (`scene.rs`) |
 //! | `/scene/static` | `foxglove.SceneUpdate` | every static body, the same way: whole, when one appeared, went or moved |
 //! | `/tf` | `foxglove.FrameTransforms` | one frame, `view`, where the layout's camera looks: the focus body, or the world's centre |
-//! | `/scene/contacts` | `foxglove.SceneUpdate` | the frame's contact normals as arrows |
+//! | `/scene/contacts` | `foxglove.SceneUpdate` | the frame's contact normals, one line list |
 //! | `/bodies` | `ricochet.Bodies` | exact body states: every body at keyframes, between them what the integrator does not predict |
 //! | `/contacts` | `ricochet.Contacts` | every contact, with the poses it was detected at |
 //! | `/stats` | `ricochet.Stats` | deterministic counters, for Foxglove's Plot panel |
@@ -51,7 +51,7 @@ struct Topics {
     scene: Option<ChannelId>,
     statics: Option<ChannelId>,
     tf: Option<ChannelId>,
-    arrows: Option<ChannelId>,
+    normals: Option<ChannelId>,
     bodies: Option<ChannelId>,
     contacts: Option<ChannelId>,
     stats: Option<ChannelId>,
@@ -66,8 +66,8 @@ pub struct Recorder<S: MessageSink = LogWriter> {
     dt: f64,
     topics: Topics,
     tracker: Tracker,
-    /// The previous frame had contact arrows (so this one sends an empty set if it has none).
-    arrows_shown: bool,
+    /// The previous frame had contact normals (so this one sends an empty set if it has none).
+    normals_shown: bool,
     /// How bodies become entities, chosen at the first frame (from its body count).
     style: Option<scene::Style>,
     /// Where the camera's frame was last sent, and where it looks without a focus body or
@@ -103,7 +103,7 @@ impl<S: MessageSink> Recorder<S> {
             t.statics =
                 Some(w.add_protobuf_channel("/scene/static", Schema::foxglove::<SceneUpdate>())?);
             t.tf = Some(w.add_protobuf_channel("/tf", Schema::foxglove::<FrameTransforms>())?);
-            t.arrows =
+            t.normals =
                 Some(w.add_protobuf_channel("/scene/contacts", Schema::foxglove::<SceneUpdate>())?);
         }
         if channels.bodies {
@@ -128,7 +128,7 @@ impl<S: MessageSink> Recorder<S> {
             dt,
             topics: t,
             tracker: Tracker::default(),
-            arrows_shown: false,
+            normals_shown: false,
             style: None,
             view: None,
         })
@@ -261,12 +261,12 @@ impl<S: MessageSink> Recorder<S> {
                     self.writer.write(ch, t, FrameTransforms { transforms })?;
                 }
             }
-            if let Some(ch) = self.topics.arrows
-                && (!out.contacts.is_empty() || self.arrows_shown)
+            if let Some(ch) = self.topics.normals
+                && (!out.contacts.is_empty() || self.normals_shown)
             {
                 self.writer
                     .write(ch, t, scene::contact_normals(&out.contacts, ts))?;
-                self.arrows_shown = !out.contacts.is_empty();
+                self.normals_shown = !out.contacts.is_empty();
             }
             if let Some(ch) = self.topics.bodies {
                 changes.bodies.time = out.frame as f64 * self.dt;

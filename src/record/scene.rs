@@ -19,18 +19,20 @@
 //!   each body is an entity `body/INDEX:GENERATION`, with its name, id, layer, kind and
 //!   velocity as `metadata`, which the 3D panel shows when the body is clicked;
 //! - [`Style::Batched`] (larger scenes): a layer's bodies, in id order, fill entities
-//!   `LAYER/K` of at most [`CHUNK_PRIMITIVES`] primitives each, so one entity stays a
+//!   `LAYER/K` of at most [`CHUNK_PARTS`] body parts each (at most 3 primitives a part:
+//!   a capsule draws 3; a polygon's fan joins the entity's one triangle list), so one entity stays a
 //!   bounded batch; its metadata names the layer, the body count and the first and last body
 //!   id, and the body at a point is found in `/bodies` (or with `ricochet dump`);
-//! - `/scene/contacts` draws the frame's contact normals as arrows in `world`: sent in every
+//! - `/scene/contacts` draws the frame's contact normals as one red line list in `world`: sent in every
 //!   frame that has contacts, and once, empty, after the last.
 //!
 //! Numbers are drawn at f32 precision (rounded to the nearest `f32`), the precision the
 //! viewer renders at: the bytes that would only say more than the screen can show are zero,
 //! and compress away. `/bodies` has the exact states.
 //!
-//! A body's shape is drawn filled: cubes for boxes, cylinders for circles, triangle fans for
-//! polygons and capsules (placed by the primitive's pose, the points in the body's frame).
+//! A body's shape is drawn filled: cubes for boxes, cylinders for circles, a cube (the
+//! segment's rectangle) and two cylinders for a capsule, and for polygons fans of triangles
+//! in the entity's one triangle list, every point in world coordinates.
 
 use ricochet_geom::{Number, Numbers, Primitive, Rot, Vec2};
 use ricochet_log::messages::fox::{
@@ -49,9 +51,9 @@ pub const VIEW: &str = "view";
 /// At most this many bodies when recording starts: each body is an entity of its own.
 pub const PER_BODY_LIMIT: usize = 256;
 
-/// At most this many primitives in one batched entity (a compound body of more parts has an
-/// entity of its own; compounds have at most `MAX_COMPOUND_PARTS`, 1024, parts).
-pub const CHUNK_PRIMITIVES: usize = 1024;
+/// At most this many body parts in one batched entity (a body is never split; compounds have
+/// at most `MAX_COMPOUND_PARTS`, 1024, parts).
+pub const CHUNK_PARTS: usize = 1024;
 
 /// Thickness of drawn shapes along z.
 const DEPTH: f64 = 0.05;
@@ -61,7 +63,7 @@ const DEPTH: f64 = 0.05;
 pub enum Style {
     /// Each body an entity, with metadata: small scenes.
     PerBody,
-    /// Each layer's bodies in entities of at most [`CHUNK_PRIMITIVES`] primitives.
+    /// Each layer's bodies in entities of at most [`CHUNK_PARTS`] body parts.
     Batched,
 }
 
@@ -325,7 +327,7 @@ impl LayerBatches {
 }
 
 /// The bodies `chosen` (in id order), each layer's in entities `LAYER/K` of at most
-/// [`CHUNK_PRIMITIVES`] primitives (a body is never split), by layer, then by `K`.
+/// [`CHUNK_PARTS`] body parts (a body is never split), by layer, then by `K`.
 fn batches(
     w: &World,
     layers: &Layers,
@@ -346,7 +348,7 @@ fn batches(
         let l = &mut by_layer[layer];
         if l.open
             .as_ref()
-            .is_some_and(|b| b.parts + parts > CHUNK_PRIMITIVES)
+            .is_some_and(|b| b.parts + parts > CHUNK_PARTS)
         {
             l.close(&names[layer]);
         }

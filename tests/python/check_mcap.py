@@ -25,7 +25,9 @@ section's, each chunk's, the summary's), and every message is decoded with
   kept); between keyframes a body
   not listed, or listed without `position` / `angle`, moves as `previous + velocity * dt`
   and `previous + angular_velocity * dt` with this frame's velocities (f64, multiply then
-  add), unless `still`; unlisted velocities are unchanged. A body that appears, and every
+  add), unless `still`; unlisted velocities are unchanged, or, while the body is `falling`
+  (switched by a listed `falling: true` or `false`; a body starts not falling),
+  `previous + gravity * dt` (`/bodies.gravity`, per component). A body that appears, and every
   body of a keyframe, has every field; a removed body has every field (its angular
   velocity too) and, if it was alive, its name, layer, shape and kind; a delta neither
   changes what only full listings carry nor sets `still` with a position or an angle.
@@ -363,6 +365,9 @@ class Bodies:
             raise Problem(f"/bodies frame {frame}: dt {dt!r}, frame 0 had {self.dt!r}")
         if m.time != frame * dt:
             raise Problem(f"/bodies frame {frame}: time {m.time!r}, frame * dt is {frame * dt!r}")
+        if len(m.gravity) not in (0, 2):
+            raise Problem(f"/bodies frame {frame}: gravity {list(m.gravity)}")
+        gravity = tuple(m.gravity) if m.gravity else (0.0, 0.0)
         before = self.live
         removed = set()
         for b in m.removed:
@@ -411,13 +416,21 @@ class Bodies:
                         raise Problem(f"/bodies frame {frame}: a delta of body {k} changes {f} (to {getattr(b, f)!r}), which readers take only from full listings")
                 if b.still and (b.position or b.HasField("angle")):
                     raise Problem(f"/bodies frame {frame}: body {k} is still but lists a position or an angle")
+                if b.HasField("falling"):
+                    state["falling"] = b.falling
                 if b.velocity:
                     state["velocity"] = tuple(b.velocity)
+                elif state.get("falling"):
+                    (vx, vy), (gx, gy) = state["velocity"], gravity
+                    state["velocity"] = (vx + gx * dt, vy + gy * dt)
                 if b.HasField("angular_velocity"):
                     state["angular_velocity"] = b.angular_velocity
                 if b.still:
                     live[k] = state
                     continue
+            elif state.get("falling"):
+                (vx, vy), (gx, gy) = state["velocity"], gravity
+                state["velocity"] = (vx + gx * dt, vy + gy * dt)
             # What the integrator predicts, with this frame's velocities: f64, multiply then add.
             if b is not None and b.position:
                 state["position"] = tuple(b.position)
@@ -454,6 +467,7 @@ class Bodies:
             state = {f: getattr(b, f) for f in self.FULL}
             state["position"] = tuple(b.position)
             state["velocity"] = tuple(b.velocity)
+            state["falling"] = b.HasField("falling") and b.falling
             live[k] = state
             self.generation[b.id] = max(self.generation.get(b.id, b.generation), b.generation)
         for k in removed:
