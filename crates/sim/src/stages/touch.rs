@@ -1,0 +1,173 @@
+//! The `touch` stage: which pairs touch at the end of the frame, and the begin and end
+//! events of the pairs whose touching changed (Box2D's begin/end touch events;
+//! `docs/touches.md`).
+//!
+//! The pairs touching at the end of frame `f`, `T_f`, are
+//! - every pair with a contact record this frame (any phase, any response), and
+//! - every pair of `T_{f-1}` with no record this frame whose bodies are both alive and
+//!   either both at rest (static, asleep or frozen: neither pose changed, so neither did
+//!   the contact) or still within [`SLOP`] at the end-of-frame poses (through the seam in a
+//!   wrapping world): resting flush.
+//!
+//! Pairs whose layers do not [`touch`](crate::Layers::touches) are left out. A pair in
+//! `T_f` and not in `T_{f-1}` begins ([`GameEvent::TouchBegin`], with its first record of
+//! the frame); one in `T_{f-1}` and not in `T_f` ends ([`GameEvent::TouchEnd`]); a pair with
+//! a body removed this frame is not in `T_f` (one that began this frame ends too). Begins
+//! then ends, each in pair order, after every other event of the frame.
+//!
+//! Cost: the frame's records are sorted by pair (a few thousand at most in a busy scene)
+//! and merged with the last frame's sorted set; only a pair that lingers without a record
+//! and is not at rest gets a narrow-phase test. Buffers are reused: nothing is allocated
+//! per frame once they have grown.
+
+use ricochet_geom::{Pose, contact};
+
+use crate::def::{BodyKind, LayerId, Layers, WorldDef};
+use crate::entity::Entity;
+use crate::event::GameEvent;
+use crate::output::FrameOutput;
+use crate::stages::{SLOP, StageCtx};
+use crate::world::World;
+
+/// A pair of bodies, the lower id first.
+pub(crate) type Pair = (Entity, Entity);
+
+/// What the `touch` stage keeps between frames: the touching set and reused buffers.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct TouchState {
+    /// Whether some layer pair touches: without one the stage never runs.
+    any: bool,
+    /// Whether every tested layer pair touches: then a record's layers need no lookup.
+    all: bool,
+    /// The pairs touching at the end of the last frame run, sorted.
+    touching: Vec<Pair>,
+    /// The static generation of the last frame run: a static body teleported since then is
+    /// not at rest.
+    static_generation: u64,
+    /// This frame's pairs with records, each with its first record's index, sorted.
+    recorded: Vec<(Entity, Entity, u32)>,
+    /// `T_f` as it is built.
+    next: Vec<Pair>,
+    /// The pairs that end this frame, in pair order.
+    ends: Vec<Pair>,
+}
+
+impl TouchState {
+    /// The state for a scene with these layers: nothing touching.
+    pub(crate) fn new(layers: &Layers) -> TouchState {
+        TouchState {
+            any: layers.any_touches(),
+            all: layers.all_touch(),
+            ..TouchState::default()
+        }
+    }
+
+    /// The pairs touching at the end of the last frame, sorted by `(a, b)`, `a < b`.
+    pub(crate) fn touching(&self) -> &[Pair] {
+        &self.touching
+    }
+}
+
+/// Whether some layer pair touches, and something touched at the end of the last frame or
+/// was recorded in this one (else `T_f` is empty, as `T_{f-1}` was).
+pub(crate) fn has_work(st: &TouchState, out: &FrameOutput) -> bool {
+    st.any && !(st.touching.is_empty() && out.contacts.is_empty())
+}
+
+/// Body `e`'s layer: alive, from the world; removed this frame, from the frame's removed
+/// bodies.
+fn layer_of(w: &World, out: &FrameOutput, e: Entity) -> Option<LayerId> {
+    match w.index_of(e) {
+        Some(i) => Some(w.layer[i]),
+        None => out.removed.iter().find(|r| r.entity == e).map(|r| r.layer),
+    }
+}
+
+/// Whether a pair of `T_{f-1}` without a record this frame still touches: both alive, and
+/// both at rest or within [`SLOP`] at the end-of-frame poses.
+fn lingers(w: &World, def: &WorldDef, statics_moved: bool, (a, b): Pair) -> bool {
+    let (Some(i), Some(j)) = (w.index_of(a), w.index_of(b)) else {
+        return false;
+    };
+    let at_rest =
+        |k: usize| (w.kind[k] == BodyKind::Static && !statics_moved) || w.asleep(k) || w.frozen(k);
+    if at_rest(i) && at_rest(j) {
+        return true;
+    }
+    let (pose_a, pose_b) = (w.pose(i), w.pose(j));
+    let mut depth = contact(w.shape(i), &pose_a, w.shape(j), &pose_b).depth;
+    if let Some(bounds) = def.bounds.filter(|b| b.wrap) {
+        // Through the seam: `b`'s images next to `a`, as `detect` meets them (`wrap.rs`).
+        for offset in &bounds.image_offsets()[1..] {
+            let image = Pose::new(pose_b.position + *offset, pose_b.angle);
+            depth = depth.max(contact(w.shape(i), &pose_a, w.shape(j), &image).depth);
+        }
+    }
+    depth >= -SLOP
+}
+
+/// Builds `T_f` from the frame's records and `T_{f-1}`, and raises the begin and end events.
+pub(crate) fn run(ctx: &mut StageCtx, st: &mut TouchState) {
+    let (w, def, out) = (&*ctx.world, ctx.def, &mut *ctx.out);
+    let layers = &def.layers;
+    st.recorded.clear();
+    for (k, c) in out.contacts.iter().enumerate() {
+        let touches = st.all
+            || matches!(
+                (layer_of(w, out, c.a), layer_of(w, out, c.b)),
+                (Some(la), Some(lb)) if layers.touches(la, lb)
+            );
+        if touches {
+            st.recorded.push((c.a, c.b, k as u32));
+        }
+    }
+    // By pair, then record: the first of each pair's records in detection order is kept.
+    st.recorded.sort_unstable();
+    st.recorded.dedup_by_key(|r| (r.0, r.1));
+    let statics_moved = w.static_generation() != st.static_generation;
+    st.static_generation = w.static_generation();
+    st.next.clear();
+    st.ends.clear();
+    let alive = |(a, b): Pair| w.index_of(a).is_some() && w.index_of(b).is_some();
+    let (mut p, mut r) = (0, 0);
+    loop {
+        let old = st.touching.get(p).copied();
+        let new = st.recorded.get(r).map(|&(a, b, k)| ((a, b), k));
+        // The lower of the two heads, or both when they are the same pair.
+        let (pair, was, recorded) = match (old, new) {
+            (None, None) => break,
+            (Some(o), Some((n, k))) if o == n => (o, true, Some(k)),
+            (Some(o), n) if n.is_none_or(|(n, _)| o < n) => (o, true, None),
+            (_, Some((n, k))) => (n, false, Some(k)),
+            (Some(o), None) => (o, true, None),
+        };
+        p += usize::from(was);
+        r += usize::from(recorded.is_some());
+        match recorded {
+            None if !lingers(w, def, statics_moved, pair) => {
+                st.ends.push(pair);
+                continue;
+            }
+            Some(k) if !was => {
+                let c = &out.contacts[k as usize];
+                out.events.push(GameEvent::TouchBegin {
+                    a: pair.0,
+                    b: pair.1,
+                    normal: c.normal,
+                    depth: c.depth,
+                    point: c.point,
+                });
+            }
+            _ => {}
+        }
+        // A recorded pair whose body was removed this frame ends in it.
+        if alive(pair) {
+            st.next.push(pair);
+        } else {
+            st.ends.push(pair);
+        }
+    }
+    out.events
+        .extend(st.ends.iter().map(|&(a, b)| GameEvent::TouchEnd { a, b }));
+    std::mem::swap(&mut st.touching, &mut st.next);
+}
