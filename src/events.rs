@@ -11,6 +11,7 @@
 //! for a body still alive, in the frame's removed bodies for one removed during it.
 
 use crate::record::Level as LogLevel;
+use ricochet_geom::Number;
 use ricochet_sim::{
     Entity, FireOutcome, FrameOutput, GameEvent, JumpOutcome, Removal, ScriptInput, World,
 };
@@ -107,7 +108,14 @@ fn message(event: &GameEvent, world: &World, out: &FrameOutput) -> String {
             if *axis == 0 { "x" } else { "y" },
         ),
         GameEvent::TouchBegin { a, b, depth, .. } => {
-            format!("{} touches {}, depth {depth}", body(*a), body(*b))
+            // Shortest round-trip digits, scientific below 1e-5: a landing's depth of
+            // 1.6e-14 is not written as fifteen zeros.
+            format!(
+                "{} touches {}, depth {}",
+                body(*a),
+                body(*b),
+                Number(*depth)
+            )
         }
         GameEvent::TouchEnd { a, b } => {
             format!("{} no longer touches {}", body(*a), body(*b))
