@@ -128,7 +128,8 @@ pub(crate) fn run(ctx: &mut StageCtx, st: &mut TouchState) {
     st.static_generation = w.static_generation();
     st.next.clear();
     st.ends.clear();
-    let alive = |(a, b): Pair| w.index_of(a).is_some() && w.index_of(b).is_some();
+    // Without a removal this frame every recorded body is alive.
+    let removals = !out.removed.is_empty();
     let (mut p, mut r) = (0, 0);
     loop {
         let old = st.touching.get(p).copied();
@@ -143,25 +144,24 @@ pub(crate) fn run(ctx: &mut StageCtx, st: &mut TouchState) {
         };
         p += usize::from(was);
         r += usize::from(recorded.is_some());
-        match recorded {
-            None if !lingers(w, def, statics_moved, pair) => {
-                st.ends.push(pair);
-                continue;
+        let keep = match recorded {
+            None => lingers(w, def, statics_moved, pair),
+            Some(k) => {
+                if !was {
+                    let c = &out.contacts[k as usize];
+                    out.events.push(GameEvent::TouchBegin {
+                        a: pair.0,
+                        b: pair.1,
+                        normal: c.normal,
+                        depth: c.depth,
+                        point: c.point,
+                    });
+                }
+                // A recorded pair whose body was removed this frame ends in it.
+                !removals || (w.index_of(pair.0).is_some() && w.index_of(pair.1).is_some())
             }
-            Some(k) if !was => {
-                let c = &out.contacts[k as usize];
-                out.events.push(GameEvent::TouchBegin {
-                    a: pair.0,
-                    b: pair.1,
-                    normal: c.normal,
-                    depth: c.depth,
-                    point: c.point,
-                });
-            }
-            _ => {}
-        }
-        // A recorded pair whose body was removed this frame ends in it.
-        if alive(pair) {
+        };
+        if keep {
             st.next.push(pair);
         } else {
             st.ends.push(pair);
