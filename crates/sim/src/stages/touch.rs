@@ -20,7 +20,7 @@
 //! and is not at rest gets a narrow-phase test. Buffers are reused: nothing is allocated
 //! per frame once they have grown.
 
-use ricochet_geom::{Pose, contact};
+use ricochet_geom::{Bounds, Pose, Vec2, contact};
 
 use crate::def::{BodyKind, LayerId, Layers, WorldDef};
 use crate::entity::Entity;
@@ -31,6 +31,48 @@ use crate::world::World;
 
 /// A pair of bodies, the lower id first.
 pub(crate) type Pair = (Entity, Entity);
+
+/// A contact record's pair and its index in the frame's records.
+type Record = (Entity, Entity, u32);
+
+/// Sorts `v` by merging its ascending runs, `scratch` and `runs` reused: `O(n log r)` for
+/// `r` runs, and nothing allocated once they have grown. The frame's records come in a few
+/// runs already sorted by pair (the `x` pass, the `y` pass, the full pass; swept hits in
+/// time order), and their indices ascend, so a platformer's thousand records are a few
+/// merges, not a sort.
+fn sort_runs(v: &mut Vec<Record>, scratch: &mut Vec<Record>, runs: &mut Vec<usize>) {
+    runs.clear();
+    runs.push(0);
+    runs.extend((1..v.len()).filter(|&k| v[k] < v[k - 1]));
+    runs.push(v.len());
+    // `runs` holds the start of each run, then the end of the last.
+    while runs.len() > 2 {
+        scratch.clear();
+        let mut kept = 1;
+        let mut k = 0;
+        while k + 1 < runs.len() {
+            let (lo, mid) = (runs[k], runs[k + 1]);
+            let hi = runs.get(k + 2).copied().unwrap_or(mid);
+            let (mut x, mut y) = (lo, mid);
+            while x < mid && y < hi {
+                if v[y] < v[x] {
+                    scratch.push(v[y]);
+                    y += 1;
+                } else {
+                    scratch.push(v[x]);
+                    x += 1;
+                }
+            }
+            scratch.extend_from_slice(&v[x..mid]);
+            scratch.extend_from_slice(&v[y..hi]);
+            runs[kept] = hi;
+            kept += 1;
+            k += 2;
+        }
+        runs.truncate(kept);
+        std::mem::swap(v, scratch);
+    }
+}
 
 /// What the `touch` stage keeps between frames: the touching set and reused buffers.
 #[derive(Clone, Debug, Default)]
@@ -45,7 +87,10 @@ pub(crate) struct TouchState {
     /// not at rest.
     static_generation: u64,
     /// This frame's pairs with records, each with its first record's index, sorted.
-    recorded: Vec<(Entity, Entity, u32)>,
+    recorded: Vec<Record>,
+    /// Reused by [`sort_runs`].
+    scratch: Vec<Record>,
+    runs: Vec<usize>,
     /// `T_f` as it is built.
     next: Vec<Pair>,
     /// The pairs that end this frame, in pair order.
@@ -95,15 +140,29 @@ fn lingers(w: &World, def: &WorldDef, statics_moved: bool, (a, b): Pair) -> bool
         return true;
     }
     let (pose_a, pose_b) = (w.pose(i), w.pose(j));
-    let mut depth = contact(w.shape(i), &pose_a, w.shape(j), &pose_b).depth;
-    if let Some(bounds) = def.bounds.filter(|b| b.wrap) {
-        // Through the seam: `b`'s images next to `a`, as `detect` meets them (`wrap.rs`).
-        for offset in &bounds.image_offsets()[1..] {
-            let image = Pose::new(pose_b.position + *offset, pose_b.angle);
-            depth = depth.max(contact(w.shape(i), &pose_a, w.shape(j), &image).depth);
-        }
+    let (shape_a, shape_b) = (w.shape(i), w.shape(j));
+    if contact(shape_a, &pose_a, shape_b, &pose_b).depth >= -SLOP {
+        return true;
     }
-    depth >= -SLOP
+    let Some(world) = def.bounds.filter(|b| b.wrap) else {
+        return false;
+    };
+    // Through the seam: `b`'s images next to `a`, as `detect` meets them (`wrap.rs`); the
+    // deepest counts, so any within `SLOP` does. Only an image whose box comes within
+    // `SLOP` of `a`'s (padded for the rounding of the translation) can be.
+    let (bounds_a, bounds_b) = (shape_a.bounds(&pose_a), shape_b.bounds(&pose_b));
+    world.image_offsets()[1..].iter().any(|&offset| {
+        let far = (bounds_b.min.abs().max(bounds_b.max.abs()) + offset.abs()).max_element();
+        let pad = Vec2::splat(SLOP + far * 4.0 * f64::EPSILON);
+        let image = Bounds {
+            min: bounds_b.min + offset - pad,
+            max: bounds_b.max + offset + pad,
+        };
+        image.overlaps(&bounds_a) && {
+            let pose = Pose::new(pose_b.position + offset, pose_b.angle);
+            contact(shape_a, &pose_a, shape_b, &pose).depth >= -SLOP
+        }
+    })
 }
 
 /// Builds `T_f` from the frame's records and `T_{f-1}`, and raises the begin and end events.
@@ -122,7 +181,7 @@ pub(crate) fn run(ctx: &mut StageCtx, st: &mut TouchState) {
         }
     }
     // By pair, then record: the first of each pair's records in detection order is kept.
-    st.recorded.sort_unstable();
+    sort_runs(&mut st.recorded, &mut st.scratch, &mut st.runs);
     st.recorded.dedup_by_key(|r| (r.0, r.1));
     let statics_moved = w.static_generation() != st.static_generation;
     st.static_generation = w.static_generation();
@@ -170,4 +229,40 @@ pub(crate) fn run(ctx: &mut StageCtx, st: &mut TouchState) {
     out.events
         .extend(st.ends.iter().map(|&(a, b)| GameEvent::TouchEnd { a, b }));
     std::mem::swap(&mut st.touching, &mut st.next);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Merging the runs is sorting: runs of every length, one element, none, reversed.
+    #[test]
+    fn sort_runs_sorts() {
+        let e = |index| Entity {
+            index,
+            generation: index % 3,
+        };
+        let (mut scratch, mut runs) = (Vec::new(), Vec::new());
+        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+        for len in [0, 1, 2, 3, 7, 64, 1000] {
+            for spread in [1, 4, 1000] {
+                let mut v: Vec<Record> = (0..len)
+                    .map(|k| {
+                        seed ^= seed << 13;
+                        seed ^= seed >> 7;
+                        seed ^= seed << 17;
+                        let a = (seed % spread) as u32;
+                        (e(a), e(a + 1 + (seed >> 32) as u32 % 3), k)
+                    })
+                    .collect();
+                let mut sorted = v.clone();
+                sorted.sort_unstable();
+                sort_runs(&mut v, &mut scratch, &mut runs);
+                assert_eq!(v, sorted, "{len} records, spread {spread}");
+                v.reverse();
+                sort_runs(&mut v, &mut scratch, &mut runs);
+                assert_eq!(v, sorted, "{len} records reversed");
+            }
+        }
+    }
 }
