@@ -1,22 +1,28 @@
 //! The `/events` channel's text: every [`GameEvent`] as a `foxglove.Log` kind, level and
 //! sentence. The simulation reports events as data; this is the only place they are worded.
 //!
+//! Contacts themselves are not events: every contact of every frame, its response and its
+//! push, is on `/contacts`. `/events` says when a pair starts and stops touching
+//! (`touch_begin`, `touch_end`; `docs/touches.md`), so a box resting on a floor writes one
+//! line when it lands and one when it leaves, none in between.
+//!
 //! A body is written `name #index:generation` (`rock #5:1`), the same id as `/bodies`,
 //! `/contacts` and `/scene` give it. Names are looked up at the end of the frame: in the world
 //! for a body still alive, in the frame's removed bodies for one removed during it.
 
 use crate::record::Level as LogLevel;
+use ricochet_geom::Number;
 use ricochet_sim::{
     Entity, FireOutcome, FrameOutput, GameEvent, JumpOutcome, Removal, ScriptInput, World,
 };
 
 /// One event as a log line.
 pub struct EventLine {
-    /// `input`, `spawn`, `destroy`, `expire`, `missed`, `contact`, `hit`, `hit_x`, `hit_y` or
-    /// `crush`.
+    /// `input`, `spawn`, `destroy`, `expire`, `missed`, `crush`, `touch_begin` or
+    /// `touch_end`.
     pub kind: &'static str,
-    /// Warnings for bodies lost and events that missed, info for inputs and spawns, debug for
-    /// collisions.
+    /// Warnings for bodies lost or crushed and events that missed, info for the rest
+    /// (inputs, spawns, touches).
     pub level: LogLevel,
     /// A sentence for people.
     pub message: String,
@@ -48,11 +54,9 @@ fn kind(event: &GameEvent) -> &'static str {
             ..
         } => "expire",
         GameEvent::Removed { .. } => "destroy",
-        GameEvent::Contact { .. } => "contact",
-        GameEvent::PushedApart { .. } => "hit",
-        GameEvent::PushedOut { axis: 0, .. } => "hit_x",
-        GameEvent::PushedOut { .. } => "hit_y",
         GameEvent::Crushed { .. } => "crush",
+        GameEvent::TouchBegin { .. } => "touch_begin",
+        GameEvent::TouchEnd { .. } => "touch_end",
     }
 }
 
@@ -97,29 +101,25 @@ fn message(event: &GameEvent, world: &World, out: &FrameOutput) -> String {
             };
             format!("{} {why}", body(*e))
         }
-        GameEvent::Contact { a, b, depth } => {
-            format!("{} touches {}, depth {depth}", body(*a), body(*b))
-        }
-        GameEvent::PushedApart { a, b, depth } => {
-            format!("{} and {} pushed apart by {depth}", body(*a), body(*b))
-        }
-        GameEvent::PushedOut {
-            body: e,
-            axis,
-            by,
-            obstacle,
-        } => format!(
-            "{} pushed along {} by {by} out of {}",
-            body(*e),
-            if *axis == 0 { "x" } else { "y" },
-            body(*obstacle)
-        ),
         GameEvent::Crushed { body: e, by, axis } => format!(
             "{} crushed by {}: no room to be pushed out along {}",
             body(*e),
             body(*by),
             if *axis == 0 { "x" } else { "y" },
         ),
+        GameEvent::TouchBegin { a, b, depth, .. } => {
+            // Shortest round-trip digits, scientific below 1e-5: a landing's depth of
+            // 1.6e-14 is not written as fifteen zeros.
+            format!(
+                "{} touches {}, depth {}",
+                body(*a),
+                body(*b),
+                Number(*depth)
+            )
+        }
+        GameEvent::TouchEnd { a, b } => {
+            format!("{} no longer touches {}", body(*a), body(*b))
+        }
     }
 }
 
@@ -128,8 +128,7 @@ pub fn line(event: &GameEvent, world: &World, out: &FrameOutput) -> EventLine {
     let kind = kind(event);
     let level = match kind {
         "destroy" | "expire" | "missed" | "crush" => LogLevel::Warning,
-        "input" | "spawn" => LogLevel::Info,
-        _ => LogLevel::Debug,
+        _ => LogLevel::Info,
     };
     EventLine {
         kind,
@@ -146,12 +145,18 @@ mod tests {
 
     /// Frame 1 destroys `old` (slot 0) and spawns `new`, which takes slot 0 again: the text
     /// names the removed body from the frame's removed list, the new one from the world,
-    /// each with its generation.
+    /// each with its generation. `old` overlapped `wall` from frame 0 on (the circles'
+    /// centres 0.75 apart, radii 0.5: depth 0.25), so their touch begins at frame 0 and ends
+    /// with the destroy, after it.
     #[test]
     fn a_reused_slot_is_worded_with_each_bodys_generation() {
         let text = r#"
 layers = ["thing"]
-bodies = [{ name = "old", template = "thing", position = [0, 0] }]
+collide = [{ a = "thing", b = "thing", response = "report" }]
+bodies = [
+    { name = "old", template = "thing", position = [0, 0] },
+    { name = "wall", template = "thing", kind = "static", position = [0.75, 0] },
+]
 script = [
     { frame = 1, action = "destroy", body = "old" },
     { frame = 1, action = "spawn", template = "thing", name = "new", position = [5, 0] },
@@ -163,31 +168,56 @@ shape = { kind = "circle", radius = 0.5 }
 "#;
         let scenario = load_scenario(text, "reuse.toml").unwrap();
         let mut sim = Simulation::new(&scenario);
-        sim.step();
+        let lines = |sim: &Simulation, out: &FrameOutput| -> Vec<(&str, LogLevel, String)> {
+            out.events
+                .iter()
+                .map(|e| {
+                    let l = line(e, sim.world(), out);
+                    (l.kind, l.level, l.message)
+                })
+                .collect()
+        };
         let out = sim.step();
-        let lines: Vec<(&str, String)> = out
-            .events
-            .iter()
-            .map(|e| {
-                let l = line(e, sim.world(), &out);
-                (l.kind, l.message)
-            })
-            .collect();
         assert_eq!(
-            lines,
+            lines(&sim, &out),
+            [(
+                "touch_begin",
+                LogLevel::Info,
+                "old #0:0 touches wall #1:0, depth 0.25".to_owned()
+            )]
+        );
+        let out = sim.step();
+        assert_eq!(
+            lines(&sim, &out),
             [
-                ("destroy", "old #0:0 destroyed by the script".to_owned()),
-                ("spawn", "new #0:1 spawned from template thing".to_owned()),
+                (
+                    "destroy",
+                    LogLevel::Warning,
+                    "old #0:0 destroyed by the script".to_owned()
+                ),
+                (
+                    "spawn",
+                    LogLevel::Info,
+                    "new #0:1 spawned from template thing".to_owned()
+                ),
                 (
                     "missed",
+                    LogLevel::Warning,
                     "set_velocity: no body named old is alive".to_owned()
+                ),
+                (
+                    "touch_end",
+                    LogLevel::Info,
+                    "old #0:0 no longer touches wall #1:0".to_owned()
                 ),
             ]
         );
     }
 
     /// A lift climbing into a ceiling with a box on it: the crush is a warning naming the box
-    /// and the lift, and the pass it was found in.
+    /// and the lift, and the pass it was found in. The box stands flush on the lift at frame
+    /// 0 (no record: no touch yet); at frame 1 gravity and the lift press them together, the
+    /// pass pushes the box up, and their touch begins, at level info like every touch.
     #[test]
     fn a_crush_is_a_warning_naming_the_box_and_what_crushed_it() {
         let text = r#"
@@ -214,6 +244,17 @@ position = [0.3, 0.65]
 "#;
         let scenario = load_scenario(text, "crush.toml").unwrap();
         let mut sim = Simulation::new(&scenario);
+        assert!(sim.step().events.is_empty(), "frame 0: flush, no record");
+        let out = sim.step();
+        let begin = line(&out.events[0], sim.world(), &out);
+        assert_eq!((begin.kind, begin.level), ("touch_begin", LogLevel::Info));
+        assert!(
+            begin
+                .message
+                .starts_with("lift #0:0 touches box #2:0, depth "),
+            "{}",
+            begin.message
+        );
         let crush = (0..30).find_map(|_| {
             let out = sim.step();
             out.events

@@ -88,6 +88,18 @@ fn each_error_class_is_named_with_its_location() {
         "6:1",
         &["collide[0].response", "\"bounce\""],
     );
+    // A touches value is located like any other: a wrong type at the value, a switch on a
+    // pair that is never tested at its key.
+    case(
+        "touches-not-a-bool",
+        "7:11",
+        &["collide[0].touches", "expected a boolean"],
+    );
+    case(
+        "touches-on-an-ignore-pair",
+        "7:1",
+        &["collide[0].touches", "`ignore` pair", "never touches"],
+    );
     case(
         "split-cycle",
         "10:1",

@@ -63,9 +63,12 @@ fn the_crowd_sends_its_narrow_phase_to_the_workers() {
     for _ in 0..30 {
         let out = sim.step();
         let pushes = out
-            .events
+            .contacts
             .iter()
-            .filter(|e| matches!(e, ricochet_sim::GameEvent::PushedApart { .. }))
+            .filter(|c| {
+                use ricochet_sim::{Phase, Response};
+                c.response == Response::Separate && matches!(c.phase, Phase::All | Phase::Swept)
+            })
             .count();
         if out.stats.narrow_tests >= 256 && pushes >= 50 {
             busy += 1;

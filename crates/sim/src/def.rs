@@ -183,6 +183,9 @@ pub struct Layers {
     sweep: Vec<bool>,
     /// Layers whose bodies move further than their size in a frame (bullets).
     fast: Vec<bool>,
+    /// `touch[a * n + b]`: whether the `touch` stage tracks the pair's touches and reports
+    /// their begin and end (default true; an `ignore` pair never touches whatever it says).
+    touch: Vec<bool>,
 }
 
 impl Layers {
@@ -195,6 +198,7 @@ impl Layers {
             matrix: vec![Response::Ignore; n * n],
             sweep: vec![false; n * n],
             fast: vec![false; n],
+            touch: vec![true; n * n],
         }
     }
 
@@ -229,6 +233,44 @@ impl Layers {
     #[inline]
     pub fn sweeps(&self, a: LayerId, b: LayerId) -> bool {
         self.sweep[usize::from(a) * self.names.len() + usize::from(b)]
+    }
+
+    /// Chooses whether the touches of a pair are tracked and reported
+    /// ([`crate::GameEvent::TouchBegin`], [`crate::GameEvent::TouchEnd`]), both ways round.
+    /// On by default; off, the pair's contacts are still detected, answered and recorded.
+    pub fn set_touches(&mut self, a: LayerId, b: LayerId, touches: bool) {
+        let n = self.names.len();
+        let (a, b) = (usize::from(a), usize::from(b));
+        self.touch[a * n + b] = touches;
+        self.touch[b * n + a] = touches;
+    }
+
+    /// Whether the touches of a pair are tracked and reported: its response is not
+    /// `ignore` (an ignored pair is never tested, so never touches) and
+    /// [`Layers::set_touches`] did not switch it off.
+    #[must_use]
+    #[inline]
+    pub fn touches(&self, a: LayerId, b: LayerId) -> bool {
+        let k = usize::from(a) * self.names.len() + usize::from(b);
+        self.touch[k] && self.matrix[k] != Response::Ignore
+    }
+
+    /// Whether some layer pair [`touches`](Layers::touches).
+    #[must_use]
+    pub fn any_touches(&self) -> bool {
+        self.matrix
+            .iter()
+            .zip(&self.touch)
+            .any(|(r, t)| *t && *r != Response::Ignore)
+    }
+
+    /// Whether every pair that is tested (not `ignore`) [`touches`](Layers::touches).
+    #[must_use]
+    pub fn all_touch(&self) -> bool {
+        self.matrix
+            .iter()
+            .zip(&self.touch)
+            .all(|(r, t)| *t || *r == Response::Ignore)
     }
 
     /// Sets the response of `(a, b)`, and the mirrored one of `(b, a)`.

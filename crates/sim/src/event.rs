@@ -62,35 +62,6 @@ pub enum GameEvent {
         /// Why.
         cause: Removal,
     },
-    /// Two bodies in a `report` layer pair overlap.
-    Contact {
-        /// The body with the lower id.
-        a: Entity,
-        /// The body with the higher id.
-        b: Entity,
-        /// Penetration depth.
-        depth: f64,
-    },
-    /// Two bodies in a `separate` layer pair were pushed apart along the contact normal.
-    PushedApart {
-        /// The body with the lower id.
-        a: Entity,
-        /// The body with the higher id.
-        b: Entity,
-        /// The depth they overlapped by.
-        depth: f64,
-    },
-    /// A box was pushed out of another along one axis (`resolve_x`, `resolve_y`).
-    PushedOut {
-        /// The box that moved.
-        body: Entity,
-        /// `0` for x, `1` for y.
-        axis: u8,
-        /// The signed distance it moved along the axis.
-        by: f64,
-        /// The box it was pushed out of.
-        obstacle: Entity,
-    },
     /// A box that a kinematic body pushed or carried this frame still overlaps a static or
     /// kinematic box after its per-axis pass: it was pushed into a wall (or ceiling, or
     /// floor) with no room to go. The engine leaves it where the pushes put it, overlapping;
@@ -103,6 +74,31 @@ pub enum GameEvent {
         by: Entity,
         /// The pass that found it: `0` for `resolve_x`, `1` for `resolve_y`.
         axis: u8,
+    },
+    /// Two bodies began to touch: the pair has a contact record this frame and did not touch
+    /// at the end of the last one (the `touch` stage, `docs/touches.md`). Raised after every
+    /// other event of the frame, begins in pair order before ends.
+    TouchBegin {
+        /// The body with the lower id.
+        a: Entity,
+        /// The body with the higher id.
+        b: Entity,
+        /// The normal of the pair's first contact record of the frame (detection order),
+        /// from `a` to `b`.
+        normal: Vec2,
+        /// Its penetration depth.
+        depth: f64,
+        /// Its contact point.
+        point: Vec2,
+    },
+    /// Two bodies that touched at the end of the last frame no longer do: no contact record
+    /// this frame and apart by more than [`crate::SLOP`] (unless both are at rest), or a
+    /// body removed this frame. After every begin of the frame, in pair order.
+    TouchEnd {
+        /// The body with the lower id.
+        a: Entity,
+        /// The body with the higher id.
+        b: Entity,
     },
 }
 

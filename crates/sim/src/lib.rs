@@ -51,7 +51,11 @@
 //! let c = &out.contacts[0];
 //! assert_eq!((c.a, c.b, c.normal), (ball, wall, Vec2::new(1.0, 0.0)));
 //! assert!((c.depth - 0.75).abs() < 1e-12);
-//! assert!(matches!(out.events[0], GameEvent::Contact { a, b, .. } if (a, b) == (ball, wall)));
+//! // Its first frame of contact: the pair begins to touch (`docs/touches.md`).
+//! assert!(matches!(out.events[0], GameEvent::TouchBegin { a, b, .. } if (a, b) == (ball, wall)));
+//! assert_eq!(sim.touching(), [(ball, wall)]);
+//! let out = sim.step(); // still overlapping (`report` lets it through): no new event
+//! assert!(out.events.is_empty() && sim.touching() == [(ball, wall)]);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!

@@ -1,8 +1,9 @@
 //! The simulation: a world, its scenario, and the fixed stage order.
 //!
-//! Frame 0 is the initial state: its script events run and contacts are detected, but
-//! nothing moves. Every later frame runs every stage in this order, skipping a stage the
-//! scene has nothing for (and counting the skip in [`crate::Stats`]):
+//! Frame 0 is the initial state: its script events run, contacts are detected and the
+//! touching pairs begin, but nothing moves. Every later frame runs every stage in this
+//! order, skipping a stage the scene has nothing for (and counting the skip in
+//! [`crate::Stats`]):
 //!
 //! | stage | does |
 //! |---|---|
@@ -20,6 +21,7 @@
 //! | `lifetimes` | count down lifetimes; remove expired bodies |
 //! | `bounds` | wrap around (Asteroids) or remove bodies that left the world |
 //! | `sleep` | count the frames each dynamic body rested; put to sleep those that rested long enough |
+//! | `touch` | the pairs touching at the end of the frame; `touch_begin` / `touch_end` events for the pairs that started or stopped (`docs/touches.md`) |
 //!
 //! The motion stages visit only the *active* bodies ([`World::active`]): moving, not frozen,
 //! not asleep. Static bodies are never visited after they are indexed.
@@ -37,13 +39,22 @@ use crate::scenario::Scenario;
 use crate::stage_set::Stage;
 use crate::stages::detect::DetectState;
 use crate::stages::separate::SeparateState;
-use crate::stages::{StageCtx, bounds, cull, detect, lifetimes, motion, script, separate, sleep};
+use crate::stages::touch::TouchState;
+use crate::stages::{
+    StageCtx, bounds, cull, detect, lifetimes, motion, script, separate, sleep, touch,
+};
 use crate::world::World;
 
 /// The stages frame 0 runs: the initial state is scripted and checked, never moved. Lifetimes
 /// count frame 0, so a body lives `lifetime` frames whether it starts there or is spawned
-/// later.
-const FRAME_ZERO: [Stage; 4] = [Stage::Script, Stage::Cull, Stage::Detect, Stage::Lifetimes];
+/// later; bodies overlapping at the start begin touching at frame 0.
+const FRAME_ZERO: [Stage; 5] = [
+    Stage::Script,
+    Stage::Cull,
+    Stage::Detect,
+    Stage::Lifetimes,
+    Stage::Touch,
+];
 
 /// A running simulation.
 #[derive(Clone)]
@@ -67,6 +78,8 @@ pub struct Simulation {
     pub(crate) detect: DetectState,
     /// The obstacle grids of `resolve_x` and `resolve_y`.
     pub(crate) separate: SeparateState,
+    /// The pairs touching at the end of the last frame (`touch`).
+    pub(crate) touch: TouchState,
     /// The threads of the parallel stages (`parallel.rs`); one by default.
     pub(crate) workers: Workers,
 }
@@ -125,6 +138,7 @@ impl Simulation {
         Simulation {
             detect: DetectState::new(layers, scenario.world.broad_phase),
             separate: SeparateState::new(layers),
+            touch: TouchState::new(layers),
             scenario,
             world,
             frame: 0,
@@ -172,6 +186,14 @@ impl Simulation {
         self.frame
     }
 
+    /// The pairs of bodies touching at the end of the last frame, sorted by `(a, b)` with
+    /// `a < b` (`docs/touches.md`): what every [`crate::GameEvent::TouchBegin`] so far
+    /// without its [`crate::GameEvent::TouchEnd`] names. Empty before frame 0 has run.
+    #[must_use]
+    pub fn touching(&self) -> &[(Entity, Entity)] {
+        self.touch.touching()
+    }
+
     /// Seconds per step.
     #[must_use]
     pub fn dt(&self) -> f64 {
@@ -185,8 +207,9 @@ impl Simulation {
         &rest[..n]
     }
 
-    /// Whether the scene has anything for `stage` to do this frame.
-    fn has_work(&self, stage: Stage) -> bool {
+    /// Whether the scene has anything for `stage` to do this frame, given what the frame
+    /// produced so far.
+    fn has_work(&self, stage: Stage, out: &FrameOutput) -> bool {
         let (w, def) = (&self.world, &self.scenario.world);
         match stage {
             Stage::Script => !self.due_events().is_empty() || !self.pending.is_empty(),
@@ -201,6 +224,7 @@ impl Simulation {
             Stage::Lifetimes => lifetimes::has_work(w),
             Stage::Bounds => bounds::has_work(def),
             Stage::Sleep => sleep::has_work(def),
+            Stage::Touch => touch::has_work(&self.touch, out),
         }
     }
 
@@ -239,6 +263,7 @@ impl Simulation {
             Stage::Lifetimes => lifetimes::run(&mut ctx),
             Stage::Bounds => bounds::run(&mut ctx),
             Stage::Sleep => sleep::run(&mut ctx),
+            Stage::Touch => touch::run(&mut ctx, &mut self.touch),
         }
     }
 
@@ -254,7 +279,7 @@ impl Simulation {
         w.start_frame();
         for stage in Stage::ALL {
             let allowed = self.frame > 0 || FRAME_ZERO.contains(&stage);
-            if allowed && self.has_work(stage) {
+            if allowed && self.has_work(stage, &out) {
                 self.run(stage, &mut out);
                 out.stats.stages_run.insert(stage);
             } else {

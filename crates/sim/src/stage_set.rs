@@ -32,11 +32,13 @@ pub enum Stage {
     Bounds,
     /// Put resting bodies to sleep.
     Sleep,
+    /// Which pairs touch; begin and end touch events.
+    Touch,
 }
 
 impl Stage {
     /// Every stage, in pipeline order.
-    pub const ALL: [Stage; 14] = [
+    pub const ALL: [Stage; 15] = [
         Stage::Script,
         Stage::Cull,
         Stage::Unground,
@@ -51,6 +53,7 @@ impl Stage {
         Stage::Lifetimes,
         Stage::Bounds,
         Stage::Sleep,
+        Stage::Touch,
     ];
 
     /// The name logs use (`"move_x"`).
@@ -71,6 +74,7 @@ impl Stage {
             Stage::Lifetimes => "lifetimes",
             Stage::Bounds => "bounds",
             Stage::Sleep => "sleep",
+            Stage::Touch => "touch",
         }
     }
 
@@ -142,7 +146,7 @@ mod tests {
         assert_eq!(names, ["script", "detect", "sleep"]);
         assert_eq!(
             Stage::ALL.iter().map(|s| s.bit()).fold(0, |a, b| a | b),
-            0x3fff
+            0x7fff
         );
     }
 }

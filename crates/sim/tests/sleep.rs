@@ -199,9 +199,8 @@ fn a_sleeping_box_wakes_when_something_lands_on_it() {
                 "frame {frame}: lone still asleep after the landing"
             );
             assert!(
-                b.events
-                    .iter()
-                    .any(|e| matches!(e, GameEvent::PushedOut { axis: 1, .. })),
+                b.events.iter().any(|e| matches!(e,
+                    GameEvent::TouchBegin { a, b, .. } if (*a, *b) == (e_lone, e_dropper))),
                 "{:?}",
                 b.events
             );

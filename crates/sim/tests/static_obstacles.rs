@@ -1,7 +1,7 @@
 //! The per-axis passes name the static box a body was pushed out of, even when other static
 //! bodies (not boxes, so not in their grid) come before it in id order.
 
-use ricochet_sim::{GameEvent, Simulation, load_scenario};
+use ricochet_sim::{Phase, Simulation, load_scenario};
 
 const SCENE: &str = r#"
 layers = ["solid"]
@@ -40,13 +40,17 @@ position = [0, 1.5]
 fn a_box_landing_on_a_tile_names_the_tile() {
     let mut sim = Simulation::new(&load_scenario(SCENE, "scene.toml").unwrap());
     let floor = sim.world().entity[sim.world().find("floor").unwrap()];
+    let crate_ = sim.world().entity[sim.world().find("crate").unwrap()];
     let mut landed = 0;
     for _ in 0..30 {
-        for e in sim.step().events {
-            if let GameEvent::PushedOut { obstacle, axis, .. } = e {
-                assert_eq!((obstacle, axis), (floor, 1), "pushed up by the floor");
-                landed += 1;
-            }
+        for c in sim.step().contacts {
+            assert_eq!(
+                (c.a, c.b, c.phase),
+                (floor, crate_, Phase::Y),
+                "on the floor"
+            );
+            assert!(c.resolved.y > 0.0, "pushed up by the floor");
+            landed += 1;
         }
     }
     assert!(landed > 0, "the crate lands");

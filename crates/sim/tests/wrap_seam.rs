@@ -159,23 +159,25 @@ fn assert_same_events(frame: u64, seam: &FrameOutput, direct: &FrameOutput) {
     for (s, d) in seam.events.iter().zip(&direct.events) {
         match (s, d) {
             (
-                GameEvent::Contact { a, b, depth },
-                GameEvent::Contact {
-                    a: a2,
-                    b: b2,
-                    depth: d2,
+                GameEvent::TouchBegin {
+                    a,
+                    b,
+                    normal,
+                    depth,
+                    ..
                 },
-            )
-            | (
-                GameEvent::PushedApart { a, b, depth },
-                GameEvent::PushedApart {
+                GameEvent::TouchBegin {
                     a: a2,
                     b: b2,
+                    normal: n2,
                     depth: d2,
+                    ..
                 },
             ) => {
+                // The points differ by the shift (through the seam, in `a`'s coordinates).
                 assert_eq!((a, b), (a2, b2), "frame {frame}");
                 assert!((depth - d2).abs() <= 1e-12, "frame {frame}");
+                assert!((*normal - *n2).length() <= 1e-9, "frame {frame}");
             }
             _ => assert_eq!(s, d, "frame {frame}"),
         }

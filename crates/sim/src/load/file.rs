@@ -108,6 +108,9 @@ pub struct CollideFile {
     /// Test along the whole frame's motion (time of impact) rather than at its end only
     /// (default: true when either layer is in `fast_layers`).
     pub sweep: Option<bool>,
+    /// Track the pair's touches and report their begin and end (`touch_begin`,
+    /// `touch_end`; default true). Not on an `ignore` pair, which never touches.
+    pub touches: Option<bool>,
 }
 
 /// A body or a template. Every field is optional in a template; a body takes its template's

@@ -135,6 +135,16 @@ fn layers(ctx: &Ctx<'_>, raw: &ScenarioFile) -> Result<Layers, ScenarioError> {
         if let Some(sweep) = r.sweep {
             layers.set_sweep(a, b, sweep);
         }
+        if let Some(touches) = r.touches {
+            if response == Response::Ignore {
+                return Err(ctx.err(
+                    c.span(),
+                    format!("{field}.touches"),
+                    "an `ignore` pair is never tested, so it never touches: leave `touches` out",
+                ));
+            }
+            layers.set_touches(a, b, touches);
+        }
     }
     Ok(layers)
 }

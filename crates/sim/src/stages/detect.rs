@@ -14,7 +14,8 @@
 //! when a body is frozen outside the active region, when both are at rest (asleep or
 //! static), or when two boxes `separate` (the per-axis stages own those). The rest are
 //! tested exactly, in `(a, b)` id order, and respond:
-//! - `report`: the contact is logged and a `contact` event raised;
+//! - `report`: the contact is logged (the `touch` stage turns a pair's first and last
+//!   frames of contact into touch events);
 //! - `destroy`: the doomed bodies are removed after the pass (children of a split spawned);
 //! - `separate`: the dynamic body is pushed out along the normal by the depth (two dynamic
 //!   bodies half each, clipped by the static bodies: `push.rs`), and its velocity into the
@@ -44,7 +45,7 @@ use ricochet_geom::{Contact, Pose, Sweep, Vec2, contact, time_of_impact};
 use crate::broad_phase::{BodyEntry, BroadPhase, BroadPhaseKind, Interactions, STATIC_BIT};
 use crate::def::{BodyKind, Doomed, Layers, Response, WorldDef};
 use crate::entity::Entity;
-use crate::event::{GameEvent, Removal};
+use crate::event::Removal;
 use crate::output::{ContactRecord, Phase};
 use crate::parallel::Workers;
 use crate::stages::push::{Statics, separate_along_normal};
@@ -545,12 +546,7 @@ fn respond(
     let mut resolved = Vec2::ZERO;
     let (ea, eb) = (w.entity[i], w.entity[j]);
     match response {
-        Response::Ignore => {}
-        Response::Report => ctx.out.events.push(GameEvent::Contact {
-            a: ea,
-            b: eb,
-            depth: c.depth,
-        }),
+        Response::Ignore | Response::Report => {}
         Response::Destroy(which) => {
             if matches!(which, Doomed::First | Doomed::Both) {
                 doomed.push((ea, eb));
@@ -562,11 +558,6 @@ fn respond(
         Response::Separate => {
             let statics = Some((push_statics, &ctx.def.layers));
             resolved = separate_along_normal(ctx.world, statics, (i, j), c.normal, c.depth);
-            ctx.out.events.push(GameEvent::PushedApart {
-                a: ea,
-                b: eb,
-                depth: c.depth,
-            });
         }
     }
     ctx.out.contacts.push(ContactRecord {

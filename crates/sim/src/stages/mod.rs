@@ -22,6 +22,7 @@ pub(crate) mod separate;
 pub(crate) mod sleep;
 pub(crate) mod sweep_axis;
 pub(crate) mod sweep_normal;
+pub(crate) mod touch;
 pub(crate) mod wrap;
 
 /// How far two solid bodies may still overlap after `separate` has pushed them apart, in

@@ -3,8 +3,8 @@
 //! After every body has moved along one axis, each dynamic box in a `separate` layer pair is
 //! checked against the other boxes it may not overlap. Where two overlap by more than
 //! [`SLOP`] on both axes, the dynamic one is pushed out along the moved axis by the smaller of
-//! the two overlaps on that axis, its velocity into the obstacle on that axis is zeroed, and a
-//! `hit_x`/`hit_y` event is raised. A push upwards sets `grounded`, and records the kinematic
+//! the two overlaps on that axis, its velocity into the obstacle on that axis is zeroed, and the
+//! contact is recorded (phase `x` or `y`). A push upwards sets `grounded`, and records the kinematic
 //! or dynamic box that pushed it as the carrier the box rides next frame; a box that a
 //! kinematic body pushed or carried and that is left overlapping a wall raises `crush`
 //! (riders: `stages/carry.rs`). Dynamic boxes settle lowest (leftmost) first, and a settled
@@ -395,12 +395,6 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
                 pose_b,
                 response: Response::Separate,
                 resolved: moved,
-            });
-            out.events.push(GameEvent::PushedOut {
-                body: w.entity[i],
-                axis: axis as u8,
-                by: moved[axis],
-                obstacle: w.entity[j],
             });
             // The box moved: go on from the next obstacle, at its new place (after a swept
             // stop, from the first: it stands where the pass may start again).

@@ -18,7 +18,6 @@
 use ricochet_geom::{Contact, Impact, Sweep, Vec2, contact, time_of_impact};
 
 use crate::def::{BodyKind, Response};
-use crate::event::GameEvent;
 use crate::output::{ContactRecord, Phase};
 use crate::stages::push::separate_along_normal;
 use crate::stages::{SLOP, StageCtx};
@@ -67,7 +66,7 @@ pub(crate) fn stop(
 /// Puts the dynamic body of `(i, j)` at its pose at `impact`, pushes it there along the
 /// normal (by the depth left against a kinematic body that moved on, or by nothing, which
 /// still removes the velocity into the surface and grounds a landing), and logs the
-/// contact (phase `swept`, at the touching poses) with a `hit` event.
+/// contact (phase `swept`, at the touching poses).
 pub(crate) fn apply(ctx: &mut StageCtx, (i, j): (usize, usize), impact: &Impact) {
     let w = &mut *ctx.world;
     let (d, at) = if w.kind[i] == BodyKind::Dynamic {
@@ -87,11 +86,6 @@ pub(crate) fn apply(ctx: &mut StageCtx, (i, j): (usize, usize), impact: &Impact)
     separate_along_normal(w, None, (i, j), normal, depth);
     let resolved = w.position[d] - end;
     let (ea, eb) = (w.entity[i], w.entity[j]);
-    ctx.out.events.push(GameEvent::PushedApart {
-        a: ea,
-        b: eb,
-        depth: impact.contact.depth,
-    });
     ctx.out.contacts.push(ContactRecord {
         a: ea,
         b: eb,

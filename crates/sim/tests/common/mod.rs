@@ -7,7 +7,9 @@
 //! the stages do (semi-implicit Euler: `x += v * dt`, frame 0 does not move).
 #![allow(dead_code, reason = "each test file uses its own part of the helpers")]
 
-use ricochet_sim::{FrameOutput, GameEvent, Phase, Simulation, StageSet, Stats, load_scenario};
+use ricochet_sim::{
+    FrameOutput, GameEvent, Phase, Response, Simulation, StageSet, Stats, load_scenario,
+};
 
 pub fn sim(text: &str) -> Simulation {
     let s = load_scenario(text, "rest.toml").unwrap_or_else(|e| panic!("{e}\n{text}"));
@@ -193,9 +195,10 @@ pub struct Totals {
     contacts: usize,
     events: usize,
     removed: usize,
-    contact_events: usize,
+    report_contacts: usize,
     hits: usize,
     per_axis: usize,
+    touches: usize,
 }
 
 impl Totals {
@@ -203,15 +206,20 @@ impl Totals {
         self.contacts += out.contacts.len();
         self.events += out.events.len();
         self.removed += out.removed.len();
-        self.contact_events += out
-            .events
+        self.report_contacts += out
+            .contacts
             .iter()
-            .filter(|e| matches!(e, GameEvent::Contact { .. }))
+            .filter(|c| c.response == Response::Report)
             .count();
         self.hits += out
+            .contacts
+            .iter()
+            .filter(|c| c.response == Response::Separate && !matches!(c.phase, Phase::X | Phase::Y))
+            .count();
+        self.touches += out
             .events
             .iter()
-            .filter(|e| matches!(e, GameEvent::PushedApart { .. }))
+            .filter(|e| matches!(e, GameEvent::TouchBegin { .. }))
             .count();
         self.per_axis += out
             .contacts
@@ -222,10 +230,11 @@ impl Totals {
 
     /// The busy scene really collides in every way it is meant to.
     pub fn assert_busy(&self) {
-        assert!(self.contact_events > 0, "no `report` contacts");
+        assert!(self.report_contacts > 0, "no `report` contacts");
         assert!(self.hits > 0, "no separation along the normal");
         assert!(self.per_axis > 0, "no per-axis separation");
         assert!(self.removed >= 2, "no bullet was removed");
+        assert!(self.touches > 0, "no pair began to touch");
     }
 }
 
