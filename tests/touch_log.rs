@@ -33,11 +33,8 @@ fn ids_in(text: &str) -> Vec<Id> {
     text.split('#')
         .skip(1)
         .map(|rest| {
-            let token: String = rest
-                .chars()
-                .take_while(|c| c.is_ascii_digit() || *c == ':')
-                .collect();
-            let (i, g) = token.split_once(':').expect("index:generation");
+            let (i, after) = rest.split_once(':').expect("index:generation");
+            let g: String = after.chars().take_while(char::is_ascii_digit).collect();
             (i.parse().unwrap(), g.parse().unwrap())
         })
         .collect()
