@@ -91,6 +91,10 @@ pub fn run(scenes: &[String], frames: u64, keep: Option<&Path>) -> anyhow::Resul
         scenes.to_vec()
     };
     let temp = tempfile::tempdir().context("creating a temporary directory for the logs")?;
+    if let Some(dir) = keep {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("creating --keep directory {}", dir.display()))?;
+    }
     let dir = keep.unwrap_or(temp.path());
     let mut rows = Vec::new();
     for name in &names {

@@ -254,7 +254,7 @@ enum Command {
         /// moving body per frame. Default scene: asteroids-10000.
         #[arg(long)]
         record: bool,
-        /// With --record: keep the logs in this directory (NAME.mcap).
+        /// With --record: keep the logs in this directory (NAME.mcap; created if missing).
         #[arg(long, value_name = "DIR", requires = "record")]
         keep: Option<PathBuf>,
     },
