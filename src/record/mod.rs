@@ -160,9 +160,7 @@ impl<S: MessageSink> Recorder<S> {
         let t = frame * self.dt_ns;
         let ts = timestamp(t);
         let (w, layers) = (sim.world(), &sim.scenario().world.layers);
-        let style = *self
-            .style
-            .get_or_insert_with(|| scene::Style::for_bodies(w.len()));
+        let style = self.style(w);
         for (channel, statics) in [(self.topics.statics, true), (self.topics.scene, false)] {
             if let Some(ch) = channel {
                 let message = scene::snapshot(w, layers, statics, style, ts);
@@ -177,6 +175,13 @@ impl<S: MessageSink> Recorder<S> {
         Ok(())
     }
 
+    /// How bodies become entities: chosen at the first frame from its body count, then kept.
+    fn style(&mut self, w: &ricochet_sim::World) -> scene::Style {
+        *self
+            .style
+            .get_or_insert_with(|| scene::Style::for_bodies(w.len()))
+    }
+
     /// The centre of the bodies' extent at the first frame recorded: where the camera looks
     /// without a focus body or world bounds.
     fn fallback_view(&self, sim: &Simulation) -> Vec2 {
@@ -188,10 +193,8 @@ impl<S: MessageSink> Recorder<S> {
 
     /// Where the camera looks now (see [`scene::view_position`]).
     fn view_at(&self, sim: &Simulation) -> Vec2 {
-        let world = &sim.scenario().world;
-        let focus = world.active_region.as_ref().map(|a| a.focus.as_str());
-        let bounds = world.bounds.map(|b| (b.min, b.max));
-        scene::view_position(sim.world(), focus, bounds, self.fallback_view(sim))
+        let bounds = sim.scenario().world.bounds.map(|b| (b.min, b.max));
+        scene::view_position(sim.world(), sim.focus(), bounds, self.fallback_view(sim))
     }
 
     /// Adds the `/validation` channel (`ricochet run --validate`).
@@ -234,9 +237,7 @@ impl<S: MessageSink> Recorder<S> {
         let layers = &sim.scenario().world.layers;
         let want_bodies = self.topics.bodies.is_some();
         if self.topics.scene.is_some() || want_bodies {
-            let style = *self
-                .style
-                .get_or_insert_with(|| scene::Style::for_bodies(w.len()));
+            let style = self.style(w);
             let mut changes = self.tracker.frame(
                 w,
                 out,

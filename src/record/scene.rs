@@ -374,18 +374,16 @@ fn batches(
     all
 }
 
-/// Where the layout's camera looks: the focus body of the scenario's active region while it
-/// is alive (the lowest id of that name), else the centre of the world's bounds, else
+/// Where the layout's camera looks: the body the active region follows while it is alive
+/// ([`ricochet_sim::Simulation::focus`]), else the centre of the world's bounds, else
 /// `fallback` (the centre of the bodies' extent when recording started).
 pub fn view_position(
     w: &World,
-    focus: Option<&str>,
+    focus: Option<Entity>,
     bounds: Option<(Vec2, Vec2)>,
     fallback: Vec2,
 ) -> Vec2 {
-    if let Some(name) = focus
-        && let Some(i) = (0..w.len()).find(|&i| w.name(i) == name)
-    {
+    if let Some(i) = focus.and_then(|e| w.index_of(e)) {
         return w.position[i];
     }
     if let Some((min, max)) = bounds {

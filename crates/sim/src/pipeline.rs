@@ -180,6 +180,12 @@ impl Simulation {
         &self.scenario
     }
 
+    /// The body the active region follows (its focus), once a step has found it alive.
+    #[must_use]
+    pub fn focus(&self) -> Option<Entity> {
+        self.focus
+    }
+
     /// The frame the next [`step`](Self::step) will run.
     #[must_use]
     pub fn frame(&self) -> u64 {
