@@ -92,7 +92,7 @@ fn message(event: &GameEvent, world: &World, out: &FrameOutput) -> String {
         GameEvent::SplitFrom { child, parent } => {
             format!("{} split from {}", body(*child), body(*parent))
         }
-        GameEvent::Removed { body: e, cause } => {
+        GameEvent::Removed { body: e, cause, .. } => {
             let why = match cause {
                 Removal::Script => "destroyed by the script".to_owned(),
                 Removal::HitBy(by) => format!("hit by {}", body(*by)),

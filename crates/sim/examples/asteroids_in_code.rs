@@ -67,6 +67,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 GameEvent::Removed {
                     body,
                     cause: Removal::HitBy(by),
+                    ..
                 } if *body == rock => {
                     // The swept hit's contact: where the bullet first touched the rock.
                     let c = out.contacts.iter().find(|c| c.a == rock || c.b == rock);

@@ -7,13 +7,13 @@
 //! so the broad phase and the per-axis stages rebuild their static structures, and wakes
 //! the sleepers (what they rested on may have moved); moving any body wakes it.
 
-use ricochet_geom::{Pose, Vec2};
+use ricochet_geom::{Pose, Shape, Vec2};
 
 use crate::action::Action;
 use crate::def::{BodyDef, WorldDef};
 use crate::entity::Entity;
 use crate::pipeline::Simulation;
-use crate::scenario::Scenario;
+use crate::scenario::{Scenario, TileRows};
 
 /// A body whose state is no longer a finite number (an overflow: gravity of 1e308, a force
 /// past what `f64` holds): nothing after it can be trusted, so a run stops there.
@@ -51,6 +51,16 @@ pub enum ControlError {
     OutOfRange {
         /// The field (`position`, `velocity`, `angle`).
         field: &'static str,
+    },
+    /// The call is for another kind of body (a target pose moves kinematic bodies only).
+    #[error("body {body} is {is}, not {needs}")]
+    WrongKind {
+        /// The body.
+        body: Entity,
+        /// Its kind.
+        is: &'static str,
+        /// The kind the call needs.
+        needs: &'static str,
     },
 }
 
@@ -133,6 +143,16 @@ impl Simulation {
         e
     }
 
+    /// Spawns every tile of `tiles` now, row by row, each row's tiles in order (a tile map
+    /// as data, as a scenario's [`TileRows`]): each tile a static body of scenery. Returns
+    /// their ids in that order, which is id order (each takes the lowest free id).
+    pub fn spawn_tiles(&mut self, tiles: &TileRows) -> Vec<Entity> {
+        let mut ids = Vec::with_capacity(tiles.len());
+        self.world.spawn_tiles(tiles, |e| ids.push(e));
+        self.world.refresh_active();
+        ids
+    }
+
     /// Whether `e` is alive.
     #[must_use]
     pub fn contains(&self, e: Entity) -> bool {
@@ -147,44 +167,6 @@ impl Simulation {
 
     fn index(&self, e: Entity) -> Result<usize, ControlError> {
         self.world.index_of(e).ok_or(ControlError::NoSuchBody(e))
-    }
-
-    /// A body's position, or `None` when it is not alive.
-    #[must_use]
-    pub fn position(&self, e: Entity) -> Option<Vec2> {
-        self.world.index_of(e).map(|i| self.world.position[i])
-    }
-
-    /// A body's angle in radians, or `None` when it is not alive.
-    #[must_use]
-    pub fn angle(&self, e: Entity) -> Option<f64> {
-        self.world.index_of(e).map(|i| self.world.angle[i])
-    }
-
-    /// A body's pose, or `None` when it is not alive.
-    #[must_use]
-    pub fn pose(&self, e: Entity) -> Option<Pose> {
-        self.world.index_of(e).map(|i| self.world.pose(i))
-    }
-
-    /// A body's velocity, or `None` when it is not alive.
-    #[must_use]
-    pub fn velocity(&self, e: Entity) -> Option<Vec2> {
-        self.world.index_of(e).map(|i| self.world.velocity(i))
-    }
-
-    /// A body's angular velocity in radians/s, or `None` when it is not alive.
-    #[must_use]
-    pub fn angular_velocity(&self, e: Entity) -> Option<f64> {
-        self.world
-            .index_of(e)
-            .map(|i| self.world.angular_velocity(i))
-    }
-
-    /// Whether a body was held up by something it stands on in the last step.
-    #[must_use]
-    pub fn grounded(&self, e: Entity) -> Option<bool> {
-        self.world.index_of(e).map(|i| self.world.grounded(i))
     }
 
     /// Moves a body to `position` now (a teleport: swept tests of this frame start there).
@@ -222,6 +204,63 @@ impl Simulation {
             return Err(ControlError::OutOfRange { field: "velocity" });
         }
         self.world.set_velocity(i, velocity);
+        Ok(())
+    }
+
+    /// Gives a body another shape now. Its bounds follow at once: a static body is
+    /// re-indexed by the broad phase and the per-axis stages at the next step (and wakes the
+    /// sleepers, as a teleport does); a moving body wakes. Like [`Simulation::spawn`], the
+    /// shape is not checked against a wrap world's size.
+    ///
+    /// # Errors
+    /// The body is not alive.
+    pub fn set_shape(&mut self, e: Entity, shape: Shape) -> Result<(), ControlError> {
+        let i = self.index(e)?;
+        self.world.set_shape(i, &shape);
+        Ok(())
+    }
+
+    /// Sets a body's [`crate::BodyDef::user_data`]: the game's own, which no stage reads.
+    ///
+    /// # Errors
+    /// The body is not alive.
+    pub fn set_user_data(&mut self, e: Entity, data: u128) -> Result<(), ControlError> {
+        let i = self.index(e)?;
+        self.world.set_user_data(i, data);
+        Ok(())
+    }
+
+    /// Moves a kinematic body to `pose` over the next moving step (rapier's
+    /// `set_next_kinematic_position`, Box2D's `b2Body_SetTargetTransform`): at the start of
+    /// that step its velocity becomes `(pose.position - position) / dt` and its angular
+    /// velocity `(pose.angle - angle) / dt`, so it arrives there (to rounding: `x + vx * dt`)
+    /// and what rides it is carried, as by any kinematic motion. The angle is taken as given
+    /// (`angle + 2π` turns a whole turn). A step with no new target stops it: its velocity
+    /// and angular velocity go back to zero, so a pose-driven platform holds still between
+    /// targets. A target set again before that step replaces the last; frame 0 moves
+    /// nothing, so a target set before it waits for frame 1.
+    ///
+    /// # Errors
+    /// The body is not alive, not kinematic, or the pose is not finite or beyond the
+    /// world limit.
+    pub fn set_target_pose(&mut self, e: Entity, pose: Pose) -> Result<(), ControlError> {
+        let i = self.index(e)?;
+        let kind = self.world.kind[i];
+        if kind != crate::BodyKind::Kinematic {
+            return Err(ControlError::WrongKind {
+                body: e,
+                is: kind.name(),
+                needs: "kinematic",
+            });
+        }
+        within("position", pose.position)?;
+        if !pose.angle.is_finite() {
+            return Err(ControlError::OutOfRange { field: "angle" });
+        }
+        match self.targets.binary_search_by_key(&e, |t| t.0) {
+            Ok(k) => self.targets[k].1 = pose,
+            Err(k) => self.targets.insert(k, (e, pose)),
+        }
         Ok(())
     }
 

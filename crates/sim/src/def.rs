@@ -111,6 +111,12 @@ pub struct BodyDef {
     pub controller: Option<Controller>,
     /// Children spawned on destruction.
     pub split: Vec<Split>,
+    /// The game's own data for this body (rapier's `user_data`, Box2D's `userData`): an id
+    /// into the game's tables, say. Kept for the body's whole life, read with
+    /// [`crate::Simulation::user_data`], changed with [`crate::Simulation::set_user_data`];
+    /// no stage reads it, and no log holds it. Default 0. A template's is given to each
+    /// body spawned from it (a ship's bullets, a split's children).
+    pub user_data: u128,
 }
 
 impl Default for BodyDef {
@@ -130,6 +136,7 @@ impl Default for BodyDef {
             lifetime: None,
             controller: None,
             split: Vec::new(),
+            user_data: 0,
         }
     }
 }

@@ -7,6 +7,7 @@
 
 use ricochet_geom::Vec2;
 
+use crate::def::LayerId;
 use crate::entity::Entity;
 
 /// One game event, in the order it happened within its frame.
@@ -57,8 +58,10 @@ pub enum GameEvent {
     },
     /// A body was removed.
     Removed {
-        /// The body (in [`crate::FrameOutput::removed`]).
+        /// The body (in [`crate::FrameOutput::removed`], with its last state).
         body: Entity,
+        /// Its layer: what tells a rock from a bullet without a look in `removed`.
+        layer: LayerId,
         /// Why.
         cause: Removal,
     },

@@ -59,6 +59,32 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!
+//! # Frame numbering
+//!
+//! [`Simulation::frame`] is the frame the *next* [`Simulation::step`] runs, and the output
+//! of a step names the frame it ran. The first step runs frame 0, the initial state: its
+//! script events run and its contacts are found, but nothing moves. An input sent between
+//! two steps ([`Simulation::apply`], [`Simulation::set_target_pose`]) lands in the next
+//! step's frame, at its start. So after `k` steps the world holds the end of frame `k - 1`,
+//! and `frame()` is `k`: what a save taken then holds, and where a restored run goes on.
+//!
+//! ```
+//! use ricochet_sim::prelude::*;
+//!
+//! let mut sim = Simulation::from_def(WorldDef::default())?;
+//! let ball = sim.spawn(&BodyDef::default());
+//! assert_eq!(sim.frame(), 0); // nothing has run
+//! assert_eq!(sim.step().frame, 0); // frame 0: the initial state, nothing moves
+//! sim.apply(ball, Action::SetVelocity(Vec2::new(60.0, 0.0)))?;
+//! assert_eq!(sim.frame(), 1); // the input lands in frame 1 ...
+//! let out = sim.step();
+//! assert_eq!(out.frame, 1); // ... which applies it, then moves the ball 1 unit
+//! assert!(matches!(out.events[0], GameEvent::Input { body, .. } if body == ball));
+//! assert_eq!(sim.position(ball), Some(Vec2::new(1.0, 0.0)));
+//! assert_eq!(sim.frame(), 2); // the world now holds the end of frame 1
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
 //! Scenario files load into the same definitions ([`load_scenario`], feature `toml`, on by
 //! default); `examples/asteroids_in_code.rs` builds an Asteroids scene and reads a
 //! destruction as a typed [`GameEvent`].
@@ -75,6 +101,8 @@ mod load;
 mod output;
 mod parallel;
 mod pipeline;
+pub mod prelude;
+mod reads;
 mod scenario;
 mod stage_set;
 mod stages;
@@ -98,3 +126,7 @@ pub use scenario::{Scenario, TileRows};
 pub use stage_set::{Stage, StageSet};
 pub use stages::SLOP;
 pub use world::{Inputs, World};
+
+/// The geometry crate, for what the prelude does not re-export (the narrow phase, ...).
+pub use ricochet_geom as geom;
+pub use ricochet_geom::{Bounds, Pose, Primitive, Shape, ShapeError, Vec2};

@@ -7,7 +7,7 @@
 //!
 //! | stage | does |
 //! |---|---|
-//! | `script` | this frame's script events: inputs, spawns, destroys, velocity/force edits |
+//! | `script` | this frame's script events: inputs, spawns, destroys, velocity/force edits; then the inputs sent with `apply`, and the kinematic bodies' target poses |
 //! | `cull` | freeze the moving bodies outside the active region, thaw those inside it |
 //! | `unground` | clear `grounded`: it is set again below by whatever holds a body up |
 //! | `controls` | controllers turn inputs into angular velocity (ship) or x velocity (runner, walker) |
@@ -30,6 +30,8 @@
 //! held up in the last `resolve_y` is carried by that kinematic body's `v * dt` in `move_x`
 //! and `move_y`, before its own motion, so it keeps its place on a moving platform; a
 //! kinematic box moving into a dynamic one pushes it in the per-axis passes.
+
+use ricochet_geom::Pose;
 
 use crate::action::{Action, Event};
 use crate::entity::Entity;
@@ -72,6 +74,12 @@ pub struct Simulation {
     pub capture_detect_poses: bool,
     /// Actions sent with [`Simulation::apply`], applied at the start of the next step.
     pub(crate) pending: Vec<(Entity, Action)>,
+    /// Target poses of kinematic bodies ([`Simulation::set_target_pose`]), by entity, for
+    /// the next moving step.
+    pub(crate) targets: Vec<(Entity, Pose)>,
+    /// The bodies the last moving step moved to a target, by entity: stopped at the next
+    /// one unless given a new target.
+    pub(crate) targeted: Vec<Entity>,
     /// The body the active region follows, once found.
     pub(crate) focus: Option<crate::Entity>,
     /// The broad phase and buffers of `detect` (given to it each frame).
@@ -84,6 +92,33 @@ pub struct Simulation {
     pub(crate) workers: Workers,
 }
 
+/// A summary, not every body (`{:?}` of a 10,000-body world would be megabytes): the
+/// scenario's name, the next frame, the body counts, what waits for the next step.
+impl std::fmt::Debug for Simulation {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let w = &self.world;
+        f.debug_struct("Simulation")
+            .field("scenario", &self.scenario.name)
+            .field("frame", &self.frame)
+            .field("dt", &self.scenario.world.dt)
+            .field("bodies", &w.len())
+            .field("moving", &w.movers().len())
+            .field("active", &w.active().len())
+            .field("sleeping", &w.sleeping())
+            .field("templates", &self.scenario.templates.len())
+            .field(
+                "script_events_left",
+                &(self.scenario.script.len() - self.cursor),
+            )
+            .field("pending", &self.pending)
+            .field("targets", &self.targets)
+            .field("touching", &self.touch.touching().len())
+            .field("focus", &self.focus)
+            .field("threads", &self.threads())
+            .finish_non_exhaustive()
+    }
+}
+
 impl Simulation {
     /// A simulation at the start of frame 0, with the scenario's bodies spawned in file order.
     #[must_use]
@@ -91,7 +126,7 @@ impl Simulation {
         let mut world = World::new();
         world.reserve(scenario.body_count());
         for t in &scenario.tiles {
-            world.spawn_tiles(t);
+            world.spawn_tiles(t, |_| {});
         }
         for b in &scenario.bodies {
             world.spawn(b);
@@ -116,7 +151,7 @@ impl Simulation {
         let mut world = World::new();
         world.reserve(scenario.body_count());
         for t in std::mem::take(&mut scenario.tiles) {
-            world.spawn_tiles(&t);
+            world.spawn_tiles(&t, |_| {});
         }
         let mut bodies = std::mem::take(&mut scenario.bodies);
         // Spawned in file order from the back of the reversed list, whose memory is given
@@ -145,6 +180,8 @@ impl Simulation {
             cursor: 0,
             capture_detect_poses: false,
             pending: Vec::new(),
+            targets: Vec::new(),
+            targeted: Vec::new(),
             focus: None,
             workers: Workers::default(),
         }
@@ -218,7 +255,11 @@ impl Simulation {
     fn has_work(&self, stage: Stage, out: &FrameOutput) -> bool {
         let (w, def) = (&self.world, &self.scenario.world);
         match stage {
-            Stage::Script => !self.due_events().is_empty() || !self.pending.is_empty(),
+            Stage::Script => {
+                !self.due_events().is_empty()
+                    || !self.pending.is_empty()
+                    || (self.frame > 0 && !(self.targets.is_empty() && self.targeted.is_empty()))
+            }
             Stage::Cull => cull::has_work(def),
             Stage::Unground => motion::has_grounded(w),
             Stage::Controls => motion::has_controls(w),
@@ -250,6 +291,9 @@ impl Simulation {
                 self.cursor += due;
                 script::run(&mut ctx, events, &self.pending);
                 self.pending.clear();
+                if self.frame > 0 {
+                    script::move_to_targets(ctx.world, dt, &mut self.targets, &mut self.targeted);
+                }
             }
             Stage::Cull => cull::run(&mut ctx, &mut self.focus),
             Stage::Unground => motion::unground(ctx.world),

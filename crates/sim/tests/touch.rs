@@ -142,6 +142,7 @@ fn a_body_destroyed_while_touching_ends_in_its_destroy_frame_after_the_removal()
                 [
                     GameEvent::Removed {
                         body: box_,
+                        layer: 0,
                         cause: Removal::Script
                     },
                     GameEvent::TouchEnd { a: floor, b: box_ },
@@ -193,6 +194,7 @@ velocity = [60, 0]
             removed,
             &GameEvent::Removed {
                 body: bullet,
+                layer: 1,
                 cause: Removal::HitBy(rock)
             }
         );

@@ -321,6 +321,8 @@ pub(crate) fn body_def(
         lifetime,
         controller,
         split,
+        // A game's own; scenario files have none.
+        user_data: 0,
     })
 }
 

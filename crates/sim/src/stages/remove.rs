@@ -25,6 +25,7 @@ pub(crate) fn remove(ctx: &mut StageCtx, entity: Entity, cause: Removal, split: 
     };
     ctx.out.events.push(GameEvent::Removed {
         body: entity,
+        layer: removed.layer,
         cause,
     });
     let children = if split { w.take_split(i) } else { Vec::new() };

@@ -127,3 +127,30 @@ fn fire(ctx: &mut StageCtx, i: usize) -> FireOutcome {
     ctx.out.events.push(GameEvent::Fired { bullet, ship });
     FireOutcome::Fired
 }
+
+/// Sets the velocities that move each kinematic body of `targets` to its target pose over
+/// this step (`(target - now) / dt`), and stops those of `targeted` (moved to a target last
+/// step) that have none this time; `targeted` becomes this step's bodies. A body gone since
+/// is skipped. See [`crate::Simulation::set_target_pose`].
+pub(crate) fn move_to_targets(
+    world: &mut crate::World,
+    dt: f64,
+    targets: &mut Vec<(Entity, ricochet_geom::Pose)>,
+    targeted: &mut Vec<Entity>,
+) {
+    for e in targeted.iter() {
+        let again = targets.binary_search_by_key(e, |t| t.0).is_ok();
+        if let (false, Some(i)) = (again, world.index_of(*e)) {
+            *world.velocity_mut(i) = Vec2::ZERO;
+            *world.angular_velocity_mut(i) = 0.0;
+        }
+    }
+    targeted.clear();
+    for (e, pose) in targets.drain(..) {
+        if let Some(i) = world.index_of(e) {
+            *world.velocity_mut(i) = (pose.position - world.position[i]) / dt;
+            *world.angular_velocity_mut(i) = (pose.angle - world.angle[i]) / dt;
+            targeted.push(e);
+        }
+    }
+}

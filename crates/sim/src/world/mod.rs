@@ -254,6 +254,7 @@ impl World {
             && def.gravity_scale.to_bits() == 1f64.to_bits()
             && def.force.x.to_bits() == 0
             && def.force.y.to_bits() == 0
+            && def.user_data == 0
     }
 
     /// Creates a body; it takes the lowest free id, and its column position follows from it.
@@ -310,7 +311,8 @@ impl World {
     /// Spawns every tile of `tiles`, row by row, each row's tiles in order: the bodies
     /// `BodyDef { name, layer, kind: Static, shape, position, ..BodyDef::default() }` with
     /// `position = start + step * k` for the `k`-th tile of a row (see [`TileRows`]).
-    pub fn spawn_tiles(&mut self, tiles: &TileRows) {
+    /// `each` is handed every tile's id, in spawn order (which is id order).
+    pub fn spawn_tiles(&mut self, tiles: &TileRows, mut each: impl FnMut(Entity)) {
         let mut def = BodyDef {
             name: tiles.name.clone(),
             layer: tiles.layer,
@@ -322,7 +324,7 @@ impl World {
         for &(start, count) in &tiles.rows {
             for k in 0..count {
                 def.position = start + tiles.step * f64::from(k);
-                self.spawn(&def);
+                each(self.spawn(&def));
             }
         }
     }
@@ -400,6 +402,51 @@ impl World {
             // A turned body's bounds follow from the cache (it widens to the any-angle disc).
             self.wake(i);
             self.refresh_active();
+        }
+    }
+
+    /// Gives body `i` another shape now, keeping the caches right as [`World::teleport`]
+    /// does: the body's bounds are recomputed, a static body bumps
+    /// [`World::static_generation`] (re-indexed by the broad phase and the per-axis stages)
+    /// and wakes every sleeper, a moving body wakes.
+    pub fn set_shape(&mut self, i: usize, shape: &Shape) {
+        let old = self.shape_id[i];
+        let layer = usize::from(self.layer[i]);
+        if !self.shapes.get(old).0.is_single_aabb() {
+            self.non_boxes[layer] -= 1;
+        }
+        shape_key(shape, &mut self.key);
+        let new = self.shapes.acquire(self.key.as_slice(), || {
+            let zero = shape.bounds(&Pose::new(Vec2::ZERO, 0.0));
+            (shape.clone(), zero)
+        });
+        // Acquired before the old one is released: a shape used by this body alone keeps
+        // its id when it is given again.
+        self.shapes.release(old);
+        self.shape_id[i] = new;
+        if !shape.is_single_aabb() {
+            if self.non_boxes.len() <= layer {
+                self.non_boxes.resize(layer + 1, 0);
+            }
+            self.non_boxes[layer] += 1;
+        }
+        let r = self.row[i];
+        if r != NO_ROW {
+            self.rows.local_bounds[r as usize] = LocalBounds::new(shape, self.angle[i]);
+        }
+        if self.kind[i] == BodyKind::Static {
+            self.static_generation += 1;
+            self.wake_all();
+        } else {
+            self.wake(i);
+            self.refresh_active();
+        }
+    }
+
+    /// Sets body `i`'s [`World::user_data`] (a body of scenery is given a row first).
+    pub fn set_user_data(&mut self, i: usize, data: u128) {
+        if data != self.user_data(i) {
+            *self.user_data_mut(i) = data;
         }
     }
 

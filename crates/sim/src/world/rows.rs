@@ -32,6 +32,7 @@ pub(super) struct Rows {
     pub(super) asleep: Vec<bool>,
     pub(super) rest_frames: Vec<u32>,
     pub(super) local_bounds: Vec<LocalBounds>,
+    pub(super) user_data: Vec<u128>,
 }
 
 /// The row columns every body reads (a copy), with what scenery reads: each gets a reader
@@ -105,6 +106,8 @@ row_readers! {
     asleep: bool = false;
     /// Consecutive frames a dynamic body has ended exactly where it started, grounded.
     rest_frames: u32 = 0;
+    /// The game's own data ([`crate::BodyDef::user_data`]).
+    user_data: u128 = 0;
 }
 
 row_writers! {
@@ -118,6 +121,7 @@ row_writers! {
     still, still_mut: bool;
     frozen, frozen_mut: bool;
     rest_frames, rest_frames_mut: u32;
+    user_data, user_data_mut: u128;
 }
 
 impl Rows {
@@ -146,6 +150,7 @@ impl Rows {
         self.rest_frames.push(0);
         self.local_bounds
             .push(LocalBounds::new(&def.shape, def.angle));
+        self.user_data.push(def.user_data);
     }
 
     /// Removes row `r`, moving the last row into its place.
@@ -169,6 +174,7 @@ impl Rows {
         self.asleep.swap_remove(r);
         self.rest_frames.swap_remove(r);
         self.local_bounds.swap_remove(r);
+        self.user_data.swap_remove(r);
     }
 
     /// Heap bytes of the columns (capacities).
@@ -197,5 +203,6 @@ impl Rows {
             + cap(&self.asleep)
             + cap(&self.rest_frames)
             + cap(&self.local_bounds)
+            + cap(&self.user_data)
     }
 }
