@@ -140,6 +140,7 @@ impl Simulation {
     pub fn spawn(&mut self, def: &BodyDef) -> Entity {
         let e = self.world.spawn(def);
         self.world.refresh_active();
+        self.queries.invalidate(&self.world);
         e
     }
 
@@ -150,6 +151,7 @@ impl Simulation {
         let mut ids = Vec::with_capacity(tiles.len());
         self.world.spawn_tiles(tiles, |e| ids.push(e));
         self.world.refresh_active();
+        self.queries.invalidate(&self.world);
         ids
     }
 
@@ -178,6 +180,7 @@ impl Simulation {
         let i = self.index(e)?;
         let position = within("position", position)?;
         self.world.teleport(i, position, self.world.angle[i]);
+        self.queries.invalidate(&self.world);
         Ok(())
     }
 
@@ -191,6 +194,7 @@ impl Simulation {
             return Err(ControlError::OutOfRange { field: "angle" });
         }
         self.world.teleport(i, self.world.position[i], angle);
+        self.queries.invalidate(&self.world);
         Ok(())
     }
 
@@ -217,6 +221,7 @@ impl Simulation {
     pub fn set_shape(&mut self, e: Entity, shape: Shape) -> Result<(), ControlError> {
         let i = self.index(e)?;
         self.world.set_shape(i, &shape);
+        self.queries.invalidate(&self.world);
         Ok(())
     }
 
@@ -346,6 +351,7 @@ impl Simulation {
     pub fn despawn(&mut self, e: Entity) -> Result<(), ControlError> {
         let i = self.index(e)?;
         self.world.despawn(i);
+        self.queries.invalidate(&self.world);
         Ok(())
     }
 }

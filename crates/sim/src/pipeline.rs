@@ -90,6 +90,9 @@ pub struct Simulation {
     pub(crate) touch: TouchState,
     /// The threads of the parallel stages (`parallel.rs`); one by default.
     pub(crate) workers: Workers,
+    /// The scene queries' trees (`query/index.rs`): built by the first query after a
+    /// change, dropped by every method that moves, adds, removes or reshapes a body.
+    pub(crate) queries: crate::query::index::QueryCache,
 }
 
 /// A summary, not every body (`{:?}` of a 10,000-body world would be megabytes): the
@@ -184,6 +187,7 @@ impl Simulation {
             targeted: Vec::new(),
             focus: None,
             workers: Workers::default(),
+            queries: crate::query::index::QueryCache::default(),
         }
     }
 
@@ -319,6 +323,7 @@ impl Simulation {
 
     /// Runs one frame and reports what happened.
     pub fn step(&mut self) -> FrameOutput {
+        self.queries.invalidate(&self.world);
         let mut out = FrameOutput {
             frame: self.frame,
             ..FrameOutput::default()
@@ -340,6 +345,9 @@ impl Simulation {
         out.stats.contacts = out.contacts.len() as u64;
         out.stats.kinetic_energy = self.world.kinetic_energy();
         self.frame += 1;
+        // The step moved bodies: the moving trees (and, if a static body changed, the
+        // static ones) are stale. Dropping an empty cell costs a branch.
+        self.queries.invalidate(&self.world);
         out
     }
 }

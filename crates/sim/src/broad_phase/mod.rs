@@ -82,7 +82,7 @@ mod mover_grid;
 mod sort_and_sweep;
 mod sorted;
 mod static_set;
-mod static_tree;
+pub(crate) mod static_tree;
 mod strips;
 mod tally;
 
@@ -185,10 +185,10 @@ struct Scratch {
 /// A body inside a structure: its bounds, its handle (an index into the caller's slice for a
 /// moving body, or a static index with [`STATIC_BIT`]), and whether it is dynamic.
 #[derive(Clone, Copy, Debug)]
-struct Member {
-    bounds: Bounds,
-    handle: u32,
-    dynamic: bool,
+pub(crate) struct Member {
+    pub(crate) bounds: Bounds,
+    pub(crate) handle: u32,
+    pub(crate) dynamic: bool,
 }
 
 /// Marks a handle as a static body's index (in the [`StaticSet`]).

@@ -1,6 +1,7 @@
 //! `SortAndSweep`'s static structure: a packed tree per layer (sort-tile-recursive: sorted
 //! once by x into slices, each slice by y, leaves of 8, a binary tree of boxes above), which
-//! each dynamic body queries in `O(log n + k)`.
+//! each dynamic body queries in `O(log n + k)`. The scene queries (`query/`) build the same
+//! trees over every layer's bodies and walk them along a ray ([`StaticTree::ray`]).
 
 use ricochet_geom::{Bounds, Vec2};
 
@@ -8,7 +9,7 @@ use super::Member;
 
 /// `SortAndSweep`'s static structure: a packed tree (sort-tile-recursive), built once.
 #[derive(Debug, Default, Clone)]
-pub(super) struct StaticTree {
+pub(crate) struct StaticTree {
     /// Leaves of [`LEAF`] consecutive members.
     items: Vec<Member>,
     /// `levels[0][i]` bounds leaf `i`; `levels[k + 1][i]` bounds `levels[k][2i..2i + 2]`.
@@ -20,7 +21,7 @@ const LEAF: usize = 8;
 
 impl StaticTree {
     /// The tree over `items`.
-    pub(super) fn new(mut items: Vec<Member>) -> StaticTree {
+    pub(crate) fn new(mut items: Vec<Member>) -> StaticTree {
         if items.is_empty() {
             return StaticTree::default();
         }
@@ -58,7 +59,7 @@ impl StaticTree {
     }
 
     /// Calls `f` on every member overlapping `q`. Returns the body tests.
-    pub(super) fn query(
+    pub(crate) fn query(
         &self,
         q: &Bounds,
         stack: &mut Vec<(u32, u32)>,
@@ -94,6 +95,76 @@ impl StaticTree {
         }
         tested
     }
+}
+
+impl StaticTree {
+    /// Calls `f` on every member whose bounds the segment `origin + t * dir`, `t` in
+    /// `[0, max]`, may cross (a slab test, touching counts). `f` returns the new `max`: a
+    /// first-hit search shrinks it, so boxes beyond the best hit so far are skipped.
+    pub(crate) fn ray(
+        &self,
+        origin: Vec2,
+        dir: Vec2,
+        mut max: f64,
+        stack: &mut Vec<(u32, u32)>,
+        f: &mut impl FnMut(&Member, f64) -> f64,
+    ) {
+        if self.items.is_empty() {
+            return;
+        }
+        let inv = Vec2::new(1.0 / dir.x, 1.0 / dir.y);
+        stack.clear();
+        stack.push(((self.levels.len() - 1) as u32, 0));
+        while let Some((level, i)) = stack.pop() {
+            let (level, i) = (level as usize, i as usize);
+            if !crosses(&self.levels[level][i], origin, inv, max) {
+                continue;
+            }
+            if level == 0 {
+                let end = (i * LEAF + LEAF).min(self.items.len());
+                for m in &self.items[i * LEAF..end] {
+                    if crosses(&m.bounds, origin, inv, max) {
+                        max = f(m, max);
+                    }
+                }
+            } else {
+                let below = self.levels[level - 1].len();
+                for c in [2 * i + 1, 2 * i] {
+                    if c < below {
+                        stack.push(((level - 1) as u32, c as u32));
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Whether the segment `o + t d`, `t` in `[0, max]` (`inv` = `1 / d` per axis), meets `b`
+/// (touching counts). Conservative: the box is widened by a rounding margin, so a segment
+/// that only grazes it is never lost to rounding (the exact test follows).
+fn crosses(b: &Bounds, o: Vec2, inv: Vec2, max: f64) -> bool {
+    let pad = (b.max.abs().max(b.min.abs()).max(o.abs())) * 1e-12;
+    let (lo, hi) = (b.min - pad, b.max + pad);
+    let (mut enter, mut exit) = (0.0_f64, max);
+    for axis in 0..2 {
+        let (ok, ik) = (o[axis], inv[axis]);
+        if ik.is_infinite() {
+            // Parallel to this axis' faces: inside the slab or never.
+            if ok < lo[axis] || ok > hi[axis] {
+                return false;
+            }
+            continue;
+        }
+        let t1 = (lo[axis] - ok) * ik;
+        let t2 = (hi[axis] - ok) * ik;
+        let (near, far) = if t1 < t2 { (t1, t2) } else { (t2, t1) };
+        enter = enter.max(near);
+        exit = exit.min(far);
+        if enter > exit {
+            return false;
+        }
+    }
+    true
 }
 
 /// The smallest box holding both, ignoring NaN coordinates (`f64::min` and `max` do; a NaN

@@ -45,6 +45,13 @@ impl LocalBounds {
         placed(self.bounds, p)
     }
 
+    /// [`LocalBounds::at`] without keeping what it computed (for a reader holding `&self`):
+    /// the same bounds.
+    fn peek(&self, shape: &Shape, angle: f64, p: Vec2) -> Bounds {
+        let mut copy = *self;
+        copy.at(shape, angle, p)
+    }
+
     pub(super) fn new(shape: &Shape, angle: f64) -> LocalBounds {
         LocalBounds {
             angle,
@@ -82,6 +89,28 @@ impl World {
             r => {
                 let shape = &self.shapes.get(self.shape_id[i]).0;
                 self.rows.local_bounds[r as usize].at(shape, self.angle[i], p)
+            }
+        }
+    }
+
+    /// [`World::bounds`] for a reader (the scene queries): the same box, computed without
+    /// keeping it.
+    pub(crate) fn bounds_now(&self, i: usize) -> Bounds {
+        let p = self.position[i];
+        match self.row[i] {
+            NO_ROW => {
+                let (shape, zero) = self.shapes.get(self.shape_id[i]);
+                let angle = self.angle[i];
+                let local = if angle.to_bits() == 0 {
+                    *zero
+                } else {
+                    shape.bounds(&Pose::new(Vec2::ZERO, angle))
+                };
+                placed(local, p)
+            }
+            r => {
+                let shape = &self.shapes.get(self.shape_id[i]).0;
+                self.rows.local_bounds[r as usize].peek(shape, self.angle[i], p)
             }
         }
     }

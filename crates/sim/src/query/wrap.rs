@@ -1,0 +1,105 @@
+//! Queries in a wrap world: every image of a body is seen, and a ray (or a cast shape's
+//! path) that leaves one edge goes on from the opposite one.
+//!
+//! A query is brought into the world first (its origin, point or pose wrapped by whole
+//! world sizes into `[min, max)`), then split into **segments** that each stay inside the
+//! world: a segment ends where the path crosses an edge, and the next starts on the
+//! opposite edge, its distance along the path accumulated. Each segment is asked of the
+//! trees nine times, translated by minus each of [`WorldBounds::image_offsets`]: the body
+//! images within one world size, which hold every image a body inside the world (or
+//! sticking out of it by less than half its size, as the wrap seam keeps them) can have.
+//! A point found in an image is reported in world coordinates, where the image is.
+//!
+//! A path crosses at most [`MAX_SEGMENTS`] edges: a ray hundreds of world sizes long (or
+//! one running along an edge forever) stops there. In a world without wrap a query is one
+//! segment, the direct image only.
+
+use ricochet_geom::Vec2;
+
+use crate::def::WorldBounds;
+
+/// The most segments a wrapped path is split into.
+pub(crate) const MAX_SEGMENTS: usize = 1024;
+
+/// The world sizes the wrap applies, if the world wraps.
+pub(crate) fn wrapping(bounds: Option<&WorldBounds>) -> Option<&WorldBounds> {
+    bounds.filter(|b| b.wrap)
+}
+
+/// The image offsets a query must look at: all nine in a wrap world, else the direct one.
+pub(crate) fn offsets(wrap: Option<&WorldBounds>) -> Vec<Vec2> {
+    match wrap {
+        Some(b) => b.image_offsets().to_vec(),
+        None => vec![Vec2::ZERO],
+    }
+}
+
+/// `p` moved by whole world sizes into `[min, max)` on each axis.
+pub(crate) fn wrap_point(b: &WorldBounds, p: Vec2) -> Vec2 {
+    let axis = |v: f64, min: f64, s: f64| {
+        if v >= min && v < min + s {
+            v
+        } else {
+            let w = min + (v - min).rem_euclid(s);
+            // Rounding can land on `min + s`.
+            if w >= min + s { min } else { w }
+        }
+    };
+    let size = b.size();
+    Vec2::new(axis(p.x, b.min.x, size.x), axis(p.y, b.min.y, size.y))
+}
+
+/// Calls `f(start, travelled, length)` for each segment of the path from `origin` along
+/// the unit `dir` for `max` (see the module docs), in order, while `f` returns `true`.
+/// `origin` is inside the world (wrapped first).
+pub(crate) fn segments(
+    wrap: Option<&WorldBounds>,
+    origin: Vec2,
+    dir: Vec2,
+    max: f64,
+    f: &mut impl FnMut(Vec2, f64, f64) -> bool,
+) {
+    let Some(b) = wrap else {
+        f(origin, 0.0, max);
+        return;
+    };
+    let (mut p, mut travelled) = (origin, 0.0);
+    for _ in 0..MAX_SEGMENTS {
+        // The distance to the edge the path leaves by, per axis.
+        let exit = |axis: usize| -> f64 {
+            let d = dir[axis];
+            if d > 0.0 {
+                (b.max[axis] - p[axis]) / d
+            } else if d < 0.0 {
+                (b.min[axis] - p[axis]) / d
+            } else {
+                f64::INFINITY
+            }
+        };
+        let (tx, ty) = (exit(0).max(0.0), exit(1).max(0.0));
+        let t = tx.min(ty);
+        let left = max - travelled;
+        if t >= left {
+            f(p, travelled, left);
+            return;
+        }
+        if !f(p, travelled, t) {
+            return;
+        }
+        travelled += t;
+        let mut next = p + dir * t;
+        for (axis, ta) in [(0, tx), (1, ty)] {
+            if ta == t {
+                // Onto the opposite edge, exactly.
+                next[axis] = if dir[axis] > 0.0 {
+                    b.min[axis]
+                } else {
+                    b.max[axis]
+                };
+            } else {
+                next[axis] = next[axis].clamp(b.min[axis], b.max[axis]);
+            }
+        }
+        p = next;
+    }
+}
