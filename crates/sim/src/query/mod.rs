@@ -1,53 +1,347 @@
-//! Scene queries: what a game asks the world between steps (rapier's `QueryPipeline`,
-//! Box2D's `b2World_CastRay`/`b2World_OverlapAABB`). Every query takes `&self`, sees the
-//! bodies through a [`QueryFilter`], and is exact, as the narrow phase is: candidates come
-//! from bounds, and each is tested with `ricochet-geom`'s exact ray, point, box, shape and
-//! time-of-impact functions, in a frame centred on the body (so an answer at `1e6` is as
-//! good as at the origin).
-//!
-//! | query | answers | as |
-//! |---|---|---|
-//! | [`Simulation::cast_ray`] | the first hit, [`RayHit`] | rapier `cast_ray`, Box2D `b2World_CastRayClosest` |
-//! | [`Simulation::cast_ray_all`] | every body hit, by distance then entity | rapier `intersections_with_ray` |
-//! | [`Simulation::cast_shape`] | the first touch of a moving shape, [`ShapeHit`] | rapier `cast_shape`, Box2D `b2World_CastShape` |
-//! | [`Simulation::overlap_point`] | the bodies at a point, id order | rapier `intersections_with_point` |
-//! | [`Simulation::overlap_aabb`] | the bodies overlapping a box (exact shapes), id order | Box2D `b2World_OverlapAABB` (bounds only there) |
-//! | [`Simulation::overlap_shape`] | the bodies a shape overlaps, id order | rapier `intersections_with_shape` |
+//! Scene queries: what a game asks the world between two steps (rapier's `QueryPipeline`,
+//! Box2D's `b2World_CastRay` / `b2World_OverlapAABB`): the first body a ray hits, every body
+//! it hits, where a swept shape first touches a body, and the bodies at a point, in a box
+//! or overlapping a shape.
 //!
 //! # Conventions
-//! - **Solid bodies** (rapier's `solid = true`): a ray starting strictly inside a body hits
-//!   it at distance 0, at the origin, with a **zero normal** (rapier gives a zero normal
-//!   too); a shape cast overlapping a body at its start pose hits it at fraction 0.
-//! - **Normals:** a ray hit's normal is the body's outward unit normal (against the ray); a
-//!   shape hit's points from the cast shape towards the body.
-//! - **Touching** counts as [`ricochet_geom::overlaps`] counts it: not at all. A point on a
-//!   body's boundary is not in it; a shape or box that only touches a body does not
-//!   overlap it. A ray that reaches a body's boundary hits it (grazing included), and a ray
-//!   starting on the boundary heading in hits at 0 with the face's normal; heading out, it
-//!   misses.
-//! - **Bad input never panics:** a zero or non-finite direction, a non-finite or negative
-//!   distance, a non-finite pose, point or box (or one beyond
-//!   [`ricochet_geom::MAX_COORDINATE`]) give `None` or an empty list.
-//! - **Order:** overlaps list entities in id order, each once; `cast_ray_all` by distance,
-//!   then entity; ties of the first hit go to the lower entity.
+//! - **Exact**, like the narrow phase: rays use [`ricochet_geom::cast_ray`] and
+//!   [`ricochet_geom::contains_point`], overlaps [`ricochet_geom::overlaps`], casts
+//!   [`ricochet_geom::time_of_impact`] (the cast shape swept, the body still), each in a
+//!   frame centred on the body.
+//! - **Solid bodies**: a ray starting strictly inside a body hits it at distance 0, at its
+//!   origin, with a zero normal (rapier's `cast_ray_and_get_normal` with `solid = true`).
+//!   Otherwise the normal points out of the body, against the ray.
+//! - **Touching** counts as [`ricochet_geom::overlaps`] counts it: not at all (`depth > 0`).
+//!   A point on a body's boundary is not in it; a box or shape that only touches a body
+//!   does not overlap it. A ray that grazes a body (tangent, or along a face) hits it.
+//! - **Input**: a direction of any length is normalised; a zero or non-finite direction,
+//!   origin, point, pose or translation, or a negative or NaN `max_distance`, gives `None`
+//!   or nothing, never a panic.
+//! - **Order**: overlaps in id order; [`Simulation::cast_ray_all`] by distance, then id;
+//!   a tie for the first hit goes to the lowest id.
+//! - **Filter**: [`QueryFilter`] picks layers and leaves one entity out.
+//! - **Wrap worlds**: every image of a body is seen, and a ray leaving one edge goes on
+//!   from the opposite one, its distance accumulated (`wrap.rs`). A query's origin, point
+//!   or pose outside a wrap world is first wrapped into it.
 //!
-//! # Wrap worlds
-//! In a world with `bounds` and `wrap = true` a query sees every image of every body (the
-//! body translated by whole world sizes): a ray that leaves one edge goes on from the
-//! other, up to `max_distance`, its distance accumulated; a shape cast follows its
-//! translation across the edges the same way; an overlap sees the images of a body
-//! straddling an edge. Hit points are on the body as the world holds it (the image's point
-//! moved back by whole world sizes). A region query spanning more than
-//! [`MAX_IMAGES_PER_AXIS`] world sizes along an axis sees only that many images.
+//! # Candidates
+//! Never a loop over every body: per layer, packed trees over the static bodies (kept
+//! while the static generation stays) and over the moving bodies (built on the first query
+//! after the world changed), walked along the ray or by the query's bounds (`index.rs`).
+//! Only the layers a filter accepts are visited.
 
-mod candidates;
 mod filter;
 mod hits;
-mod images;
-mod overlaps;
-mod rays;
-mod shapes;
+pub(crate) mod index;
+mod wrap;
+
+use ricochet_geom::{Bounds, Pose, Ray, Shape, Sweep, Vec2};
 
 pub use filter::QueryFilter;
 pub use hits::{RayHit, ShapeHit};
-pub use images::MAX_IMAGES_PER_AXIS;
+
+use crate::broad_phase::Member;
+use crate::entity::Entity;
+use crate::pipeline::Simulation;
+
+impl Simulation {
+    /// The first body the ray from `origin` along `direction` hits within `max_distance`
+    /// (the module's conventions: solid bodies, the normal out of the body, the lowest id
+    /// on a tie). `None` for a miss or bad input.
+    #[must_use]
+    pub fn cast_ray(
+        &self,
+        origin: Vec2,
+        direction: Vec2,
+        max_distance: f64,
+        filter: &QueryFilter,
+    ) -> Option<RayHit> {
+        let mut best: Option<RayHit> = None;
+        self.ray_hits(origin, direction, max_distance, filter, true, &mut |h| {
+            if best.is_none_or(|b| (h.distance, h.entity) < (b.distance, b.entity)) {
+                best = Some(h);
+            }
+            best.map_or(f64::INFINITY, |b| b.distance)
+        });
+        best
+    }
+
+    /// Every body the ray hits within `max_distance`, once each (its first hit), by
+    /// distance, then id. Empty for bad input.
+    #[must_use]
+    pub fn cast_ray_all(
+        &self,
+        origin: Vec2,
+        direction: Vec2,
+        max_distance: f64,
+        filter: &QueryFilter,
+    ) -> Vec<RayHit> {
+        let mut all: Vec<RayHit> = Vec::new();
+        self.ray_hits(origin, direction, max_distance, filter, false, &mut |h| {
+            all.push(h);
+            f64::INFINITY
+        });
+        // Each body once, at its first hit (a body may be met in several images).
+        all.sort_by(|a, b| {
+            a.entity
+                .cmp(&b.entity)
+                .then(a.distance.total_cmp(&b.distance))
+        });
+        all.dedup_by_key(|h| h.entity);
+        all.sort_by(|a, b| {
+            a.distance
+                .total_cmp(&b.distance)
+                .then(a.entity.cmp(&b.entity))
+        });
+        all
+    }
+
+    /// Where `shape` at `pose`, moved by `translation` (its angle fixed), first touches a
+    /// body ([`ricochet_geom::time_of_impact`]: within `1e-9` of the smaller size of
+    /// touching): the smallest fraction of the translation, the lowest id on a tie. A shape
+    /// already overlapping a body touches it at fraction 0. In a wrap world the path goes
+    /// on from the opposite edge, as a ray's does. `None` for no touch or bad input.
+    #[must_use]
+    pub fn cast_shape(
+        &self,
+        shape: &Shape,
+        pose: Pose,
+        translation: Vec2,
+        filter: &QueryFilter,
+    ) -> Option<ShapeHit> {
+        if !(pose.position.is_finite() && pose.angle.is_finite() && translation.is_finite()) {
+            return None;
+        }
+        let w = &self.world;
+        let wrap = wrap::wrapping(self.scenario.world.bounds.as_ref());
+        let start = wrap.map_or(pose.position, |b| wrap::wrap_point(b, pose.position));
+        let total = translation.length();
+        let dir = if total > 0.0 {
+            translation / total
+        } else {
+            Vec2::ZERO
+        };
+        let trees = self.queries.trees(w);
+        let offsets = wrap::offsets(wrap);
+        let mut stack = Vec::new();
+        let mut best: Option<ShapeHit> = None;
+        let mut segment = |from: Vec2, travelled: f64, len: f64| {
+            let to = from + dir * len;
+            for &o in &offsets {
+                let sweep = Sweep {
+                    start: from - o,
+                    end: to - o,
+                    angle: pose.angle,
+                };
+                let q = shape
+                    .bounds(&Pose::new(sweep.start, pose.angle))
+                    .union(shape.bounds(&Pose::new(sweep.end, pose.angle)));
+                index::each_in_box(
+                    w,
+                    &trees,
+                    |l| filter.accepts_layer(l),
+                    &q,
+                    &mut stack,
+                    &mut |i| {
+                        if !filter.accepts(w.layer[i], w.entity[i]) {
+                            return;
+                        }
+                        let body = Sweep {
+                            start: w.position[i],
+                            end: w.position[i],
+                            angle: w.angle[i],
+                        };
+                        let Some(hit) =
+                            ricochet_geom::time_of_impact(shape, &sweep, w.shape(i), &body)
+                        else {
+                            return;
+                        };
+                        let fraction = if total > 0.0 {
+                            ((travelled + hit.t * len) / total).min(1.0)
+                        } else {
+                            0.0
+                        };
+                        let h = ShapeHit {
+                            entity: w.entity[i],
+                            fraction,
+                            point: hit.contact.point + o,
+                            normal: hit.contact.normal,
+                        };
+                        if best.is_none_or(|b| (h.fraction, h.entity) < (b.fraction, b.entity)) {
+                            best = Some(h);
+                        }
+                    },
+                );
+            }
+            // A touch in this segment comes before any in the next.
+            best.is_none()
+        };
+        if total > 0.0 {
+            wrap::segments(wrap, start, dir, total, &mut segment);
+        } else {
+            segment(start, 0.0, 0.0);
+        }
+        best
+    }
+
+    /// The bodies `point` is strictly inside, in id order.
+    #[must_use]
+    pub fn overlap_point(&self, point: Vec2, filter: &QueryFilter) -> Vec<Entity> {
+        if !point.is_finite() {
+            return Vec::new();
+        }
+        let q = Bounds {
+            min: point,
+            max: point,
+        };
+        self.overlapping(q, filter, &mut |i, o| {
+            let w = &self.world;
+            ricochet_geom::contains_point(w.shape(i), &w.pose(i), point - o)
+        })
+    }
+
+    /// The bodies whose shape overlaps the box `bounds` (exact shape against box, touching
+    /// not counted), in id order. Empty for a non-finite or inverted box, or one thinner
+    /// than [`ricochet_geom::MIN_SIZE`] (it has no inside to overlap).
+    #[must_use]
+    pub fn overlap_aabb(&self, bounds: Bounds, filter: &QueryFilter) -> Vec<Entity> {
+        let ok = bounds.min.is_finite()
+            && bounds.max.is_finite()
+            && bounds.min.x <= bounds.max.x
+            && bounds.min.y <= bounds.max.y;
+        if !ok {
+            return Vec::new();
+        }
+        let Ok(shape) = Shape::aabb(bounds.half_extents()) else {
+            return Vec::new();
+        };
+        self.overlap_shape(&shape, Pose::new(bounds.center(), 0.0), filter)
+    }
+
+    /// The bodies `shape` at `pose` overlaps (touching not counted), in id order.
+    #[must_use]
+    pub fn overlap_shape(&self, shape: &Shape, pose: Pose, filter: &QueryFilter) -> Vec<Entity> {
+        if !(pose.position.is_finite() && pose.angle.is_finite()) {
+            return Vec::new();
+        }
+        let q = shape.bounds(&pose);
+        self.overlapping(q, filter, &mut |i, o| {
+            let w = &self.world;
+            let at = Pose::new(pose.position - o, pose.angle);
+            ricochet_geom::overlaps(shape, &at, w.shape(i), &w.pose(i))
+        })
+    }
+
+    /// The accepted bodies, in id order, for which `test(i, offset)` holds at some image
+    /// offset whose translated bounds meet `q` (moved into a wrap world first).
+    fn overlapping(
+        &self,
+        q: Bounds,
+        filter: &QueryFilter,
+        test: &mut impl FnMut(usize, Vec2) -> bool,
+    ) -> Vec<Entity> {
+        let w = &self.world;
+        let wrap = wrap::wrapping(self.scenario.world.bounds.as_ref());
+        let shift = wrap.map_or(Vec2::ZERO, |b| wrap::wrap_point(b, q.center()) - q.center());
+        let trees = self.queries.trees(w);
+        let mut stack = Vec::new();
+        let mut found = Vec::new();
+        for o in wrap::offsets(wrap) {
+            // The query moved by `shift - o`: the body's image at `o` against the query.
+            let d = shift - o;
+            let qo = q.translated(d);
+            index::each_in_box(
+                w,
+                &trees,
+                |l| filter.accepts_layer(l),
+                &qo,
+                &mut stack,
+                &mut |i| {
+                    if filter.accepts(w.layer[i], w.entity[i]) && test(i, o - shift) {
+                        found.push(w.entity[i]);
+                    }
+                },
+            );
+        }
+        found.sort_unstable();
+        found.dedup();
+        found
+    }
+
+    /// Calls `f` with each body's first hit by the ray in each image it is met in (in no
+    /// set order); `f` returns the distance beyond which hits no longer matter.
+    /// `first`: stop at the first wrap segment with a hit.
+    fn ray_hits(
+        &self,
+        origin: Vec2,
+        direction: Vec2,
+        max_distance: f64,
+        filter: &QueryFilter,
+        first: bool,
+        f: &mut impl FnMut(RayHit) -> f64,
+    ) {
+        if max_distance.is_nan() || max_distance < 0.0 {
+            return;
+        }
+        let Some(ray) = Ray::new(origin, direction) else {
+            return;
+        };
+        let w = &self.world;
+        let wrap = wrap::wrapping(self.scenario.world.bounds.as_ref());
+        let start = wrap.map_or(origin, |b| wrap::wrap_point(b, origin));
+        let dir = ray.direction();
+        let trees = self.queries.trees(w);
+        let offsets = wrap::offsets(wrap);
+        let mut stack = Vec::new();
+        let mut limit = f64::INFINITY;
+        let mut segment = |from: Vec2, travelled: f64, len: f64| {
+            let mut hit_here = false;
+            for &o in &offsets {
+                let Some(seg) = Ray::new(from - o, dir) else {
+                    continue;
+                };
+                for set in &trees {
+                    for (layer, tree) in &set.layers {
+                        if !filter.accepts_layer(*layer) {
+                            continue;
+                        }
+                        let room = len.min(limit - travelled);
+                        if room < 0.0 {
+                            continue;
+                        }
+                        tree.ray(
+                            seg.origin(),
+                            dir,
+                            room,
+                            &mut stack,
+                            &mut |m: &Member, max| {
+                                let e = set.entities[m.handle as usize];
+                                let Some(i) = w.index_of(e) else {
+                                    return max;
+                                };
+                                if !filter.accepts(w.layer[i], e) {
+                                    return max;
+                                }
+                                let Some(h) =
+                                    ricochet_geom::cast_ray(w.shape(i), &w.pose(i), &seg, max)
+                                else {
+                                    return max;
+                                };
+                                hit_here = true;
+                                limit = f(RayHit {
+                                    entity: e,
+                                    point: if h.distance == 0.0 { from } else { h.point + o },
+                                    normal: h.normal,
+                                    distance: travelled + h.distance,
+                                });
+                                max.min(limit - travelled)
+                            },
+                        );
+                    }
+                }
+            }
+            !(first && hit_here)
+        };
+        wrap::segments(wrap, start, dir, max_distance, &mut segment);
+    }
+}
