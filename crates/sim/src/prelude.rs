@@ -16,3 +16,4 @@ pub use crate::event::{FireOutcome, GameEvent, JumpOutcome, Removal, ScriptInput
 pub use crate::output::{ContactRecord, FrameOutput, RemovedBody};
 pub use crate::pipeline::Simulation;
 pub use crate::scenario::{Scenario, TileRows};
+pub use crate::snapshot::{Snapshot, SnapshotError};
