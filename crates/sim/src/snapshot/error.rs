@@ -37,23 +37,18 @@ pub enum SnapshotError {
     /// The snapshot was taken of another scene (another world definition, templates or
     /// script, or another initial set of bodies) than the simulation's.
     #[error(
-        "snapshot of another scene: scene {snapshot_scene:016x} (start {snapshot_start:016x}), \
-         the simulation runs {scene:016x} (start {start:016x})"
+        "snapshot of another scene: scene {snapshot_scene:016x}, the simulation runs {scene:016x}"
     )]
     OtherScene {
         /// The hash of the snapshot's scene definition.
         snapshot_scene: u64,
-        /// The hash of the bodies at the start of the snapshot's run (0: none referenced).
-        snapshot_start: u64,
         /// The hash of the simulation's scene definition.
         scene: u64,
-        /// The hash of the simulation's bodies at the start of its run.
-        start: u64,
     },
 }
 
 impl SnapshotError {
-    #[allow(dead_code, reason = "used by the decoder, next commit")]
+    /// A [`SnapshotError::Malformed`] naming `what`.
     pub(crate) fn malformed(what: impl Into<String>) -> SnapshotError {
         SnapshotError::Malformed { what: what.into() }
     }
