@@ -29,6 +29,28 @@ pub struct EntityAllocator {
 }
 
 impl EntityAllocator {
+    /// Each slot's generation (a live body's, or the one a freed slot hands out next).
+    pub(crate) fn generations(&self) -> &[u32] {
+        &self.generations
+    }
+
+    /// The allocator whose slots have these generations, every slot not in `live` free (as
+    /// every slot is that is not a live body's).
+    /// `live` is ascending.
+    pub(crate) fn from_parts(generations: Vec<u32>, live: impl Iterator<Item = u32>) -> Self {
+        let mut live = live.peekable();
+        let free = (0..generations.len() as u32)
+            .filter(|&i| {
+                let is_live = live.peek() == Some(&i);
+                if is_live {
+                    live.next();
+                }
+                !is_live
+            })
+            .collect();
+        EntityAllocator { generations, free }
+    }
+
     /// A new id.
     pub fn allocate(&mut self) -> Entity {
         if let Some(index) = self.free.pop_first() {

@@ -17,3 +17,4 @@ pub use crate::output::{ContactRecord, FrameOutput, RemovedBody};
 pub use crate::pipeline::Simulation;
 pub use crate::query::{QueryFilter, RayHit, ShapeHit};
 pub use crate::scenario::{Scenario, TileRows};
+pub use crate::snapshot::{Snapshot, SnapshotError};

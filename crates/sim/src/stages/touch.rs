@@ -111,6 +111,22 @@ impl TouchState {
     pub(crate) fn touching(&self) -> &[Pair] {
         &self.touching
     }
+
+    /// The static generation of the last frame run (a snapshot keeps whether the world's has
+    /// moved on since).
+    pub(crate) fn static_generation(&self) -> u64 {
+        self.static_generation
+    }
+
+    /// The state for a scene with these layers, `touching` (sorted) at the end of the last
+    /// frame, which ran at `static_generation` (a restore).
+    pub(crate) fn restored(layers: &Layers, touching: Vec<Pair>, static_generation: u64) -> Self {
+        TouchState {
+            touching,
+            static_generation,
+            ..TouchState::new(layers)
+        }
+    }
 }
 
 /// Whether some layer pair touches, and something touched at the end of the last frame or

@@ -31,16 +31,7 @@ impl LocalBounds {
     #[inline]
     fn at_with<'s>(&mut self, shape: impl FnOnce() -> &'s Shape, angle: f64, p: Vec2) -> Bounds {
         if !self.any_angle && self.angle.to_bits() != angle.to_bits() {
-            // The farthest corner of the angle-0 box is as far as any point of the shape.
-            let b = shape().bounds(&Pose::default());
-            let r = b.min.abs().max(b.max.abs()).length();
-            // A rotated point may round one ulp past the exact radius.
-            let r = r + r * 1e-12;
-            self.bounds = Bounds {
-                min: Vec2::splat(-r),
-                max: Vec2::splat(r),
-            };
-            self.any_angle = true;
+            *self = LocalBounds::turned(shape(), angle);
         }
         placed(self.bounds, p)
     }
@@ -50,6 +41,41 @@ impl LocalBounds {
     fn peek(&self, shape: &Shape, angle: f64, p: Vec2) -> Bounds {
         let mut copy = *self;
         copy.at(shape, angle, p)
+    }
+
+    /// The bounds of a body of `shape` that has turned: the square around the disc that
+    /// holds the shape at every angle.
+    pub(super) fn turned(shape: &Shape, angle: f64) -> LocalBounds {
+        // The farthest corner of the angle-0 box is as far as any point of the shape.
+        let b = shape.bounds(&Pose::default());
+        let r = b.min.abs().max(b.max.abs()).length();
+        // A rotated point may round one ulp past the exact radius.
+        let r = r + r * 1e-12;
+        LocalBounds {
+            angle,
+            any_angle: true,
+            bounds: Bounds {
+                min: Vec2::splat(-r),
+                max: Vec2::splat(r),
+            },
+        }
+    }
+
+    /// Whether the bounds of a body of `shape` at `angle` are (or, at their next use,
+    /// become) the any-angle square of [`LocalBounds::turned`]: the body turned since they
+    /// were computed exactly. False for a shape that turning does not change. A snapshot
+    /// keeps this bit: the broad phase's candidates, counted in `Stats`, depend on it.
+    pub(super) fn has_turned(&self, shape: &Shape, angle: f64) -> bool {
+        (self.any_angle || self.angle.to_bits() != angle.to_bits()) && !turning_keeps_bounds(shape)
+    }
+
+    /// Bounds that [`LocalBounds::has_turned`] tells `turned` of, for `shape` at `angle`.
+    pub(super) fn restored(shape: &Shape, angle: f64, turned: bool) -> LocalBounds {
+        if turned {
+            LocalBounds::turned(shape, angle)
+        } else {
+            LocalBounds::new(shape, angle)
+        }
     }
 
     pub(super) fn new(shape: &Shape, angle: f64) -> LocalBounds {

@@ -35,6 +35,8 @@ use crate::scenario::TileRows;
 mod bounds;
 mod measures;
 mod rows;
+mod sleep;
+mod state;
 
 use bounds::LocalBounds;
 use rows::Rows;
@@ -96,6 +98,9 @@ pub struct World {
     non_boxes: Vec<u32>,
     /// Scratch for a shape's key.
     key: Vec<u64>,
+    /// Whether [`World::set_shape`] ever ran: until then every body has the shape it was
+    /// spawned with (a snapshot compares shapes only after it).
+    reshaped: bool,
 }
 
 impl World {
@@ -260,6 +265,13 @@ impl World {
     /// Creates a body; it takes the lowest free id, and its column position follows from it.
     pub fn spawn(&mut self, def: &BodyDef) -> Entity {
         let e = self.ids.allocate();
+        self.insert(e, def);
+        e
+    }
+
+    /// Creates body `e` (an id the caller took from the allocator, or a restored one) at its
+    /// place in id order.
+    fn insert(&mut self, e: Entity, def: &BodyDef) {
         let i = self.entity.partition_point(|x| *x < e);
         self.entity.insert(i, e);
         let name = self.names.acquire(def.name.as_str(), || ());
@@ -305,7 +317,6 @@ impl World {
             }
             self.non_boxes[l] += 1;
         }
-        e
     }
 
     /// Spawns every tile of `tiles`, row by row, each row's tiles in order: the bodies
@@ -410,6 +421,7 @@ impl World {
     /// [`World::static_generation`] (re-indexed by the broad phase and the per-axis stages)
     /// and wakes every sleeper, a moving body wakes.
     pub fn set_shape(&mut self, i: usize, shape: &Shape) {
+        self.reshaped = true;
         let old = self.shape_id[i];
         let layer = usize::from(self.layer[i]);
         if !self.shapes.get(old).0.is_single_aabb() {
@@ -480,48 +492,6 @@ impl World {
             let r = row[i as usize] as usize;
             !rows.frozen[r] && !rows.asleep[r]
         }));
-    }
-
-    /// Wakes body `i` if it sleeps: it is integrated again from the next frame (or the
-    /// next [`World::refresh_active`]). Scenery never sleeps.
-    pub fn wake(&mut self, i: usize) {
-        let r = self.row[i];
-        if r == NO_ROW {
-            return;
-        }
-        let r = r as usize;
-        if self.rows.asleep[r] {
-            self.sleeping -= 1;
-        }
-        self.rows.asleep[r] = false;
-        self.rows.rest_frames[r] = 0;
-    }
-
-    /// Puts body `i` to sleep (from the next [`World::refresh_active`] on). A sleeper rides
-    /// nothing: when it wakes, the next `resolve_y` finds what it stands on.
-    pub fn put_to_sleep(&mut self, i: usize) {
-        let r = self.row_of(i);
-        if !self.rows.asleep[r] {
-            self.sleeping += 1;
-        }
-        self.rows.asleep[r] = true;
-        self.rows.carrier[r] = None;
-    }
-
-    /// How many bodies are asleep.
-    #[must_use]
-    pub fn sleeping(&self) -> usize {
-        self.sleeping
-    }
-
-    /// Wakes every sleeping body, now: the active list is recomputed.
-    pub fn wake_all(&mut self) {
-        if self.sleeping > 0 {
-            self.sleeping = 0;
-            self.rows.asleep.fill(false);
-            self.rows.rest_frames.fill(0);
-            self.refresh_active();
-        }
     }
 
     /// Changes whenever a static body is added or removed (static bodies never move).

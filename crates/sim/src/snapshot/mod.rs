@@ -1,0 +1,334 @@
+//! Snapshots: the state a step reads, as bytes, and a checksum of it.
+//!
+//! [`Simulation::snapshot`] is taken between two steps, at [`Simulation::frame`]: the frame
+//! the next step runs. [`Simulation::restore`] puts a simulation of the same scene back in
+//! that state, and it then steps exactly as the original did (byte-identical
+//! [`crate::FrameOutput`]s). [`Simulation::checksum`] hashes the same encoding without the
+//! game's data: two simulations with equal checksums step identically.
+//!
+//! # What is saved
+//!
+//! The scene's definition (world settings, layers, templates and script) is never copied:
+//! a snapshot holds its hash, and restoring onto a simulation of another scene is
+//! [`SnapshotError::OtherScene`]. Every field of the simulation is one of:
+//!
+//! | field | is | saved | in `checksum` |
+//! |---|---|---|---|
+//! | `Simulation::frame`, `cursor` (next script event) | state | yes | yes |
+//! | `pending` (inputs sent with `apply`) | state | yes | yes |
+//! | `targets`, `targeted` (kinematic target poses) | state | yes | yes |
+//! | `focus` (the body the active region follows) | state | yes | yes |
+//! | `touch.touching` (pairs touching at the end of the last frame) | state | yes | yes |
+//! | `touch.static_generation` | state, as one bit: did a static body change since the last `touch` | yes | yes |
+//! | `scenario` (world def, templates, script) | definition | its hash | no (equal by the scene check) |
+//! | `capture_detect_poses`, `workers` | settings of the output and the threads, not of the result | no | no |
+//! | `detect` (broad phase, static entries, buffers), `separate` (static and mover grids) | caches rebuilt from the world | no: restore builds them new | no |
+//! | `touch` buffers (`recorded`, `next`, `ends`, ...) | scratch | no | no |
+//! | World: `entity`, `layer`, `kind`, `position`, `angle`, shape, name | state (a script finds bodies by name) | yes, shapes by value | yes |
+//! | World: the allocator's generations (its free list: every slot not alive) | state | yes | yes |
+//! | World: `shapes`, `names` tables, `row`, `movers`, `active`, counters, `non_boxes`, `key` | caches of the above | no: rebuilt | no |
+//! | World: `static_generation` | a counter the caches compare | no: a restored world counts anew and its caches are new | no |
+//! | Rows: `mass`, `velocity`, `angular_velocity`, `force`, `gravity_scale`, `lifetime`, `controller`, `inputs`, `grounded`, `on_static`, `carrier`, `still`, `split`, `frozen`, `asleep`, `rest_frames` | state | yes | yes |
+//! | Rows: whether a static body has a row (scenery given one) | state of the layout | yes | yes |
+//! | Rows: `local_bounds` | a cache, but its history shows in the broad phase's candidates: one bit (turned: the any-angle square) | yes | yes |
+//! | Rows: `start_position` | a cache: `start_frame` sets it from `position` each step | no | no |
+//! | Rows: `entity` (row to body) | the layout | no | no |
+//! | Rows: `user_data` | game data: no stage reads it | yes | **no** |
+//!
+//! `world/state.rs` destructures `Rows` whole: a new column fails to compile until it is
+//! written there or named a cache.
+//!
+//! # Bytes
+//!
+//! `RCSN`, [`SNAPSHOT_VERSION`] (u32), the total length (u64), the frame, the scene hash
+//! (u64 each), the state's length (u32) and the state, then an FNV-1a 64 of every byte
+//! before it. Little-endian, every float as its bits. Every truncation or flipped bit is an
+//! error, never a panic.
+//!
+//! ```
+//! use ricochet_sim::prelude::*;
+//!
+//! let mut sim = Simulation::from_def(WorldDef::default())?;
+//! let ball = sim.spawn(&BodyDef { velocity: Vec2::new(60.0, 0.0), ..BodyDef::default() });
+//! for _ in 0..10 {
+//!     sim.step();
+//! }
+//! let bytes = sim.snapshot().to_bytes(); // at frame 10: the next step runs frame 10
+//! let sum = sim.checksum();
+//! let later: Vec<_> = (0..5).map(|_| sim.step()).collect();
+//! sim.restore(&Snapshot::from_bytes(&bytes)?)?;
+//! assert_eq!((sim.frame(), sim.checksum()), (10, sum));
+//! let again: Vec<_> = (0..5).map(|_| sim.step()).collect();
+//! assert_eq!(later, again);
+//! assert_eq!(sim.position(ball), Some(Vec2::new(14.0, 0.0)));
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+pub(crate) mod codec;
+mod error;
+
+pub use error::SnapshotError;
+
+use codec::{Fnv, Reader, Sink, fnv};
+
+use crate::pipeline::Simulation;
+use crate::stages::detect::DetectState;
+use crate::stages::separate::SeparateState;
+use crate::stages::touch::TouchState;
+use crate::world::World;
+
+/// The version of the snapshot format [`Snapshot::to_bytes`] writes and
+/// [`Snapshot::from_bytes`] reads.
+pub const SNAPSHOT_VERSION: u32 = 1;
+
+/// The first bytes of a snapshot.
+const MAGIC: &[u8; 4] = b"RCSN";
+
+/// Magic, version, total length, frame, scene, state length.
+const HEADER: usize = 4 + 4 + 8 + 8 + 8 + 4;
+
+/// A simulation's state between two steps ([`Simulation::snapshot`]), restored with
+/// [`Simulation::restore`] onto a simulation of the same scene.
+#[derive(Clone, Debug)]
+pub struct Snapshot {
+    /// [`Simulation::frame`] when it was taken.
+    frame: u64,
+    /// The hash of the scene definition (world, templates, script).
+    scene: u64,
+    /// The encoded state (the module docs' table).
+    payload: Vec<u8>,
+}
+
+impl Snapshot {
+    /// The frame the next step of a simulation restored from it runs: [`Simulation::frame`]
+    /// when it was taken.
+    #[must_use]
+    pub fn frame(&self) -> u64 {
+        self.frame
+    }
+
+    /// The snapshot as bytes: versioned, with a checksum of the bytes (module docs).
+    #[must_use]
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let total = HEADER + self.payload.len() + 8;
+        let mut b = Vec::with_capacity(total);
+        b.put(MAGIC);
+        b.u32(SNAPSHOT_VERSION);
+        b.u64(total as u64);
+        b.u64(self.frame);
+        b.u64(self.scene);
+        Sink::len(&mut b, self.payload.len());
+        b.put(&self.payload);
+        let sum = fnv(&b);
+        b.u64(sum);
+        b
+    }
+
+    /// A snapshot from [`Snapshot::to_bytes`]'s bytes.
+    ///
+    /// # Errors
+    /// Any damage: another magic, version, a truncation, a checksum mismatch, a state that
+    /// does not hold together. Never a panic.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Snapshot, SnapshotError> {
+        if bytes.len() < 4 || &bytes[..4] != MAGIC {
+            return Err(SnapshotError::BadMagic);
+        }
+        let mut r = Reader::new(&bytes[4..]);
+        let version = r.u32()?;
+        if version != SNAPSHOT_VERSION {
+            return Err(SnapshotError::Version {
+                found: version,
+                expected: SNAPSHOT_VERSION,
+            });
+        }
+        let total = r.u64()?;
+        if total != bytes.len() as u64 {
+            return Err(SnapshotError::Truncated {
+                needed: total,
+                found: bytes.len() as u64,
+            });
+        }
+        let (body, sum) = bytes.split_at(bytes.len().saturating_sub(8));
+        if sum.len() != 8 || fnv(body) != Reader::new(sum).u64()? {
+            return Err(SnapshotError::Checksum);
+        }
+        let mut r = Reader::new(&body[16..]);
+        let frame = r.u64()?;
+        let scene = r.u64()?;
+        let n = r.len(1)?;
+        if HEADER + n != body.len() {
+            return Err(SnapshotError::malformed("the state's length"));
+        }
+        let payload = body[HEADER..].to_vec();
+        let s = Snapshot {
+            frame,
+            scene,
+            payload,
+        };
+        // Checked now, so that a snapshot that parses restores (layers checked then).
+        s.decode(usize::from(u8::MAX) + 1)?;
+        Ok(s)
+    }
+
+    /// The state in the payload, for a scene of `layers` layers.
+    fn decode(&self, layers: usize) -> Result<State, SnapshotError> {
+        let mut r = Reader::new(&self.payload);
+        let frame = r.u64()?;
+        if frame != self.frame {
+            return Err(SnapshotError::malformed("the frame"));
+        }
+        let cursor = usize::try_from(r.u64()?).map_err(|_| SnapshotError::malformed("cursor"))?;
+        let n = r.len(9)?;
+        let pending = (0..n)
+            .map(|_| Ok((r.entity()?, r.action()?)))
+            .collect::<Result<Vec<_>, SnapshotError>>()?;
+        let n = r.len(32)?;
+        let targets = (0..n)
+            .map(|_| Ok((r.entity()?, r.pose()?)))
+            .collect::<Result<Vec<_>, SnapshotError>>()?;
+        let n = r.len(8)?;
+        let targeted = (0..n).map(|_| r.entity()).collect::<Result<Vec<_>, _>>()?;
+        let focus = r.opt_entity()?;
+        let n = r.len(16)?;
+        let touching = (0..n)
+            .map(|_| Ok((r.entity()?, r.entity()?)))
+            .collect::<Result<Vec<_>, SnapshotError>>()?;
+        if touching.windows(2).any(|p| p[0] >= p[1]) || touching.iter().any(|(a, b)| a >= b) {
+            return Err(SnapshotError::malformed("touching pairs out of order"));
+        }
+        let statics_moved = r.bool()?;
+        let world = World::decode(&mut r, layers)?;
+        if !r.is_done() {
+            return Err(SnapshotError::malformed("bytes after the state"));
+        }
+        Ok(State {
+            cursor,
+            pending,
+            targets,
+            targeted,
+            focus,
+            touching,
+            statics_moved,
+            world,
+        })
+    }
+}
+
+/// A decoded snapshot, ready to move into a simulation.
+struct State {
+    cursor: usize,
+    pending: Vec<(crate::Entity, crate::Action)>,
+    targets: Vec<(crate::Entity, ricochet_geom::Pose)>,
+    targeted: Vec<crate::Entity>,
+    focus: Option<crate::Entity>,
+    touching: Vec<(crate::Entity, crate::Entity)>,
+    statics_moved: bool,
+    world: World,
+}
+
+impl Simulation {
+    /// The hash of what a snapshot references instead of copying: the world settings,
+    /// layers, templates and script (their `Debug` text, which writes every float exactly).
+    fn scene_hash(&self) -> u64 {
+        let s = &self.scenario;
+        fnv(format!("{:?}|{:?}|{:?}", s.world, s.templates, s.script).as_bytes())
+    }
+
+    /// Writes the state a step reads (module docs), and with `game_data` the user data.
+    fn encode_state(&self, s: &mut impl Sink, game_data: bool) {
+        s.u64(self.frame);
+        s.u64(self.cursor as u64);
+        s.len(self.pending.len());
+        for (e, a) in &self.pending {
+            s.entity(*e);
+            s.action(a);
+        }
+        s.len(self.targets.len());
+        for (e, p) in &self.targets {
+            s.entity(*e);
+            s.pose(*p);
+        }
+        s.len(self.targeted.len());
+        for e in &self.targeted {
+            s.entity(*e);
+        }
+        s.opt_entity(self.focus);
+        let touching = self.touch.touching();
+        s.len(touching.len());
+        for (a, b) in touching {
+            s.entity(*a);
+            s.entity(*b);
+        }
+        s.bool(self.touch.static_generation() != self.world.static_generation());
+        self.world.encode(s, game_data);
+    }
+
+    /// The state the next step reads, and the game's user data: every body's state (the
+    /// module docs' table), the scene by its hash.
+    #[must_use]
+    pub fn snapshot(&self) -> Snapshot {
+        let mut payload = Vec::new();
+        self.encode_state(&mut payload, true);
+        Snapshot {
+            frame: self.frame,
+            scene: self.scene_hash(),
+            payload,
+        }
+    }
+
+    /// Puts the simulation back in the state of `s`: it then steps exactly as the one `s`
+    /// was taken of did from there. The broad phase and the grids are built anew. The
+    /// thread count and `capture_detect_poses` stay this simulation's.
+    ///
+    /// # Errors
+    /// [`SnapshotError::OtherScene`] for a snapshot of another scene,
+    /// [`SnapshotError::Malformed`] for a state this scene cannot hold (a layer it lacks, a
+    /// script cursor past its script). The simulation is unchanged then.
+    pub fn restore(&mut self, s: &Snapshot) -> Result<(), SnapshotError> {
+        let scene = self.scene_hash();
+        if s.scene != scene {
+            return Err(SnapshotError::OtherScene {
+                snapshot_scene: s.scene,
+                scene,
+            });
+        }
+        let layers = &self.scenario.world.layers;
+        let st = s.decode(layers.names().len())?;
+        if st.cursor > self.scenario.script.len() {
+            return Err(SnapshotError::malformed("a script cursor past the script"));
+        }
+        self.detect = DetectState::new(layers, self.scenario.world.broad_phase);
+        self.separate = SeparateState::new(layers);
+        let g = st.world.static_generation();
+        let seen = if st.statics_moved {
+            g.wrapping_sub(1)
+        } else {
+            g
+        };
+        self.touch = TouchState::restored(layers, st.touching, seen);
+        self.world = st.world;
+        // Another world: neither tree set of the scene queries may be kept (a static
+        // generation can repeat with other static bodies).
+        self.queries = crate::query::index::QueryCache::default();
+        self.frame = s.frame;
+        self.cursor = st.cursor;
+        self.pending = st.pending;
+        self.targets = st.targets;
+        self.targeted = st.targeted;
+        self.focus = st.focus;
+        Ok(())
+    }
+
+    /// A checksum of exactly the state a step reads: the module docs' table, every column
+    /// marked "in `checksum`" (frame, script cursor, pending inputs, kinematic targets,
+    /// focus, touching pairs, every body's state and shape and name, the id generations),
+    /// each float by its bits. Not the user data (no stage reads it), not the caches, not
+    /// the scene's definition. Two simulations of one scene with equal checksums step
+    /// identically; a change of any one of those fields changes it.
+    #[must_use]
+    pub fn checksum(&self) -> u64 {
+        let mut h = Fnv::default();
+        self.encode_state(&mut h, false);
+        h.0
+    }
+}
