@@ -5,7 +5,7 @@
 //! bounding box of any shape at any pose ([`Bounds`]), the scenario/case-file description of a
 //! shape ([`ShapeDef`]) with its validation, and the narrow phase: a cheap boolean
 //! [`overlaps`] and a full [`contact`] (signed depth, unit normal from `a` to `b`, a contact
-//! point) for every pairing.
+//! point) for every pairing, and rays against every shape ([`cast_ray`], [`contains_point`]).
 //!
 //! **Never:** does I/O (a case file is read from a reader its caller opened, through
 //! [`CaseReader`]), keeps state between calls, reads the clock, allocates in the narrow phase
@@ -54,6 +54,7 @@ mod def;
 mod math;
 mod number;
 mod placed;
+mod ray;
 mod shape;
 mod toi;
 
@@ -68,6 +69,7 @@ pub use number::{Number, Numbers};
 pub use placed::{
     PlacedAabb, PlacedCapsule, PlacedCircle, PlacedObb, PlacedPolygon, PlacedPrimitive, place,
 };
+pub use ray::{Ray, RayIntersection, cast_ray, contains_placed, contains_point};
 pub use shape::{
     Aabb, Capsule, Circle, Compound, MAX_COMPOUND_PARTS, MAX_COORDINATE, MAX_POLYGON_VERTICES,
     MIN_SIZE, Obb, Polygon, Primitive, Shape, ShapeError, ShapeKind,

@@ -15,4 +15,5 @@ pub use crate::entity::Entity;
 pub use crate::event::{FireOutcome, GameEvent, JumpOutcome, Removal, ScriptInput};
 pub use crate::output::{ContactRecord, FrameOutput, RemovedBody};
 pub use crate::pipeline::Simulation;
+pub use crate::query::{QueryFilter, RayHit, ShapeHit};
 pub use crate::scenario::{Scenario, TileRows};
