@@ -14,7 +14,7 @@ use anyhow::{Context, bail};
 
 use crate::{files, out};
 use ricochet_scenes::bench::{DEFAULT_SCENES, Scene};
-use ricochet_study::bench::{MAX_FRAMES, Row, report, run_scene};
+use ricochet_study::bench::{MAX_FRAMES, Row, queries, report, run_scene};
 
 /// Set in the environment of the process that runs one scene (`run` starts one per scene):
 /// it runs the scenes in-process and prints each result as a JSON line. Set it yourself to
@@ -112,5 +112,40 @@ pub fn run(scenes: &[String], frames: u64, csv: Option<&Path>) -> anyhow::Result
     if let Some(path) = csv {
         files::write(path, report::csv_text(&rows).as_bytes())?;
     }
+    Ok(ExitCode::from(if agree { 0 } else { 1 }))
+}
+
+/// `bench --queries`: the named scenes (or [`DEFAULT_SCENES`]) stepped `frames` frames, then
+/// the same seeded rays and boxes asked of Ricochet, rapier and Box2D in this process
+/// ([`ricochet_study::bench::queries`]); prints the table. Exit code 0 when every answer
+/// agrees, 1 when one does not, 2 for a bad scene name or frame count.
+pub fn run_queries(scenes: &[String], frames: u64) -> anyhow::Result<ExitCode> {
+    let names: Vec<String> = if scenes.is_empty() {
+        DEFAULT_SCENES.iter().map(|s| (*s).to_owned()).collect()
+    } else {
+        scenes.to_vec()
+    };
+    let mut parsed = Vec::new();
+    for name in &names {
+        match Scene::parse(name) {
+            Ok(kind) => parsed.push((name.clone(), kind)),
+            Err(e) => {
+                out::error(&format!("error: {e:#}"));
+                return Ok(ExitCode::from(2));
+            }
+        }
+    }
+    if let Some(code) = bad_frames(frames)? {
+        return Ok(code);
+    }
+    let mut rows = Vec::new();
+    for (name, kind) in &parsed {
+        let _ = out::note(&format!("bench --queries: {name}"));
+        rows.push(queries::run_queries(name, *kind, frames)?);
+    }
+    out::print(&format!("{}{}\n", queries::table(&rows), queries::NOTES))?;
+    let agree = rows
+        .iter()
+        .all(|r| r.ray_differences == [0, 0] && r.overlap_differences == [0, 0]);
     Ok(ExitCode::from(if agree { 0 } else { 1 }))
 }

@@ -257,6 +257,14 @@ enum Command {
         /// With --record: keep the logs in this directory (NAME.mcap; created if missing).
         #[arg(long, value_name = "DIR", requires = "record")]
         keep: Option<PathBuf>,
+        /// Measure the scene queries instead: after --frames frames, the same 2000 seeded rays
+        /// (20 units, from outside every body) and 2000 boxes (about a body's size) asked of
+        /// Ricochet (cast_ray, overlap_aabb), rapier's QueryPipeline and Box2D
+        /// (b2World_CastRayClosest, b2World_OverlapShape, b2World_OverlapAABB), in one
+        /// process; prints rays/s and overlaps/s, the hits, and how many answers differ from
+        /// Ricochet's. Exit code 1 if any does.
+        #[arg(long, conflicts_with_all = ["record", "csv"])]
+        queries: bool,
     },
     /// Check a scenario file without running it: syntax, units, layers, templates, script.
     ///
@@ -348,10 +356,17 @@ fn main() -> ExitCode {
             csv,
             record: true,
             keep,
+            ..
         } => {
             let _ = csv;
             bench_record::run(&scenes, frames, keep.as_deref())
         }
+        Command::Bench {
+            scenes,
+            frames,
+            queries: true,
+            ..
+        } => bench::run_queries(&scenes, frames),
         Command::Bench {
             scenes,
             frames,

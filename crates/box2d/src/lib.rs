@@ -69,16 +69,22 @@
 //! with the manifold's smallest separation so that the comparison can tell a penetration from
 //! Box2D's speculative contacts.
 //!
+//! `queries.rs` asks the same world `ricochet bench --queries`'s rays and box overlaps
+//! ([`Box2dScene::queries`]: `b2World_CastRayClosest`, `b2World_OverlapAABB`,
+//! `b2World_OverlapShape`), each convention stated there.
+//!
 //! [`Simulation`]: ricochet_sim::Simulation
 //! [`FrameOutput`]: ricochet_sim::FrameOutput
 
 mod agreement;
 mod convert;
 mod filter;
+mod queries;
 mod scene;
 
 pub use agreement::{Box2dAgreement, compare_box2d};
 pub use filter::BOX2D_LAYERS;
+pub use queries::{Box2dQueries, Box2dRayHit};
 pub use scene::{Box2dScene, SUB_STEPS, StepTimes};
 
 /// The tolerance of the contact-set comparison, world units, on both sides of touching:

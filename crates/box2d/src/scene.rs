@@ -16,7 +16,7 @@ use crate::filter::layer_filter;
 pub const SUB_STEPS: i32 = 4;
 
 /// A boxdd error as ours, with what was being done.
-fn box2d(what: &'static str) -> impl FnOnce(boxdd::Error) -> Box2dError {
+pub(crate) fn box2d(what: &'static str) -> impl FnOnce(boxdd::Error) -> Box2dError {
     move |e| Box2dError::Box2d(format!("{what}: {e}"))
 }
 
@@ -45,7 +45,7 @@ impl StepTimes {
 /// for a game that moves its own bodies and asks Box2D for the contacts. See the crate docs
 /// for the configuration and why.
 pub struct Box2dScene {
-    world: World,
+    pub(crate) world: World,
     /// Every body's Box2D body, by dense index.
     bodies: Vec<BodyId>,
     /// Every body's Box2D shape, by dense index.
@@ -255,7 +255,7 @@ impl Box2dScene {
 
     /// The entity whose shape this is: the body at dense index `i`'s, or the one its user data
     /// names.
-    fn entity_of(&mut self, i: usize, shape: ShapeId) -> Result<Entity, Box2dError> {
+    pub(crate) fn entity_of(&mut self, i: usize, shape: ShapeId) -> Result<Entity, Box2dError> {
         if self.shapes[i] == shape {
             return Ok(self.entities[i]);
         }

@@ -33,6 +33,10 @@
 //! referee's machinery: a record at other poses is recomputed as the referee recomputes every
 //! record, and a pair's threshold is the referee's.
 //!
+//! `queries.rs` asks the same scene `ricochet bench --queries`'s rays and overlaps
+//! ([`RapierScene::cast_ray`], [`RapierScene::overlap_aabb`], [`RapierScene::overlap_point`])
+//! through rapier's `QueryPipeline`.
+//!
 //! [`FrameOutput`]: ricochet_sim::FrameOutput
 //! [`Simulation`]: ricochet_sim::Simulation
 //! [`ActiveCollisionTypes`]: rapier2d_f64::prelude::ActiveCollisionTypes
@@ -40,10 +44,12 @@
 
 mod agreement;
 mod frame_pairs;
+mod queries;
 mod scene;
 
 pub use agreement::{ContactAgreement, compare_contacts};
 pub use frame_pairs::{FramePairs, Pair, threshold, wrapped};
+pub use queries::RapierRayHit;
 pub use scene::RapierScene;
 
 /// The tolerance of the contact-set comparison, world units, on both sides of touching:

@@ -48,15 +48,15 @@ pub(super) fn collider_pose(shape: &Shape, pose: &Pose) -> Result<PPose, OracleE
 pub struct RapierScene {
     pipeline: CollisionPipeline,
     islands: IslandManager,
-    broad_phase: BroadPhaseBvh,
-    narrow_phase: NarrowPhase,
+    pub(super) broad_phase: BroadPhaseBvh,
+    pub(super) narrow_phase: NarrowPhase,
     /// Always empty: every collider is parentless.
-    bodies: RigidBodySet,
-    colliders: ColliderSet,
+    pub(super) bodies: RigidBodySet,
+    pub(super) colliders: ColliderSet,
     /// Every non-static body: its dense index and its collider.
     moving: Vec<(usize, ColliderHandle)>,
     /// Every body's entity, by dense index (the index in the collider's `user_data`).
-    entities: Vec<Entity>,
+    pub(super) entities: Vec<Entity>,
     /// The scene's layers: the pair filter ([`LayerFilter`]) reads them.
     layers: Layers,
 }

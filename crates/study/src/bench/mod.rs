@@ -1,9 +1,11 @@
 //! The benchmark behind `ricochet bench`: Ricochet's full step against rapier2d's
 //! collision-only pipeline and Box2D v3's step, on the scenes of [`ricochet_scenes::bench`],
 //! in the same process on the same frames. [`measure`](mod@measure) runs one scene;
-//! [`report`] makes the table, the CSV and each scene's contact summaries.
+//! [`report`] makes the table, the CSV and each scene's contact summaries; [`queries`] is
+//! `ricochet bench --queries` (rays and box overlaps against rapier's and Box2D's queries).
 
 pub mod measure;
+pub mod queries;
 pub mod report;
 
 pub use measure::{MAX_FRAMES, Row, run_scene};
