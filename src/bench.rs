@@ -61,12 +61,12 @@ pub fn bad_frames(frames: u64) -> anyhow::Result<Option<ExitCode>> {
     Ok(None)
 }
 
-/// Runs the named scenes (or [`DEFAULT_SCENES`]), `frames` timed frames each, prints the
-/// table, writes the CSV. Each scene runs in its own process (see [`CHILD_ENV`]). Exit code
-/// 0 when every scene's contact sets agree with both rapier's and Box2D's, 1 when one does
-/// not, 2 for an unknown scene name, a count past [`ricochet_scenes::bench::MAX_COUNT`], or a
-/// frame count of 0 or past [`MAX_FRAMES`].
-pub fn run(scenes: &[String], frames: u64, csv: Option<&Path>) -> anyhow::Result<ExitCode> {
+/// The named scenes (or [`DEFAULT_SCENES`]), parsed, or exit code 2 after saying why (an
+/// unknown scene name, or a bad `--frames`).
+fn parse_scenes(
+    scenes: &[String],
+    frames: u64,
+) -> anyhow::Result<Result<Vec<(String, Scene)>, ExitCode>> {
     let names: Vec<String> = if scenes.is_empty() {
         DEFAULT_SCENES.iter().map(|s| (*s).to_owned()).collect()
     } else {
@@ -78,13 +78,26 @@ pub fn run(scenes: &[String], frames: u64, csv: Option<&Path>) -> anyhow::Result
             Ok(kind) => parsed.push((name.clone(), kind)),
             Err(e) => {
                 out::error(&format!("error: {e:#}"));
-                return Ok(ExitCode::from(2));
+                return Ok(Err(ExitCode::from(2)));
             }
         }
     }
     if let Some(code) = bad_frames(frames)? {
-        return Ok(code);
+        return Ok(Err(code));
     }
+    Ok(Ok(parsed))
+}
+
+/// Runs the named scenes (or [`DEFAULT_SCENES`]), `frames` timed frames each, prints the
+/// table, writes the CSV. Each scene runs in its own process (see [`CHILD_ENV`]). Exit code
+/// 0 when every scene's contact sets agree with both rapier's and Box2D's, 1 when one does
+/// not, 2 for an unknown scene name, a count past [`ricochet_scenes::bench::MAX_COUNT`], or a
+/// frame count of 0 or past [`MAX_FRAMES`].
+pub fn run(scenes: &[String], frames: u64, csv: Option<&Path>) -> anyhow::Result<ExitCode> {
+    let parsed = match parse_scenes(scenes, frames)? {
+        Ok(parsed) => parsed,
+        Err(code) => return Ok(code),
+    };
     if let Some(path) = csv {
         files::check_writable(path)?;
     }
@@ -120,24 +133,10 @@ pub fn run(scenes: &[String], frames: u64, csv: Option<&Path>) -> anyhow::Result
 /// ([`ricochet_study::bench::queries`]); prints the table. Exit code 0 when every answer
 /// agrees, 1 when one does not, 2 for a bad scene name or frame count.
 pub fn run_queries(scenes: &[String], frames: u64) -> anyhow::Result<ExitCode> {
-    let names: Vec<String> = if scenes.is_empty() {
-        DEFAULT_SCENES.iter().map(|s| (*s).to_owned()).collect()
-    } else {
-        scenes.to_vec()
+    let parsed = match parse_scenes(scenes, frames)? {
+        Ok(parsed) => parsed,
+        Err(code) => return Ok(code),
     };
-    let mut parsed = Vec::new();
-    for name in &names {
-        match Scene::parse(name) {
-            Ok(kind) => parsed.push((name.clone(), kind)),
-            Err(e) => {
-                out::error(&format!("error: {e:#}"));
-                return Ok(ExitCode::from(2));
-            }
-        }
-    }
-    if let Some(code) = bad_frames(frames)? {
-        return Ok(code);
-    }
     let mut rows = Vec::new();
     for (name, kind) in &parsed {
         let _ = out::note(&format!("bench --queries: {name}"));

@@ -101,17 +101,7 @@ impl World {
     pub fn bounds(&mut self, i: usize) -> Bounds {
         let p = self.position[i];
         match self.row[i] {
-            NO_ROW => {
-                // Scenery never turns: its bounds at its angle, translated.
-                let (shape, zero) = self.shapes.get(self.shape_id[i]);
-                let angle = self.angle[i];
-                let local = if angle.to_bits() == 0 {
-                    *zero
-                } else {
-                    shape.bounds(&Pose::new(Vec2::ZERO, angle))
-                };
-                placed(local, p)
-            }
+            NO_ROW => self.scenery_bounds(i),
             r => {
                 let shape = &self.shapes.get(self.shape_id[i]).0;
                 self.rows.local_bounds[r as usize].at(shape, self.angle[i], p)
@@ -119,21 +109,25 @@ impl World {
         }
     }
 
+    /// [`World::bounds`] of scenery `i`, which never turns: its bounds at its angle,
+    /// translated.
+    fn scenery_bounds(&self, i: usize) -> Bounds {
+        let (shape, zero) = self.shapes.get(self.shape_id[i]);
+        let angle = self.angle[i];
+        let local = if angle.to_bits() == 0 {
+            *zero
+        } else {
+            shape.bounds(&Pose::new(Vec2::ZERO, angle))
+        };
+        placed(local, self.position[i])
+    }
+
     /// [`World::bounds`] for a reader (the scene queries): the same box, computed without
     /// keeping it.
     pub(crate) fn bounds_now(&self, i: usize) -> Bounds {
         let p = self.position[i];
         match self.row[i] {
-            NO_ROW => {
-                let (shape, zero) = self.shapes.get(self.shape_id[i]);
-                let angle = self.angle[i];
-                let local = if angle.to_bits() == 0 {
-                    *zero
-                } else {
-                    shape.bounds(&Pose::new(Vec2::ZERO, angle))
-                };
-                placed(local, p)
-            }
+            NO_ROW => self.scenery_bounds(i),
             r => {
                 let shape = &self.shapes.get(self.shape_id[i]).0;
                 self.rows.local_bounds[r as usize].peek(shape, self.angle[i], p)
