@@ -134,3 +134,9 @@ pub use world::{Inputs, World};
 /// The geometry crate, for what the prelude does not re-export (the narrow phase, ...).
 pub use ricochet_geom as geom;
 pub use ricochet_geom::{Bounds, Pose, Primitive, Shape, ShapeError, Vec2};
+
+/// README.md's rust snippets (its "Embed the simulation in a game" section), run as this
+/// crate's doctests so that what a newcomer copies compiles and does what it says.
+#[cfg(doctest)]
+#[doc = include_str!("../../../README.md")]
+pub struct ReadmeDoctests;
