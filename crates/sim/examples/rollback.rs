@@ -173,6 +173,11 @@ fn run(broken: bool) -> Result<ExitCode, Box<dyn std::error::Error>> {
         eprintln!("rollback --break: the nudged restores were NOT caught by ggrs");
         return Ok(ExitCode::FAILURE);
     }
+    // "No desync" means something only if frames were rolled back and stepped again.
+    if counts.loads == 0 || counts.steps <= FRAMES {
+        eprintln!("rollback: ggrs never rolled back: nothing was compared");
+        return Ok(ExitCode::FAILURE);
+    }
     let ships_left = ships.iter().filter(|&&s| sim.contains(s)).count();
     println!(
         "rollback: {FRAMES} frames of 2 players, check distance {CHECK_DISTANCE}: {} steps ({} of them again after a rollback), {} loads, {} saves, no desync; {} bodies and {ships_left} ship(s) at the end",
