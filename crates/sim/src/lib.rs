@@ -85,9 +85,45 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!
+//! # Tiles and moving platforms
+//!
+//! [`Simulation::spawn_tiles`] spawns a tile map given as data ([`TileRows`]: rows of
+//! identical static bodies, an entity each, ids in row order). A kinematic body is moved by
+//! the game with [`Simulation::set_target_pose`] (it gets the velocity that takes it there
+//! in the next step); a box standing on it is carried by its motion from the step after
+//! the one that found it standing there ([`Simulation::carrier`]).
+//!
+//! # Scene queries
+//!
+//! Between two steps a game asks the world: [`Simulation::cast_ray`] (the first body hit,
+//! a [`RayHit`]), [`Simulation::cast_ray_all`] (every one, by distance then id),
+//! [`Simulation::cast_shape`] (where a moved shape first touches, a [`ShapeHit`]),
+//! [`Simulation::overlap_point`], [`Simulation::overlap_aabb`] and
+//! [`Simulation::overlap_shape`] (the bodies inside, in id order). A [`QueryFilter`] picks
+//! layers and leaves one body out. They are exact, as the collision geometry is; bodies are
+//! solid (a ray starting inside one hits it at distance 0 with a zero normal); touching is
+//! not overlapping (a point on a body's edge is not in it, a box that only touches a body
+//! does not overlap it), while a ray that grazes a body hits it; in a wrap world every
+//! image is seen and a ray leaving one edge goes on from the other. Bad input (a zero or
+//! non-finite direction, a negative distance) answers nothing, never a panic.
+//!
+//! # Snapshots and rollback
+//!
+//! [`Simulation::snapshot`] holds everything the next step reads (every body, the pending
+//! inputs and targets, the touching pairs, the script cursor, the id generations) and the
+//! game's [`BodyDef::user_data`]; [`Snapshot::to_bytes`] and [`Snapshot::from_bytes`] make
+//! it bytes (versioned and hashed: damaged bytes are a [`SnapshotError`]).
+//! [`Simulation::restore`] puts any simulation of the same scene back in that state: the
+//! same world settings, layers, templates and script, which a snapshot references by a
+//! hash; the bodies come from the snapshot, so a peer that built the scene anew can restore
+//! it. [`Simulation::checksum`] hashes exactly the state a step reads (not the user data):
+//! equal checksums step identically, which is what rollback netcode compares.
+//! `examples/rollback.rs` runs a `ggrs` `SyncTestSession` on them.
+//!
 //! Scenario files load into the same definitions ([`load_scenario`], feature `toml`, on by
 //! default); `examples/asteroids_in_code.rs` builds an Asteroids scene and reads a
-//! destruction as a typed [`GameEvent`].
+//! destruction as a typed [`GameEvent`]. README's "Embed the simulation in a game" has more
+//! examples, each run as a doctest of this crate.
 
 mod action;
 pub mod broad_phase;
@@ -134,3 +170,9 @@ pub use world::{Inputs, World};
 /// The geometry crate, for what the prelude does not re-export (the narrow phase, ...).
 pub use ricochet_geom as geom;
 pub use ricochet_geom::{Bounds, Pose, Primitive, Shape, ShapeError, Vec2};
+
+/// README.md's rust snippets (its "Embed the simulation in a game" section), run as this
+/// crate's doctests so that what a newcomer copies compiles and does what it says.
+#[cfg(doctest)]
+#[doc = include_str!("../../../README.md")]
+pub struct ReadmeDoctests;
