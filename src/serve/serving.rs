@@ -231,6 +231,14 @@ impl Serving {
                 self.session.refresh_live()?;
             }
             services::Command::Speed(x) => self.speed = x,
+            services::Command::Query(request) => {
+                let next = self.session.next_frame();
+                return Ok(Some(super::query::answer(
+                    self.session.sim(),
+                    next,
+                    &request,
+                )));
+            }
             services::Command::Seek(target) => {
                 return match self.seek(target, hub, asker)? {
                     Ok(()) => Ok(None),
@@ -470,6 +478,34 @@ impl Serving {
             }
         }
         Ok(true)
+    }
+
+    /// Answers the clicked points that came since the last look (`click.rs`): each with an
+    /// `/events` line for the live clients, listing the bodies at the point in the state
+    /// they were last sent. Never recorded. While a seek or step is under way, the clicker
+    /// is told to click again when it is done.
+    pub fn clicks(&mut self, hub: &Hub) -> anyhow::Result<()> {
+        let clicks = std::mem::take(&mut hub.lock().clicks);
+        for (client, payload) in clicks {
+            if let Some(busy) = self.busy() {
+                hub.lock()
+                    .tell(client, 1, &format!("clicked point not answered: {busy}"));
+                continue;
+            }
+            let click = match super::click::parse(&payload) {
+                Ok(c) => c,
+                Err(why) => {
+                    hub.lock().tell(client, 2, &why);
+                    continue;
+                }
+            };
+            let at = click.in_world(self.session.view_at());
+            let sim = self.session.sim();
+            let bodies = sim.overlap_point(at, &ricochet_sim::QueryFilter::all());
+            let line = crate::events::click(sim, at, &bodies);
+            self.session.event_live(line)?;
+        }
+        Ok(())
     }
 
     /// Refuses a call or a timeline request while a seek or step is under way.
