@@ -310,7 +310,7 @@ impl Shared {
         }
         if advertised != Some(Publication::Input) {
             return Err(format!(
-                "channel {channel} is not an advertised /input or {CLICKED_POINT} channel (JSON)"
+                "channel {channel} is not an advertised /input channel, nor {CLICKED_POINT} (both JSON)"
             ));
         }
         if payload.len() > crate::session::MAX_INPUT {
