@@ -329,3 +329,46 @@ fn a_click_is_answered_on_events_and_the_recording_still_replays_byte_for_byte()
     );
     assert_eq!(replays_byte_for_byte(&out), 8, "frames 0 to 7");
 }
+
+/// After an overflow the simulation holds the frame that overflowed, which no client was
+/// sent (nor the recording holds): a query or a click is refused, saying so, until a seek
+/// back; then it is answered again.
+#[test]
+fn after_an_overflow_queries_and_clicks_are_refused_until_a_seek_back() {
+    let dir = tempfile::tempdir().unwrap();
+    // Gravity of 1e154: the rock's kinetic energy passes f64 within about 80 frames.
+    let scenario = dir.path().join("overflow.toml");
+    std::fs::write(
+        &scenario,
+        "layers = [\"a\"]\nframes = 1000\nworld.gravity = [0, -1e154]\n[[bodies]]\nname = \
+         \"rock\"\nlayer = \"a\"\nshape = { kind = \"circle\", radius = 1 }\n",
+    )
+    .unwrap();
+    let server = serve(&[scenario.to_str().unwrap(), "--paused"]);
+    runtime().block_on(async {
+        let (mut ws, services) = open(&server, "foxglove.websocket.v1").await;
+        let failed = call(&mut ws, &services, "/step", 1, r#"{"frames": 500}"#)
+            .await
+            .unwrap_err();
+        assert!(failed.contains("overflowed"), "{failed}");
+        let point = json!({"kind": "point", "point": [0, 0]});
+        let refused = query(&mut ws, &services, 2, point.clone())
+            .await
+            .unwrap_err();
+        assert!(refused.contains("overflowed"), "{refused}");
+        advertise_click(&mut ws).await;
+        click(&mut ws, "world", 0.0, 0.0).await;
+        let (level, text) = next_status(&mut ws).await;
+        assert_eq!(level, 1);
+        assert!(
+            text.starts_with("clicked point not answered: ") && text.contains("overflowed"),
+            "{text}"
+        );
+        // Back after frame 0, which moves nothing (the initial state, `pipeline.rs`): the
+        // rock is still at the origin.
+        let back = call(&mut ws, &services, "/seek", 3, r#"{"frame": 1}"#).await;
+        assert_eq!(back.unwrap()["frame"], 1);
+        let rock = query(&mut ws, &services, 4, point).await.unwrap();
+        assert_eq!(bodies(&rock), [("0:0".into(), "rock".into(), "a".into())]);
+    });
+}

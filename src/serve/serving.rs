@@ -232,6 +232,11 @@ impl Serving {
             }
             services::Command::Speed(x) => self.speed = x,
             services::Command::Query(request) => {
+                // After an overflow the simulation holds the frame that overflowed, which no
+                // client was sent.
+                if let Some(why) = self.halted() {
+                    return Ok(Some(Err(why)));
+                }
                 let next = self.session.next_frame();
                 return Ok(Some(super::query::answer(
                     self.session.sim(),
@@ -482,14 +487,14 @@ impl Serving {
 
     /// Answers the clicked points that came since the last look (`click.rs`): each with an
     /// `/events` line for the live clients, listing the bodies at the point in the state
-    /// they were last sent. Never recorded. While a seek or step is under way, the clicker
-    /// is told to click again when it is done.
+    /// they were last sent. Never recorded. While a seek or step is under way, or after an
+    /// overflow, the clicker is told why there is no answer.
     pub fn clicks(&mut self, hub: &Hub) -> anyhow::Result<()> {
         let clicks = std::mem::take(&mut hub.lock().clicks);
         for (client, payload) in clicks {
-            if let Some(busy) = self.busy() {
+            if let Some(why) = self.busy().or_else(|| self.halted()) {
                 hub.lock()
-                    .tell(client, 1, &format!("clicked point not answered: {busy}"));
+                    .tell(client, 1, &format!("clicked point not answered: {why}"));
                 continue;
             }
             let click = match super::click::parse(&payload) {
