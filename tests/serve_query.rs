@@ -372,3 +372,47 @@ fn after_an_overflow_queries_and_clicks_are_refused_until_a_seek_back() {
         assert_eq!(bodies(&rock), [("0:0".into(), "rock".into(), "a".into())]);
     });
 }
+
+/// An answer lists at most 256 hits, the first by the API's order, and counts them all:
+/// 300 unit circles on the x axis, 3 apart (body `i` at `x = 3 i`), all in one box and on
+/// one ray.
+#[test]
+fn an_answer_lists_at_most_256_hits_and_counts_them_all() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = dir.path().join("row.toml");
+    let mut text = String::from("layers = [\"a\"]\n");
+    for i in 0..300 {
+        text += &format!(
+            "[[bodies]]\nname = \"c{i}\"\nlayer = \"a\"\nkind = \"static\"\nshape = {{ kind = \
+             \"circle\", radius = 1 }}\nposition = [{}, 0]\n",
+            3 * i
+        );
+    }
+    std::fs::write(&scenario, text).unwrap();
+    let server = serve(&[scenario.to_str().unwrap(), "--paused"]);
+    runtime().block_on(async {
+        let (mut ws, services) = open(&server, "foxglove.websocket.v1").await;
+        let boxed = json!({"kind": "aabb", "min": [-2, -2], "max": [900, 2]});
+        let all = query(&mut ws, &services, 1, boxed).await.unwrap();
+        assert_eq!(all["count"], 300);
+        assert_eq!(all["truncated"], true);
+        let ids: Vec<String> = bodies(&all).into_iter().map(|b| b.0).collect();
+        let first: Vec<String> = (0..256).map(|i| format!("{i}:0")).collect();
+        assert_eq!(ids, first);
+        // From the left, along the row: circle i is met at distance 3 i - 1 + 5.
+        let ray = json!({"kind": "ray", "origin": [-5, 0], "direction": [1, 0],
+                         "max_distance": 1000, "all": true});
+        let hits = query(&mut ws, &services, 2, ray).await.unwrap();
+        assert_eq!(hits["count"], 300);
+        assert_eq!(hits["truncated"], true);
+        let listed = hits["hits"].as_array().unwrap();
+        assert_eq!(listed.len(), 256);
+        for (i, h) in listed.iter().enumerate() {
+            assert_eq!(h["body"], format!("{i}:0"));
+            assert!(
+                near(h["distance"].as_f64().unwrap(), 3.0 * i as f64 + 4.0),
+                "{h}"
+            );
+        }
+    });
+}
