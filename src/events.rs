@@ -11,15 +11,16 @@
 //! for a body still alive, in the frame's removed bodies for one removed during it.
 
 use crate::record::Level as LogLevel;
-use ricochet_geom::Number;
+use ricochet_geom::{Number, ShapeDef, Vec2};
 use ricochet_sim::{
-    Entity, FireOutcome, FrameOutput, GameEvent, JumpOutcome, Removal, ScriptInput, World,
+    BodyKind, Controller, Entity, FireOutcome, FrameOutput, GameEvent, JumpOutcome, Removal,
+    ScriptInput, Simulation, World,
 };
 
 /// One event as a log line.
 pub struct EventLine {
-    /// `input`, `spawn`, `destroy`, `expire`, `missed`, `crush`, `touch_begin` or
-    /// `touch_end`.
+    /// `input`, `spawn`, `destroy`, `expire`, `missed`, `crush`, `touch_begin`,
+    /// `touch_end`, or `click` (a live answer of `ricochet serve`, never recorded).
     pub kind: &'static str,
     /// Warnings for bodies lost or crushed and events that missed, info for the rest
     /// (inputs, spawns, touches).
@@ -134,6 +135,91 @@ pub fn line(event: &GameEvent, world: &World, out: &FrameOutput) -> EventLine {
         kind,
         level,
         message: message(event, world, out),
+    }
+}
+
+/// Bodies a click's line lists at most (about 400 bytes each); the rest are counted.
+pub const MAX_CLICK_BODIES: usize = 16;
+
+/// `[x, y]` with [`Number`]'s digits.
+fn pair(v: Vec2) -> String {
+    format!("[{}, {}]", Number(v.x), Number(v.y))
+}
+
+/// A body's whole state, after its `name #id`: what a step reads of it, as `/bodies` and
+/// the reads by entity give it (its `user_data` is the game's and never written).
+fn state(sim: &Simulation, e: Entity) -> Option<String> {
+    let layer = sim.scenario().world.layers.name(sim.layer(e)?);
+    let shape = serde_json::to_string(&ShapeDef::from_shape(sim.shape(e)?)).ok()?;
+    let yes = |b: bool| if b { "yes" } else { "no" };
+    let mut s = format!(
+        "layer {layer}, {}, shape {shape}, position {}, angle {}, velocity {}, angular velocity {}",
+        sim.kind(e)?.name(),
+        pair(sim.position(e)?),
+        Number(sim.angle(e)?),
+        pair(sim.velocity(e)?),
+        Number(sim.angular_velocity(e)?),
+    );
+    if sim.kind(e)? == BodyKind::Dynamic {
+        s += &format!(", mass {}", Number(sim.mass(e)?));
+    }
+    s += &format!(
+        ", force {}, gravity scale {}, lifetime {}",
+        pair(sim.force(e)?),
+        Number(sim.gravity_scale(e)?),
+        sim.lifetime(e)?
+            .map_or("unlimited".to_owned(), |f| format!("{f} frames")),
+    );
+    if let Some(c) = sim.controller(e)? {
+        let i = sim.inputs(e)?;
+        s += &match c {
+            Controller::Ship { .. } => format!(
+                ", ship: thrust {}, turn {}",
+                if i.thrust { "on" } else { "off" },
+                Number(i.turn)
+            ),
+            Controller::Runner { .. } => format!(", runner: move {}", Number(i.run)),
+            Controller::Walker { .. } => ", walker".to_owned(),
+        };
+    }
+    let carrier = sim.carrier(e)?.map_or("nothing".to_owned(), |c| {
+        format!("{} #{c}", sim.name(c).unwrap_or("?"))
+    });
+    s += &format!(
+        ", grounded {}, on static {}, carried by {carrier}, asleep {}, frozen {}",
+        yes(sim.grounded(e)?),
+        yes(sim.on_static(e)?),
+        yes(sim.asleep(e)?),
+        yes(sim.frozen(e)?),
+    );
+    Some(s)
+}
+
+/// The line answering a click at `point` (world coordinates; `ricochet serve`, live only)
+/// that found `bodies` there: each with its whole state, at most [`MAX_CLICK_BODIES`].
+pub fn click(sim: &Simulation, point: Vec2, bodies: &[Entity]) -> EventLine {
+    let mut message = format!("click at {}: ", pair(point));
+    if bodies.is_empty() {
+        message += "no body there";
+    } else {
+        let listed: Vec<String> = bodies
+            .iter()
+            .take(MAX_CLICK_BODIES)
+            .map(|&e| {
+                let name = sim.name(e).unwrap_or("?");
+                let state = state(sim, e).unwrap_or_default();
+                format!("{name} #{e} ({state})")
+            })
+            .collect();
+        message += &listed.join("; ");
+        if bodies.len() > MAX_CLICK_BODIES {
+            message += &format!("; and {} more", bodies.len() - MAX_CLICK_BODIES);
+        }
+    }
+    EventLine {
+        kind: "click",
+        level: LogLevel::Info,
+        message,
     }
 }
 

@@ -318,6 +318,32 @@ impl<S: MessageSink> Session<S> {
         self.recorder.refresh_live(&self.sim, frame)
     }
 
+    /// Sends live clients an `/events` line at the last frame stepped (the answer to a
+    /// click): never recorded, so a replay never needs it (see [`MessageSink::write_live`]).
+    pub fn event_live(&mut self, line: crate::events::EventLine) -> Result<(), LogError> {
+        let Some(ch) = self.events else {
+            return Ok(());
+        };
+        let t = self
+            .next
+            .saturating_sub(1)
+            .saturating_mul(self.recorder.dt_ns());
+        let message = Log {
+            timestamp: Some(timestamp(t)),
+            level: line.level as i32,
+            message: line.message,
+            name: line.kind.to_owned(),
+            file: String::new(),
+            line: 0,
+        };
+        self.recorder.sink_mut().write_live(ch, t, message)
+    }
+
+    /// Where the layout's camera looks now: the `view` frame's origin in `world`.
+    pub fn view_at(&self) -> Vec2 {
+        self.recorder.view_at(&self.sim)
+    }
+
     /// The simulation.
     pub fn sim(&self) -> &Simulation {
         &self.sim

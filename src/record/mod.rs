@@ -191,8 +191,9 @@ impl<S: MessageSink> Recorder<S> {
         )
     }
 
-    /// Where the camera looks now (see [`scene::view_position`]).
-    fn view_at(&self, sim: &Simulation) -> Vec2 {
+    /// Where the camera looks now, the `view` frame's origin in `world` (see
+    /// [`scene::view_position`]).
+    pub fn view_at(&self, sim: &Simulation) -> Vec2 {
         let bounds = sim.scenario().world.bounds.map(|b| (b.min, b.max));
         scene::view_position(sim.world(), sim.focus(), bounds, self.fallback_view(sim))
     }

@@ -126,11 +126,29 @@ const LATCHED: [&str; 3] = ["/scene", "/scene/static", "/tf"];
 /// Inputs waiting for the next frame, from all clients, beyond which new ones are refused.
 pub const MAX_PENDING_INPUTS: usize = 10_000;
 
+/// Clicked points waiting for the simulation loop, from all clients, beyond which new ones
+/// are refused (each is answered between frames, so a few are ever waiting).
+pub const MAX_PENDING_CLICKS: usize = 64;
+
+/// The topic Lichtblick's 3D panel publishes its "publish point" clicks on (its default).
+pub const CLICKED_POINT: &str = "/clicked_point";
+
+/// What a client's channel carries.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Publication {
+    /// Inputs (`/input`, JSON).
+    Input,
+    /// Clicked points (`/clicked_point`, JSON: Lichtblick's `geometry_msgs/PointStamped`).
+    Click,
+    /// Anything else (the 3D panel's pose tools, a Publish panel): advertised, refused.
+    Other,
+}
+
 /// One connected client.
 struct Client {
     queue: ClientQueue,
-    /// Its channels, by its id: those on `/input` in JSON.
-    publishes: BTreeMap<u32, bool>,
+    /// Its channels, by its id.
+    publishes: BTreeMap<u32, Publication>,
     /// By channel id: the client's subscription id.
     subscriptions: BTreeMap<u32, u32>,
     /// Messages dropped since it was last told.
@@ -150,6 +168,9 @@ pub struct Shared {
     /// Inputs in the order they came, with the client that sent each: the next frame takes
     /// them all.
     pub inputs: std::collections::VecDeque<(u64, String)>,
+    /// Clicked points in the order they came (the JSON, not yet read), with the client that
+    /// sent each: answered between frames, never applied to the simulation.
+    pub clicks: std::collections::VecDeque<(u64, Vec<u8>)>,
     /// Service calls in the order they came, with the client that made each.
     pub calls: std::collections::VecDeque<(u64, protocol::ServiceCall)>,
     /// Playback-control requests in the order they came, with the client that made each.
@@ -232,9 +253,9 @@ impl Shared {
     }
 
     /// `client` will publish on its channel `id`. Any channel may be advertised (Foxglove's
-    /// 3D panel advertises its click tools' topics); only messages on `/input` in JSON are
-    /// taken, others are refused when they come. Past [`MAX_CLIENT_CHANNELS`] a new channel
-    /// is refused (an error for the client's status).
+    /// 3D panel advertises its click tools' topics); only messages on `/input` and
+    /// [`CLICKED_POINT`] in JSON are taken, others are refused when they come. Past
+    /// [`MAX_CLIENT_CHANNELS`] a new channel is refused (an error for the client's status).
     pub fn advertise(
         &mut self,
         client: u64,
@@ -242,7 +263,11 @@ impl Shared {
         topic: &str,
         encoding: &str,
     ) -> Result<(), String> {
-        let input = topic == "/input" && encoding == "json";
+        let publication = match (topic, encoding) {
+            ("/input", "json") => Publication::Input,
+            (CLICKED_POINT, "json") => Publication::Click,
+            _ => Publication::Other,
+        };
         if let Some(c) = self.clients.get_mut(&client) {
             if c.publishes.len() >= MAX_CLIENT_CHANNELS && !c.publishes.contains_key(&id) {
                 return Err(format!(
@@ -250,7 +275,7 @@ impl Shared {
                      {MAX_CLIENT_CHANNELS} channels (unadvertise some first)"
                 ));
             }
-            c.publishes.insert(id, input);
+            c.publishes.insert(id, publication);
         }
         Ok(())
     }
@@ -262,15 +287,30 @@ impl Shared {
         }
     }
 
-    /// An input `client` published on its channel `channel`, queued for the next frame.
+    /// A message `client` published on its channel `channel`: an input, queued for the next
+    /// frame, or a clicked point, queued for the loop's next look at its clients.
     pub fn input(&mut self, client: u64, channel: u32, payload: &[u8]) -> Result<(), String> {
         let advertised = self
             .clients
             .get(&client)
             .and_then(|c| c.publishes.get(&channel).copied());
-        if advertised != Some(true) {
+        if advertised == Some(Publication::Click) {
+            if payload.len() > crate::session::MAX_INPUT {
+                return Err(format!(
+                    "a clicked point of {} bytes, more than {}",
+                    payload.len(),
+                    crate::session::MAX_INPUT
+                ));
+            }
+            if self.clicks.len() >= MAX_PENDING_CLICKS {
+                return Err("too many clicked points waiting".to_owned());
+            }
+            self.clicks.push_back((client, payload.to_vec()));
+            return Ok(());
+        }
+        if advertised != Some(Publication::Input) {
             return Err(format!(
-                "channel {channel} is not an advertised /input channel"
+                "channel {channel} is not an advertised /input channel, nor {CLICKED_POINT} (both JSON)"
             ));
         }
         if payload.len() > crate::session::MAX_INPUT {

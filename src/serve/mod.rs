@@ -8,9 +8,11 @@
 //! the wall clock only paces, it never reaches a message. The WebSocket side runs on a tokio
 //! runtime of its own thread (`server.rs`); the two share the [`hub::Hub`].
 
+mod click;
 mod hub;
 mod load_path;
 mod protocol;
+mod query;
 mod server;
 mod services;
 mod serving;
@@ -266,6 +268,7 @@ fn run_loop(serving: &mut Serving, hub: &Hub, interrupted: &AtomicBool) -> anyho
             }
             anchor = (Instant::now(), frames);
         }
+        serving.clicks(hub)?;
         let requests = std::mem::take(&mut hub.lock().playback);
         for (client, request) in requests {
             if let Some(busy) = serving.busy() {

@@ -236,7 +236,7 @@ pub enum ServerMessage<'a> {
         name: &'a str,
         /// What it supports beyond subscribing (`time`).
         capabilities: &'a [&'a str],
-        /// Message encodings clients may publish in (none yet).
+        /// Message encodings clients may publish in (`json`).
         supported_encodings: &'a [&'a str],
         /// Free-form.
         metadata: BTreeMap<String, String>,
@@ -299,7 +299,7 @@ pub struct Subscription {
 pub struct ClientChannel {
     /// The client's id for it.
     pub id: u32,
-    /// Topic: only `/input` is taken.
+    /// Topic: only `/input` and `/clicked_point` are taken.
     pub topic: String,
     /// Message encoding: only `json` is taken.
     pub encoding: String,

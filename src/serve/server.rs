@@ -79,6 +79,15 @@ pub async fn accept(listener: TcpListener, hub: Hub, session: String) {
     }
 }
 
+/// The server's metadata: `ROS_DISTRO`, because Lichtblick's (and Foxglove Studio's) 3D
+/// panel offers its publish tools ("Publish point": `/clicked_point`, `click.rs`) only to
+/// a ROS data source, which it recognises by that key. Any value but a ROS 1 distro makes
+/// it a ROS 2 source; `humble` picks the message definitions it ships for that. Ricochet
+/// speaks no ROS otherwise: every channel stays protobuf, every schema Foxglove's or its own.
+fn metadata() -> std::collections::BTreeMap<String, String> {
+    [("ROS_DISTRO".to_owned(), "humble".to_owned())].into()
+}
+
 /// A line on stderr (lost lines are no failure).
 fn tracing_note(text: &str) {
     let _ = crate::out::note(text);
@@ -142,7 +151,7 @@ async fn client(
                 name: "ricochet",
                 capabilities: &["time", "clientPublish", "services", "playbackControl"],
                 supported_encodings: &["json"],
-                metadata: Default::default(),
+                metadata: metadata(),
                 session_id: session,
                 data_start_time: protocol::Time::from_ns(0),
                 data_end_time: protocol::Time::from_ns(s.data_end_ns),

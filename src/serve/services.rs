@@ -10,8 +10,9 @@
 //! | `/load` | `{"scenario": "scenarios/level.toml"}` | another scenario file (a relative path, below the server's directory), from frame 0, likewise |
 //! | `/seek` | `{"frame": N}` | to frame N: forward by stepping as fast as it can, back by stepping again from the latest snapshot before N with the inputs since (recording: from frame 0, writing the recording's file again, so that it holds the session as it now stands and replays on its own) |
 //! | `/speed` | `{"speed": X}` | simulation seconds per wall second, from now (0.01 to 100) |
+//! | `/query` | `{"kind": "ray", "origin": [0, 0], "direction": [1, 0], "max_distance": 50}`, or `point`, `aabb`, `shape` (`query.rs`) | a scene query of the state the clients were last sent: `{"frame": F, "count": N, "hits": [...], "truncated": T}` |
 //!
-//! Every response is `{"frame": F, "paused": P}` (the next frame, and whether stepping is
+//! Every response but `/query`'s is `{"frame": F, "paused": P}` (the next frame, and whether stepping is
 //! paused), with `"recording": "FILE"` after a reset or load that started a new file, or a
 //! seek back that writes one again.
 //!
@@ -43,16 +44,27 @@ pub enum Command {
     Seek(u64),
     /// Simulation seconds per wall second.
     Speed(f64),
+    /// A scene query, answered at once (`query.rs`).
+    Query(super::query::Request),
 }
 
 /// At most this many frames in one `/step`.
 pub const MAX_STEP: u64 = 10_000;
 
-const NAMES: [&str; 7] = [
-    "/pause", "/play", "/step", "/reset", "/load", "/seek", "/speed",
+const NAMES: [&str; 8] = [
+    "/pause", "/play", "/step", "/reset", "/load", "/seek", "/speed", "/query",
 ];
 
-/// The services, ids 1 to 7.
+/// `/query`'s request: one of four kinds, each with optional `layers` (`query.rs`).
+const QUERY_REQUEST: &str = r#"{"type": "object", "properties": {"kind": {"type": "string", "enum": ["ray", "point", "aabb", "shape"]}, "origin": {"type": "array", "items": {"type": "number"}, "minItems": 2, "maxItems": 2}, "direction": {"type": "array", "items": {"type": "number"}, "minItems": 2, "maxItems": 2}, "max_distance": {"type": "number", "minimum": 0}, "all": {"type": "boolean"}, "point": {"type": "array", "items": {"type": "number"}, "minItems": 2, "maxItems": 2}, "min": {"type": "array", "items": {"type": "number"}, "minItems": 2, "maxItems": 2}, "max": {"type": "array", "items": {"type": "number"}, "minItems": 2, "maxItems": 2}, "shape": {"type": "object", "properties": {"kind": {"type": "string", "enum": ["circle", "aabb", "obb", "capsule", "polygon", "compound"]}}, "required": ["kind"]}, "position": {"type": "array", "items": {"type": "number"}, "minItems": 2, "maxItems": 2}, "angle": {"type": "number"}, "layers": {"type": "array", "items": {"type": "string"}}}, "required": ["kind"]}"#;
+
+/// `/query`'s answer.
+const QUERY_RESPONSE: &str = r#"{"type": "object", "properties": {"frame": {"type": "integer"}, "count": {"type": "integer"}, "truncated": {"type": "boolean"}, "hits": {"type": "array", "items": {"type": "object", "properties": {"body": {"type": "string"}, "name": {"type": "string"}, "layer": {"type": "string"}, "point": {"type": "array", "items": {"type": "number"}}, "normal": {"type": "array", "items": {"type": "number"}}, "distance": {"type": "number"}}}}}}"#;
+
+/// The id of `/query` (the services' ids are their places in the list, from 1).
+pub const QUERY: u32 = 8;
+
+/// The services, ids 1 to 8.
 pub fn list() -> Vec<Service> {
     let empty = r#"{"type": "object", "properties": {}}"#;
     let response = r#"{"type": "object", "properties": {"frame": {"type": "integer"}, "paused": {"type": "boolean"}, "recording": {"type": "string"}}}"#;
@@ -64,6 +76,7 @@ pub fn list() -> Vec<Service> {
         r#"{"type": "object", "properties": {"scenario": {"type": "string"}}, "required": ["scenario"]}"#,
         r#"{"type": "object", "properties": {"frame": {"type": "integer", "minimum": 0}}, "required": ["frame"]}"#,
         r#"{"type": "object", "properties": {"speed": {"type": "number"}}, "required": ["speed"]}"#,
+        QUERY_REQUEST,
     ];
     NAMES
         .iter()
@@ -74,7 +87,11 @@ pub fn list() -> Vec<Service> {
             name: (*name).to_owned(),
             kind: format!("ricochet{name}"),
             request: ServiceSchema::json(&format!("ricochet{name}.Request"), request),
-            response: ServiceSchema::json("ricochet.ServiceResponse", response),
+            response: if i as u32 + 1 == QUERY {
+                ServiceSchema::json("ricochet/query.Response", QUERY_RESPONSE)
+            } else {
+                ServiceSchema::json("ricochet.ServiceResponse", response)
+            },
         })
         .collect()
 }
@@ -166,6 +183,7 @@ pub fn parse(id: u32, payload: &[u8]) -> Result<Command, String> {
             }
             Ok(Command::Speed(r.speed))
         }
+        QUERY => super::query::parse(body).map(Command::Query),
         other => Err(format!("no service {other}")),
     }
 }

@@ -231,6 +231,19 @@ impl Serving {
                 self.session.refresh_live()?;
             }
             services::Command::Speed(x) => self.speed = x,
+            services::Command::Query(request) => {
+                // After an overflow the simulation holds the frame that overflowed, which no
+                // client was sent.
+                if let Some(why) = self.halted() {
+                    return Ok(Some(Err(why)));
+                }
+                let next = self.session.next_frame();
+                return Ok(Some(super::query::answer(
+                    self.session.sim(),
+                    next,
+                    &request,
+                )));
+            }
             services::Command::Seek(target) => {
                 return match self.seek(target, hub, asker)? {
                     Ok(()) => Ok(None),
@@ -470,6 +483,34 @@ impl Serving {
             }
         }
         Ok(true)
+    }
+
+    /// Answers the clicked points that came since the last look (`click.rs`): each with an
+    /// `/events` line for the live clients, listing the bodies at the point in the state
+    /// they were last sent. Never recorded. While a seek or step is under way, or after an
+    /// overflow, the clicker is told why there is no answer.
+    pub fn clicks(&mut self, hub: &Hub) -> anyhow::Result<()> {
+        let clicks = std::mem::take(&mut hub.lock().clicks);
+        for (client, payload) in clicks {
+            if let Some(why) = self.busy().or_else(|| self.halted()) {
+                hub.lock()
+                    .tell(client, 1, &format!("clicked point not answered: {why}"));
+                continue;
+            }
+            let click = match super::click::parse(&payload) {
+                Ok(c) => c,
+                Err(why) => {
+                    hub.lock().tell(client, 2, &why);
+                    continue;
+                }
+            };
+            let at = click.in_world(self.session.view_at());
+            let sim = self.session.sim();
+            let bodies = sim.overlap_point(at, &ricochet_sim::QueryFilter::all());
+            let line = crate::events::click(sim, at, &bodies);
+            self.session.event_live(line)?;
+        }
+        Ok(())
     }
 
     /// Refuses a call or a timeline request while a seek or step is under way.

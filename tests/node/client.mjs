@@ -4,7 +4,11 @@
 // Connects; checks the server info and every advertised channel (protobuf, with a schema);
 // subscribes to /stats and /scene and checks that /stats frames arrive in order; publishes
 // inputs on /input (two applied, one refused and answered with a status); calls the
-// services /pause, /step, /seek (back) and /reset and checks their answers; disconnects.
+// services /pause, /step, /seek (back) and /reset and checks their answers; at frame 0 of
+// the reset (the scenario's own positions: the ship at the origin, angle 0, its triangle's
+// back edge at x = -0.8), calls /query (a ray, a point, an unknown layer) and publishes a
+// /clicked_point as Lichtblick's 3D panel does (JSON geometry_msgs/PointStamped), whose
+// answer comes on /events; disconnects.
 // Exits 1 with a message on any failure; prints a summary line on success.
 
 import wsProtocol from "@foxglove/ws-protocol";
@@ -44,6 +48,38 @@ function statsFrame(bytes) {
   }
   return value;
 }
+
+// The `message` (3) and `name` (4) strings of a foxglove.Log: the top-level fields read by
+// their wire types (varint 0, fixed64 1, length-delimited 2, fixed32 5).
+function logLine(bytes) {
+  const out = {};
+  let i = 0;
+  const varint = () => {
+    let value = 0, shift = 0;
+    for (;;) {
+      const b = bytes[i++];
+      value += (b & 0x7f) * 2 ** shift;
+      if ((b & 0x80) === 0) return value;
+      shift += 7;
+    }
+  };
+  while (i < bytes.length) {
+    const key = varint();
+    const field = Math.floor(key / 8), wire = key % 8;
+    if (wire === 0) varint();
+    else if (wire === 1) i += 8;
+    else if (wire === 5) i += 4;
+    else if (wire === 2) {
+      const len = varint();
+      const text = new TextDecoder().decode(bytes.subarray(i, i + len));
+      if (field === 3) out.message = text;
+      if (field === 4) out.name = text;
+      i += len;
+    } else fail(`foxglove.Log: wire type ${wire}`);
+  }
+  return out;
+}
+let clicked;
 
 client.on("error", (e) => fail(`client error: ${e}`));
 client.on("serverInfo", (i) => {
@@ -85,10 +121,15 @@ client.on("advertise", (list) => {
   const id = (t) => channels.find((c) => c.topic === t).id;
   const stats = client.subscribe(id("/stats"));
   const scene = client.subscribe(id("/scene"));
+  const events = client.subscribe(id("/events"));
   client.on("message", ({ subscriptionId, data }) => {
     const bytes = new Uint8Array(data.buffer, data.byteOffset, data.byteLength);
     if (subscriptionId === stats) frames.push(statsFrame(bytes));
     if (subscriptionId === scene) scenes += 1;
+    if (subscriptionId === events) {
+      const line = logLine(bytes);
+      if (line.name === "click") clicked?.(line.message);
+    }
     if (frames.length === 10 && !published) {
       published = true;
       publish();
@@ -114,10 +155,48 @@ async function services_() {
   if (back.frame !== 10 || !back.recording) fail(`/seek 10 answered ${JSON.stringify(back)}`);
   const reset = await callService("/reset", {});
   if (reset.frame !== 0) fail(`/reset answered ${JSON.stringify(reset)}`);
+  const queried = await queries();
   await callService("/play", {});
-  servicesDone = `services: paused at ${paused.frame}, stepped to ${stepped.frame}, sought back to ${back.frame}, reset to ${reset.frame}`;
+  servicesDone = `services: paused at ${paused.frame}, stepped to ${stepped.frame}, sought back to ${back.frame}, reset to ${reset.frame}; ${queried}`;
 }
 let servicesDone = "";
+
+// At frame 0, still paused: the ship at (0, 0), angle 0.
+async function queries() {
+  const near = (a, b) => Math.abs(a - b) <= 1e-9;
+  const ray = await callService("/query", {
+    kind: "ray", origin: [-10, 0], direction: [2, 0], max_distance: 20, layers: ["ship"],
+  });
+  const hit = ray.hits?.[0];
+  const exact = ray.count === 1 && hit.body === "0:0" && hit.name === "ship" && hit.layer === "ship" &&
+    near(hit.distance, 9.2) && near(hit.point[0], -0.8) && near(hit.point[1], 0) &&
+    near(hit.normal[0], -1) && near(hit.normal[1], 0);
+  if (!exact) fail(`/query ray answered ${JSON.stringify(ray)}`);
+  const point = await callService("/query", { kind: "point", point: [0.2, 0] });
+  if (point.count !== 1 || point.hits[0].name !== "ship") fail(`/query point answered ${JSON.stringify(point)}`);
+  const refused = await callService("/query", { kind: "point", point: [0, 0], layers: ["lava"] }).then(
+    (a) => fail(`/query with an unknown layer answered ${JSON.stringify(a)}`),
+    (e) => e.message,
+  );
+  if (!refused.includes("no layer")) fail(`/query with an unknown layer: ${refused}`);
+  // As Lichtblick's 3D panel: advertised with the first encoding the server supports, the
+  // message as its makePointMessage builds it, in the display frame.
+  const channel = client.advertise({
+    topic: "/clicked_point", encoding: "json", schemaName: "geometry_msgs/PointStamped",
+  });
+  const answer = new Promise((resolve) => (clicked = resolve));
+  const now = Date.now();
+  const message = {
+    header: { stamp: { sec: Math.floor(now / 1000), nsec: (now % 1000) * 1e6 }, frame_id: "world" },
+    point: { x: 0.2, y: 0, z: 0 },
+  };
+  client.sendMessage(channel, new TextEncoder().encode(JSON.stringify(message)));
+  const line = await answer;
+  if (!line.startsWith("click at [0.2, 0]: ship #0:0 (layer ship, dynamic, ") || !line.includes("position [0, 0], angle 0,")) {
+    fail(`the click was answered ${line}`);
+  }
+  return `/query: the ship at distance ${hit.distance}, a point, an unknown layer refused; a click answered on /events`;
+}
 
 function finish() {
   for (let i = 1; i < frames.length; i++) {
