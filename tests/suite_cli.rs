@@ -323,3 +323,88 @@ fn suite_an_item_prints_one_json_result_line_with_the_golden_digest() {
         std::fs::read(dir.path().join("recordings/platformer.mcap")).unwrap()
     );
 }
+
+/// The verdict lines of running `docs/examples/` as a scheduler would, once per task index
+/// `0..n`, with `env(k)` set; each task's output is checked to end with its summary.
+fn run_example(
+    dir: &Path,
+    n: usize,
+    command: &[&str],
+    env: impl Fn(usize) -> Vec<(String, String)>,
+) -> Vec<String> {
+    let bin = Path::new(env!("CARGO_BIN_EXE_ricochet")).parent().unwrap();
+    let path = format!(
+        "{}:{}",
+        bin.display(),
+        std::env::var("PATH").unwrap_or_default()
+    );
+    let mut lines = Vec::new();
+    for k in 0..n {
+        let o = std::process::Command::new(command[0])
+            .args(&command[1..])
+            .current_dir(dir)
+            .env("PATH", &path)
+            .envs(env(k))
+            .output()
+            .unwrap();
+        let out = stdout(&o);
+        assert_eq!(
+            o.status.code(),
+            Some(0),
+            "task {k}: {out}{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        assert!(
+            out.lines().last().unwrap().ends_with(" passed, 0 failed"),
+            "{out}"
+        );
+        lines.extend(verdicts(&out).into_iter().map(str::to_owned));
+    }
+    lines.sort();
+    lines
+}
+
+#[test]
+fn suite_the_slurm_and_kubernetes_examples_run_every_scenario_once() {
+    let dir = suite_copy();
+    let all: Vec<String> = names()
+        .iter()
+        .map(|n| format!("scenarios/{n}.toml: ok"))
+        .collect();
+    let script = crate::util::root().join("docs/examples/slurm-golden.sh");
+    let slurm = run_example(dir.path(), 3, &["bash", script.to_str().unwrap()], |k| {
+        vec![
+            ("SLURM_ARRAY_TASK_ID".into(), k.to_string()),
+            ("SLURM_ARRAY_TASK_COUNT".into(), "3".into()),
+            ("SLURM_CPUS_PER_TASK".into(), "1".into()),
+        ]
+    });
+    assert_eq!(slurm, all);
+    for k in 0..3 {
+        assert!(dir.path().join(format!("reports/golden-{k}.xml")).is_file());
+    }
+    // The Job's container command, as its shell runs it, with each completion index.
+    let yaml =
+        std::fs::read_to_string(crate::util::root().join("docs/examples/k8s-golden.yaml")).unwrap();
+    let completions: usize = yaml
+        .lines()
+        .find_map(|l| l.trim().strip_prefix("completions:"))
+        .and_then(|v| v.split('#').next())
+        .unwrap()
+        .trim()
+        .parse()
+        .unwrap();
+    let command = yaml
+        .lines()
+        .find_map(|l| l.trim().strip_prefix("- ricochet test"))
+        .map(|rest| format!("ricochet test{rest}"))
+        .unwrap();
+    assert!(
+        command.contains(&format!("--shard \"$JOB_COMPLETION_INDEX/{completions}\"")),
+        "{command}"
+    );
+    let k8s = run_example(dir.path(), completions, &["sh", "-c", &command], |k| {
+        vec![("JOB_COMPLETION_INDEX".into(), k.to_string())]
+    });
+    assert_eq!(k8s, all);
+}
