@@ -216,7 +216,10 @@ fn judge(
         .map_err(|e| format!("{}: frames {}: {e}", path.display(), scenario.frames))?;
     let temp;
     let log = match opts.out {
-        Some(dir) => dir.join(format!("{name}.mcap")),
+        Some(dir) => {
+            std::fs::create_dir_all(dir).map_err(|e| format!("--out {}: {e}", dir.display()))?;
+            dir.join(format!("{name}.mcap"))
+        }
         None => {
             temp = tempfile::tempdir().map_err(|e| format!("a temporary directory: {e}"))?;
             temp.path().join(format!("{name}.mcap"))
