@@ -305,7 +305,8 @@ See docs/suites.md: the result line of one item, Slurm and Kubernetes examples."
         #[arg(long, value_name = "DIR")]
         golden: Option<PathBuf>,
         /// Scenarios run at once, each in its own process. Default: the number of cores.
-        #[arg(short, long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=256))]
+        #[arg(short, long, value_name = "N", conflicts_with = "item",
+              value_parser = clap::value_parser!(u16).range(1..=256))]
         jobs: Option<u16>,
         /// Write the goldens (log and digest, each through a temporary file renamed into
         /// place) instead of comparing; each line says `blessed (new)`, `blessed

@@ -408,3 +408,74 @@ fn suite_the_slurm_and_kubernetes_examples_run_every_scenario_once() {
     });
     assert_eq!(k8s, all);
 }
+
+#[test]
+fn suite_ctrl_c_stops_the_run_and_leaves_every_golden_whole() {
+    // Scenarios long enough to be under way when the signal comes (tens of seconds each
+    // in a debug build), so that their blessing is what a stop must not tear.
+    let dir = tempfile::tempdir().unwrap();
+    let long = dir.path().join("long");
+    let golden = dir.path().join("golden");
+    std::fs::create_dir_all(&long).unwrap();
+    std::fs::create_dir_all(&golden).unwrap();
+    let text = std::fs::read_to_string(crate::util::root().join("scenarios/platformer.toml"))
+        .unwrap()
+        .lines()
+        .map(|l| {
+            if l.starts_with("frames = ") {
+                "frames = 200000".to_owned()
+            } else {
+                l.to_owned()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    for n in ["p1", "p2", "p3"] {
+        std::fs::write(long.join(format!("{n}.toml")), &text).unwrap();
+    }
+    // An old golden, which the stopped bless must leave as it was.
+    let old = std::fs::read(crate::util::root().join("recordings/platformer.mcap")).unwrap();
+    std::fs::write(golden.join("p1.mcap"), &old).unwrap();
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_ricochet"))
+        .args(["test", "long", "--golden", "golden", "--bless", "-j", "2"])
+        .current_dir(dir.path())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let kill = std::process::Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    // Bounded: a run the signal did not stop ends the test, not the CI job.
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(120);
+    while child.try_wait().unwrap().is_none() {
+        if std::time::Instant::now() > deadline {
+            let _ = child.kill();
+            panic!("Ctrl-C did not stop `ricochet test` within 120 s");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    let o = child.wait_with_output().unwrap();
+    let out = stdout(&o);
+    assert_eq!(
+        o.status.code(),
+        Some(130),
+        "{out}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert_eq!(
+        out,
+        "long/p1.toml: interrupted\nlong/p2.toml: interrupted\n0 passed, 2 failed\n"
+    );
+    assert!(String::from_utf8_lossy(&o.stderr).contains("1 of 3 scenarios not started"));
+    let mut left: Vec<String> = std::fs::read_dir(&golden)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    left.sort();
+    assert_eq!(left, ["p1.mcap"], "no new golden, no temporary file");
+    assert!(std::fs::read(golden.join("p1.mcap")).unwrap() == old);
+}
