@@ -24,6 +24,7 @@ mod replay;
 mod run;
 mod serve;
 mod session;
+mod suite;
 mod validate;
 
 use std::path::PathBuf;
@@ -266,6 +267,70 @@ enum Command {
         #[arg(long, conflicts_with_all = ["record", "csv"])]
         queries: bool,
     },
+    /// Run a folder of scenarios against their golden logs: any change in your game's
+    /// physics fails, with its first divergence named.
+    ///
+    /// Each scenario (a file, or every *.toml at the top of a folder; default: scenarios/)
+    /// is recorded as `ricochet run` records it and compared with its golden log
+    /// GOLDEN/NAME.mcap and digest GOLDEN/NAME.digest (frames, bodies, and a hash of the
+    /// final state). One line per scenario, sorted by name: `ok`, `differs: frame 185,
+    /// /contacts, pair 6:0/9:0, depth 0.031 → 0.029` (the first divergence, as `ricochet
+    /// diff` finds it), or `no golden (run with --bless)`; then `N passed, M failed`. The
+    /// output is the same bytes whatever -j or --shard. Each scenario runs in its own
+    /// process, -j at a time. Ctrl-C stops: no more are started, the running ones stop at
+    /// their next frame, and no golden is left half-written.
+    ///
+    /// Exit code: 0 all passed, 1 any failed (a scenario that does not load is a failed
+    /// line), 2 bad input (no such path, a folder without scenarios, a bad --shard), 130
+    /// interrupted.
+    #[command(after_help = "\
+Examples:
+  ricochet test                           every scenarios/*.toml against recordings/
+  ricochet test levels --golden goldens   your folders
+  ricochet test scenarios/platformer.toml one scenario
+  ricochet test --bless                   write the goldens, saying which changed
+  ricochet test --junit report.xml        also a JUnit report for CI
+  ricochet test --shard 0/4               the first of 4 slices (a job array's task)
+  ricochet test --keep fresh              keep the fresh logs, then:
+  ricochet diff recordings/level.mcap fresh/level.mcap
+
+See docs/suites.md: the result line of one item, Slurm and Kubernetes examples.")]
+    Test {
+        /// Scenario files or folders (the *.toml at a folder's top level). Default:
+        /// scenarios/.
+        #[arg(conflicts_with = "item")]
+        paths: Vec<PathBuf>,
+        /// The folder of golden logs and digests. Default: recordings/ beside each
+        /// scenario's folder (game/scenarios/a.toml: game/recordings/a.mcap).
+        #[arg(long, value_name = "DIR")]
+        golden: Option<PathBuf>,
+        /// Scenarios run at once, each in its own process. Default: the number of cores.
+        #[arg(short, long, value_name = "N", conflicts_with = "item",
+              value_parser = clap::value_parser!(u16).range(1..=256))]
+        jobs: Option<u16>,
+        /// Write the goldens (log and digest, each through a temporary file renamed into
+        /// place) instead of comparing; each line says `blessed (new)`, `blessed
+        /// (changed)` or `unchanged`.
+        #[arg(long)]
+        bless: bool,
+        /// Also write the results as JUnit XML here (one testcase per scenario).
+        #[arg(long, value_name = "FILE", conflicts_with = "item")]
+        junit: Option<PathBuf>,
+        /// Run only the K-th (from 0) of N slices of the sorted scenarios: items K, K+N,
+        /// K+2N, ... The N shards together are the whole suite, each scenario once.
+        #[arg(long, value_name = "K/N", conflicts_with = "item")]
+        shard: Option<suite::shard::Shard>,
+        /// Keep the fresh logs in this folder, as NAME.mcap (created if missing).
+        #[arg(long, value_name = "DIR", conflicts_with = "item")]
+        keep: Option<PathBuf>,
+        /// Run one scenario and print its result as one JSON line (docs/suites.md): what
+        /// each of the runner's processes, or a cluster worker, runs.
+        #[arg(long, value_name = "SCENARIO", hide = true)]
+        item: Option<PathBuf>,
+        /// With --item: keep the fresh log in this folder, as NAME.mcap.
+        #[arg(long, value_name = "DIR", hide = true, requires = "item")]
+        out: Option<PathBuf>,
+    },
     /// Check a scenario file without running it: syntax, units, layers, templates, script.
     ///
     /// Errors are printed as FILE:LINE:COLUMN: FIELD: PROBLEM, with exit code 2.
@@ -350,6 +415,31 @@ fn main() -> ExitCode {
         }
         Command::Validate { scenario, frames } => validate::run(&scenario, frames),
         Command::Check { scenario } => check::check(&scenario),
+        Command::Test {
+            item: Some(item),
+            golden,
+            out,
+            bless,
+            ..
+        } => suite::run_item(&item, golden.as_deref(), out.as_deref(), bless),
+        Command::Test {
+            paths,
+            golden,
+            jobs,
+            bless,
+            junit,
+            shard,
+            keep,
+            ..
+        } => suite::run(&suite::Options {
+            paths,
+            golden,
+            jobs: jobs.map(usize::from),
+            bless,
+            junit,
+            shard,
+            keep,
+        }),
         Command::Bench {
             scenes,
             frames,

@@ -1,17 +1,19 @@
-//! Golden logs: every scenario in `scenarios/` is re-run and must give the recording in
-//! `recordings/` byte for byte, and the digest of its final state (Box2D's determinism gate:
-//! frame count and a hash of every body's raw float bits in id order) must match
-//! `recordings/<name>.digest`.
+//! Golden logs: every scenario in `scenarios/` is re-run by `ricochet test scenarios
+//! --golden recordings` (the runner a game uses on its own scenarios) and must give the
+//! recording in `recordings/` byte for byte, and the digest of its final state (Box2D's
+//! determinism gate: frame count and a hash of every body's raw float bits in id order)
+//! must match `recordings/<name>.digest`.
 //!
-//! On a mismatch the test prints `ricochet diff`'s report (first divergent frame, topic,
-//! body, field, both values). If the change is intended, re-bless:
-//! `RICOCHET_BLESS=1 cargo test --test integration golden`.
+//! On a mismatch the test prints the runner's lines and `ricochet diff`'s report of each
+//! failing scenario (first divergent frame, topic, body, field, both values). If the change
+//! is intended, re-bless: `RICOCHET_BLESS=1 cargo test --test integration golden`, which
+//! runs `ricochet test scenarios --golden recordings --bless`.
 
 use std::path::{Path, PathBuf};
 
-use ricochet_sim::{Simulation, load_scenario};
+use ricochet_sim::load_scenario;
 
-use crate::util::{record, ricochet, root, scenarios};
+use crate::util::{one_ulp_up, record, ricochet, root, scenarios};
 
 const BLESS: &str = "RICOCHET_BLESS=1 cargo test --test integration golden";
 
@@ -22,20 +24,79 @@ fn recording(name: &str, ext: &str) -> PathBuf {
     root().join("recordings").join(format!("{name}.{ext}"))
 }
 
-/// `frames N`, `bodies N`, `hash X` of the scenario's final state, computed by the library.
-fn digest(scenario: &Path) -> String {
-    let text = std::fs::read_to_string(scenario).unwrap();
-    let s = load_scenario(&text, &scenario.display().to_string()).unwrap();
-    let mut sim = Simulation::new(&s);
-    for _ in 0..=s.frames {
-        sim.step();
+#[test]
+fn golden_every_scenario_matches_its_recording_and_digest() {
+    let bless = std::env::var_os("RICOCHET_BLESS").is_some_and(|v| v == "1");
+    let fresh = tempfile::tempdir().unwrap();
+    let keep = fresh.path().to_str().unwrap();
+    let mut args = vec![
+        "test",
+        "scenarios",
+        "--golden",
+        "recordings",
+        "--keep",
+        keep,
+    ];
+    if bless {
+        args.push("--bless");
     }
-    format!(
-        "frames {}\nbodies {}\nhash {:016x}\n",
-        s.frames,
-        sim.world().len(),
-        sim.world().digest()
-    )
+    let o = ricochet(&args, b"");
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    let expected = scenarios();
+    // The sizes of the fresh logs, which equal the recordings when the test passes.
+    for scenario in &expected {
+        let name = scenario.file_stem().unwrap().to_string_lossy();
+        let log = fresh.path().join(format!("{name}.mcap"));
+        let size = std::fs::metadata(&log)
+            .unwrap_or_else(|e| panic!("{}: {e}\n{stdout}", log.display()))
+            .len();
+        assert!(
+            size <= MAX_RECORDING_BYTES,
+            "{name}.mcap is {size} bytes, over {MAX_RECORDING_BYTES}"
+        );
+    }
+    let mut report = String::new();
+    for line in stdout.lines().filter(|l| l.contains(": differs")) {
+        let name = Path::new(line.split(':').next().unwrap())
+            .file_stem()
+            .unwrap()
+            .to_string_lossy()
+            .into_owned();
+        let fresh_log = fresh.path().join(format!("{name}.mcap"));
+        let golden = recording(&name, "mcap");
+        let d = ricochet(
+            &[
+                "diff",
+                golden.to_str().unwrap(),
+                fresh_log.to_str().unwrap(),
+            ],
+            b"",
+        );
+        report += &String::from_utf8_lossy(&d.stdout);
+    }
+    assert!(
+        o.status.success(),
+        "the golden logs or digests no longer match:\n{stdout}{}\n{report}\nIf this change in \
+         the physics is intended, re-bless the recordings:\n    {BLESS}\n",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    // Every scenario was judged, each on its own line, then the summary.
+    let n = expected.len();
+    assert_eq!(stdout.lines().count(), n + 1, "{stdout}");
+    let verdict = if bless { "" } else { ": ok" };
+    for scenario in &expected {
+        let shown = scenario.strip_prefix(root()).unwrap().display().to_string();
+        assert!(
+            stdout
+                .lines()
+                .any(|l| l.starts_with(&format!("{shown}:")) && l.contains(verdict)),
+            "{shown} has no line with {verdict:?}:\n{stdout}"
+        );
+    }
+    assert!(
+        stdout.ends_with(&format!("\n{n} passed, 0 failed\n")),
+        "{stdout}"
+    );
 }
 
 /// Compares a fresh log with the golden one; the error says what diverged and what to do.
@@ -60,65 +121,9 @@ fn compare(golden: &Path, fresh: &Path) -> Result<(), String> {
 }
 
 #[test]
-fn golden_every_scenario_matches_its_recording_and_digest() {
-    let bless = std::env::var_os("RICOCHET_BLESS").is_some_and(|v| v == "1");
-    let dir = tempfile::tempdir().unwrap();
-    let mut failures = Vec::new();
-    for scenario in scenarios() {
-        let name = scenario.file_stem().unwrap().to_string_lossy().into_owned();
-        let fresh = dir.path().join(format!("{name}.mcap"));
-        record(&scenario, &fresh);
-        let size = std::fs::metadata(&fresh).unwrap().len();
-        assert!(
-            size <= MAX_RECORDING_BYTES,
-            "{name}.mcap is {size} bytes, over {MAX_RECORDING_BYTES}"
-        );
-        let d = digest(&scenario);
-        if bless {
-            std::fs::copy(&fresh, recording(&name, "mcap")).unwrap();
-            std::fs::write(recording(&name, "digest"), &d).unwrap();
-            continue;
-        }
-        if let Err(e) = compare(&recording(&name, "mcap"), &fresh) {
-            failures.push(e);
-        }
-        let kept = std::fs::read_to_string(recording(&name, "digest")).unwrap_or_default();
-        if kept != d {
-            failures.push(format!(
-                "{name}: the final-state digest changed\n  recorded:\n{kept}  now:\n{d}If intended:\n    {BLESS}\n"
-            ));
-        }
-    }
-    assert!(failures.is_empty(), "{}", failures.join("\n"));
-}
-
-/// The velocity line of the first body that has one, nudged up by one ulp in x.
-fn perturbed(text: &str) -> (String, usize) {
-    let mut out = String::new();
-    let mut body = None;
-    let mut bodies = 0;
-    for line in text.lines() {
-        if line.trim_start().starts_with("[[bodies]]") {
-            bodies += 1;
-        }
-        let mut line = line.to_owned();
-        if body.is_none() && bodies > 0 && line.starts_with("velocity = [") {
-            let inner = &line["velocity = [".len()..line.find(']').unwrap()];
-            let (x, rest) = inner.split_once(',').unwrap();
-            let x: f64 = x.trim().parse().unwrap();
-            line = format!("velocity = [{:?},{rest}]", x.next_up());
-            body = Some(bodies - 1);
-        }
-        out.push_str(&line);
-        out.push('\n');
-    }
-    (out, body.expect("a body with a velocity line"))
-}
-
-#[test]
 fn golden_a_one_ulp_velocity_change_fails_and_the_diff_names_the_body_and_frame() {
     let scenario = root().join("scenarios/asteroids.toml");
-    let (text, index) = perturbed(&std::fs::read_to_string(&scenario).unwrap());
+    let (text, index) = one_ulp_up(&std::fs::read_to_string(&scenario).unwrap());
     let name = load_scenario(&text, "perturbed.toml").unwrap().bodies[index]
         .name
         .clone();

@@ -122,3 +122,56 @@ pub fn shape_def(v: &serde_json::Value) -> ricochet_geom::ShapeDef {
         other => panic!("unknown shape kind {other}"),
     }
 }
+
+/// Runs the built `ricochet` binary with `args` in the folder `dir`, stdin empty.
+pub fn ricochet_in(dir: &std::path::Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_ricochet"))
+        .args(args)
+        .current_dir(dir)
+        .stdin(Stdio::null())
+        .output()
+        .expect("the ricochet binary starts")
+}
+
+/// A temporary folder holding a copy of `scenarios/*.toml` (the top level) and of
+/// `recordings/`, as a game's repository would: for tests that change or bless them.
+pub fn suite_copy() -> tempfile::TempDir {
+    let dir = tempfile::tempdir().expect("a temporary folder");
+    for (from, to) in [("scenarios", "scenarios"), ("recordings", "recordings")] {
+        std::fs::create_dir(dir.path().join(to)).unwrap();
+        for entry in std::fs::read_dir(root().join(from)).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_file() {
+                std::fs::copy(&path, dir.path().join(to).join(path.file_name().unwrap())).unwrap();
+            }
+        }
+    }
+    dir
+}
+
+/// A scenario's text with the x velocity of the first body that has a `velocity = [x, y]`
+/// line raised by one ulp (the next float up, from its bits), and that body's index in the
+/// file (its id: bodies are spawned in file order).
+pub fn one_ulp_up(text: &str) -> (String, usize) {
+    let mut out = String::new();
+    let mut body = None;
+    let mut bodies = 0;
+    for line in text.lines() {
+        if line.trim_start().starts_with("[[bodies]]") {
+            bodies += 1;
+        }
+        let mut line = line.to_owned();
+        if body.is_none() && bodies > 0 && line.starts_with("velocity = [") {
+            let inner = &line["velocity = [".len()..line.find(']').unwrap()];
+            let (x, rest) = inner.split_once(',').unwrap();
+            let x: f64 = x.trim().parse().unwrap();
+            let up = f64::from_bits(x.to_bits() + 1);
+            assert!(x > 0.0 && up > x, "a positive x to raise: {x}");
+            line = format!("velocity = [{up:?},{rest}]");
+            body = Some(bodies - 1);
+        }
+        out.push_str(&line);
+        out.push('\n');
+    }
+    (out, body.expect("a body with a velocity line"))
+}

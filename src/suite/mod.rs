@@ -1,0 +1,276 @@
+//! `ricochet test [PATHS…]`: the golden-log runner for a folder of scenarios.
+//!
+//! Each scenario is one item: recorded as `ricochet run` records it and compared with its
+//! golden log and digest (`item.rs`), in its own process (`pool.rs`, `-j N` at a time). The
+//! runner gathers the items, sorts them, keeps its `--shard` (`shard.rs`), and prints the
+//! verdicts in that sorted order, whatever order the processes finish in, so the output is
+//! the same bytes with any `-j` and shards concatenate to the whole suite. Then the summary
+//! `N passed, M failed`, and `--junit` (`junit.rs`).
+
+pub mod item;
+mod junit;
+mod pool;
+pub mod shard;
+
+use std::collections::BTreeMap;
+use std::ffi::OsString;
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+use crate::out;
+use item::{ItemOptions, ItemResult, default_golden, name_of};
+use shard::Shard;
+
+/// The folder `ricochet test` runs without paths.
+pub const DEFAULT_FOLDER: &str = "scenarios";
+
+/// The name of the JUnit testsuite.
+const SUITE: &str = "ricochet test";
+
+/// `ricochet test`'s options, as parsed.
+pub struct Options {
+    /// Scenario files and folders (the `*.toml` at a folder's top level).
+    pub paths: Vec<PathBuf>,
+    /// The goldens' folder; default: `recordings/` beside each scenario's folder.
+    pub golden: Option<PathBuf>,
+    /// Item processes at once; default: the number of cores.
+    pub jobs: Option<usize>,
+    /// Write the goldens instead of comparing.
+    pub bless: bool,
+    /// Also write a JUnit XML report here.
+    pub junit: Option<PathBuf>,
+    /// Run only this slice of the sorted items.
+    pub shard: Option<Shard>,
+    /// Keep the fresh logs in this folder (NAME.mcap); default: a temporary folder.
+    pub keep: Option<PathBuf>,
+}
+
+/// Sets a flag on Ctrl-C, SIGTERM and SIGHUP. If a handler can't be installed, the signal
+/// just ends the process; goldens are still only ever renamed into place whole.
+fn stop_flag() -> Arc<AtomicBool> {
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&stop);
+    let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
+    stop
+}
+
+/// `ricochet test --item SCENARIO`: runs one item and prints its result line (JSON). Exit
+/// code 0 passed, 1 failed.
+pub fn run_item(
+    scenario: &Path,
+    golden: Option<&Path>,
+    out_dir: Option<&Path>,
+    bless: bool,
+) -> anyhow::Result<ExitCode> {
+    let stop = stop_flag();
+    let result = item::run(
+        &ItemOptions {
+            scenario,
+            golden,
+            out: out_dir,
+            bless,
+        },
+        &stop,
+    );
+    out::print(&(serde_json::to_string(&result)? + "\n"))?;
+    Ok(if result.verdict.passed() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
+}
+
+/// The scenarios the paths name, sorted by name then path, each once; `Err` is a bad-input
+/// message (exit code 2).
+fn gather(paths: &[PathBuf], golden: Option<&Path>) -> Result<Vec<PathBuf>, String> {
+    let default = [PathBuf::from(DEFAULT_FOLDER)];
+    let paths = if paths.is_empty() {
+        &default[..]
+    } else {
+        paths
+    };
+    let mut items = Vec::new();
+    for path in paths {
+        let shown = out::escape_controls(&path.display().to_string());
+        let meta = std::fs::metadata(path).map_err(|e| format!("{shown}: {e}"))?;
+        if !meta.is_dir() {
+            items.push(path.clone());
+            continue;
+        }
+        let mut found: Vec<PathBuf> = std::fs::read_dir(path)
+            .map_err(|e| format!("{shown}: {e}"))?
+            .filter_map(Result::ok)
+            .map(|e| e.path())
+            .filter(|p| p.extension().is_some_and(|e| e == "toml") && p.is_file())
+            .collect();
+        if found.is_empty() {
+            return Err(format!(
+                "{shown}: no scenario files (*.toml) at the top of this folder"
+            ));
+        }
+        found.sort();
+        items.extend(found);
+    }
+    items.sort_by_key(|p| (name_of(p), p.clone()));
+    items.dedup();
+    // Two scenarios with one name would share a golden: each must have its own.
+    let mut owners: BTreeMap<(PathBuf, String), &Path> = BTreeMap::new();
+    for p in &items {
+        let dir = golden.map_or_else(|| default_golden(p), Path::to_owned);
+        let name = name_of(p);
+        if let Some(other) = owners.insert((dir.clone(), name.clone()), p) {
+            return Err(format!(
+                "{} and {} would share the golden {}: rename one",
+                out::escape_controls(&other.display().to_string()),
+                out::escape_controls(&p.display().to_string()),
+                out::escape_controls(&dir.join(format!("{name}.mcap")).display().to_string())
+            ));
+        }
+    }
+    Ok(items)
+}
+
+/// `ricochet test`: exit code 0 all passed, 1 any failed, 2 bad input, 130 interrupted.
+pub fn run(opts: &Options) -> anyhow::Result<ExitCode> {
+    let items = match gather(&opts.paths, opts.golden.as_deref()) {
+        Ok(items) => items,
+        Err(e) => {
+            out::error(&format!("error: {e}"));
+            return Ok(ExitCode::from(2));
+        }
+    };
+    if let Some(g) = &opts.golden
+        && !opts.bless
+        && !g.is_dir()
+    {
+        out::error(&format!(
+            "error: --golden {}: no such folder (--bless creates it)",
+            out::escape_controls(&g.display().to_string())
+        ));
+        return Ok(ExitCode::from(2));
+    }
+    if let Some(j) = &opts.junit
+        && let Err(e) = crate::files::check_writable(j)
+    {
+        out::error(&format!("error: --junit: {e:#}"));
+        return Ok(ExitCode::from(2));
+    }
+    let items = match opts.shard {
+        Some(s) => s.select(items),
+        None => items,
+    };
+    let temp;
+    let logs = match &opts.keep {
+        Some(dir) => {
+            if let Err(e) = std::fs::create_dir_all(dir) {
+                out::error(&format!("error: --keep {}: {e}", dir.display()));
+                return Ok(ExitCode::from(2));
+            }
+            dir.clone()
+        }
+        None => {
+            temp = tempfile::tempdir()?;
+            temp.path().to_owned()
+        }
+    };
+    let jobs = opts
+        .jobs
+        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, usize::from));
+    let stop = stop_flag();
+    let started = Instant::now();
+    let bar = std::io::stderr().is_terminal().then(|| {
+        let bar = indicatif::ProgressBar::new(items.len() as u64);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} scenarios {elapsed}")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        bar
+    });
+    let argv = |i: usize| {
+        let scenario: &Path = &items[i];
+        let mut a: Vec<OsString> = vec!["test".into(), "--item".into(), scenario.into()];
+        a.extend(["--out".into(), logs.clone().into_os_string()]);
+        if let Some(g) = &opts.golden {
+            a.extend(["--golden".into(), g.clone().into_os_string()]);
+        }
+        if opts.bless {
+            a.push("--bless".into());
+        }
+        (scenario.to_owned(), a)
+    };
+    // Results by item; printed in item order as soon as every earlier one is in.
+    let mut results: Vec<Option<ItemResult>> = vec![None; items.len()];
+    let mut printed = 0;
+    let mut write_error = None;
+    let started_count = pool::run(items.len(), jobs, &stop, argv, |i, r| {
+        results[i] = Some(r);
+        if let Some(b) = &bar {
+            b.inc(1);
+        }
+        while let Some(Some(r)) = results.get(printed) {
+            let line = format!("{}: {}\n", out::escape_controls(&r.scenario), r.line);
+            let written = match &bar {
+                Some(b) => b.suspend(|| out::print(&line)),
+                None => out::print(&line),
+            };
+            if let Err(e) = written {
+                write_error.get_or_insert(e);
+            }
+            printed += 1;
+        }
+    })?;
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    if let Some(e) = write_error {
+        return Err(e.into());
+    }
+    let interrupted = stop.load(Ordering::SeqCst);
+    // After a stop, the results that came in after a missing one.
+    let done: Vec<ItemResult> = results.into_iter().flatten().collect();
+    for r in done.iter().skip(printed) {
+        out::print(&format!(
+            "{}: {}\n",
+            out::escape_controls(&r.scenario),
+            r.line
+        ))?;
+    }
+    let passed = done.iter().filter(|r| r.verdict.passed()).count();
+    let failed = done.len() - passed;
+    out::print(&format!("{passed} passed, {failed} failed\n"))?;
+    if let Some(path) = &opts.junit {
+        junit::write(path, SUITE, &done)?;
+    }
+    let shard = opts
+        .shard
+        .map_or_else(String::new, |s| format!(" (shard {s})"));
+    out::note(&format!(
+        "{} scenario{}{shard} in {:.1} s, {} at a time",
+        done.len(),
+        if done.len() == 1 { "" } else { "s" },
+        started.elapsed().as_secs_f64(),
+        jobs.min(items.len()).max(1)
+    ))?;
+    if interrupted {
+        let stopped = done
+            .iter()
+            .filter(|r| r.verdict == item::Verdict::Interrupted)
+            .count();
+        out::note(&format!(
+            "interrupted: {} of {} scenarios not started, {stopped} stopped; no golden was \
+             left half-written",
+            items.len() - started_count,
+            items.len()
+        ))?;
+        return Ok(ExitCode::from(130));
+    }
+    Ok(if failed == 0 {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
+}
