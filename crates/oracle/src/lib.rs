@@ -38,6 +38,7 @@ mod frame_report;
 mod motion;
 mod pairs;
 mod referee;
+mod scene_queries;
 mod seam;
 mod summary;
 mod swept;
@@ -48,6 +49,7 @@ pub use motion::{
     rapier_free_flight,
 };
 pub use referee::{FrameReport, Referee};
+pub use scene_queries::{QueryReferee, QueryTolerance, ReferenceRayHit};
 pub use summary::{MAX_DETAILS, ValidationSummary, summary_table, validate};
 
 /// How closely Ricochet and rapier must agree on one contact.
