@@ -45,7 +45,10 @@ struct Tally {
     asked: BTreeMap<&'static str, usize>,
     rules: BTreeMap<&'static str, usize>,
     unexplained: Vec<String>,
-    worst_distance: f64,
+    /// Worst ray distance difference, world units.
+    worst_ray: f64,
+    /// Worst cast difference along the path, world units.
+    worst_cast: f64,
     worst_normal: f64,
 }
 
@@ -70,7 +73,8 @@ impl Tally {
             *self.rules.entry(k).or_default() += v;
         }
         self.unexplained.extend(o.unexplained);
-        self.worst_distance = self.worst_distance.max(o.worst_distance);
+        self.worst_ray = self.worst_ray.max(o.worst_ray);
+        self.worst_cast = self.worst_cast.max(o.worst_cast);
         self.worst_normal = self.worst_normal.max(o.worst_normal);
     }
 
@@ -79,8 +83,9 @@ impl Tally {
         let mut s = String::new();
         let _ = writeln!(
             s,
-            "{name}: asked {:?}, rules {:?}, worst distance {:e}, worst normal {:e} rad",
-            self.asked, self.rules, self.worst_distance, self.worst_normal
+            "{name}: asked {:?}, rules {:?}, worst ray distance {:e}, worst cast {:e}, worst \
+             normal {:e} rad",
+            self.asked, self.rules, self.worst_ray, self.worst_cast, self.worst_normal
         );
         for u in self.unexplained.iter().take(20) {
             let _ = writeln!(s, "  {u}");
@@ -300,7 +305,7 @@ fn compare_hit(
     let size = r
         .body(ours.entity)
         .map_or(1.0, |(s, _)| s.min_width().max(1e-3));
-    t.worst_distance = t.worst_distance.max(dd);
+    t.worst_ray = t.worst_ray.max(dd);
     if dd > b {
         t.fail(format!(
             "ray {o:?} along {d:?} max {max}: {:?} at {} (ricochet) vs {} (rapier), band {b:e}",
@@ -508,7 +513,7 @@ fn compare_cast(
     match (ours, theirs) {
         (None, None) => {}
         (Some((a, fa)), Some((b, fb))) if a == b => {
-            t.worst_distance = t.worst_distance.max((fa - fb).abs() * len);
+            t.worst_cast = t.worst_cast.max((fa - fb).abs() * len);
             if !agrees(a, fa, fb) {
                 let at = |f: f64| Pose::new(pose.position + tr * f, pose.angle);
                 t.fail(format!(
@@ -664,7 +669,7 @@ fn a_wrap_world_answers_as_its_nine_images() {
         match (ours, theirs) {
             (None, None) => {}
             (Some(a), Some(b)) if a.entity == original[&b.entity] => {
-                t.worst_distance = t.worst_distance.max((a.distance - b.distance).abs());
+                t.worst_ray = t.worst_ray.max((a.distance - b.distance).abs());
                 if (a.distance - b.distance).abs() > eps || (a.normal - b.normal).length() > eps {
                     t.fail(format!("wrap ray {o:?} along {d:?}: {a:?} vs images {b:?}"));
                 }
