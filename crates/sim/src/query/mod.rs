@@ -35,7 +35,7 @@ mod hits;
 pub(crate) mod index;
 mod wrap;
 
-use ricochet_geom::{Bounds, Pose, Ray, Shape, Sweep, Vec2};
+use ricochet_geom::{Aabb, Bounds, Pose, Primitive, Ray, Shape, Sweep, Vec2};
 
 pub use filter::QueryFilter;
 pub use hits::{RayHit, ShapeHit};
@@ -123,7 +123,8 @@ impl Simulation {
         };
         let trees = self.queries.trees(w);
         let (offsets, images) = wrap::offsets(wrap);
-        let mut stack = Vec::new();
+        // A walk holds at most one pending node per level (< 33): never regrown.
+        let mut stack = Vec::with_capacity(64);
         let mut best: Option<ShapeHit> = None;
         let mut segment = |from: Vec2, travelled: f64, len: f64| {
             let to = from + dir * len;
@@ -212,9 +213,16 @@ impl Simulation {
         if !ok {
             return Vec::new();
         }
-        let Ok(shape) = Shape::aabb(bounds.half_extents()) else {
+        let half = bounds.half_extents();
+        if half.x < ricochet_geom::MIN_SIZE || half.y < ricochet_geom::MIN_SIZE {
             return Vec::new();
-        };
+        }
+        // Checked above as `Shape::aabb` would check it, without its error text: that
+        // validation formats its field names, two allocations a query.
+        let shape = Shape::Primitive(Primitive::Aabb(Aabb {
+            center: Vec2::ZERO,
+            half_extents: half,
+        }));
         self.overlap_shape(&shape, Pose::new(bounds.center(), 0.0), filter)
     }
 
@@ -244,7 +252,8 @@ impl Simulation {
         let wrap = wrap::wrapping(self.scenario.world.bounds.as_ref());
         let shift = wrap.map_or(Vec2::ZERO, |b| wrap::wrap_point(b, q.center()) - q.center());
         let trees = self.queries.trees(w);
-        let mut stack = Vec::new();
+        // A walk holds at most one pending node per level (< 33): never regrown.
+        let mut stack = Vec::with_capacity(64);
         let mut found = Vec::new();
         let (offsets, images) = wrap::offsets(wrap);
         for &o in &offsets[..images] {
