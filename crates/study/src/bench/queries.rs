@@ -467,3 +467,43 @@ pub fn table(rows: &[QueryRow]) -> String {
     }
     s
 }
+
+#[cfg(test)]
+mod tests {
+    use ricochet_sim::{BodyDef, BodyKind, Layers, WorldDef};
+
+    use super::*;
+
+    /// A static unit box (half extents 0.5) at the origin, and a query box whose left face
+    /// is `gap` from its right face (x = 0.5).
+    fn skin(gap: f64) -> bool {
+        let mut sim = Simulation::from_def(WorldDef {
+            layers: Layers::new(vec!["a".into()]),
+            gravity: Vec2::ZERO,
+            ..WorldDef::default()
+        })
+        .unwrap();
+        let e = sim.spawn(&BodyDef {
+            kind: BodyKind::Static,
+            shape: Shape::aabb(Vec2::splat(0.5)).unwrap(),
+            ..BodyDef::default()
+        });
+        let b = Bounds {
+            min: Vec2::new(0.5 + gap, -0.25),
+            max: Vec2::new(1.5 + gap, 0.25),
+        };
+        within_skin(&sim, b, e)
+    }
+
+    #[test]
+    fn box2d_skin_counts_only_bodies_apart_by_at_most_the_skin() {
+        // The platformer-100-10 case: 3.4e-4 apart, inside Box2D's 5e-4.
+        assert!(skin(3.4e-4));
+        assert!(skin(0.0));
+        assert!(skin(BOX2D_OVERLAP_SKIN + BOX2D_SKIN_SLACK * 0.5));
+        // Beyond the skin and its f32 slack, or overlapping: a real difference.
+        assert!(!skin(BOX2D_OVERLAP_SKIN + BOX2D_SKIN_SLACK * 2.0));
+        assert!(!skin(1e-3));
+        assert!(!skin(-1e-3));
+    }
+}
