@@ -11,7 +11,10 @@
 //! the [`ValidationSummary`] with its printable [`summary_table`]; the rapier side of
 //! `ricochet bench` ([`bench`](mod@bench): rapier's collision-only pipeline on the same
 //! shapes and poses, and the rule by which two contact sets agree, judged with the referee's
-//! own recheck); and the one layer filter both use (`pairs.rs`: rapier's collision groups
+//! own recheck); the query referee's rapier side ([`QueryReferee`]: every body as a
+//! collider, asked through rapier's `QueryPipeline` as Ricochet's scene queries are asked,
+//! with the exact checks of the rules in `docs/validation.md`, "Scene queries"); and the one
+//! layer filter both use (`pairs.rs`: rapier's collision groups
 //! up to 32 layers, the layer matrix as a pair hook beyond). See `docs/validation.md` for
 //! the rules, the tolerances and the figures.
 //!
@@ -38,6 +41,7 @@ mod frame_report;
 mod motion;
 mod pairs;
 mod referee;
+mod scene_queries;
 mod seam;
 mod summary;
 mod swept;
@@ -48,6 +52,7 @@ pub use motion::{
     rapier_free_flight,
 };
 pub use referee::{FrameReport, Referee};
+pub use scene_queries::{QueryReferee, QueryTolerance, ReferenceRayHit};
 pub use summary::{MAX_DETAILS, ValidationSummary, summary_table, validate};
 
 /// How closely Ricochet and rapier must agree on one contact.

@@ -100,50 +100,74 @@ impl StaticTree {
 impl StaticTree {
     /// Calls `f` on every member whose bounds the segment `origin + t * dir`, `t` in
     /// `[0, max]`, may cross (a slab test, touching counts). `f` returns the new `max`: a
-    /// first-hit search shrinks it, so boxes beyond the best hit so far are skipped.
+    /// first-hit search shrinks it, so boxes beyond the best hit so far are skipped. Nearer
+    /// boxes are walked first (of two children, the one the segment enters first), so the
+    /// first hit is found early and prunes the rest.
     pub(crate) fn ray(
         &self,
         origin: Vec2,
         dir: Vec2,
         mut max: f64,
-        stack: &mut Vec<(u32, u32)>,
         f: &mut impl FnMut(&Member, f64) -> f64,
     ) {
         if self.items.is_empty() {
             return;
         }
         let inv = Vec2::new(1.0 / dir.x, 1.0 / dir.y);
-        stack.clear();
-        stack.push(((self.levels.len() - 1) as u32, 0));
-        while let Some((level, i)) = stack.pop() {
-            let (level, i) = (level as usize, i as usize);
-            if !crosses(&self.levels[level][i], origin, inv, max) {
+        let top = self.levels.len() - 1;
+        // One rounding margin for the whole walk: the root's, which is at least any box's.
+        let root = &self.levels[top][0];
+        let pad = root.max.abs().max(root.min.abs()).max(origin.abs()) * 1e-12;
+        // (level, index, entry distance). A walk that pushes two children per node holds at
+        // most one pending sibling per level, and a tree over 2^32 members has < 32 levels.
+        let mut stack = [(0u32, 0u32, 0.0f64); 64];
+        let Some(t) = enter(root, origin, inv, max, pad) else {
+            return;
+        };
+        stack[0] = (top as u32, 0, t);
+        let mut len = 1;
+        while len > 0 {
+            len -= 1;
+            let (level, i, t) = stack[len];
+            if t > max {
                 continue;
             }
+            let (level, i) = (level as usize, i as usize);
             if level == 0 {
                 let end = (i * LEAF + LEAF).min(self.items.len());
                 for m in &self.items[i * LEAF..end] {
-                    if crosses(&m.bounds, origin, inv, max) {
+                    if enter(&m.bounds, origin, inv, max, pad).is_some() {
                         max = f(m, max);
                     }
                 }
-            } else {
-                let below = self.levels[level - 1].len();
-                for c in [2 * i + 1, 2 * i] {
-                    if c < below {
-                        stack.push(((level - 1) as u32, c as u32));
-                    }
+                continue;
+            }
+            let below = &self.levels[level - 1];
+            let mut near = [None, None];
+            for (k, c) in [2 * i, 2 * i + 1].into_iter().enumerate() {
+                if let Some(b) = below.get(c) {
+                    near[k] = enter(b, origin, inv, max, pad).map(|t| (c, t));
                 }
+            }
+            // The farther child first onto the stack, so the nearer is walked first.
+            if let [Some(a), Some(b)] = near
+                && b.1 < a.1
+            {
+                near = [Some(b), Some(a)];
+            }
+            for (c, t) in near.into_iter().rev().flatten() {
+                stack[len] = ((level - 1) as u32, c as u32, t);
+                len += 1;
             }
         }
     }
 }
 
-/// Whether the segment `o + t d`, `t` in `[0, max]` (`inv` = `1 / d` per axis), meets `b`
-/// (touching counts). Conservative: the box is widened by a rounding margin, so a segment
-/// that only grazes it is never lost to rounding (the exact test follows).
-fn crosses(b: &Bounds, o: Vec2, inv: Vec2, max: f64) -> bool {
-    let pad = (b.max.abs().max(b.min.abs()).max(o.abs())) * 1e-12;
+/// Where the segment `o + t d`, `t` in `[0, max]` (`inv` = `1 / d` per axis), enters `b`
+/// widened by `pad` per axis (touching counts), or `None` if it misses. The margin covers
+/// rounding, so a segment that only grazes a box is never lost (the exact test follows).
+#[inline]
+fn enter(b: &Bounds, o: Vec2, inv: Vec2, max: f64, pad: Vec2) -> Option<f64> {
     let (lo, hi) = (b.min - pad, b.max + pad);
     let (mut enter, mut exit) = (0.0_f64, max);
     for axis in 0..2 {
@@ -151,7 +175,7 @@ fn crosses(b: &Bounds, o: Vec2, inv: Vec2, max: f64) -> bool {
         if ik.is_infinite() {
             // Parallel to this axis' faces: inside the slab or never.
             if ok < lo[axis] || ok > hi[axis] {
-                return false;
+                return None;
             }
             continue;
         }
@@ -161,10 +185,10 @@ fn crosses(b: &Bounds, o: Vec2, inv: Vec2, max: f64) -> bool {
         enter = enter.max(near);
         exit = exit.min(far);
         if enter > exit {
-            return false;
+            return None;
         }
     }
-    true
+    Some(enter)
 }
 
 /// The smallest box holding both, ignoring NaN coordinates (`f64::min` and `max` do; a NaN

@@ -26,44 +26,73 @@ use crate::def::{BodyKind, LayerId};
 use crate::entity::Entity;
 use crate::world::World;
 
-/// Trees over one set of bodies (the static ones or the moving ones), by layer.
+/// One tree over one set of bodies (the static ones or the moving ones), every layer in it.
+///
+/// One tree per set, not per layer, as rapier's one BVH and Box2D's one tree per body type:
+/// a query that sees every layer walks one tree, not one per layer; a filter is applied to
+/// each candidate by its layer, read from [`Trees::layers`] before the body is looked up.
 #[derive(Debug, Default)]
 pub(crate) struct Trees {
     /// The static generation they were built at (static trees only).
     generation: u64,
-    /// The layers that have bodies, ascending, each with its tree.
-    pub(crate) layers: Vec<(LayerId, StaticTree)>,
+    /// The tree; a member's handle indexes the vectors below.
+    pub(crate) tree: StaticTree,
     /// Each member's entity, by handle.
     pub(crate) entities: Vec<Entity>,
+    /// Each member's layer, by handle.
+    pub(crate) layers: Vec<LayerId>,
+    /// Each member's dense index when the tree was built: still right unless a body was
+    /// removed since (then the entity is looked up, [`Trees::index`]).
+    dense: Vec<u32>,
+    /// The box around every member (`None` when empty): an image of a query that misses it
+    /// skips this set without walking its tree. In a wrap world most of the nine images of
+    /// a query lie outside the world, so this is what keeps a query near one tree walk.
+    pub(crate) bounds: Option<Bounds>,
 }
 
 impl Trees {
     /// The trees over the bodies `which` picks.
     fn build(world: &World, generation: u64, which: impl Iterator<Item = usize>) -> Trees {
-        let mut by_layer: Vec<Vec<Member>> = Vec::new();
-        let mut entities = Vec::new();
+        let mut members = Vec::new();
+        let (mut entities, mut layers, mut dense) = (Vec::new(), Vec::new(), Vec::new());
+        let mut all: Option<Bounds> = None;
         for i in which {
-            let layer = usize::from(world.layer[i]);
-            if by_layer.len() <= layer {
-                by_layer.resize_with(layer + 1, Vec::new);
-            }
-            by_layer[layer].push(Member {
-                bounds: world.bounds_now(i),
+            let bounds = world.bounds_now(i);
+            all = Some(all.map_or(bounds, |a| a.union(bounds)));
+            members.push(Member {
+                bounds,
                 handle: entities.len() as u32,
                 dynamic: false,
             });
             entities.push(world.entity[i]);
+            layers.push(world.layer[i]);
+            dense.push(i as u32);
         }
-        let layers = by_layer
-            .into_iter()
-            .enumerate()
-            .filter(|(_, m)| !m.is_empty())
-            .map(|(l, m)| (l as LayerId, StaticTree::new(m)))
-            .collect();
         Trees {
             generation,
-            layers,
+            tree: StaticTree::new(members),
             entities,
+            layers,
+            dense,
+            bounds: all,
+        }
+    }
+
+    /// Whether `q` may meet a member of this set (touching counts).
+    pub(crate) fn may_meet(&self, q: &Bounds) -> bool {
+        self.bounds.is_some_and(|b| b.overlaps(q))
+    }
+
+    /// The dense index in `world` of the member `handle`, if its body is still there: the
+    /// index it was built with when that still names the body (a lookup by entity else).
+    pub(crate) fn index(&self, world: &World, handle: u32) -> Option<usize> {
+        let h = handle as usize;
+        let e = self.entities[h];
+        let i = self.dense[h] as usize;
+        if world.entity.get(i) == Some(&e) {
+            Some(i)
+        } else {
+            world.index_of(e)
         }
     }
 }
@@ -126,14 +155,15 @@ pub(crate) fn each_in_box(
     f: &mut impl FnMut(usize),
 ) {
     for set in trees {
-        for (layer, tree) in &set.layers {
-            if accepts_layer(*layer) {
-                tree.query(q, stack, &mut |m: &Member| {
-                    if let Some(i) = world.index_of(set.entities[m.handle as usize]) {
-                        f(i);
-                    }
-                });
-            }
+        if !set.may_meet(q) {
+            continue;
         }
+        set.tree.query(q, stack, &mut |m: &Member| {
+            if accepts_layer(set.layers[m.handle as usize])
+                && let Some(i) = set.index(world, m.handle)
+            {
+                f(i);
+            }
+        });
     }
 }

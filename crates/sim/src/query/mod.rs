@@ -35,7 +35,7 @@ mod hits;
 pub(crate) mod index;
 mod wrap;
 
-use ricochet_geom::{Bounds, Pose, Ray, Shape, Sweep, Vec2};
+use ricochet_geom::{Aabb, Bounds, Pose, Primitive, Ray, Shape, Sweep, Vec2};
 
 pub use filter::QueryFilter;
 pub use hits::{RayHit, ShapeHit};
@@ -122,12 +122,13 @@ impl Simulation {
             Vec2::ZERO
         };
         let trees = self.queries.trees(w);
-        let offsets = wrap::offsets(wrap);
-        let mut stack = Vec::new();
+        let (offsets, images) = wrap::offsets(wrap);
+        // A walk holds at most one pending node per level (< 33): never regrown.
+        let mut stack = Vec::with_capacity(64);
         let mut best: Option<ShapeHit> = None;
         let mut segment = |from: Vec2, travelled: f64, len: f64| {
             let to = from + dir * len;
-            for &o in &offsets {
+            for &o in &offsets[..images] {
                 let sweep = Sweep {
                     start: from - o,
                     end: to - o,
@@ -212,9 +213,16 @@ impl Simulation {
         if !ok {
             return Vec::new();
         }
-        let Ok(shape) = Shape::aabb(bounds.half_extents()) else {
+        let half = bounds.half_extents();
+        if half.x < ricochet_geom::MIN_SIZE || half.y < ricochet_geom::MIN_SIZE {
             return Vec::new();
-        };
+        }
+        // Checked above as `Shape::aabb` would check it, without its error text: that
+        // validation formats its field names, two allocations a query.
+        let shape = Shape::Primitive(Primitive::Aabb(Aabb {
+            center: Vec2::ZERO,
+            half_extents: half,
+        }));
         self.overlap_shape(&shape, Pose::new(bounds.center(), 0.0), filter)
     }
 
@@ -244,9 +252,11 @@ impl Simulation {
         let wrap = wrap::wrapping(self.scenario.world.bounds.as_ref());
         let shift = wrap.map_or(Vec2::ZERO, |b| wrap::wrap_point(b, q.center()) - q.center());
         let trees = self.queries.trees(w);
-        let mut stack = Vec::new();
+        // A walk holds at most one pending node per level (< 33): never regrown.
+        let mut stack = Vec::with_capacity(64);
         let mut found = Vec::new();
-        for o in wrap::offsets(wrap) {
+        let (offsets, images) = wrap::offsets(wrap);
+        for &o in &offsets[..images] {
             // The query moved by `shift - o`: the body's image at `o` against the query.
             let d = shift - o;
             let qo = q.translated(d);
@@ -291,53 +301,59 @@ impl Simulation {
         let start = wrap.map_or(origin, |b| wrap::wrap_point(b, origin));
         let dir = ray.direction();
         let trees = self.queries.trees(w);
-        let offsets = wrap::offsets(wrap);
-        let mut stack = Vec::new();
+        let (offsets, images) = wrap::offsets(wrap);
         let mut limit = f64::INFINITY;
         let mut segment = |from: Vec2, travelled: f64, len: f64| {
             let mut hit_here = false;
-            for &o in &offsets {
+            let room = len.min(limit - travelled);
+            // The segment's box (none for an endless ray): an image whose box misses a tree
+            // set's skips that set.
+            let reach = room
+                .is_finite()
+                .then(|| Bounds::of_points(&[from, from + dir * room.max(0.0)]));
+            for &o in &offsets[..images] {
+                let seen = reach.map(|r| r.translated(-o));
+                let meets = |set: &index::Trees| seen.is_none_or(|q| set.may_meet(&q));
+                if !trees.iter().any(|set| meets(set)) {
+                    continue;
+                }
                 let Some(seg) = Ray::new(from - o, dir) else {
                     continue;
                 };
                 for set in &trees {
-                    for (layer, tree) in &set.layers {
-                        if !filter.accepts_layer(*layer) {
-                            continue;
-                        }
-                        let room = len.min(limit - travelled);
-                        if room < 0.0 {
-                            continue;
-                        }
-                        tree.ray(
-                            seg.origin(),
-                            dir,
-                            room,
-                            &mut stack,
-                            &mut |m: &Member, max| {
-                                let e = set.entities[m.handle as usize];
-                                let Some(i) = w.index_of(e) else {
-                                    return max;
-                                };
-                                if !filter.accepts(w.layer[i], e) {
-                                    return max;
-                                }
-                                let Some(h) =
-                                    ricochet_geom::cast_ray(w.shape(i), &w.pose(i), &seg, max)
-                                else {
-                                    return max;
-                                };
-                                hit_here = true;
-                                limit = f(RayHit {
-                                    entity: e,
-                                    point: if h.distance == 0.0 { from } else { h.point + o },
-                                    normal: h.normal,
-                                    distance: travelled + h.distance,
-                                });
-                                max.min(limit - travelled)
-                            },
-                        );
+                    if !meets(set) {
+                        continue;
                     }
+                    let room = len.min(limit - travelled);
+                    if room < 0.0 {
+                        continue;
+                    }
+                    set.tree
+                        .ray(seg.origin(), dir, room, &mut |m: &Member, max| {
+                            if !filter.accepts_layer(set.layers[m.handle as usize]) {
+                                return max;
+                            }
+                            let Some(i) = set.index(w, m.handle) else {
+                                return max;
+                            };
+                            let e = w.entity[i];
+                            if !filter.accepts(w.layer[i], e) {
+                                return max;
+                            }
+                            let Some(h) =
+                                ricochet_geom::cast_ray(w.shape(i), &w.pose(i), &seg, max)
+                            else {
+                                return max;
+                            };
+                            hit_here = true;
+                            limit = f(RayHit {
+                                entity: e,
+                                point: if h.distance == 0.0 { from } else { h.point + o },
+                                normal: h.normal,
+                                distance: travelled + h.distance,
+                            });
+                            max.min(limit - travelled)
+                        });
                 }
             }
             !(first && hit_here)

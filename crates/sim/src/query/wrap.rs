@@ -26,11 +26,12 @@ pub(crate) fn wrapping(bounds: Option<&WorldBounds>) -> Option<&WorldBounds> {
     bounds.filter(|b| b.wrap)
 }
 
-/// The image offsets a query must look at: all nine in a wrap world, else the direct one.
-pub(crate) fn offsets(wrap: Option<&WorldBounds>) -> Vec<Vec2> {
+/// The image offsets a query must look at: all nine in a wrap world, else the direct one
+/// (the array, and how many of it are used; no allocation per query).
+pub(crate) fn offsets(wrap: Option<&WorldBounds>) -> ([Vec2; 9], usize) {
     match wrap {
-        Some(b) => b.image_offsets().to_vec(),
-        None => vec![Vec2::ZERO],
+        Some(b) => (b.image_offsets(), 9),
+        None => ([Vec2::ZERO; 9], 1),
     }
 }
 
