@@ -10,7 +10,7 @@
 //! `/contacts` and `/scene` give it. Names are looked up at the end of the frame: in the world
 //! for a body still alive, in the frame's removed bodies for one removed during it.
 
-use crate::record::Level as LogLevel;
+use crate::recorder::Level as LogLevel;
 use ricochet_geom::{Number, ShapeDef, Vec2};
 use ricochet_sim::{
     BodyKind, Controller, Entity, FireOutcome, FrameOutput, GameEvent, JumpOutcome, Removal,

@@ -25,8 +25,8 @@ use ricochet_log::messages::{Schema, fox::Log, fox::log::Level, timestamp};
 use ricochet_log::{ChannelId, LogError, MessageSink};
 use ricochet_sim::{Action, ActionFile, BodyKind, FrameOutput, Scenario, Simulation};
 
+use crate::Recorder;
 use crate::channels::Channels;
-use crate::record::Recorder;
 
 /// The largest input accepted, bytes.
 pub const MAX_INPUT: usize = 4096;
@@ -39,12 +39,14 @@ pub const SCENARIO_ATTACHMENT: &str = "scenario.toml";
 pub const MAX_INPUT_VALUE: f64 = ricochet_geom::MAX_COORDINATE;
 
 /// Why a step was not recorded.
-#[derive(Debug)]
+#[derive(Debug, thiserror::Error)]
 pub enum StepError {
     /// Writing the frame failed.
-    Log(LogError),
+    #[error(transparent)]
+    Log(#[from] LogError),
     /// The step made a value non-finite: neither it nor its inputs were written, and the
     /// session steps no more (its simulation can't be trusted).
+    #[error("frame {frame}: {what}; the simulation overflowed")]
     Overflow {
         /// The frame that overflowed (the log holds the frames before it).
         frame: u64,
@@ -53,30 +55,18 @@ pub enum StepError {
     },
 }
 
-impl std::fmt::Display for StepError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            StepError::Log(e) => e.fmt(f),
-            StepError::Overflow { frame, what } => {
-                write!(f, "frame {frame}: {what}; the simulation overflowed")
-            }
-        }
-    }
-}
-
-impl std::error::Error for StepError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match self {
-            StepError::Log(e) => Some(e),
-            StepError::Overflow { .. } => None,
-        }
-    }
-}
-
-impl From<LogError> for StepError {
-    fn from(e: LogError) -> StepError {
-        StepError::Log(e)
-    }
+/// A non-finite body for people: `body NAME #id:generation has a non-finite FIELD [x, y]`
+/// (the name's control characters escaped).
+pub fn describe(sim: &Simulation, bad: &ricochet_sim::NonFinite) -> String {
+    let w = sim.world();
+    let name = w.index_of(bad.body).map_or("?", |i| w.name(i));
+    format!(
+        "body {} #{} has a non-finite {} {}",
+        ricochet_log::escape_controls(name),
+        bad.body,
+        bad.field,
+        ricochet_geom::Numbers(bad.value)
+    )
 }
 
 /// A scenario being stepped, its frames written to `S` with every input.
@@ -286,7 +276,7 @@ impl<S: MessageSink> Session<S> {
         }
         let out = self.sim.step();
         if let Some(bad) = self.sim.first_non_finite() {
-            let what = crate::validate::describe(&self.sim, &bad);
+            let what = describe(&self.sim, &bad);
             self.unwritten.clear();
             self.overflowed = Some((out.frame, what.clone()));
             return Err(StepError::Overflow {
