@@ -10,26 +10,21 @@
 mod accuracy;
 mod bench;
 mod bench_record;
+mod channels;
 mod check;
 mod collide;
 mod diff;
 mod dump;
+mod events;
 mod files;
 mod load;
 mod out;
+mod record;
 mod replay;
 mod run;
 mod serve;
+mod session;
 mod validate;
-
-// The recorder, `/events` and sessions are `ricochet-record`'s; these names keep the paths
-// the commands use (`crate::record::Recorder`, `crate::channels::Channels`, ...).
-use ricochet_record as record;
-#[allow(
-    unused_imports,
-    reason = "paths kept for every command, not each used by all"
-)]
-use ricochet_record::{channels, events, session};
 
 use std::path::PathBuf;
 use std::process::ExitCode;

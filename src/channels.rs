@@ -1,0 +1,3 @@
+//! Which channels a run records: `ricochet-record`'s, under the name the commands use.
+
+pub use ricochet_record::channels::*;
