@@ -3,6 +3,9 @@
 //! every frame's ball against the integrator's documented arithmetic (`v += g dt; x += v dt`,
 //! IEEE f64; a script's velocity is set at the start of its frame, before the step), so the log is shown to hold the game's frames, bit for bit.
 //!
+//! The same level as a scenario file, `examples/shared/thrown_ball.toml`, run by `ricochet
+//! run`, gives the same bytes (`.ci/run` compares them).
+//!
 //! `--golden PATH` compares the run with a golden log instead (`RICOCHET_BLESS=1` records it):
 //! what a game's own `cargo test` does with `ricochet_record::golden::check`.
 //!
