@@ -139,7 +139,7 @@ pub fn run(
         if let Some(v) = &mut validation {
             let report = v.frame(&sim, &out);
             recorder
-                .record_validation(&report)
+                .record_validation(crate::validate::verdict(&report))
                 .with_context(|| format!("writing frame {} to {}", out.frame, output.display()))?;
         }
         ran += 1;

@@ -67,15 +67,26 @@ impl Validation {
 
 /// A non-finite body for people: `body NAME #id:generation has a non-finite FIELD [x, y]`.
 pub fn describe(sim: &Simulation, bad: &NonFinite) -> String {
-    let w = sim.world();
-    let name = w.index_of(bad.body).map_or("?", |i| w.name(i));
-    format!(
-        "body {} #{} has a non-finite {} {}",
-        crate::out::escape_controls(name),
-        bad.body,
-        bad.field,
-        ricochet_geom::Numbers(bad.value)
-    )
+    ricochet_record::session::describe(sim, bad)
+}
+
+/// The referee's verdict on a frame, as `/validation` records it.
+pub fn verdict(r: &FrameReport) -> ricochet_log::messages::ricochet::Validation {
+    ricochet_log::messages::ricochet::Validation {
+        frame: r.frame,
+        contacts_compared: r.contacts_compared,
+        mismatches: r.mismatches,
+        worst_depth_error: r.worst_depth_error,
+        worst_normal_error: r.worst_normal_error,
+        pairs_confirmed: r.pairs_confirmed,
+        swept_confirmed: r.swept_confirmed,
+        explained: r
+            .explained
+            .iter()
+            .map(|(k, v)| ((*k).to_owned(), *v))
+            .collect(),
+        details: r.details.clone(),
+    }
 }
 
 /// `ricochet validate SCENARIO`: simulate without writing a log, referee every frame.

@@ -10,7 +10,9 @@
 //!   embeds as its schemas (MCAP's protobuf profile), so it opens in Foxglove offline;
 //! - rebuilding every body's full state at every frame from `/bodies` deltas
 //!   ([`BodyStates`]);
-//! - decoding any message of a log to JSON from the schema in the log ([`LogMessage`]).
+//! - decoding any message of a log to JSON from the schema in the log ([`LogMessage`]);
+//! - comparing two logs ([`diff`]): the first divergence (frame, topic, body, field, both
+//!   values) and the count per topic, as `ricochet diff` and golden checks print them.
 //!
 //! Logs are deterministic: the same calls give byte-identical files, written on the
 //! writer thread or inline. So this crate must never:
@@ -21,17 +23,20 @@
 //!   in id order);
 //! - compute any physics: it records what the simulation hands it.
 
+pub mod diff;
 pub mod messages;
 
 mod bodies;
 mod decode;
 mod error;
+mod escape;
 mod log_file;
 mod reader;
 mod writer;
 
 pub use bodies::BodyStates;
 pub use error::LogError;
+pub use escape::escape_controls;
 pub use log_file::{ChannelInfo, LogFile, Messages, RawMessage};
 pub use messages::Schema;
 pub use reader::{LogMessage, read_log, read_log_file};

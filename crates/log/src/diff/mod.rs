@@ -1,17 +1,16 @@
-//! `ricochet diff A.mcap B.mcap`: compare two logs message by message, decoded, so chunking
-//! and compression never matter. Reports the first divergent frame, topic, body and field
-//! with both values, then how many messages differ per topic. Both logs are streamed, one
-//! topic at a time and one message at a time: memory does not grow with their length.
+//! Two logs compared message by message, decoded, so chunking and compression never matter
+//! (`ricochet diff A.mcap B.mcap`, and golden checks): the first divergent frame, topic, body
+//! and field with both values, then how many messages differ per topic. Both logs are
+//! streamed, one topic at a time and one message at a time: memory does not grow with their
+//! length.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
-use std::process::ExitCode;
 
-use ricochet_log::{LogError, LogFile, Messages, RawMessage};
+use crate::{LogError, LogFile, Messages, RawMessage, escape_controls};
 
 mod fields;
 
-use crate::out;
 use fields::first_in_message;
 use serde::Serialize;
 use serde_json::Value;
@@ -84,36 +83,24 @@ fn rank(topic: &str) -> usize {
         .unwrap_or(TOPIC_ORDER.len())
 }
 
-/// Why two logs could not be compared: exit code 2.
-#[derive(Debug)]
+/// Why two logs could not be compared (`ricochet diff`'s exit code 2).
+#[derive(Debug, thiserror::Error)]
 pub enum DiffError {
     /// A log is unreadable, cut short or damaged.
-    Log(LogError),
+    #[error(transparent)]
+    Log(#[from] LogError),
     /// A log is an MCAP file, but not one Ricochet wrote.
+    #[error("{0}")]
     Foreign(String),
     /// `--topic` names a topic neither log has.
+    #[error("{0}")]
     UnknownTopic(String),
-}
-
-impl std::fmt::Display for DiffError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            DiffError::Log(e) => write!(f, "{e}"),
-            DiffError::Foreign(s) | DiffError::UnknownTopic(s) => f.write_str(s),
-        }
-    }
-}
-
-impl From<LogError> for DiffError {
-    fn from(e: LogError) -> Self {
-        DiffError::Log(e)
-    }
 }
 
 /// Opens a log and checks that Ricochet wrote it: its header names `ricochet` as the library
 /// and every channel is protobuf with a protobuf schema, or JSON with a JSON Schema (what the
 /// comparison decodes).
-fn open(path: &Path) -> Result<LogFile, DiffError> {
+pub fn open(path: &Path) -> Result<LogFile, DiffError> {
     let log = LogFile::open(path)?;
     let name = path.display();
     let library = log.library();
@@ -341,7 +328,7 @@ fn schema_difference(a: &LogFile, b: &LogFile) -> Option<Divergence> {
                 .map(|(i, (message, name, encoding, data))| {
                     let mut text = format!(
                         "{} ({message} messages, {encoding} schema of {} bytes)",
-                        out::escape_controls(name),
+                        escape_controls(name),
                         data.len()
                     );
                     // Same name and size: say where the bytes part.
@@ -409,7 +396,7 @@ fn diff_messages(
         };
         return Err(DiffError::UnknownTopic(format!(
             "--topic {}: neither log has that topic{hint}; they have: {}",
-            out::escape_controls(t),
+            escape_controls(t),
             list.join(", ")
         )));
     }
@@ -449,50 +436,6 @@ fn diff_messages(
         first,
         topics,
     })
-}
-
-/// `ricochet diff`: exit code 0 equal, 1 they differ, 2 a log can't be compared (unreadable,
-/// cut short, damaged, not a Ricochet log, an unknown `--topic`, a bad `--tolerance`).
-pub fn run(
-    a: &Path,
-    b: &Path,
-    tolerance: f64,
-    topic: Option<&str>,
-    json: bool,
-) -> anyhow::Result<ExitCode> {
-    if !(tolerance.is_finite() && tolerance >= 0.0) {
-        out::error(&format!(
-            "error: --tolerance must be a finite number >= 0, got {}",
-            ricochet_geom::Number(tolerance)
-        ));
-        return Ok(ExitCode::from(2));
-    }
-    let report = open(a)
-        .and_then(|la| open(b).map(|lb| (la, lb)))
-        .and_then(|(la, lb)| diff_files(&la, &lb, tolerance, topic));
-    let report = match report {
-        Ok(r) => r,
-        Err(e) => {
-            out::error(&format!("error: {e}"));
-            return Ok(ExitCode::from(2));
-        }
-    };
-    let code = if report.equal {
-        ExitCode::SUCCESS
-    } else {
-        ExitCode::from(1)
-    };
-    let text = if json {
-        serde_json::to_string_pretty(&report)? + "\n"
-    } else {
-        render(&report, a, b)
-    };
-    match out::print(&text) {
-        // The reader went away (`| head`): the verdict is still the exit code.
-        Err(e) if e.is_closed() => Ok(code),
-        Err(e) => Err(e.into()),
-        Ok(()) => Ok(code),
-    }
 }
 
 /// The human-readable report.

@@ -17,7 +17,7 @@
 use ricochet_geom::{MAX_COORDINATE, Vec2};
 use serde::Deserialize;
 
-use crate::record::scene::{VIEW, WORLD};
+use ricochet_record::scene::{VIEW, WORLD};
 
 /// `geometry_msgs/PointStamped` as Lichtblick writes it in JSON (a ROS 1 `seq`, or other
 /// fields, are ignored).

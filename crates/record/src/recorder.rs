@@ -16,9 +16,6 @@
 //! nanoseconds: nothing from the wall clock reaches the file. Messages are built here and
 //! encoded and compressed on the log's writer thread.
 
-mod bodies;
-pub mod scene;
-
 use std::path::Path;
 
 use ricochet_geom::Vec2;
@@ -27,8 +24,9 @@ use ricochet_log::messages::{Schema, ricochet as pb, timestamp};
 use ricochet_log::{ChannelId, LogError, LogWriter, MessageSink, Threading};
 use ricochet_sim::{FrameOutput, Layers, Simulation};
 
+use crate::bodies::Tracker;
 use crate::channels::Channels;
-use bodies::Tracker;
+use crate::scene;
 
 /// The `library` field of every log's header.
 pub const LIBRARY: &str = concat!("ricochet ", env!("CARGO_PKG_VERSION"));
@@ -207,25 +205,12 @@ impl<S: MessageSink> Recorder<S> {
         Ok(())
     }
 
-    /// Writes the referee's verdict on a frame to `/validation`.
-    pub fn record_validation(&mut self, r: &ricochet_oracle::FrameReport) -> Result<(), LogError> {
+    /// Writes a referee's verdict on a frame (its `frame` field) to `/validation`, if added.
+    /// The referee is the caller's (`ricochet run --validate` uses rapier's): this crate
+    /// only records it.
+    pub fn record_validation(&mut self, verdict: pb::Validation) -> Result<(), LogError> {
         if let Some(ch) = self.topics.validation {
-            let msg = pb::Validation {
-                frame: r.frame,
-                contacts_compared: r.contacts_compared,
-                mismatches: r.mismatches,
-                worst_depth_error: r.worst_depth_error,
-                worst_normal_error: r.worst_normal_error,
-                pairs_confirmed: r.pairs_confirmed,
-                swept_confirmed: r.swept_confirmed,
-                explained: r
-                    .explained
-                    .iter()
-                    .map(|(k, v)| ((*k).to_owned(), *v))
-                    .collect(),
-                details: r.details.clone(),
-            };
-            self.writer.write(ch, r.frame * self.dt_ns, msg)?;
+            self.writer.write(ch, verdict.frame * self.dt_ns, verdict)?;
         }
         Ok(())
     }

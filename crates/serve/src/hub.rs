@@ -16,7 +16,7 @@ use ricochet_log::{ChannelId, LogError, MessageSink, Schema};
 use tokio::sync::mpsc;
 use tokio_tungstenite::tungstenite::Message;
 
-use super::protocol::{self, Channel};
+use crate::protocol::{self, Channel};
 
 /// Bytes of messages queued for one client before new ones are dropped for it: 8 MiB, a
 /// few frames of a scene of thousands of bodies (a 3,000-body frame is about 0.3 MB). A
@@ -295,11 +295,11 @@ impl Shared {
             .get(&client)
             .and_then(|c| c.publishes.get(&channel).copied());
         if advertised == Some(Publication::Click) {
-            if payload.len() > crate::session::MAX_INPUT {
+            if payload.len() > ricochet_record::session::MAX_INPUT {
                 return Err(format!(
                     "a clicked point of {} bytes, more than {}",
                     payload.len(),
-                    crate::session::MAX_INPUT
+                    ricochet_record::session::MAX_INPUT
                 ));
             }
             if self.clicks.len() >= MAX_PENDING_CLICKS {
@@ -313,11 +313,11 @@ impl Shared {
                 "channel {channel} is not an advertised /input channel, nor {CLICKED_POINT} (both JSON)"
             ));
         }
-        if payload.len() > crate::session::MAX_INPUT {
+        if payload.len() > ricochet_record::session::MAX_INPUT {
             return Err(format!(
                 "an input of {} bytes, more than {}",
                 payload.len(),
-                crate::session::MAX_INPUT
+                ricochet_record::session::MAX_INPUT
             ));
         }
         if self.inputs.len() >= MAX_PENDING_INPUTS {

@@ -1,47 +1,37 @@
-//! `ricochet serve`: a scenario stepped in real time and streamed live over the Foxglove
-//! WebSocket protocol, the same messages and schemas as `ricochet run` writes (a viewer that
-//! subscribes gets the last `/scene`, `/scene/static` and `/tf` at once: each is whole),
-//! optionally recorded to a file at the same time.
+//! The real-time loop: a simulation stepped on a fixed-timestep schedule and streamed live
+//! over the Foxglove WebSocket protocol, the same messages and schemas as `ricochet run`
+//! writes (a viewer that subscribes gets the last `/scene`, `/scene/static` and `/tf` at
+//! once: each is whole), optionally recorded to a file at the same time.
 //!
-//! The simulation runs on this thread, paced by a fixed-timestep schedule (frame `n` starts
-//! at `n * dt / speed` after the start: a late frame is not skipped, the next ones catch up);
-//! the wall clock only paces, it never reaches a message. The WebSocket side runs on a tokio
-//! runtime of its own thread (`server.rs`); the two share the [`hub::Hub`].
-
-mod click;
-mod hub;
-mod load_path;
-mod protocol;
-mod query;
-mod server;
-mod services;
-mod serving;
+//! The simulation runs on the calling thread (frame `n` starts at `n * dt / speed` after the
+//! start: a late frame is not skipped, the next ones catch up); the wall clock only paces,
+//! it never reaches a message. The WebSocket side runs on a tokio runtime of its own thread
+//! (`server.rs`); the two share the [`Hub`].
 
 use std::net::SocketAddr;
 use std::path::{Path, PathBuf};
-use std::process::ExitCode;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
-use anyhow::Context;
 use ricochet_log::{ChannelId, LogError, LogWriter, MessageSink, Schema};
+use ricochet_record::session::{SCENARIO_ATTACHMENT, Session, StepError};
+use ricochet_sim::Scenario;
 
-use crate::out;
-use crate::session::{SCENARIO_ATTACHMENT, Session};
-use hub::{Hub, LiveSink};
-use serving::{Asker, Serving};
+use crate::hub::{Hub, LiveSink};
+use crate::serving::{Asker, Serving};
+use crate::{server, services};
 
 /// Where `serve` listens unless told: what Foxglove's "Open connection" suggests.
 pub const DEFAULT_BIND: &str = "127.0.0.1:8765";
 
 /// Where a served session's messages go: the live stream, and the recording if any.
-struct ServeSink {
-    live: LiveSink,
+pub(crate) struct ServeSink {
+    pub(crate) live: LiveSink,
     /// The recording, with its channel for each live channel id.
-    file: Option<(LogWriter, Vec<ChannelId>)>,
+    pub(crate) file: Option<(LogWriter, Vec<ChannelId>)>,
     /// While a seek re-simulates: the recording gets every frame, the clients none.
-    muted: bool,
+    pub(crate) muted: bool,
 }
 
 impl MessageSink for ServeSink {
@@ -84,7 +74,7 @@ impl MessageSink for ServeSink {
 
 /// The recording of segment `k` of a session recorded to `path`: `path` itself, then
 /// `NAME-1.mcap`, `NAME-2.mcap`, ... (a reset or a load starts a new file).
-fn segment(path: &Path, k: u32) -> PathBuf {
+pub(crate) fn segment(path: &Path, k: u32) -> PathBuf {
     if k == 0 {
         return path.to_path_buf();
     }
@@ -97,22 +87,24 @@ fn segment(path: &Path, k: u32) -> PathBuf {
     path.with_file_name(format!("{stem}-{k}.{ext}"))
 }
 
-/// A new session of `scenario` (whose file's text is `text`) for `hub`, recording to
-/// segment `k` of `record` if asked.
-fn start(
-    scenario: &ricochet_sim::Scenario,
+/// A new session of `scenario` (whose file's text is `text`, attached to the recording
+/// when not empty, for `ricochet replay`) for `hub`, recording to segment `k` of `record` if
+/// asked.
+pub(crate) fn start(
+    scenario: &Scenario,
     text: &str,
     hub: &Hub,
     record: Option<&Path>,
     k: u32,
-) -> anyhow::Result<Session<ServeSink>> {
+) -> Result<Session<ServeSink>, ServeError> {
     let file = match record {
         None => None,
         Some(path) => {
             let path = segment(path, k);
-            let mut file = LogWriter::create(&path, crate::record::LIBRARY)
-                .with_context(|| format!("creating {}", path.display()))?;
-            file.attach(SCENARIO_ATTACHMENT, "application/toml", text.as_bytes())?;
+            let mut file = LogWriter::create(&path, ricochet_record::LIBRARY)?;
+            if !text.is_empty() {
+                file.attach(SCENARIO_ATTACHMENT, "application/toml", text.as_bytes())?;
+            }
             Some((file, Vec::new()))
         }
     };
@@ -125,119 +117,191 @@ fn start(
 }
 
 /// Finishes a session's recording, if it has one.
-fn finish(session: Session<ServeSink>) -> anyhow::Result<()> {
+pub(crate) fn finish(session: Session<ServeSink>) -> Result<(), ServeError> {
     if let Some((file, _)) = session.into_sink().file {
         file.finish()?;
     }
     Ok(())
 }
 
-/// The options of `ricochet serve`.
-pub struct Options<'a> {
-    /// The scenario (none: the built-in demo).
-    pub scenario: Option<&'a Path>,
-    /// Address to listen on.
-    pub bind: &'a str,
-    /// Simulation seconds per wall second.
+/// Where the server's notes go (a client connected, a frame overflowed, how late frames
+/// were): a line each, without a newline. Losing one is no failure.
+pub type Note = Arc<dyn Fn(&str) + Send + Sync>;
+
+/// How to serve.
+pub struct Options {
+    /// Simulation seconds per wall second (positive, finite).
     pub speed: f64,
-    /// Stop after this many frames (default: run until interrupted).
+    /// Stop after this many frames after frame 0 (`None`: until stopped, at most
+    /// [`ricochet_sim::MAX_FRAMES`]); no `/step` or seek goes past it either.
     pub frames: Option<u64>,
-    /// Also write the log here.
-    pub record: Option<&'a Path>,
-    /// Start paused (the clients see frame 0; `/play` or `/step` goes on).
+    /// Also record the session here, as `ricochet run` writes a log (`/reset` and `/load`
+    /// start `NAME-1.mcap`, ...).
+    pub record: Option<PathBuf>,
+    /// Start paused: frame 0 is shown; `/play` or `/step` goes on.
     pub paused: bool,
+    /// Where notes go.
+    pub note: Note,
 }
 
-/// Runs `ricochet serve`. Exit code 0 when stopped (Ctrl-C, SIGTERM, `--frames`), 2 for bad
-/// input (scenario, address, speed).
-pub fn run(o: &Options) -> anyhow::Result<ExitCode> {
-    if !(o.speed.is_finite() && o.speed > 0.0) {
-        out::error(&format!(
-            "error: --speed must be a positive number, got {}",
-            ricochet_geom::Number(o.speed)
-        ));
-        return Ok(ExitCode::from(2));
+impl Default for Options {
+    /// Real time, until stopped, no recording, notes to stderr.
+    fn default() -> Self {
+        Options {
+            speed: 1.0,
+            frames: None,
+            record: None,
+            paused: false,
+            note: Arc::new(|text: &str| eprintln!("{text}")),
+        }
     }
-    let (scenario, text) = match crate::load::load_text(o.scenario) {
-        Ok(s) => s,
-        Err(code) => return Ok(code),
-    };
+}
+
+/// Why serving failed or could not start.
+#[derive(Debug, thiserror::Error)]
+pub enum ServeError {
+    /// An option is out of range.
+    #[error("{0}")]
+    Options(String),
+    /// The address could not be listened on.
+    #[error("cannot listen on {addr}: {source}")]
+    Bind {
+        /// The address asked for.
+        addr: SocketAddr,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// The WebSocket runtime or its thread could not start.
+    #[error("starting the WebSocket server: {0}")]
+    Runtime(std::io::Error),
+    /// Writing the recording (or the live stream's bookkeeping) failed.
+    #[error(transparent)]
+    Log(#[from] LogError),
+    /// Recording a frame failed.
+    #[error(transparent)]
+    Step(#[from] StepError),
+}
+
+/// A bound WebSocket listener, not serving yet (so the caller can say where it listens).
+pub struct Listener {
+    runtime: tokio::runtime::Runtime,
+    listener: tokio::net::TcpListener,
+    local: SocketAddr,
+}
+
+impl Listener {
+    /// Listens on `addr` (port 0: any free port).
+    pub fn bind(addr: SocketAddr) -> Result<Listener, ServeError> {
+        let runtime = tokio::runtime::Builder::new_current_thread()
+            .enable_all()
+            .build()
+            .map_err(ServeError::Runtime)?;
+        let listener = runtime
+            .block_on(tokio::net::TcpListener::bind(addr))
+            .map_err(|source| ServeError::Bind { addr, source })?;
+        let local = listener
+            .local_addr()
+            .map_err(|source| ServeError::Bind { addr, source })?;
+        Ok(Listener {
+            runtime,
+            listener,
+            local,
+        })
+    }
+
+    /// The address it listens on (the port chosen, for port 0).
+    pub fn local_addr(&self) -> SocketAddr {
+        self.local
+    }
+}
+
+/// What a served session did.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Served {
+    /// The frame the session would step next: it holds frames 0 to `next_frame - 1`.
+    pub next_frame: u64,
+    /// Steps in all (seeks' and `/step`'s included).
+    pub stepped: u64,
+    /// Frames stepped on the real-time schedule.
+    pub real_time: u64,
+    /// Messages slow clients lost.
+    pub dropped: u64,
+}
+
+/// Serves `scenario` (a file's, or one a game builds in code; `text` is its file, attached
+/// to the recording for `ricochet replay`, or empty) on `listener` until `stop` is set or
+/// the last frame is stepped. Clients' inputs (`/input`, JSON actions addressed by body
+/// name) apply at the next frame boundary; their service calls (`/reset`, `/load`, `/step`,
+/// `/query`, ...) and Foxglove's timeline (play, pause, seek, speed) between frames.
+pub fn serve(
+    listener: Listener,
+    scenario: Scenario,
+    text: String,
+    o: &Options,
+    stop: &AtomicBool,
+) -> Result<Served, ServeError> {
+    if !(o.speed.is_finite() && o.speed > 0.0) {
+        return Err(ServeError::Options(format!(
+            "speed must be a positive number, got {}",
+            ricochet_geom::Number(o.speed)
+        )));
+    }
     // Every frame's log time must be a whole number of nanoseconds that fits in a u64.
     let last = o.frames.unwrap_or(ricochet_sim::MAX_FRAMES);
     if let Err(e) = scenario.world.last_time_ns(last) {
-        out::error(&format!("error: --frames {last}: {e}"));
-        return Ok(ExitCode::from(2));
-    }
-    let addr: SocketAddr = match o.bind.parse() {
-        Ok(a) => a,
-        Err(e) => {
-            out::error(&format!(
-                "error: --bind {}: {e} (expected IP:PORT, e.g. {DEFAULT_BIND})",
-                o.bind
-            ));
-            return Ok(ExitCode::from(2));
-        }
-    };
-    let interrupted = Arc::new(AtomicBool::new(false));
-    {
-        let flag = Arc::clone(&interrupted);
-        let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
-    }
-    let runtime = tokio::runtime::Builder::new_current_thread()
-        .enable_all()
-        .build()
-        .context("starting the WebSocket runtime")?;
-    let listener = match runtime.block_on(tokio::net::TcpListener::bind(addr)) {
-        Ok(l) => l,
-        Err(e) => {
-            out::error(&format!("error: cannot listen on {addr}: {e}"));
-            return Ok(ExitCode::from(2));
-        }
-    };
-    let local = listener.local_addr().context("reading the bound address")?;
-    if !local.ip().is_loopback() {
-        out::note(&format!(
-            "warning: listening on {local}, beyond this machine: the Foxglove WebSocket \
-             protocol has no authentication, anyone who can reach it can watch"
-        ))?;
+        return Err(ServeError::Options(format!("frames {last}: {e}")));
     }
     let hub = Hub::default();
     hub.lock().data_end_ns = scenario
         .frames
         .saturating_mul((scenario.world.dt * 1e9).round() as u64);
-    let session = start(&scenario, &text, &hub, o.record, 0)?;
+    let session = start(&scenario, &text, &hub, o.record.as_deref(), 0)?;
     let session_id = format!("ricochet-{}", scenario.name);
     let server_hub = hub.clone();
+    let Listener {
+        runtime, listener, ..
+    } = listener;
+    let note = o.note.clone();
     std::thread::Builder::new()
         .name("serve".into())
-        .spawn(move || runtime.block_on(server::accept(listener, server_hub, session_id)))
-        .context("starting the WebSocket thread")?;
-    out::note(&format!(
-        "serving {} on ws://{local} (Foxglove: Open connection; layout foxglove/ricochet-layout.json); Ctrl-C stops",
-        scenario.name
-    ))?;
+        .spawn(move || runtime.block_on(server::accept(listener, server_hub, session_id, note)))
+        .map_err(ServeError::Runtime)?;
     let mut serving = Serving::new(session, scenario, text, o);
-    let frames = run_loop(&mut serving, &hub, &interrupted)?;
-    let next = serving.session.next_frame();
+    let real_time = run_loop(&mut serving, &hub, stop, &o.note)?;
+    let next_frame = serving.session.next_frame();
     let stepped = serving.stepped;
     finish(serving.session)?;
     let dropped = hub.lock().dropped;
-    let session = match next.checked_sub(1) {
-        Some(last) => format!("frames 0 to {last}"),
-        None => "no frame".to_owned(),
-    };
-    out::note(&format!(
-        "served {session} ({stepped} steps in all, {frames} in real time, the rest by /step \
-         and seeks); {dropped} messages dropped for slow clients; {} s of CPU",
-        cpu_seconds().map_or("?".to_owned(), |s| format!("{s:.2}"))
-    ))?;
-    Ok(ExitCode::SUCCESS)
+    Ok(Served {
+        next_frame,
+        stepped,
+        real_time,
+        dropped,
+    })
+}
+
+/// CPU time this process used (user + system), from `/proc/self/stat` (Linux); `None`
+/// elsewhere.
+pub fn cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // Fields after the command name (in parentheses, which may hold spaces).
+    let rest = stat.rsplit_once(')')?.1;
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    let utime: f64 = fields.get(11)?.parse().ok()?;
+    let stime: f64 = fields.get(12)?.parse().ok()?;
+    // Clock ticks: 100 a second on Linux.
+    Some((utime + stime) / 100.0)
 }
 
 /// Steps on the real-time schedule until stopped, taking the clients' inputs at each frame
 /// boundary and their service calls between frames, running a seek or a step in slices;
 /// returns the real-time frames stepped.
-fn run_loop(serving: &mut Serving, hub: &Hub, interrupted: &AtomicBool) -> anyhow::Result<u64> {
+fn run_loop(
+    serving: &mut Serving,
+    hub: &Hub,
+    interrupted: &AtomicBool,
+    note: &Note,
+) -> Result<u64, ServeError> {
     // The schedule: frame `anchor.1 + n` starts at `anchor.0 + n * step`; moved when stepping
     // pauses, resumes, or starts over.
     let mut anchor = (Instant::now(), 0u64);
@@ -321,26 +385,13 @@ fn run_loop(serving: &mut Serving, hub: &Hub, interrupted: &AtomicBool) -> anyho
         serving.frame(hub)?;
         frames += 1;
     }
-    out::note(&format!(
+    note(&format!(
         "frame starts late against the real-time schedule: p50 {:.3} ms, p99 {:.3} ms, max {:.3} ms",
         lateness.quantile(0.5),
         lateness.quantile(0.99),
         lateness.max_ms
-    ))?;
+    ));
     Ok(frames)
-}
-
-/// CPU time this process used (user + system), from `/proc/self/stat` (Linux); `None`
-/// elsewhere.
-fn cpu_seconds() -> Option<f64> {
-    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
-    // Fields after the command name (in parentheses, which may hold spaces).
-    let rest = stat.rsplit_once(')')?.1;
-    let fields: Vec<&str> = rest.split_whitespace().collect();
-    let utime: f64 = fields.get(11)?.parse().ok()?;
-    let stime: f64 = fields.get(12)?.parse().ok()?;
-    // Clock ticks: 100 a second on Linux.
-    Some((utime + stime) / 100.0)
 }
 
 /// How late frames start, in a fixed histogram (bounded memory however long the server

@@ -308,8 +308,8 @@ mod tests {
     use ricochet_scenes::bench::Scene;
     use ricochet_sim::Simulation;
 
+    use crate::Recorder;
     use crate::channels::Channels;
-    use crate::record::Recorder;
 
     /// `/bodies`, rebuilt with [`BodyStates`], gives every body's exact state (bit for bit)
     /// at every frame, against the simulation itself: rain (everything falling, landing,

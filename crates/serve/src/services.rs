@@ -25,7 +25,7 @@
 
 use serde::Deserialize;
 
-use super::protocol::{Service, ServiceSchema};
+use crate::protocol::{Service, ServiceSchema};
 
 /// A request the simulation loop carries out at the next frame boundary.
 #[derive(Debug)]
@@ -45,7 +45,7 @@ pub enum Command {
     /// Simulation seconds per wall second.
     Speed(f64),
     /// A scene query, answered at once (`query.rs`).
-    Query(super::query::Request),
+    Query(crate::query::Request),
 }
 
 /// At most this many frames in one `/step`.
@@ -183,7 +183,7 @@ pub fn parse(id: u32, payload: &[u8]) -> Result<Command, String> {
             }
             Ok(Command::Speed(r.speed))
         }
-        QUERY => super::query::parse(body).map(Command::Query),
+        QUERY => crate::query::parse(body).map(Command::Query),
         other => Err(format!("no service {other}")),
     }
 }

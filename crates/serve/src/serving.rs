@@ -19,9 +19,11 @@ use std::time::{Duration, Instant};
 use ricochet_sim::{Scenario, Simulation};
 use tokio_tungstenite::tungstenite::Message;
 
-use super::hub::{Hub, LiveSink};
-use super::{ServeSink, finish, protocol, segment, services, start};
-use crate::session::Session;
+use crate::hub::{Hub, LiveSink};
+use crate::protocol;
+use crate::realtime::{Options, ServeError, ServeSink, finish, segment, start};
+use crate::services;
+use ricochet_record::session::{Session, StepError};
 
 /// Frames between two snapshots of a session that is not recorded.
 pub const SNAPSHOT_EVERY: u64 = 600;
@@ -126,6 +128,7 @@ pub struct Serving {
     pub running: Option<Running>,
     /// Frames stepped in all (seeks' and steps' included).
     pub stepped: u64,
+    note: crate::realtime::Note,
 }
 
 impl Serving {
@@ -135,7 +138,7 @@ impl Serving {
         session: Session<ServeSink>,
         scenario: Scenario,
         text: String,
-        o: &super::Options,
+        o: &Options,
     ) -> Serving {
         Serving {
             session,
@@ -152,7 +155,8 @@ impl Serving {
             } else {
                 "the most a log holds"
             },
-            record: o.record.map(std::path::Path::to_path_buf),
+            record: o.record.clone(),
+            note: o.note.clone(),
             running: None,
             stepped: 0,
         }
@@ -184,7 +188,7 @@ impl Serving {
         command: services::Command,
         hub: &Hub,
         asker: Asker,
-    ) -> anyhow::Result<Option<Result<String, String>>> {
+    ) -> Result<Option<Result<String, String>>, ServeError> {
         let mut recording = None;
         match command {
             services::Command::Pause => self.paused = true,
@@ -220,7 +224,7 @@ impl Serving {
                     ))));
                 }
                 if let services::Command::Load(path) = command {
-                    match super::load_path::load(&path) {
+                    match crate::load_path::load(&path) {
                         Ok((scenario, text)) => (self.scenario, self.text) = (scenario, text),
                         Err(why) => return Ok(Some(Err(why))),
                     }
@@ -238,7 +242,7 @@ impl Serving {
                     return Ok(Some(Err(why)));
                 }
                 let next = self.session.next_frame();
-                return Ok(Some(super::query::answer(
+                return Ok(Some(crate::query::answer(
                     self.session.sim(),
                     next,
                     &request,
@@ -273,7 +277,7 @@ impl Serving {
         target: u64,
         hub: &Hub,
         asker: Asker,
-    ) -> anyhow::Result<Result<(), String>> {
+    ) -> Result<Result<(), String>, ServeError> {
         if target > self.last {
             return Ok(Err(format!(
                 "frame {target} is past the session's last frame, {} ({})",
@@ -338,7 +342,7 @@ impl Serving {
 
     /// Goes on with the seek or step under way for one slice; answers its asker when it is
     /// done.
-    pub fn slice(&mut self, hub: &Hub) -> anyhow::Result<()> {
+    pub fn slice(&mut self, hub: &Hub) -> Result<(), ServeError> {
         let Some(mut run) = self.running.take() else {
             return Ok(());
         };
@@ -416,7 +420,7 @@ impl Serving {
 
     /// A new session of the current scenario from frame 0: in a new recording file, or
     /// (a seek back) writing the current one again; the file, if recording.
-    fn restart(&mut self, hub: &Hub, new_file: bool) -> anyhow::Result<Option<String>> {
+    fn restart(&mut self, hub: &Hub, new_file: bool) -> Result<Option<String>, ServeError> {
         if new_file && self.record.is_some() {
             self.segment += 1;
         }
@@ -440,7 +444,7 @@ impl Serving {
     }
 
     /// One frame: the clients' inputs, then the step; false if it overflowed.
-    pub fn frame(&mut self, hub: &Hub) -> anyhow::Result<bool> {
+    pub fn frame(&mut self, hub: &Hub) -> Result<bool, ServeError> {
         let dt_ns = self.session.recorder().dt_ns();
         let inputs = std::mem::take(&mut hub.lock().inputs);
         for (client, text) in inputs {
@@ -458,13 +462,13 @@ impl Serving {
     /// Steps the session, keeping a snapshot every [`SNAPSHOT_EVERY`] frames; false if the
     /// step overflowed (then the session is paused at its last good frame and every client
     /// told).
-    fn step(&mut self, hub: &Hub) -> anyhow::Result<bool> {
+    fn step(&mut self, hub: &Hub) -> Result<bool, ServeError> {
         match self.session.step() {
             Ok(_) => {}
-            Err(crate::session::StepError::Overflow { .. }) => {
+            Err(StepError::Overflow { .. }) => {
                 self.paused = true;
                 let why = self.halted().unwrap_or_default();
-                crate::out::note(&format!("error: {why}"))?;
+                (self.note)(&format!("error: {why}"));
                 broadcast_status(hub, 2, &why);
                 return Ok(false);
             }
@@ -489,7 +493,7 @@ impl Serving {
     /// `/events` line for the live clients, listing the bodies at the point in the state
     /// they were last sent. Never recorded. While a seek or step is under way, or after an
     /// overflow, the clicker is told why there is no answer.
-    pub fn clicks(&mut self, hub: &Hub) -> anyhow::Result<()> {
+    pub fn clicks(&mut self, hub: &Hub) -> Result<(), ServeError> {
         let clicks = std::mem::take(&mut hub.lock().clicks);
         for (client, payload) in clicks {
             if let Some(why) = self.busy().or_else(|| self.halted()) {
@@ -497,7 +501,7 @@ impl Serving {
                     .tell(client, 1, &format!("clicked point not answered: {why}"));
                 continue;
             }
-            let click = match super::click::parse(&payload) {
+            let click = match crate::click::parse(&payload) {
                 Ok(c) => c,
                 Err(why) => {
                     hub.lock().tell(client, 2, &why);
@@ -507,7 +511,7 @@ impl Serving {
             let at = click.in_world(self.session.view_at());
             let sim = self.session.sim();
             let bodies = sim.overlap_point(at, &ricochet_sim::QueryFilter::all());
-            let line = crate::events::click(sim, at, &bodies);
+            let line = ricochet_record::events::click(sim, at, &bodies);
             self.session.event_live(line)?;
         }
         Ok(())

@@ -3,11 +3,11 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 
-use ricochet_log::LogMessage;
+use crate::LogMessage;
 use serde_json::Value;
 
 use super::Divergence;
-use crate::out;
+use crate::escape_controls;
 
 /// Compares two JSON values; returns the first differing path with both values.
 fn compare(
@@ -96,7 +96,7 @@ fn label(v: &Value) -> String {
         body_id(v, "b", "b_generation"),
     );
     match (id_of(v), v.get("name").and_then(Value::as_str), pair) {
-        (Some(id), Some(name), _) => format!("{id} ({})", out::escape_controls(name)),
+        (Some(id), Some(name), _) => format!("{id} ({})", escape_controls(name)),
         (Some(id), None, _) => id.to_string(),
         (None, _, (Some(a), Some(b))) => format!("pair {a}/{b}"),
         _ => String::new(),

@@ -18,8 +18,9 @@ use tokio_tungstenite::tungstenite::Message;
 use tokio_tungstenite::tungstenite::handshake::server::{ErrorResponse, Request, Response};
 use tokio_tungstenite::tungstenite::http::{HeaderValue, StatusCode};
 
-use super::hub::{Hub, client_queue};
-use super::protocol::{self, ClientMessage, ServerMessage};
+use crate::hub::{Hub, client_queue};
+use crate::protocol::{self, ClientMessage, ServerMessage};
+use crate::realtime::Note;
 
 /// Clients served at once; more are refused (HTTP 503).
 pub const MAX_CLIENTS: usize = 64;
@@ -38,7 +39,7 @@ pub const HANDSHAKE_TIMEOUT: Duration = Duration::from_secs(5);
 const ACCEPT_BACKOFF: Duration = Duration::from_millis(100);
 
 /// Accepts connections on `listener` until the runtime stops.
-pub async fn accept(listener: TcpListener, hub: Hub, session: String) {
+pub async fn accept(listener: TcpListener, hub: Hub, session: String, note: Note) {
     // The handshakes under way, oldest first: dropping one's sender evicts it; a finished
     // one has dropped its receiver.
     let mut pending: VecDeque<oneshot::Sender<()>> = VecDeque::new();
@@ -48,7 +49,7 @@ pub async fn accept(listener: TcpListener, hub: Hub, session: String) {
             Ok(accepted) => accepted,
             Err(e) => {
                 if !failing {
-                    tracing_note(&format!("serve: accepting a connection: {e}"));
+                    note(&format!("serve: accepting a connection: {e}"));
                 }
                 failing = true;
                 pending.retain(|p| !p.is_closed());
@@ -70,10 +71,10 @@ pub async fn accept(listener: TcpListener, hub: Hub, session: String) {
         }
         let (evict, evicted) = oneshot::channel();
         pending.push_back(evict);
-        let (hub, session) = (hub.clone(), session.clone());
+        let (hub, session, note) = (hub.clone(), session.clone(), note.clone());
         tokio::spawn(async move {
-            if let Err(e) = client(stream, peer, hub, &session, evicted).await {
-                tracing_note(&format!("serve: client {peer}: {e}"));
+            if let Err(e) = client(stream, peer, hub, &session, evicted, &note).await {
+                note(&format!("serve: client {peer}: {e}"));
             }
         });
     }
@@ -86,11 +87,6 @@ pub async fn accept(listener: TcpListener, hub: Hub, session: String) {
 /// speaks no ROS otherwise: every channel stays protobuf, every schema Foxglove's or its own.
 fn metadata() -> std::collections::BTreeMap<String, String> {
     [("ROS_DISTRO".to_owned(), "humble".to_owned())].into()
-}
-
-/// A line on stderr (lost lines are no failure).
-fn tracing_note(text: &str) {
-    let _ = crate::out::note(text);
 }
 
 /// The handshake's answer: the subprotocol chosen, or HTTP 400 naming the ones accepted.
@@ -125,6 +121,7 @@ async fn client(
     hub: Hub,
     session: &str,
     evicted: oneshot::Receiver<()>,
+    note: &Note,
 ) -> Result<(), String> {
     let config = tokio_tungstenite::tungstenite::protocol::WebSocketConfig::default()
         .max_message_size(Some(MAX_CLIENT_MESSAGE))
@@ -160,7 +157,7 @@ async fn client(
                 channels: s.channels(),
             };
             let services = ServerMessage::AdvertiseServices {
-                services: &super::services::list(),
+                services: &crate::services::list(),
             };
             let hello = [info.json(), advertise.json(), services.json()];
             (s.connect(queue.clone()), hello)
@@ -174,7 +171,7 @@ async fn client(
         let _ = out.send(Message::text(status.json())).await;
         return Err("refused: too many clients".to_owned());
     };
-    tracing_note(&format!("serve: client {peer} connected"));
+    note(&format!("serve: client {peer} connected"));
     let mut limit = RateLimit::new();
     let result = async {
         for text in hello {
@@ -210,7 +207,7 @@ async fn client(
     }
     .await;
     hub.lock().disconnect(id);
-    tracing_note(&format!("serve: client {peer} disconnected"));
+    note(&format!("serve: client {peer} disconnected"));
     result
 }
 

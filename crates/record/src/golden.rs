@@ -1,0 +1,158 @@
+//! Golden-log checks for a game's own `cargo test`: a simulation the game builds in code is
+//! stepped and recorded, and the log is compared with one recorded before (the golden).
+//!
+//! ```no_run
+//! # fn level1() -> ricochet_sim::Simulation { unimplemented!() }
+//! // In a test: fails with the first divergence, as `ricochet diff` prints it.
+//! let mut sim = level1();
+//! ricochet_record::golden::check("tests/golden/level1.mcap", &mut sim, 600).unwrap();
+//! ```
+//!
+//! `RICOCHET_BLESS=1 cargo test` records the golden instead (or again, after a change that
+//! is meant). The log is written to a temporary file renamed onto the golden when it is
+//! complete, so an interrupted bless leaves the old golden whole. A check that fails keeps
+//! the new log beside the golden (`level1.new.mcap`) for `ricochet diff` or Foxglove; a
+//! check that passes removes it.
+
+use std::path::{Path, PathBuf};
+
+use ricochet_log::LogError;
+use ricochet_log::diff::{self, DiffError, Divergence};
+use ricochet_sim::Simulation;
+
+use crate::Recorder;
+use crate::channels::Channels;
+
+/// Set to `1`, [`check`] records the golden instead of comparing with it.
+pub const BLESS_ENV: &str = "RICOCHET_BLESS";
+
+/// Why a golden check failed.
+#[derive(Debug, thiserror::Error)]
+pub enum GoldenError {
+    /// There is no golden log yet.
+    #[error(
+        "{}: no golden log yet; run the test with RICOCHET_BLESS=1 to record it (this run's log is {})",
+        golden.display(),
+        new.display()
+    )]
+    Missing {
+        /// The golden's path.
+        golden: PathBuf,
+        /// Where this run's log was kept.
+        new: PathBuf,
+    },
+    /// The run's log differs from the golden.
+    #[error(
+        "{report}the run differs from its golden log; if the change is meant, re-record it with \
+         RICOCHET_BLESS=1 (this run's log is {})",
+        new.display()
+    )]
+    Differs {
+        /// The first divergence: frame, topic, body, field and both values (A is the golden).
+        first: Box<Divergence>,
+        /// The report as `ricochet diff GOLDEN NEW` prints it.
+        report: String,
+        /// Where this run's log was kept.
+        new: PathBuf,
+    },
+    /// A step made a value non-finite: nothing after it can be trusted.
+    #[error("frame {frame}: {what}; the simulation overflowed")]
+    Overflow {
+        /// The frame that overflowed.
+        frame: u64,
+        /// Which body and value.
+        what: String,
+    },
+    /// Writing the log failed.
+    #[error(transparent)]
+    Log(#[from] LogError),
+    /// The golden could not be read (cut short, damaged, not a Ricochet log).
+    #[error(transparent)]
+    Diff(#[from] DiffError),
+}
+
+/// Steps `sim` for frame 0 and `frames` more (as `ricochet run --frames N` does: the first
+/// step of a new simulation is frame 0, its initial state), records every frame on every
+/// channel, and compares the log with the golden at `golden`: `Ok(())` when equal
+/// message by message, else the first divergence. With `RICOCHET_BLESS=1` in the
+/// environment, writes the golden instead (creating its directory).
+pub fn check(
+    golden: impl AsRef<Path>,
+    sim: &mut Simulation,
+    frames: u64,
+) -> Result<(), GoldenError> {
+    let bless = std::env::var_os(BLESS_ENV).is_some_and(|v| v == "1");
+    check_or_bless(golden.as_ref(), sim, frames, bless)
+}
+
+/// [`check`], with the choice to bless given rather than read from the environment.
+pub fn check_or_bless(
+    golden: &Path,
+    sim: &mut Simulation,
+    frames: u64,
+    bless: bool,
+) -> Result<(), GoldenError> {
+    if bless {
+        if let Some(dir) = golden.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir).map_err(|source| LogError::Create {
+                path: dir.to_path_buf(),
+                source,
+            })?;
+        }
+        return record(golden, sim, frames);
+    }
+    let new = new_path(golden);
+    record(&new, sim, frames)?;
+    if !golden.exists() {
+        return Err(GoldenError::Missing {
+            golden: golden.to_path_buf(),
+            new,
+        });
+    }
+    let (a, b) = (diff::open(golden)?, diff::open(&new)?);
+    let report = diff::diff_files(&a, &b, 0.0, None)?;
+    match report.first {
+        None => {
+            drop(b);
+            // Nothing to look at: the run is the golden.
+            let _ = std::fs::remove_file(&new);
+            Ok(())
+        }
+        Some(_) => {
+            let text = diff::render(&report, golden, &new);
+            let first = report.first.expect("matched Some above");
+            Err(GoldenError::Differs {
+                first: Box::new(first),
+                report: text,
+                new,
+            })
+        }
+    }
+}
+
+/// Where a check keeps the run's log: `NAME.new.mcap` beside the golden `NAME.mcap`.
+fn new_path(golden: &Path) -> PathBuf {
+    let stem = golden
+        .file_stem()
+        .map_or_else(|| "golden".into(), |s| s.to_string_lossy());
+    golden.with_file_name(format!("{stem}.new.mcap"))
+}
+
+/// Steps and records frame 0 to `frames` into `path` (temporary file, renamed when complete).
+fn record(path: &Path, sim: &mut Simulation, frames: u64) -> Result<(), GoldenError> {
+    let mut log = Recorder::create(path, sim.scenario().world.dt, Channels::default())?;
+    for _ in 0..=frames {
+        let out = sim.step();
+        if let Some(bad) = sim.first_non_finite() {
+            // Like `ricochet run`: the frame that overflowed is not written.
+            log.finish()?;
+            return Err(GoldenError::Overflow {
+                frame: out.frame,
+                what: crate::session::describe(sim, &bad),
+            });
+        }
+        log.record(sim, &out)?;
+    }
+    log.finish()?;
+    Ok(())
+}

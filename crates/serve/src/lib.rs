@@ -1,0 +1,38 @@
+//! Serving a Ricochet simulation live to Foxglove (or Lichtblick) over the Foxglove
+//! WebSocket protocol, in real time, with inputs, services and seeks coming back.
+//!
+//! This crate owns:
+//! - the protocol (`protocol.rs`: both subprotocols, foxglove.websocket.v1 and
+//!   foxglove.sdk.v1), the connections and their bounds (`server.rs`), and the hub the
+//!   simulation and the connections share (`hub.rs`: channels, queues, inputs, calls);
+//! - the services a client calls (`services.rs`: `/reset`, `/load`, `/step`, `/query`, ...),
+//!   scene queries (`query.rs`) and Lichtblick's clicked point (`click.rs`);
+//! - the real-time loop ([`serve`]: a fixed-timestep schedule, seeks, `/step`, pauses),
+//!   recording the session as it goes ([`Options::record`]).
+//!
+//! The messages are `ricochet-record`'s, the same a log holds; the inputs are its sessions'.
+//! This crate never lets the wall clock reach a message (it only paces the frames), never
+//! computes physics, and never prints, parses command lines or installs signal handlers:
+//! notes go to [`Options::note`], and the caller's flag stops it.
+//!
+//! ```no_run
+//! use std::sync::atomic::AtomicBool;
+//! # fn level() -> ricochet_sim::Scenario { ricochet_sim::Scenario::default() }
+//! let listener = ricochet_serve::Listener::bind("127.0.0.1:8765".parse().unwrap()).unwrap();
+//! let options = ricochet_serve::Options { frames: Some(600), ..Default::default() };
+//! let stop = AtomicBool::new(false);
+//! let served = ricochet_serve::serve(listener, level(), String::new(), &options, &stop).unwrap();
+//! println!("served frames 0 to {}", served.next_frame - 1);
+//! ```
+
+mod click;
+mod hub;
+mod load_path;
+mod protocol;
+mod query;
+mod realtime;
+mod server;
+mod services;
+mod serving;
+
+pub use realtime::{DEFAULT_BIND, Listener, Note, Options, ServeError, Served, cpu_seconds, serve};
