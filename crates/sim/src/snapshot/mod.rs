@@ -69,7 +69,9 @@ mod error;
 
 pub use error::SnapshotError;
 
-use codec::{Fnv, Reader, Sink, fnv};
+use std::sync::{Arc, OnceLock};
+
+use codec::{Hasher, Reader, Sink, hash};
 
 use crate::pipeline::Simulation;
 use crate::stages::detect::DetectState;
@@ -79,7 +81,7 @@ use crate::world::World;
 
 /// The version of the snapshot format [`Snapshot::to_bytes`] writes and
 /// [`Snapshot::from_bytes`] reads.
-pub const SNAPSHOT_VERSION: u32 = 1;
+pub const SNAPSHOT_VERSION: u32 = 2;
 
 /// The first bytes of a snapshot.
 const MAGIC: &[u8; 4] = b"RCSN";
@@ -119,7 +121,7 @@ impl Snapshot {
         b.u64(self.scene);
         Sink::len(&mut b, self.payload.len());
         b.put(&self.payload);
-        let sum = fnv(&b);
+        let sum = hash(&b);
         b.u64(sum);
         b
     }
@@ -149,7 +151,7 @@ impl Snapshot {
             });
         }
         let (body, sum) = bytes.split_at(bytes.len().saturating_sub(8));
-        if sum.len() != 8 || fnv(body) != Reader::new(sum).u64()? {
+        if sum.len() != 8 || hash(body) != Reader::new(sum).u64()? {
             return Err(SnapshotError::Checksum);
         }
         let mut r = Reader::new(&body[16..]);
@@ -160,18 +162,16 @@ impl Snapshot {
             return Err(SnapshotError::malformed("the state's length"));
         }
         let payload = body[HEADER..].to_vec();
-        let s = Snapshot {
+        // The bodies are checked by `restore`, against the baseline they are written from.
+        Ok(Snapshot {
             frame,
             scene,
             payload,
-        };
-        // Checked now, so that a snapshot that parses restores (layers checked then).
-        s.decode(usize::from(u8::MAX) + 1)?;
-        Ok(s)
+        })
     }
 
-    /// The state in the payload, for a scene of `layers` layers.
-    fn decode(&self, layers: usize) -> Result<State, SnapshotError> {
+    /// The state in the payload, for a scene of `layers` layers starting as `base`.
+    fn decode(&self, base: &World, layers: usize) -> Result<State, SnapshotError> {
         let mut r = Reader::new(&self.payload);
         let frame = r.u64()?;
         if frame != self.frame {
@@ -197,7 +197,7 @@ impl Snapshot {
             return Err(SnapshotError::malformed("touching pairs out of order"));
         }
         let statics_moved = r.bool()?;
-        let world = World::decode(&mut r, layers)?;
+        let bodies = World::decode(&mut r, base, layers)?;
         if !r.is_done() {
             return Err(SnapshotError::malformed("bytes after the state"));
         }
@@ -209,7 +209,7 @@ impl Snapshot {
             focus,
             touching,
             statics_moved,
-            world,
+            bodies,
         })
     }
 }
@@ -223,15 +223,40 @@ struct State {
     focus: Option<crate::Entity>,
     touching: Vec<(crate::Entity, crate::Entity)>,
     statics_moved: bool,
+    bodies: crate::world::Bodies,
+}
+
+/// The world as the simulation was built, before its first step: what a snapshot's bodies
+/// are written against (`world/state.rs`). Shared by the simulation's clones.
+#[derive(Debug)]
+pub(crate) struct Baseline {
     world: World,
+    /// The scene's hash: its definition and this world (computed at the first snapshot).
+    scene: OnceLock<u64>,
+}
+
+impl Baseline {
+    /// The baseline of a simulation whose world is `world` before its first step.
+    pub(crate) fn new(world: &World) -> Arc<Baseline> {
+        Arc::new(Baseline {
+            world: world.clone(),
+            scene: OnceLock::new(),
+        })
+    }
 }
 
 impl Simulation {
     /// The hash of what a snapshot references instead of copying: the world settings,
-    /// layers, templates and script (their `Debug` text, which writes every float exactly).
+    /// layers, templates and script (their `Debug` text, which writes every float exactly),
+    /// and the baseline's bodies, every field.
     fn scene_hash(&self) -> u64 {
-        let s = &self.scenario;
-        fnv(format!("{:?}|{:?}|{:?}", s.world, s.templates, s.script).as_bytes())
+        *self.baseline.scene.get_or_init(|| {
+            let s = &self.scenario;
+            let mut h = Hasher::default();
+            h.str(&format!("{:?}|{:?}|{:?}", s.world, s.templates, s.script));
+            self.baseline.world.encode(&World::new(), &mut h, true);
+            h.finish()
+        })
     }
 
     /// Writes the state a step reads (module docs), and with `game_data` the user data.
@@ -260,14 +285,14 @@ impl Simulation {
             s.entity(*b);
         }
         s.bool(self.touch.static_generation() != self.world.static_generation());
-        self.world.encode(s, game_data);
+        self.world.encode(&self.baseline.world, s, game_data);
     }
 
     /// The state the next step reads, and the game's user data: every body's state (the
     /// module docs' table), the scene by its hash.
     #[must_use]
     pub fn snapshot(&self) -> Snapshot {
-        let mut payload = Vec::new();
+        let mut payload = Vec::with_capacity(64 + 26 * self.world.movers().len());
         self.encode_state(&mut payload, true);
         Snapshot {
             frame: self.frame,
@@ -293,20 +318,20 @@ impl Simulation {
             });
         }
         let layers = &self.scenario.world.layers;
-        let st = s.decode(layers.names().len())?;
+        let st = s.decode(&self.baseline.world, layers.names().len())?;
         if st.cursor > self.scenario.script.len() {
             return Err(SnapshotError::malformed("a script cursor past the script"));
         }
         self.detect = DetectState::new(layers, self.scenario.world.broad_phase);
         self.separate = SeparateState::new(layers);
-        let g = st.world.static_generation();
+        self.world.restore_bodies(&self.baseline.world, &st.bodies);
+        let g = self.world.static_generation();
         let seen = if st.statics_moved {
             g.wrapping_sub(1)
         } else {
             g
         };
         self.touch = TouchState::restored(layers, st.touching, seen);
-        self.world = st.world;
         // Another world: neither tree set of the scene queries may be kept (a static
         // generation can repeat with other static bodies).
         self.queries = crate::query::index::QueryCache::default();
@@ -327,8 +352,8 @@ impl Simulation {
     /// identically; a change of any one of those fields changes it.
     #[must_use]
     pub fn checksum(&self) -> u64 {
-        let mut h = Fnv::default();
-        self.encode_state(&mut h, false);
-        h.0
+        let mut b = Vec::with_capacity(64 + 26 * self.world.movers().len());
+        self.encode_state(&mut b, false);
+        hash(&b)
     }
 }

@@ -38,6 +38,8 @@ mod rows;
 mod sleep;
 mod state;
 
+pub(crate) use state::Bodies;
+
 use bounds::LocalBounds;
 use rows::Rows;
 
