@@ -15,7 +15,7 @@
 //! | field | is | saved | in `checksum` |
 //! |---|---|---|---|
 //! | `Simulation::frame`, `cursor` (next script event) | state | yes | yes |
-//! | `pending` (inputs sent with `apply`) | state | yes | yes |
+//! | `pending` (inputs the game sent for the next step) | state | yes | yes |
 //! | `targets`, `targeted` (kinematic target poses) | state | yes | yes |
 //! | `focus` (the body the active region follows) | state | yes | yes |
 //! | `touch.touching` (pairs touching at the end of the last frame) | state | yes | yes |
@@ -24,26 +24,47 @@
 //! | `capture_detect_poses`, `workers` | settings of the output and the threads, not of the result | no | no |
 //! | `detect` (broad phase, static entries, buffers), `separate` (static and mover grids) | caches rebuilt from the world | no: restore builds them new | no |
 //! | `touch` buffers (`recorded`, `next`, `ends`, ...) | scratch | no | no |
-//! | World: `entity`, `layer`, `kind`, `position`, `angle`, shape, name | state (a script finds bodies by name) | yes, shapes by value | yes |
-//! | World: the allocator's generations (its free list: every slot not alive) | state | yes | yes |
-//! | World: `shapes`, `names` tables, `row`, `movers`, `active`, counters, `non_boxes`, `key` | caches of the above | no: rebuilt | no |
-//! | World: `static_generation` | a counter the caches compare | no: a restored world counts anew and its caches are new | no |
-//! | Rows: `mass`, `velocity`, `angular_velocity`, `force`, `gravity_scale`, `lifetime`, `controller`, `inputs`, `grounded`, `on_static`, `carrier`, `still`, `split`, `frozen`, `asleep`, `rest_frames` | state | yes | yes |
-//! | Rows: whether a static body has a row (scenery given one) | state of the layout | yes | yes |
+//! | World: `entity`, `layer`, `kind`, `position`, `angle`, `shape`, `name` | state (a script finds bodies by name) | as they differ from the baseline | yes |
+//! | World: the allocator's `generations` (its free list: every slot not alive) | state | as they differ from the baseline | yes |
+//! | World: `shapes`, `names` tables, `row`, `movers`, `active`, counters, `non_boxes`, `key` | caches of the above | no: rebuilt or patched | no |
+//! | World: `static_generation` | a counter the caches compare | no: the caches are built new | no |
+//! | World: `reshaped` | whether a body may no longer have the baseline's shape and name: only what is compared | no | no |
+//! | Rows: `mass`, `velocity`, `angular_velocity`, `force`, `gravity_scale`, `lifetime`, `controller`, `inputs`, `grounded`, `on_static`, `carrier`, `still`, `split`, `frozen`, `asleep`, `rest_frames` | state | as they differ from the baseline | yes |
+//! | Rows: whether a static body has a row (`has_row`: scenery given one) | state of the layout | yes | yes |
 //! | Rows: `local_bounds` | a cache, but its history shows in the broad phase's candidates: one bit (turned: the any-angle square) | yes | yes |
 //! | Rows: `start_position` | a cache: `start_frame` sets it from `position` each step | no | no |
 //! | Rows: `entity` (row to body) | the layout | no | no |
 //! | Rows: `user_data` | game data: no stage reads it | yes | **no** |
+//! | `baseline` (the world before the first step) | definition | its hash, in the scene's | no |
 //!
-//! `world/state.rs` destructures `Rows` whole: a new column fails to compile until it is
-//! written there or named a cache.
+//! `world/checksum_fields.rs` changes every field marked "in `checksum`" in turn and checks
+//! that the checksum changes (its list is checked against this table, and it destructures
+//! `Rows`); `world/state.rs` destructures `Rows` too: a new column fails to compile until it
+//! is placed in both.
+//!
+//! # The baseline
+//!
+//! A simulation keeps a copy of its world as it was built, before the first step (shared
+//! by its clones; it costs as much memory as that world). A snapshot writes the bodies as
+//! they differ from it (`world/state.rs`): runs of bodies kept or dropped, a mask of the
+//! field groups that changed, and whole records for bodies spawned later or redefined. A
+//! drifting asteroid costs 25 bytes (its position and angle), a tile that did not move
+//! nothing. The encoding is a function of the state alone (never of interned ids or row
+//! order), so [`Simulation::checksum`] hashes it too. The baseline's hash is part of the
+//! scene's: a snapshot restores only onto a simulation built the same way.
+//!
+//! [`Simulation::restore`] onto a simulation whose world has the same bodies as the
+//! snapshot, each with the baseline's definition (a rollback: the common case), patches the
+//! columns in place; otherwise it builds the world anew. The broad phase, grids and query
+//! trees are built new either way.
 //!
 //! # Bytes
 //!
 //! `RCSN`, [`SNAPSHOT_VERSION`] (u32), the total length (u64), the frame, the scene hash
-//! (u64 each), the state's length (u32) and the state, then an FNV-1a 64 of every byte
-//! before it. Little-endian, every float as its bits. Every truncation or flipped bit is an
-//! error, never a panic.
+//! (u64 each), the state's length (u32) and the state, then an XXH3-64 (fixed seed) of
+//! every byte before it. Little-endian, every float as its bits. Every truncation or
+//! flipped bit is an error, never a panic; the state is checked against the baseline by
+//! `restore`, which leaves the simulation unchanged when it fails.
 //!
 //! ```
 //! use ricochet_sim::prelude::*;

@@ -33,6 +33,8 @@ use crate::interned::{NameTable, ShapeTable, shape_key};
 use crate::scenario::TileRows;
 
 mod bounds;
+#[cfg(test)]
+mod checksum_fields;
 mod measures;
 mod rows;
 mod sleep;

@@ -173,8 +173,8 @@ impl World {
     }
 
     /// Whether body `i` has the definition of `base`'s body `j` (the same entity): what a
-    /// `CHANGED` record takes from the baseline. Shapes and names have no setter but
-    /// `set_shape`: compared only once it ran (or a restore redefined a body).
+    /// `CHANGED` record takes from the baseline. A shape changes only by `set_shape`, which
+    /// sets `reshaped` (as a restore that redefined a body does): compared only then.
     fn same_definition(&self, i: usize, base: &World, j: usize) -> bool {
         let (r, q) = (self.row[i], base.row[j]);
         self.layer[i] == base.layer[j]
@@ -183,9 +183,8 @@ impl World {
             && self.mass(i).to_bits() == base.mass(j).to_bits()
             && self.gravity_scale(i).to_bits() == base.gravity_scale(j).to_bits()
             && same_bits(self.split(i), base.split(j), |s, x| s.splits(x))
-            && (!self.reshaped
-                || (self.name(i) == base.name(j)
-                    && same_bits(self.shape(i), base.shape(j), |s, x| s.shape(x))))
+            && self.name(i) == base.name(j)
+            && (!self.reshaped || same_bits(self.shape(i), base.shape(j), |s, x| s.shape(x)))
     }
 
     /// The groups in which body `i` differs from `base`'s body `j`, bit for bit.
