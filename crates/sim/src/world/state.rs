@@ -6,7 +6,8 @@
 //!   for a whole level);
 //! - `DROP n`: the next `n` bodies of the baseline are gone;
 //! - `CHANGED` with a mask of the [`group`]s that differ from the baseline's body, each
-//!   written whole (a drifting asteroid: position and angle, 25 bytes);
+//!   written whole (a drifting asteroid: position and angle, 25 bytes; its turned bit is a
+//!   bit of the mask);
 //! - `WHOLE`: a body the baseline does not have (spawned later), or one whose definition
 //!   (layer, kind, shape, name, mass, gravity scale, children, having a row) is no longer
 //!   the baseline's: every field, as version 1 wrote every body.
@@ -45,12 +46,14 @@ pub(crate) mod group {
     pub(crate) const SPIN: u8 = 8;
     /// `lifetime`.
     pub(crate) const LIFETIME: u8 = 16;
-    /// [`super::Motion`]: force, controller, inputs, contact flags, carrier, sleep, turned.
+    /// [`super::Motion`]: force, controller, inputs, contact flags, carrier, sleep, and
+    /// `user_data` (left out of the checksum's mask and bytes).
     pub(crate) const MOTION: u8 = 32;
-    /// `user_data` (never in the checksum).
-    pub(crate) const USER: u8 = 64;
+    /// The turned bit (the broad phase's bounds: exact, or the any-angle square once the
+    /// body turned) is not the baseline's: no bytes, the bit says it all.
+    pub(crate) const TURNED: u8 = 64;
     /// The groups only a body with a row has.
-    pub(crate) const ROW: u8 = VELOCITY | SPIN | LIFETIME | MOTION | USER;
+    pub(crate) const ROW: u8 = VELOCITY | SPIN | LIFETIME | MOTION | TURNED;
 }
 
 const KEEP: u8 = 0;
@@ -72,8 +75,8 @@ pub(crate) struct Motion {
     frozen: bool,
     asleep: bool,
     rest_frames: u32,
-    /// The broad phase's bounds: exact, or the any-angle square once the body turned.
-    turned: bool,
+    /// The game's data: in the snapshot, never in the checksum.
+    user_data: u128,
 }
 
 /// A body written whole (a `WHOLE` record, or a baseline body a restore rebuilds).
@@ -99,7 +102,8 @@ struct WholeRow {
     lifetime: Option<u32>,
     split: Vec<Split>,
     motion: Motion,
-    user_data: u128,
+    /// The broad phase's bounds: exact, or the any-angle square once the body turned.
+    turned: bool,
 }
 
 /// The groups of a `CHANGED` record (the others are the baseline's).
@@ -110,7 +114,6 @@ struct Delta {
     velocity: Vec2,
     spin: f64,
     lifetime: Option<u32>,
-    user_data: u128,
     /// Index in [`Bodies::motions`] (with [`group::MOTION`]).
     motion: u32,
 }
@@ -168,7 +171,7 @@ impl World {
             frozen: self.frozen(i),
             asleep: self.asleep(i),
             rest_frames: self.rest_frames(i),
-            turned: self.turned(i),
+            user_data: self.user_data(i),
         }
     }
 
@@ -208,11 +211,11 @@ impl World {
         if self.lifetime(i) != base.lifetime(j) {
             m |= group::LIFETIME;
         }
-        if !self.same_motion(i, base, j) {
+        if !self.same_motion(i, base, j) || (game_data && self.user_data(i) != base.user_data(j)) {
             m |= group::MOTION;
         }
-        if game_data && self.user_data(i) != base.user_data(j) {
-            m |= group::USER;
+        if self.turned(i) != base.turned(j) {
+            m |= group::TURNED;
         }
         m
     }
@@ -230,7 +233,6 @@ impl World {
             && self.frozen(i) == base.frozen(j)
             && self.asleep(i) == base.asleep(j)
             && self.rest_frames(i) == base.rest_frames(j)
-            && self.turned(i) == base.turned(j)
             && match (self.controller(i), base.controller(j)) {
                 (None, None) => true,
                 (a, b) => same_bits(&a, &b, |s, x| s.controller(*x)),
@@ -277,7 +279,7 @@ impl World {
             match step {
                 Step::Changed(m) => {
                     s.u8(CHANGED | m);
-                    self.write_groups(i, m, s);
+                    self.write_groups(i, m, s, game_data);
                     (i, j) = (i + 1, j + 1);
                 }
                 Step::Whole => {
@@ -310,7 +312,7 @@ impl World {
     }
 
     /// The groups of `mask` of body `i`, in [`group`] order.
-    fn write_groups(&self, i: usize, mask: u8, s: &mut impl Sink) {
+    fn write_groups(&self, i: usize, mask: u8, s: &mut impl Sink, game_data: bool) {
         if mask & group::POSITION != 0 {
             s.vec2(self.position[i]);
         }
@@ -327,10 +329,7 @@ impl World {
             write_lifetime(s, self.lifetime(i));
         }
         if mask & group::MOTION != 0 {
-            write_motion(s, &self.motion(i));
-        }
-        if mask & group::USER != 0 {
-            s.u128(self.user_data(i));
+            write_motion(s, &self.motion(i), game_data);
         }
     }
 
@@ -355,8 +354,8 @@ impl World {
             frozen: _,
             asleep: _,
             rest_frames: _,
-            local_bounds: _, // `turned`, in the motion group
-            user_data,
+            local_bounds: _, // `turned`, below
+            user_data: _,
         } = &self.rows;
         // The `_` columns above are the motion group's ([`World::motion`] reads them all).
         s.entity(self.entity[i]);
@@ -378,10 +377,8 @@ impl World {
         s.f64(gravity_scale[r]);
         write_lifetime(s, lifetime[r]);
         s.splits(&split[r]);
-        write_motion(s, &self.motion(i));
-        if game_data {
-            s.u128(user_data[r]);
-        }
+        write_motion(s, &self.motion(i), game_data);
+        s.bool(self.turned(i));
     }
 
     /// Reads what [`World::encode`] wrote against `base` (with `game_data`), checked against
@@ -563,19 +560,12 @@ impl World {
             } else {
                 base.lifetime(j)
             };
-            rows.user_data[r] = if pick(group::USER) {
-                d.user_data
-            } else {
-                base.user_data(j)
-            };
-            let turned = if pick(group::MOTION) {
-                let mo = b.motion(d);
-                self.set_motion(r, mo);
-                mo.turned
+            if pick(group::MOTION) {
+                self.set_motion(r, b.motion(d));
             } else {
                 self.set_motion(r, &base.motion(j));
-                base.turned(j)
-            };
+            }
+            let turned = base.turned(j) != pick(group::TURNED);
             let (shape, angle) = (&self.shapes.get(self.shape_id[i]).0, self.angle[i]);
             let lb = &mut self.rows.local_bounds[r];
             // Bounds that tell `turned` as they should are what a restore would build: an
@@ -606,6 +596,7 @@ impl World {
         rows.frozen[r] = m.frozen;
         rows.asleep[r] = m.asleep;
         rows.rest_frames[r] = m.rest_frames;
+        rows.user_data[r] = m.user_data;
     }
 
     /// The counters of the rows, counted again.
@@ -657,7 +648,7 @@ impl World {
             lifetime: self.lifetime(i),
             split: self.split(i).to_vec(),
             motion: self.motion(i),
-            user_data: self.user_data(i),
+            turned: self.turned(i),
         });
         Whole {
             entity: self.entity[i],
@@ -695,7 +686,7 @@ impl World {
         def.lifetime = row.lifetime;
         def.controller = row.motion.controller.clone();
         def.split = row.split;
-        def.user_data = row.user_data;
+        def.user_data = row.motion.user_data;
         self.insert(x.entity, &def);
         let i = self.len() - 1;
         let k = self.row_of(i);
@@ -710,7 +701,7 @@ impl World {
         rows.carrier[k] = m.carrier;
         rows.still[k] = m.still;
         rows.frozen[k] = m.frozen;
-        rows.local_bounds[k] = LocalBounds::restored(&def.shape, def.angle, m.turned);
+        rows.local_bounds[k] = LocalBounds::restored(&def.shape, def.angle, row.turned);
         sleep.push((k, m.asleep, m.rest_frames));
     }
 }
@@ -739,8 +730,8 @@ impl Whole {
         if mask & group::MOTION != 0 {
             row.motion = b.motion(d).clone();
         }
-        if mask & group::USER != 0 {
-            row.user_data = d.user_data;
+        if mask & group::TURNED != 0 {
+            row.turned = !row.turned;
         }
     }
 }
@@ -780,7 +771,7 @@ fn read_lifetime(r: &mut Reader) -> Result<Option<u32>, SnapshotError> {
     Ok(if r.bool()? { Some(r.u32()?) } else { None })
 }
 
-fn write_motion(s: &mut impl Sink, m: &Motion) {
+fn write_motion(s: &mut impl Sink, m: &Motion, game_data: bool) {
     s.vec2(m.force);
     s.controller(m.controller.as_ref());
     s.inputs(&m.inputs);
@@ -791,7 +782,9 @@ fn write_motion(s: &mut impl Sink, m: &Motion) {
     s.bool(m.frozen);
     s.bool(m.asleep);
     s.u32(m.rest_frames);
-    s.bool(m.turned);
+    if game_data {
+        s.u128(m.user_data);
+    }
 }
 
 fn read_motion(r: &mut Reader) -> Result<Motion, SnapshotError> {
@@ -806,7 +799,7 @@ fn read_motion(r: &mut Reader) -> Result<Motion, SnapshotError> {
         frozen: r.bool()?,
         asleep: r.bool()?,
         rest_frames: r.u32()?,
-        turned: r.bool()?,
+        user_data: r.u128()?,
     })
 }
 
@@ -834,9 +827,6 @@ fn read_groups(
     if mask & group::MOTION != 0 {
         d.motion = motions.len() as u32;
         motions.push(read_motion(r)?);
-    }
-    if mask & group::USER != 0 {
-        d.user_data = r.u128()?;
     }
     Ok(d)
 }
@@ -881,7 +871,7 @@ fn read_whole(r: &mut Reader, layers: usize) -> Result<Whole, SnapshotError> {
         lifetime: read_lifetime(r)?,
         split: r.splits()?,
         motion: read_motion(r)?,
-        user_data: r.u128()?,
+        turned: r.bool()?,
     });
     Ok(w)
 }
