@@ -3,11 +3,14 @@
 //! rollback's distance); then each pass times `snapshot`, `to_bytes`, `from_bytes`,
 //! `restore` (back those frames, onto the same bodies: patched in place), `checksum` and a
 //! `Simulation` clone. Each figure is the median of the passes. Figures, never assertions.
+//! Against rapier's serde snapshot of the same bodies at the same frame
+//! ([`ricochet_oracle::bench::rapier_snapshot`]: `bincode` of its `PhysicsWorld`).
 
 use std::fmt::Write as _;
 use std::time::Instant;
 
 use anyhow::Context;
+use ricochet_oracle::bench::{RapierSnapshot, rapier_snapshot};
 use ricochet_scenes::bench::Scene;
 use ricochet_sim::{Simulation, Snapshot};
 
@@ -41,6 +44,8 @@ pub struct SnapshotRow {
     pub checksum_us: f64,
     /// `Simulation::clone`.
     pub clone_us: f64,
+    /// rapier's snapshot of the same bodies.
+    pub rapier: RapierSnapshot,
 }
 
 impl SnapshotRow {
@@ -72,6 +77,8 @@ pub fn run_snapshots(name: &str, scene: Scene, frames: u64) -> anyhow::Result<Sn
     for _ in 0..frames {
         drop(sim.step());
     }
+    let rapier =
+        rapier_snapshot(&sim, PASSES).with_context(|| format!("{name}: rapier's snapshot"))?;
     let at = sim.snapshot();
     let bytes = at.to_bytes().len();
     let sum = sim.checksum();
@@ -109,6 +116,7 @@ pub fn run_snapshots(name: &str, scene: Scene, frames: u64) -> anyhow::Result<Sn
         round_trip_us: rt,
         checksum_us: e,
         clone_us: f,
+        rapier,
     })
 }
 
@@ -118,7 +126,8 @@ pub fn table(rows: &[SnapshotRow]) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "{:<20} {:>6} {:>7} {:>7} {:>9} {:>8} {:>9} {:>9} {:>10} {:>9} {:>11} {:>9} {:>9}",
+        "{:<20} {:>6} {:>7} {:>7} {:>9} {:>8} {:>9} {:>9} {:>10} {:>9} {:>11} {:>9} {:>9} \
+         {:>10} {:>10} {:>10} {:>10}",
         "scene",
         "frame",
         "bodies",
@@ -131,13 +140,17 @@ pub fn table(rows: &[SnapshotRow]) -> String {
         "restore µs",
         "round µs",
         "check µs",
-        "clone µs"
+        "clone µs",
+        "rapier B",
+        "B/moving",
+        "ser µs",
+        "de µs"
     );
     for r in rows {
         let _ = writeln!(
             s,
             "{:<20} {:>6} {:>7} {:>7} {:>9} {:>8.1} {:>9.1} {:>9.1} {:>10.1} {:>9.1} {:>11.1} \
-             {:>9.1} {:>9.1}",
+             {:>9.1} {:>9.1} {:>10} {:>10.1} {:>10.1} {:>10.1}",
             r.scene,
             r.frame,
             r.bodies,
@@ -150,7 +163,11 @@ pub fn table(rows: &[SnapshotRow]) -> String {
             r.restore_us,
             r.round_trip_us,
             r.checksum_us,
-            r.clone_us
+            r.clone_us,
+            r.rapier.bytes,
+            r.rapier.bytes as f64 / r.moving.max(1) as f64,
+            r.rapier.serialize_us,
+            r.rapier.deserialize_us
         );
     }
     s
@@ -160,6 +177,8 @@ pub fn table(rows: &[SnapshotRow]) -> String {
 pub const NOTES: &str = "\
 bytes: Snapshot::to_bytes at the frame; B/moving: per dynamic or kinematic body. Times: median \
 of 21 passes, in microseconds: snapshot, to_bytes (bytes), from_bytes (parse), restore (8 frames \
-back, onto the same bodies), their sum (round), checksum, Simulation::clone. A debug build's \
-times say nothing: build with --release.
+back, onto the same bodies), their sum (round), checksum, Simulation::clone. rapier: bincode of \
+its PhysicsWorld (every set a step reads; dynamic bodies with the same velocities, stepped once): \
+bytes, per moving body, serialise and deserialise times. A debug build's times say nothing: \
+build with --release.
 ";
