@@ -14,7 +14,7 @@ use anyhow::{Context, bail};
 
 use crate::{files, out};
 use ricochet_scenes::bench::{DEFAULT_SCENES, Scene};
-use ricochet_study::bench::{MAX_FRAMES, Row, queries, report, run_scene};
+use ricochet_study::bench::{MAX_FRAMES, Row, queries, report, run_scene, snapshots};
 
 /// Set in the environment of the process that runs one scene (`run` starts one per scene):
 /// it runs the scenes in-process and prints each result as a JSON line. Set it yourself to
@@ -147,4 +147,30 @@ pub fn run_queries(scenes: &[String], frames: u64) -> anyhow::Result<ExitCode> {
         .iter()
         .all(|r| r.ray_differences == [0, 0] && r.overlap_differences == [0, 0]);
     Ok(ExitCode::from(if agree { 0 } else { 1 }))
+}
+
+/// `bench --snapshots`: the named scenes (or asteroids-75 and asteroids-10000) snapshotted
+/// at frame `frames` ([`ricochet_study::bench::snapshots`]); prints the table. Exit code 0,
+/// 2 for a bad scene name or frame count.
+pub fn run_snapshots(scenes: &[String], frames: u64) -> anyhow::Result<ExitCode> {
+    let scenes = if scenes.is_empty() {
+        vec!["asteroids-75".to_owned(), "asteroids-10000".to_owned()]
+    } else {
+        scenes.to_vec()
+    };
+    let parsed = match parse_scenes(&scenes, frames)? {
+        Ok(parsed) => parsed,
+        Err(code) => return Ok(code),
+    };
+    let mut rows = Vec::new();
+    for (name, kind) in &parsed {
+        let _ = out::note(&format!("bench --snapshots: {name}"));
+        rows.push(snapshots::run_snapshots(name, *kind, frames)?);
+    }
+    out::print(&format!(
+        "{}{}\n",
+        snapshots::table(&rows),
+        snapshots::NOTES
+    ))?;
+    Ok(ExitCode::SUCCESS)
 }

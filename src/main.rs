@@ -266,6 +266,15 @@ enum Command {
         /// Ricochet's. Exit code 1 if any does.
         #[arg(long, conflicts_with_all = ["record", "csv"])]
         queries: bool,
+        /// Measure snapshots instead (issue #22): each scene (default asteroids-75 and
+        /// asteroids-10000) stepped --frames frames, snapshotted, stepped 8 more; then the
+        /// bytes per moving body, and the median of 21 passes of snapshot, to_bytes,
+        /// from_bytes, restore (the 8 frames back, onto the same bodies), their sum,
+        /// checksum and a Simulation clone, in microseconds. Build with --release.
+        ///
+        /// Example: ricochet bench --snapshots asteroids-75 asteroids-10000 --frames 300
+        #[arg(long, conflicts_with_all = ["record", "csv", "queries"])]
+        snapshots: bool,
     },
     /// Run a folder of scenarios against their golden logs: any change in your game's
     /// physics fails, with its first divergence named.
@@ -457,6 +466,12 @@ fn main() -> ExitCode {
             queries: true,
             ..
         } => bench::run_queries(&scenes, frames),
+        Command::Bench {
+            scenes,
+            frames,
+            snapshots: true,
+            ..
+        } => bench::run_snapshots(&scenes, frames),
         Command::Bench {
             scenes,
             frames,

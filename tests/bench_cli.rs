@@ -115,3 +115,34 @@ fn counts_and_frames_past_the_caps_are_bad_input() {
     assert!(help.contains("from 1 to 1000000"), "{help}");
     assert!(help.contains("at most 1000000"), "{help}");
 }
+
+/// `bench --snapshots` on a small scene: a row with sane numbers (no time asserted).
+#[test]
+fn bench_snapshots_prints_bytes_and_times_for_a_small_scene() {
+    let o = ricochet(
+        &["bench", "--snapshots", "asteroids-75", "--frames", "20"],
+        b"",
+    );
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{stdout}{stderr}");
+    let row: Vec<&str> = stdout
+        .lines()
+        .find(|l| l.starts_with("asteroids-75 "))
+        .unwrap_or_else(|| panic!("no row\n{stdout}"))
+        .split_whitespace()
+        .collect();
+    assert_eq!(row.len(), 17, "{stdout}");
+    let n: Vec<f64> = row[1..].iter().map(|x| x.parse().unwrap()).collect();
+    // The frame, 75 asteroids + 100 bullets + a ship, all moving.
+    assert_eq!(&n[..3], &[20.0, 176.0, 176.0], "{stdout}");
+    // Every asteroid drifted and turned: at least its position and angle (24 bytes), and
+    // no more than the bound.
+    assert!(n[4] >= 24.0 && n[4] <= 48.0, "{stdout}");
+    assert!((n[3] / 176.0 - n[4]).abs() <= 0.05, "{stdout}");
+    // rapier's serde snapshot holds more than the moving state.
+    assert!(n[12] > n[3], "{stdout}");
+    for (k, t) in n.iter().enumerate().skip(5) {
+        assert!(t.is_finite() && *t > 0.0, "column {k}: {t}\n{stdout}");
+    }
+}

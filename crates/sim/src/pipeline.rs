@@ -93,6 +93,8 @@ pub struct Simulation {
     /// The scene queries' trees (`query/index.rs`): built by the first query after a
     /// change, dropped by every method that moves, adds, removes or reshapes a body.
     pub(crate) queries: crate::query::index::QueryCache,
+    /// The world before the first step, that snapshots are written against (`snapshot/`).
+    pub(crate) baseline: std::sync::Arc<crate::snapshot::Baseline>,
 }
 
 /// A summary, not every body (`{:?}` of a 10,000-body world would be megabytes): the
@@ -172,6 +174,7 @@ impl Simulation {
 
     /// A simulation of `scenario` with its bodies already in `world`.
     fn with_world(scenario: Scenario, world: World) -> Simulation {
+        let baseline = crate::snapshot::Baseline::new(&world);
         let layers = &scenario.world.layers;
         Simulation {
             detect: DetectState::new(layers, scenario.world.broad_phase),
@@ -188,6 +191,7 @@ impl Simulation {
             focus: None,
             workers: Workers::default(),
             queries: crate::query::index::QueryCache::default(),
+            baseline,
         }
     }
 

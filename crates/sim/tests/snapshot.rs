@@ -68,3 +68,28 @@ fn every_truncation_and_bit_flip_is_an_error() {
         assert!(Snapshot::from_bytes(&b).is_err(), "bit {bit}");
     }
 }
+
+/// A rollback onto the same bodies (patched in place) at frame 300 of a drifting-asteroids
+/// bench scene: the bytes hold little more than each asteroid's position and angle (the
+/// issue's bound: 48 bytes a moving body), and the run steps on as it did.
+#[test]
+fn a_rollback_patches_in_place_and_costs_at_most_48_bytes_a_moving_body() {
+    let scene = ricochet_scenes::bench::asteroids(1000, 400);
+    let mut a = Simulation::new(&scene);
+    for _ in 0..300 {
+        a.step();
+    }
+    let bytes = a.snapshot().to_bytes();
+    let moving = a.world().movers().len();
+    assert!(
+        bytes.len() <= 48 * moving,
+        "{} bytes for {moving} moving bodies",
+        bytes.len()
+    );
+    let sum = a.checksum();
+    let first: Vec<_> = (0..40).map(|_| a.step()).collect();
+    a.restore(&Snapshot::from_bytes(&bytes).unwrap()).unwrap();
+    assert_eq!((a.frame(), a.checksum()), (300, sum));
+    let again: Vec<_> = (0..40).map(|_| a.step()).collect();
+    assert_eq!(first, again);
+}

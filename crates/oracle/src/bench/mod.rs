@@ -46,11 +46,13 @@ mod agreement;
 mod frame_pairs;
 mod queries;
 mod scene;
+mod snapshots;
 
 pub use agreement::{ContactAgreement, compare_contacts};
 pub use frame_pairs::{FramePairs, Pair, threshold, wrapped};
 pub use queries::RapierRayHit;
 pub use scene::RapierScene;
+pub use snapshots::{RapierSnapshot, rapier_snapshot, rapier_world};
 
 /// The tolerance of the contact-set comparison, world units, on both sides of touching:
 /// Ricochet's depth `<= CONTACT_TOLERANCE` or rapier's `dist >= -CONTACT_TOLERANCE` is a

@@ -1,7 +1,8 @@
 //! The snapshot's byte encoding: little-endian fixed-width numbers, a length before every
-//! list and string, a tag before every enum. One writer ([`Sink`]) feeds both the bytes
-//! ([`Vec<u8>`]) and the checksum ([`Fnv`]), so the two cover the same fields by
-//! construction; the [`Reader`] returns an error at the first byte missing or out of range.
+//! list and string, a tag before every enum, LEB128 for counts that are usually small. One
+//! writer ([`Sink`]) writes both the snapshot's bytes and what [`crate::Simulation::checksum`]
+//! hashes, so the two cover the same fields by construction; the [`Reader`] returns an error
+//! at the first byte missing or out of range.
 
 use ricochet_geom::{Aabb, Capsule, Circle, Obb, Polygon};
 use ricochet_geom::{Pose, Primitive, Shape, Vec2};
@@ -31,6 +32,18 @@ pub(crate) trait Sink {
     }
     fn u128(&mut self, x: u128) {
         self.put(&x.to_le_bytes());
+    }
+    /// LEB128: 7 bits a byte, low first (a run of 10,000 bodies is 2 bytes).
+    fn var(&mut self, mut x: u64) {
+        let mut b = [0u8; 10];
+        let mut n = 0;
+        while x >= 0x80 {
+            b[n] = (x as u8) | 0x80;
+            x >>= 7;
+            n += 1;
+        }
+        b[n] = x as u8;
+        self.put(&b[..=n]);
     }
     /// A float's bits: `-0.0` and NaN payloads are kept.
     fn f64(&mut self, x: f64) {
@@ -192,30 +205,35 @@ impl Sink for Vec<u8> {
     }
 }
 
-/// 64-bit FNV-1a over the bytes written (the hash of [`crate::World::digest`]).
-pub(crate) struct Fnv(pub(crate) u64);
+/// The hash of the snapshot's bytes, of its scene and of [`crate::Simulation::checksum`]'s
+/// encoding: XXH3-64 (a kept, specified hash, the same on every platform) with a fixed seed.
+pub(crate) fn hash(bytes: &[u8]) -> u64 {
+    xxhash_rust::xxh3::xxh3_64_with_seed(bytes, SEED)
+}
 
-impl Default for Fnv {
+/// [`hash`] of everything written, for what is too large to gather first (a whole level).
+pub(crate) struct Hasher(xxhash_rust::xxh3::Xxh3);
+
+impl Default for Hasher {
     fn default() -> Self {
-        Fnv(0xcbf2_9ce4_8422_2325)
+        Hasher(xxhash_rust::xxh3::Xxh3::with_seed(SEED))
     }
 }
 
-impl Sink for Fnv {
+impl Hasher {
+    pub(crate) fn finish(&self) -> u64 {
+        self.0.digest()
+    }
+}
+
+impl Sink for Hasher {
     fn put(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.0 ^= u64::from(b);
-            self.0 = self.0.wrapping_mul(0x0000_0100_0000_01b3);
-        }
+        self.0.update(bytes);
     }
 }
 
-/// 64-bit FNV-1a of `bytes`.
-pub(crate) fn fnv(bytes: &[u8]) -> u64 {
-    let mut h = Fnv::default();
-    h.put(bytes);
-    h.0
-}
+/// "RCSN" and the format's first version: any fixed value would do, this one is ours.
+const SEED: u64 = 0x5243_534e_0000_0002;
 
 /// Reads what a [`Sink`] wrote, from a slice.
 pub(crate) struct Reader<'a> {
@@ -274,6 +292,17 @@ impl<'a> Reader<'a> {
     }
     pub(crate) fn u128(&mut self) -> Result<u128, SnapshotError> {
         Ok(u128::from_le_bytes(self.array()?))
+    }
+    pub(crate) fn var(&mut self) -> Result<u64, SnapshotError> {
+        let mut x = 0u64;
+        for shift in (0..64).step_by(7) {
+            let b = self.u8()?;
+            x |= u64::from(b & 0x7f) << shift;
+            if b < 0x80 {
+                return Ok(x);
+            }
+        }
+        Err(bad("a count longer than 64 bits"))
     }
     pub(crate) fn f64(&mut self) -> Result<f64, SnapshotError> {
         Ok(f64::from_bits(self.u64()?))

@@ -15,7 +15,7 @@
 //! | field | is | saved | in `checksum` |
 //! |---|---|---|---|
 //! | `Simulation::frame`, `cursor` (next script event) | state | yes | yes |
-//! | `pending` (inputs sent with `apply`) | state | yes | yes |
+//! | `pending` (inputs the game sent for the next step) | state | yes | yes |
 //! | `targets`, `targeted` (kinematic target poses) | state | yes | yes |
 //! | `focus` (the body the active region follows) | state | yes | yes |
 //! | `touch.touching` (pairs touching at the end of the last frame) | state | yes | yes |
@@ -24,26 +24,47 @@
 //! | `capture_detect_poses`, `workers` | settings of the output and the threads, not of the result | no | no |
 //! | `detect` (broad phase, static entries, buffers), `separate` (static and mover grids) | caches rebuilt from the world | no: restore builds them new | no |
 //! | `touch` buffers (`recorded`, `next`, `ends`, ...) | scratch | no | no |
-//! | World: `entity`, `layer`, `kind`, `position`, `angle`, shape, name | state (a script finds bodies by name) | yes, shapes by value | yes |
-//! | World: the allocator's generations (its free list: every slot not alive) | state | yes | yes |
-//! | World: `shapes`, `names` tables, `row`, `movers`, `active`, counters, `non_boxes`, `key` | caches of the above | no: rebuilt | no |
-//! | World: `static_generation` | a counter the caches compare | no: a restored world counts anew and its caches are new | no |
-//! | Rows: `mass`, `velocity`, `angular_velocity`, `force`, `gravity_scale`, `lifetime`, `controller`, `inputs`, `grounded`, `on_static`, `carrier`, `still`, `split`, `frozen`, `asleep`, `rest_frames` | state | yes | yes |
-//! | Rows: whether a static body has a row (scenery given one) | state of the layout | yes | yes |
+//! | World: `entity`, `layer`, `kind`, `position`, `angle`, `shape`, `name` | state (a script finds bodies by name) | as they differ from the baseline | yes |
+//! | World: the allocator's `generations` (its free list: every slot not alive) | state | as they differ from the baseline | yes |
+//! | World: `shapes`, `names` tables, `row`, `movers`, `active`, counters, `non_boxes`, `key` | caches of the above | no: rebuilt or patched | no |
+//! | World: `static_generation` | a counter the caches compare | no: the caches are built new | no |
+//! | World: `reshaped` | whether a body may no longer have the baseline's shape and name: only what is compared | no | no |
+//! | Rows: `mass`, `velocity`, `angular_velocity`, `force`, `gravity_scale`, `lifetime`, `controller`, `inputs`, `grounded`, `on_static`, `carrier`, `still`, `split`, `frozen`, `asleep`, `rest_frames` | state | as they differ from the baseline | yes |
+//! | Rows: whether a static body has a row (`has_row`: scenery given one) | state of the layout | yes | yes |
 //! | Rows: `local_bounds` | a cache, but its history shows in the broad phase's candidates: one bit (turned: the any-angle square) | yes | yes |
 //! | Rows: `start_position` | a cache: `start_frame` sets it from `position` each step | no | no |
 //! | Rows: `entity` (row to body) | the layout | no | no |
 //! | Rows: `user_data` | game data: no stage reads it | yes | **no** |
+//! | `baseline` (the world before the first step) | definition | its hash, in the scene's | no |
 //!
-//! `world/state.rs` destructures `Rows` whole: a new column fails to compile until it is
-//! written there or named a cache.
+//! `world/checksum_fields.rs` changes every field marked "in `checksum`" in turn and checks
+//! that the checksum changes (its list is checked against this table, and it destructures
+//! `Rows`); `world/state.rs` destructures `Rows` too: a new column fails to compile until it
+//! is placed in both.
+//!
+//! # The baseline
+//!
+//! A simulation keeps a copy of its world as it was built, before the first step (shared
+//! by its clones; it costs as much memory as that world). A snapshot writes the bodies as
+//! they differ from it (`world/state.rs`): runs of bodies kept or dropped, a mask of the
+//! field groups that changed, and whole records for bodies spawned later or redefined. A
+//! drifting asteroid costs 25 bytes (its position and angle), a tile that did not move
+//! nothing. The encoding is a function of the state alone (never of interned ids or row
+//! order), so [`Simulation::checksum`] hashes it too. The baseline's hash is part of the
+//! scene's: a snapshot restores only onto a simulation built the same way.
+//!
+//! [`Simulation::restore`] onto a simulation whose world has the same bodies as the
+//! snapshot, each with the baseline's definition (a rollback: the common case), patches the
+//! columns in place; otherwise it builds the world anew. The broad phase, grids and query
+//! trees are built new either way.
 //!
 //! # Bytes
 //!
 //! `RCSN`, [`SNAPSHOT_VERSION`] (u32), the total length (u64), the frame, the scene hash
-//! (u64 each), the state's length (u32) and the state, then an FNV-1a 64 of every byte
-//! before it. Little-endian, every float as its bits. Every truncation or flipped bit is an
-//! error, never a panic.
+//! (u64 each), the state's length (u32) and the state, then an XXH3-64 (fixed seed) of
+//! every byte before it. Little-endian, every float as its bits. Every truncation or
+//! flipped bit is an error, never a panic; the state is checked against the baseline by
+//! `restore`, which leaves the simulation unchanged when it fails.
 //!
 //! ```
 //! use ricochet_sim::prelude::*;
@@ -69,7 +90,9 @@ mod error;
 
 pub use error::SnapshotError;
 
-use codec::{Fnv, Reader, Sink, fnv};
+use std::sync::{Arc, OnceLock};
+
+use codec::{Hasher, Reader, Sink, hash};
 
 use crate::pipeline::Simulation;
 use crate::stages::detect::DetectState;
@@ -79,7 +102,7 @@ use crate::world::World;
 
 /// The version of the snapshot format [`Snapshot::to_bytes`] writes and
 /// [`Snapshot::from_bytes`] reads.
-pub const SNAPSHOT_VERSION: u32 = 1;
+pub const SNAPSHOT_VERSION: u32 = 2;
 
 /// The first bytes of a snapshot.
 const MAGIC: &[u8; 4] = b"RCSN";
@@ -119,7 +142,7 @@ impl Snapshot {
         b.u64(self.scene);
         Sink::len(&mut b, self.payload.len());
         b.put(&self.payload);
-        let sum = fnv(&b);
+        let sum = hash(&b);
         b.u64(sum);
         b
     }
@@ -149,7 +172,7 @@ impl Snapshot {
             });
         }
         let (body, sum) = bytes.split_at(bytes.len().saturating_sub(8));
-        if sum.len() != 8 || fnv(body) != Reader::new(sum).u64()? {
+        if sum.len() != 8 || hash(body) != Reader::new(sum).u64()? {
             return Err(SnapshotError::Checksum);
         }
         let mut r = Reader::new(&body[16..]);
@@ -160,18 +183,16 @@ impl Snapshot {
             return Err(SnapshotError::malformed("the state's length"));
         }
         let payload = body[HEADER..].to_vec();
-        let s = Snapshot {
+        // The bodies are checked by `restore`, against the baseline they are written from.
+        Ok(Snapshot {
             frame,
             scene,
             payload,
-        };
-        // Checked now, so that a snapshot that parses restores (layers checked then).
-        s.decode(usize::from(u8::MAX) + 1)?;
-        Ok(s)
+        })
     }
 
-    /// The state in the payload, for a scene of `layers` layers.
-    fn decode(&self, layers: usize) -> Result<State, SnapshotError> {
+    /// The state in the payload, for a scene of `layers` layers starting as `base`.
+    fn decode(&self, base: &World, layers: usize) -> Result<State, SnapshotError> {
         let mut r = Reader::new(&self.payload);
         let frame = r.u64()?;
         if frame != self.frame {
@@ -197,7 +218,7 @@ impl Snapshot {
             return Err(SnapshotError::malformed("touching pairs out of order"));
         }
         let statics_moved = r.bool()?;
-        let world = World::decode(&mut r, layers)?;
+        let bodies = World::decode(&mut r, base, layers)?;
         if !r.is_done() {
             return Err(SnapshotError::malformed("bytes after the state"));
         }
@@ -209,7 +230,7 @@ impl Snapshot {
             focus,
             touching,
             statics_moved,
-            world,
+            bodies,
         })
     }
 }
@@ -223,15 +244,40 @@ struct State {
     focus: Option<crate::Entity>,
     touching: Vec<(crate::Entity, crate::Entity)>,
     statics_moved: bool,
+    bodies: crate::world::Bodies,
+}
+
+/// The world as the simulation was built, before its first step: what a snapshot's bodies
+/// are written against (`world/state.rs`). Shared by the simulation's clones.
+#[derive(Debug)]
+pub(crate) struct Baseline {
     world: World,
+    /// The scene's hash: its definition and this world (computed at the first snapshot).
+    scene: OnceLock<u64>,
+}
+
+impl Baseline {
+    /// The baseline of a simulation whose world is `world` before its first step.
+    pub(crate) fn new(world: &World) -> Arc<Baseline> {
+        Arc::new(Baseline {
+            world: world.clone(),
+            scene: OnceLock::new(),
+        })
+    }
 }
 
 impl Simulation {
     /// The hash of what a snapshot references instead of copying: the world settings,
-    /// layers, templates and script (their `Debug` text, which writes every float exactly).
+    /// layers, templates and script (their `Debug` text, which writes every float exactly),
+    /// and the baseline's bodies, every field.
     fn scene_hash(&self) -> u64 {
-        let s = &self.scenario;
-        fnv(format!("{:?}|{:?}|{:?}", s.world, s.templates, s.script).as_bytes())
+        *self.baseline.scene.get_or_init(|| {
+            let s = &self.scenario;
+            let mut h = Hasher::default();
+            h.str(&format!("{:?}|{:?}|{:?}", s.world, s.templates, s.script));
+            self.baseline.world.encode(&World::new(), &mut h, true);
+            h.finish()
+        })
     }
 
     /// Writes the state a step reads (module docs), and with `game_data` the user data.
@@ -260,14 +306,14 @@ impl Simulation {
             s.entity(*b);
         }
         s.bool(self.touch.static_generation() != self.world.static_generation());
-        self.world.encode(s, game_data);
+        self.world.encode(&self.baseline.world, s, game_data);
     }
 
     /// The state the next step reads, and the game's user data: every body's state (the
     /// module docs' table), the scene by its hash.
     #[must_use]
     pub fn snapshot(&self) -> Snapshot {
-        let mut payload = Vec::new();
+        let mut payload = Vec::with_capacity(64 + 26 * self.world.movers().len());
         self.encode_state(&mut payload, true);
         Snapshot {
             frame: self.frame,
@@ -293,20 +339,20 @@ impl Simulation {
             });
         }
         let layers = &self.scenario.world.layers;
-        let st = s.decode(layers.names().len())?;
+        let st = s.decode(&self.baseline.world, layers.names().len())?;
         if st.cursor > self.scenario.script.len() {
             return Err(SnapshotError::malformed("a script cursor past the script"));
         }
         self.detect = DetectState::new(layers, self.scenario.world.broad_phase);
         self.separate = SeparateState::new(layers);
-        let g = st.world.static_generation();
+        self.world.restore_bodies(&self.baseline.world, &st.bodies);
+        let g = self.world.static_generation();
         let seen = if st.statics_moved {
             g.wrapping_sub(1)
         } else {
             g
         };
         self.touch = TouchState::restored(layers, st.touching, seen);
-        self.world = st.world;
         // Another world: neither tree set of the scene queries may be kept (a static
         // generation can repeat with other static bodies).
         self.queries = crate::query::index::QueryCache::default();
@@ -327,8 +373,8 @@ impl Simulation {
     /// identically; a change of any one of those fields changes it.
     #[must_use]
     pub fn checksum(&self) -> u64 {
-        let mut h = Fnv::default();
-        self.encode_state(&mut h, false);
-        h.0
+        let mut b = Vec::with_capacity(64 + 26 * self.world.movers().len());
+        self.encode_state(&mut b, false);
+        hash(&b)
     }
 }

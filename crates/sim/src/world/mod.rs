@@ -33,10 +33,14 @@ use crate::interned::{NameTable, ShapeTable, shape_key};
 use crate::scenario::TileRows;
 
 mod bounds;
+#[cfg(test)]
+mod checksum_fields;
 mod measures;
 mod rows;
 mod sleep;
 mod state;
+
+pub(crate) use state::Bodies;
 
 use bounds::LocalBounds;
 use rows::Rows;

@@ -1,14 +1,30 @@
-//! The world's part of a snapshot: every body's state in id order, and the id allocator.
+//! The world's part of a snapshot: the bodies as they differ from the *baseline* (the world
+//! as the simulation was built, before its first step), and the id generations likewise.
+//!
+//! The bodies are visited in id order beside the baseline's, and each becomes one record:
+//! - `KEEP n`: the next `n` bodies of the baseline, alive and unchanged (scenery: 2 bytes
+//!   for a whole level);
+//! - `DROP n`: the next `n` bodies of the baseline are gone;
+//! - `CHANGED` with a mask of the [`group`]s that differ from the baseline's body, each
+//!   written whole (a drifting asteroid: position and angle, 25 bytes; its turned bit is a
+//!   bit of the mask);
+//! - `WHOLE`: a body the baseline does not have (spawned later), or one whose definition
+//!   (layer, kind, shape, name, mass, gravity scale, children, having a row) is no longer
+//!   the baseline's: every field, as version 1 wrote every body.
 //!
 //! Written through one [`Sink`], so the snapshot's bytes and [`crate::Simulation::checksum`]
-//! cover the same fields; `game_data` false leaves out what no stage reads (`user_data`).
-//! Rows are destructured whole: a new row column does not compile until it is written here
-//! (or named as a cache).
+//! cover the same fields; `game_data` false leaves out what no stage reads (`user_data`),
+//! from the mask too. The encoding of a state is a function of the state and the baseline
+//! alone, never of the history (interned ids, row order): equal states, equal bytes.
+//! `Rows` is destructured whole in [`World::write_whole`]: a new column does not compile
+//! until it is placed here (or named a cache).
+
+use ricochet_geom::{Shape, Vec2};
 
 use super::bounds::LocalBounds;
 use super::rows::Rows;
-use super::{NO_ROW, World};
-use crate::def::{BodyDef, BodyKind};
+use super::{Inputs, NO_ROW, World};
+use crate::def::{BodyDef, BodyKind, Controller, LayerId, Split};
 use crate::entity::{Entity, EntityAllocator};
 use crate::snapshot::SnapshotError;
 use crate::snapshot::codec::{Reader, Sink};
@@ -17,175 +33,853 @@ fn bad(what: &str) -> SnapshotError {
     SnapshotError::malformed(what)
 }
 
+/// The field groups a `CHANGED` record writes when they differ from the baseline's, each a
+/// bit of its mask (the tag's low 7 bits), in this order.
+pub(crate) mod group {
+    /// `position`.
+    pub(crate) const POSITION: u8 = 1;
+    /// `angle`.
+    pub(crate) const ANGLE: u8 = 2;
+    /// `velocity`.
+    pub(crate) const VELOCITY: u8 = 4;
+    /// `angular_velocity`.
+    pub(crate) const SPIN: u8 = 8;
+    /// `lifetime`.
+    pub(crate) const LIFETIME: u8 = 16;
+    /// [`super::Motion`]: force, controller, inputs, contact flags, carrier, sleep, and
+    /// `user_data` (left out of the checksum's mask and bytes).
+    pub(crate) const MOTION: u8 = 32;
+    /// The turned bit (the broad phase's bounds: exact, or the any-angle square once the
+    /// body turned) is not the baseline's: no bytes, the bit says it all.
+    pub(crate) const TURNED: u8 = 64;
+    /// The groups only a body with a row has.
+    pub(crate) const ROW: u8 = VELOCITY | SPIN | LIFETIME | MOTION | TURNED;
+}
+
+const KEEP: u8 = 0;
+const DROP: u8 = 1;
+const WHOLE: u8 = 2;
+const END: u8 = 3;
+const CHANGED: u8 = 0x80;
+
+/// The row state the stages change besides motion and lifetime: one group of the mask.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Motion {
+    force: Vec2,
+    controller: Option<Controller>,
+    inputs: Inputs,
+    grounded: bool,
+    on_static: bool,
+    carrier: Option<Entity>,
+    still: bool,
+    frozen: bool,
+    asleep: bool,
+    rest_frames: u32,
+    /// The game's data: in the snapshot, never in the checksum.
+    user_data: u128,
+}
+
+/// A body written whole (a `WHOLE` record, or a baseline body a restore rebuilds).
+#[derive(Clone, Debug)]
+pub(crate) struct Whole {
+    entity: Entity,
+    layer: LayerId,
+    kind: BodyKind,
+    position: Vec2,
+    angle: f64,
+    shape: Shape,
+    name: String,
+    row: Option<WholeRow>,
+}
+
+/// The row of a [`Whole`] body.
+#[derive(Clone, Debug)]
+struct WholeRow {
+    mass: f64,
+    velocity: Vec2,
+    spin: f64,
+    gravity_scale: f64,
+    lifetime: Option<u32>,
+    split: Vec<Split>,
+    motion: Motion,
+    /// The broad phase's bounds: exact, or the any-angle square once the body turned.
+    turned: bool,
+}
+
+/// The groups of a `CHANGED` record (the others are the baseline's).
+#[derive(Clone, Copy, Debug, Default)]
+struct Delta {
+    position: Vec2,
+    angle: f64,
+    velocity: Vec2,
+    spin: f64,
+    lifetime: Option<u32>,
+    /// Index in [`Bodies::motions`] (with [`group::MOTION`]).
+    motion: u32,
+}
+
+/// One body of a decoded snapshot, in id order.
+#[derive(Clone, Copy, Debug)]
+struct Entry {
+    /// Its index in the baseline, or `u32::MAX` for a whole body.
+    base: u32,
+    /// The changed groups (0: the baseline's body as it was).
+    mask: u8,
+    /// Index in [`Bodies::deltas`] (with a mask), or in [`Bodies::wholes`].
+    at: u32,
+}
+
+/// The bodies of a snapshot, decoded and checked against the baseline, not yet in a world.
+#[derive(Debug, Default)]
+pub(crate) struct Bodies {
+    entries: Vec<Entry>,
+    entities: Vec<Entity>,
+    deltas: Vec<Delta>,
+    motions: Vec<Motion>,
+    wholes: Vec<Whole>,
+    generations: Vec<u32>,
+    /// A whole body has a baseline body's entity: its definition changed.
+    redefined: bool,
+}
+
+impl Bodies {
+    /// The motion group of a `CHANGED` record that has one.
+    fn motion(&self, d: &Delta) -> &Motion {
+        &self.motions[d.motion as usize]
+    }
+}
+
 impl World {
-    /// Writes every body's state, in id order, then each slot's generation.
-    pub(crate) fn encode(&self, s: &mut impl Sink, game_data: bool) {
+    /// Whether body `i`'s broad-phase bounds are the any-angle square (`Motion::turned`).
+    fn turned(&self, i: usize) -> bool {
+        match self.row[i] {
+            NO_ROW => false,
+            r => self.rows.local_bounds[r as usize].has_turned(self.shape(i), self.angle[i]),
+        }
+    }
+
+    /// Body `i`'s [`Motion`] (scenery: the defaults).
+    fn motion(&self, i: usize) -> Motion {
+        Motion {
+            force: self.force(i),
+            controller: self.controller(i).cloned(),
+            inputs: self.inputs(i),
+            grounded: self.grounded(i),
+            on_static: self.on_static(i),
+            carrier: self.carrier(i),
+            still: self.still(i),
+            frozen: self.frozen(i),
+            asleep: self.asleep(i),
+            rest_frames: self.rest_frames(i),
+            user_data: self.user_data(i),
+        }
+    }
+
+    /// Whether body `i` has the definition of `base`'s body `j` (the same entity): what a
+    /// `CHANGED` record takes from the baseline. A shape changes only by `set_shape`, which
+    /// sets `reshaped` (as a restore that redefined a body does): compared only then.
+    fn same_definition(&self, i: usize, base: &World, j: usize) -> bool {
+        let (r, q) = (self.row[i], base.row[j]);
+        self.layer[i] == base.layer[j]
+            && self.kind[i] == base.kind[j]
+            && (r == NO_ROW) == (q == NO_ROW)
+            && self.mass(i).to_bits() == base.mass(j).to_bits()
+            && self.gravity_scale(i).to_bits() == base.gravity_scale(j).to_bits()
+            && same_splits(self.split(i), base.split(j))
+            && self.name(i) == base.name(j)
+            && (!self.reshaped || same_bits(self.shape(i), base.shape(j), |s, x| s.shape(x)))
+    }
+
+    /// The groups in which body `i` differs from `base`'s body `j`, bit for bit.
+    fn changes(&self, i: usize, base: &World, j: usize, game_data: bool) -> u8 {
+        let mut m = 0;
+        if !same_vec(self.position[i], base.position[j]) {
+            m |= group::POSITION;
+        }
+        if self.angle[i].to_bits() != base.angle[j].to_bits() {
+            m |= group::ANGLE;
+        }
+        if self.row[i] == NO_ROW {
+            return m;
+        }
+        if !same_vec(self.velocity(i), base.velocity(j)) {
+            m |= group::VELOCITY;
+        }
+        if self.angular_velocity(i).to_bits() != base.angular_velocity(j).to_bits() {
+            m |= group::SPIN;
+        }
+        if self.lifetime(i) != base.lifetime(j) {
+            m |= group::LIFETIME;
+        }
+        if !self.same_motion(i, base, j) || (game_data && self.user_data(i) != base.user_data(j)) {
+            m |= group::MOTION;
+        }
+        if self.turned(i) != base.turned(j) {
+            m |= group::TURNED;
+        }
+        m
+    }
+
+    fn same_motion(&self, i: usize, base: &World, j: usize) -> bool {
+        let (a, b) = (self.inputs(i), base.inputs(j));
+        same_vec(self.force(i), base.force(j))
+            && a.thrust == b.thrust
+            && a.turn.to_bits() == b.turn.to_bits()
+            && a.run.to_bits() == b.run.to_bits()
+            && self.grounded(i) == base.grounded(j)
+            && self.on_static(i) == base.on_static(j)
+            && self.carrier(i) == base.carrier(j)
+            && self.still(i) == base.still(j)
+            && self.frozen(i) == base.frozen(j)
+            && self.asleep(i) == base.asleep(j)
+            && self.rest_frames(i) == base.rest_frames(j)
+            && match (self.controller(i), base.controller(j)) {
+                (None, None) => true,
+                (a, b) => same_bits(&a, &b, |s, x| s.controller(*x)),
+            }
+    }
+
+    /// Writes every body as it differs from `base` (module docs), then each slot's
+    /// generation as it differs from `base`'s.
+    pub(crate) fn encode(&self, base: &World, s: &mut impl Sink, game_data: bool) {
+        let (mut i, mut j) = (0, 0);
+        // The pending run: (KEEP or DROP, length).
+        let mut run = (KEEP, 0u64);
+        loop {
+            let (a, b) = (self.entity.get(i), base.entity.get(j));
+            let step = match (a, b) {
+                (None, None) => break,
+                (Some(a), Some(b)) if a == b => {
+                    if self.same_definition(i, base, j) {
+                        match self.changes(i, base, j, game_data) {
+                            0 => Step::Run(KEEP),
+                            m => Step::Changed(m),
+                        }
+                    } else {
+                        Step::Whole
+                    }
+                }
+                (Some(a), b) if b.is_none_or(|b| a.index < b.index) => Step::New,
+                _ => Step::Run(DROP),
+            };
+            if let Step::Run(tag) = step {
+                if run.0 != tag && run.1 > 0 {
+                    write_run(s, run);
+                    run.1 = 0;
+                }
+                run = (tag, run.1 + 1);
+                j += 1;
+                i += usize::from(tag == KEEP);
+                continue;
+            }
+            if run.1 > 0 {
+                write_run(s, run);
+                run.1 = 0;
+            }
+            match step {
+                Step::Changed(m) => {
+                    s.u8(CHANGED | m);
+                    self.write_groups(i, m, s, game_data);
+                    (i, j) = (i + 1, j + 1);
+                }
+                Step::Whole => {
+                    s.u8(WHOLE);
+                    self.write_whole(i, s, game_data);
+                    (i, j) = (i + 1, j + 1);
+                }
+                Step::New => {
+                    s.u8(WHOLE);
+                    self.write_whole(i, s, game_data);
+                    i += 1;
+                }
+                Step::Run(_) => unreachable!("handled above"),
+            }
+        }
+        if run.1 > 0 {
+            write_run(s, run);
+        }
+        s.u8(END);
+        let (g, bg) = (self.ids.generations(), base.ids.generations());
+        s.len(g.len());
+        let differs = |k: &usize| bg.get(*k) != Some(&g[*k]);
+        s.len((0..g.len()).filter(differs).count());
+        let mut last = 0;
+        for k in (0..g.len()).filter(differs) {
+            s.var((k - last) as u64);
+            s.u32(g[k]);
+            last = k;
+        }
+    }
+
+    /// The groups of `mask` of body `i`, in [`group`] order.
+    fn write_groups(&self, i: usize, mask: u8, s: &mut impl Sink, game_data: bool) {
+        if mask & group::POSITION != 0 {
+            s.vec2(self.position[i]);
+        }
+        if mask & group::ANGLE != 0 {
+            s.f64(self.angle[i]);
+        }
+        if mask & group::VELOCITY != 0 {
+            s.vec2(self.velocity(i));
+        }
+        if mask & group::SPIN != 0 {
+            s.f64(self.angular_velocity(i));
+        }
+        if mask & group::LIFETIME != 0 {
+            write_lifetime(s, self.lifetime(i));
+        }
+        if mask & group::MOTION != 0 {
+            write_motion(s, &self.motion(i), game_data);
+        }
+    }
+
+    /// Body `i`, every field.
+    fn write_whole(&self, i: usize, s: &mut impl Sink, game_data: bool) {
         let Rows {
-            entity: _, // the body's, written below
+            entity: _, // the body's, written first
             mass,
             start_position: _, // a cache: `start_frame` copies `position` there each step
             velocity,
             angular_velocity,
-            force,
+            force: _,
             gravity_scale,
             lifetime,
-            controller,
-            inputs,
-            grounded,
-            on_static,
-            carrier,
-            still,
+            controller: _,
+            inputs: _,
+            grounded: _,
+            on_static: _,
+            carrier: _,
+            still: _,
             split,
-            frozen,
-            asleep,
-            rest_frames,
-            local_bounds,
-            user_data,
+            frozen: _,
+            asleep: _,
+            rest_frames: _,
+            local_bounds: _, // `turned`, below
+            user_data: _,
         } = &self.rows;
-        s.len(self.len());
-        for i in 0..self.len() {
-            s.entity(self.entity[i]);
-            s.u8(self.layer[i]);
-            s.u8(kind_tag(self.kind[i]));
-            s.vec2(self.position[i]);
-            s.f64(self.angle[i]);
-            s.shape(self.shape(i));
-            s.str(self.name(i));
+        // The `_` columns above are the motion group's ([`World::motion`] reads them all).
+        s.entity(self.entity[i]);
+        s.u8(self.layer[i]);
+        s.u8(kind_tag(self.kind[i]));
+        s.vec2(self.position[i]);
+        s.f64(self.angle[i]);
+        s.shape(self.shape(i));
+        s.str(self.name(i));
+        let r = self.row[i];
+        s.bool(r != NO_ROW);
+        if r == NO_ROW {
+            return;
+        }
+        let r = r as usize;
+        s.f64(mass[r]);
+        s.vec2(velocity[r]);
+        s.f64(angular_velocity[r]);
+        s.f64(gravity_scale[r]);
+        write_lifetime(s, lifetime[r]);
+        s.splits(&split[r]);
+        write_motion(s, &self.motion(i), game_data);
+        s.bool(self.turned(i));
+    }
+
+    /// Reads what [`World::encode`] wrote against `base` (with `game_data`), checked against
+    /// it: every baseline body accounted for, ids in order and live, layers below `layers`.
+    pub(crate) fn decode(
+        r: &mut Reader,
+        base: &World,
+        layers: usize,
+    ) -> Result<Bodies, SnapshotError> {
+        let mut b = Bodies::default();
+        let m = base.len();
+        let mut j = 0usize;
+        loop {
+            let tag = r.u8()?;
+            match tag {
+                KEEP | DROP => {
+                    let n = usize::try_from(r.var()?).unwrap_or(usize::MAX);
+                    if n == 0 || n > m - j {
+                        return Err(bad("a run of bodies past the baseline's"));
+                    }
+                    if tag == KEEP {
+                        for k in j..j + n {
+                            b.entries.push(Entry {
+                                base: k as u32,
+                                mask: 0,
+                                at: 0,
+                            });
+                            b.entities.push(base.entity[k]);
+                        }
+                    }
+                    j += n;
+                }
+                WHOLE => {
+                    let w = read_whole(r, layers)?;
+                    if base.entity.get(j) == Some(&w.entity) {
+                        j += 1;
+                        b.redefined = true;
+                    }
+                    b.entities.push(w.entity);
+                    b.entries.push(Entry {
+                        base: u32::MAX,
+                        mask: 0,
+                        at: b.wholes.len() as u32,
+                    });
+                    b.wholes.push(w);
+                }
+                END => break,
+                t if t & CHANGED != 0 => {
+                    let mask = t & !CHANGED;
+                    if j >= m {
+                        return Err(bad("a changed body past the baseline's"));
+                    }
+                    if mask & group::ROW != 0 && base.row[j] == NO_ROW {
+                        return Err(bad("moving state for scenery"));
+                    }
+                    let d = read_groups(r, mask, &mut b.motions)?;
+                    b.entities.push(base.entity[j]);
+                    b.entries.push(Entry {
+                        base: j as u32,
+                        mask,
+                        at: b.deltas.len() as u32,
+                    });
+                    b.deltas.push(d);
+                    j += 1;
+                }
+                _ => return Err(bad("a body's tag")),
+            }
+        }
+        if j != m {
+            return Err(bad("baseline bodies neither kept nor dropped"));
+        }
+        if b.entities.windows(2).any(|p| p[0].index >= p[1].index) {
+            return Err(bad("bodies out of id order"));
+        }
+        let n = r.u32()? as usize;
+        let changed = r.len(5)?;
+        let mut g = base.ids.generations().to_vec();
+        // Every slot past the baseline's is listed: a damaged count reserves nothing more.
+        if n > g.len() + changed {
+            return Err(bad("more id slots than generations"));
+        }
+        g.resize(n, 0);
+        let mut k = 0usize;
+        for c in 0..changed {
+            let gap = usize::try_from(r.var()?).unwrap_or(usize::MAX);
+            k = k.saturating_add(gap);
+            if (c > 0 && gap == 0) || k >= n {
+                return Err(bad("a generation's slot"));
+            }
+            g[k] = r.u32()?;
+        }
+        if b.entities
+            .iter()
+            .any(|e| g.get(e.index as usize) != Some(&e.generation))
+        {
+            return Err(bad("a body's generation is not its slot's"));
+        }
+        b.generations = g;
+        // Every carrier a live body.
+        for (k, e) in b.entries.iter().enumerate() {
+            let carrier = match (e.base, e.mask & group::MOTION != 0) {
+                (u32::MAX, _) => b.wholes[e.at as usize]
+                    .row
+                    .as_ref()
+                    .and_then(|w| w.motion.carrier),
+                (_, true) => b.motion(&b.deltas[e.at as usize]).carrier,
+                (j, false) => base.carrier(j as usize),
+            };
+            if carrier.is_some_and(|c| b.entities.binary_search(&c).is_err()) {
+                return Err(bad(&format!("body {k}'s carrier is not a live body")));
+            }
+        }
+        Ok(b)
+    }
+
+    /// Puts the decoded bodies in this world. A world with the same bodies, each with the
+    /// baseline's definition (a rollback a few frames back, the common case), is patched in
+    /// place, column by column; any other is built anew. Either way every cache (rows,
+    /// counters, active list, bounds) is right for the state.
+    pub(crate) fn restore_bodies(&mut self, base: &World, b: &Bodies) {
+        if !self.patch(base, b) {
+            *self = World::rebuilt(base, b);
+        }
+    }
+
+    /// Patches the columns in place; false (nothing changed) when this world's bodies are
+    /// not `b`'s with the baseline's definitions.
+    fn patch(&mut self, base: &World, b: &Bodies) -> bool {
+        if !b.wholes.is_empty() || self.reshaped || self.entity != b.entities {
+            return false;
+        }
+        let rows_match = b.entries.iter().enumerate().all(|(i, e)| {
+            let j = e.base as usize;
+            (self.row[i] == NO_ROW) == (base.row[j] == NO_ROW)
+                && self.layer[i] == base.layer[j]
+                && self.kind[i] == base.kind[j]
+        });
+        if !rows_match {
+            return false;
+        }
+        let empty = Delta::default();
+        for (i, e) in b.entries.iter().enumerate() {
+            let (j, m) = (e.base as usize, e.mask);
+            let d = if m == 0 {
+                &empty
+            } else {
+                &b.deltas[e.at as usize]
+            };
+            let pick = |g: u8| m & g != 0;
+            self.position[i] = if pick(group::POSITION) {
+                d.position
+            } else {
+                base.position[j]
+            };
+            self.angle[i] = if pick(group::ANGLE) {
+                d.angle
+            } else {
+                base.angle[j]
+            };
             let r = self.row[i];
-            s.bool(r != NO_ROW);
             if r == NO_ROW {
                 continue;
             }
             let r = r as usize;
-            s.f64(mass[r]);
-            s.vec2(velocity[r]);
-            s.f64(angular_velocity[r]);
-            s.vec2(force[r]);
-            s.f64(gravity_scale[r]);
-            s.bool(lifetime[r].is_some());
-            s.u32(lifetime[r].unwrap_or(0));
-            s.controller(controller[r].as_ref());
-            s.inputs(&inputs[r]);
-            s.bool(grounded[r]);
-            s.bool(on_static[r]);
-            s.opt_entity(carrier[r]);
-            s.bool(still[r]);
-            s.splits(&split[r]);
-            s.bool(frozen[r]);
-            s.bool(asleep[r]);
-            s.u32(rest_frames[r]);
-            // The broad phase's bounds: exact, or the any-angle square once the body turned.
-            s.bool(local_bounds[r].has_turned(self.shape(i), self.angle[i]));
-            if game_data {
-                s.u128(user_data[r]);
+            let rows = &mut self.rows;
+            rows.start_position[r] = self.position[i];
+            rows.velocity[r] = if pick(group::VELOCITY) {
+                d.velocity
+            } else {
+                base.velocity(j)
+            };
+            rows.angular_velocity[r] = if pick(group::SPIN) {
+                d.spin
+            } else {
+                base.angular_velocity(j)
+            };
+            rows.lifetime[r] = if pick(group::LIFETIME) {
+                d.lifetime
+            } else {
+                base.lifetime(j)
+            };
+            if pick(group::MOTION) {
+                self.set_motion(r, b.motion(d));
+            } else {
+                self.set_motion(r, &base.motion(j));
+            }
+            let turned = base.turned(j) != pick(group::TURNED);
+            let (shape, angle) = (&self.shapes.get(self.shape_id[i]).0, self.angle[i]);
+            let lb = &mut self.rows.local_bounds[r];
+            // Bounds that tell `turned` as they should are what a restore would build: an
+            // exact box at another angle becomes the square at its next use.
+            if lb.has_turned(shape, angle) != turned {
+                *lb = LocalBounds::restored(shape, angle, turned);
             }
         }
-        let g = self.ids.generations();
-        s.len(g.len());
-        for &x in g {
-            s.u32(x);
-        }
+        self.recount();
+        self.ids =
+            EntityAllocator::from_parts(b.generations.clone(), self.entity.iter().map(|e| e.index));
+        self.refresh_active();
+        true
     }
 
-    /// The world [`World::encode`] wrote (with `game_data`), its caches rebuilt.
-    pub(crate) fn decode(r: &mut Reader, layers: usize) -> Result<World, SnapshotError> {
+    /// Row `r`'s motion group set to `m` (its `turned` is the caller's).
+    fn set_motion(&mut self, r: usize, m: &Motion) {
+        let rows = &mut self.rows;
+        rows.force[r] = m.force;
+        if rows.controller[r].is_some() || m.controller.is_some() {
+            rows.controller[r].clone_from(&m.controller);
+        }
+        rows.inputs[r] = m.inputs;
+        rows.grounded[r] = m.grounded;
+        rows.on_static[r] = m.on_static;
+        rows.carrier[r] = m.carrier;
+        rows.still[r] = m.still;
+        rows.frozen[r] = m.frozen;
+        rows.asleep[r] = m.asleep;
+        rows.rest_frames[r] = m.rest_frames;
+        rows.user_data[r] = m.user_data;
+    }
+
+    /// The counters of the rows, counted again.
+    fn recount(&mut self) {
+        let rows = &self.rows;
+        self.sleeping = rows.asleep.iter().filter(|&&a| a).count();
+        self.with_lifetime = rows.lifetime.iter().filter(|l| l.is_some()).count();
+        self.with_controller = rows.controller.iter().filter(|c| c.is_some()).count();
+    }
+
+    /// A world of `b`'s bodies, built body by body (the baseline's definitions cloned).
+    fn rebuilt(base: &World, b: &Bodies) -> World {
         let mut w = World::new();
-        let n = r.len(40)?;
-        w.reserve(n);
-        let mut last: Option<Entity> = None;
+        w.reserve(b.entries.len());
         // Sleep is set once every body is in: a static body's insertion wakes every sleeper.
         let mut sleep = Vec::new();
-        for _ in 0..n {
-            let e = r.entity()?;
-            if last.is_some_and(|l| l.index >= e.index) {
-                return Err(bad("bodies out of id order"));
-            }
-            last = Some(e);
-            let layer = r.u8()?;
-            if usize::from(layer) >= layers {
-                return Err(bad("a body's layer"));
-            }
-            let kind = match r.u8()? {
-                0 => BodyKind::Dynamic,
-                1 => BodyKind::Static,
-                2 => BodyKind::Kinematic,
-                _ => return Err(bad("a body's kind")),
-            };
-            let mut def = BodyDef {
-                kind,
-                layer,
-                position: r.vec2()?,
-                angle: r.f64()?,
-                shape: r.shape()?,
-                name: r.str()?,
-                ..BodyDef::default()
-            };
-            if !r.bool()? {
-                def.controller = None;
-                if !World::makes_scenery(&def) {
-                    return Err(bad("scenery that is not static"));
+        for e in &b.entries {
+            let whole = match e.base {
+                u32::MAX => b.wholes[e.at as usize].clone(),
+                j => {
+                    let mut x = base.whole(j as usize);
+                    if e.mask != 0 {
+                        x.apply(e.mask, &b.deltas[e.at as usize], b);
+                    }
+                    x
                 }
-                w.insert(e, &def);
-                continue;
-            }
-            def.mass = r.f64()?;
-            def.velocity = r.vec2()?;
-            def.angular_velocity = r.f64()?;
-            def.force = r.vec2()?;
-            def.gravity_scale = r.f64()?;
-            let has_lifetime = r.bool()?;
-            let l = r.u32()?;
-            def.lifetime = has_lifetime.then_some(l);
-            def.controller = r.controller()?;
-            let inputs = r.inputs()?;
-            let grounded = r.bool()?;
-            let on_static = r.bool()?;
-            let carrier = r.opt_entity()?;
-            let still = r.bool()?;
-            def.split = r.splits()?;
-            let frozen = r.bool()?;
-            let asleep = r.bool()?;
-            let rest_frames = r.u32()?;
-            let turned = r.bool()?;
-            def.user_data = r.u128()?;
-            w.insert(e, &def);
-            let i = w.len() - 1;
-            let k = w.row_of(i);
-            let rows = &mut w.rows;
-            // A static body's velocity stays zero in its row as `spawn` makes it.
-            rows.velocity[k] = def.velocity;
-            rows.angular_velocity[k] = def.angular_velocity;
-            rows.inputs[k] = inputs;
-            rows.grounded[k] = grounded;
-            rows.on_static[k] = on_static;
-            rows.carrier[k] = carrier;
-            rows.still[k] = still;
-            rows.frozen[k] = frozen;
-            rows.local_bounds[k] = LocalBounds::restored(&def.shape, def.angle, turned);
-            sleep.push((k, asleep, rest_frames));
+            };
+            w.insert_whole(whole, &mut sleep);
         }
         for (k, asleep, rest_frames) in sleep {
             w.rows.asleep[k] = asleep;
             w.rows.rest_frames[k] = rest_frames;
             w.sleeping += usize::from(asleep);
         }
-        let g = r.len(4)?;
-        let generations = (0..g).map(|_| r.u32()).collect::<Result<Vec<_>, _>>()?;
-        for e in &w.entity {
-            if generations.get(e.index as usize) != Some(&e.generation) {
-                return Err(bad("a body's generation is not its slot's"));
-            }
-        }
-        w.ids = EntityAllocator::from_parts(generations, w.entity.iter().map(|e| e.index));
-        for i in 0..w.len() {
-            let c = w.carrier(i);
-            if c.is_some_and(|c| w.index_of(c).is_none()) {
-                return Err(bad("a carrier that is not a live body"));
-            }
-        }
+        w.ids =
+            EntityAllocator::from_parts(b.generations.clone(), w.entity.iter().map(|e| e.index));
+        w.reshaped = b.redefined;
         w.refresh_active();
-        Ok(w)
+        w
     }
+
+    /// Body `i` as a [`Whole`].
+    fn whole(&self, i: usize) -> Whole {
+        let row = (self.row[i] != NO_ROW).then(|| WholeRow {
+            mass: self.mass(i),
+            velocity: self.velocity(i),
+            spin: self.angular_velocity(i),
+            gravity_scale: self.gravity_scale(i),
+            lifetime: self.lifetime(i),
+            split: self.split(i).to_vec(),
+            motion: self.motion(i),
+            turned: self.turned(i),
+        });
+        Whole {
+            entity: self.entity[i],
+            layer: self.layer[i],
+            kind: self.kind[i],
+            position: self.position[i],
+            angle: self.angle[i],
+            shape: self.shape(i).clone(),
+            name: self.name(i).to_owned(),
+            row,
+        }
+    }
+
+    /// Inserts a whole body; its sleep state goes to `sleep`, set once every body is in.
+    fn insert_whole(&mut self, x: Whole, sleep: &mut Vec<(usize, bool, u32)>) {
+        let mut def = BodyDef {
+            kind: x.kind,
+            layer: x.layer,
+            position: x.position,
+            angle: x.angle,
+            shape: x.shape,
+            name: x.name,
+            controller: None,
+            ..BodyDef::default()
+        };
+        let Some(row) = x.row else {
+            self.insert(x.entity, &def);
+            return;
+        };
+        def.mass = row.mass;
+        def.velocity = row.velocity;
+        def.angular_velocity = row.spin;
+        def.force = row.motion.force;
+        def.gravity_scale = row.gravity_scale;
+        def.lifetime = row.lifetime;
+        def.controller = row.motion.controller.clone();
+        def.split = row.split;
+        def.user_data = row.motion.user_data;
+        self.insert(x.entity, &def);
+        let i = self.len() - 1;
+        let k = self.row_of(i);
+        let m = &row.motion;
+        let rows = &mut self.rows;
+        // A static body's velocity stays zero in its row as `spawn` makes it.
+        rows.velocity[k] = def.velocity;
+        rows.angular_velocity[k] = def.angular_velocity;
+        rows.inputs[k] = m.inputs;
+        rows.grounded[k] = m.grounded;
+        rows.on_static[k] = m.on_static;
+        rows.carrier[k] = m.carrier;
+        rows.still[k] = m.still;
+        rows.frozen[k] = m.frozen;
+        rows.local_bounds[k] = LocalBounds::restored(&def.shape, def.angle, row.turned);
+        sleep.push((k, m.asleep, m.rest_frames));
+    }
+}
+
+impl Whole {
+    /// The groups of `mask` from `d`.
+    fn apply(&mut self, mask: u8, d: &Delta, b: &Bodies) {
+        if mask & group::POSITION != 0 {
+            self.position = d.position;
+        }
+        if mask & group::ANGLE != 0 {
+            self.angle = d.angle;
+        }
+        let Some(row) = &mut self.row else {
+            return;
+        };
+        if mask & group::VELOCITY != 0 {
+            row.velocity = d.velocity;
+        }
+        if mask & group::SPIN != 0 {
+            row.spin = d.spin;
+        }
+        if mask & group::LIFETIME != 0 {
+            row.lifetime = d.lifetime;
+        }
+        if mask & group::MOTION != 0 {
+            row.motion = b.motion(d).clone();
+        }
+        if mask & group::TURNED != 0 {
+            row.turned = !row.turned;
+        }
+    }
+}
+
+enum Step {
+    Run(u8),
+    Changed(u8),
+    Whole,
+    New,
+}
+
+fn write_run(s: &mut impl Sink, (tag, n): (u8, u64)) {
+    s.u8(tag);
+    s.var(n);
+}
+
+fn same_vec(a: Vec2, b: Vec2) -> bool {
+    a.x.to_bits() == b.x.to_bits() && a.y.to_bits() == b.y.to_bits()
+}
+
+/// Whether `a` and `b` encode to the same bytes (floats by their bits, unlike `==`).
+fn same_bits<T: ?Sized>(a: &T, b: &T, write: impl Fn(&mut Vec<u8>, &T)) -> bool {
+    let (mut x, mut y) = (Vec::new(), Vec::new());
+    write(&mut x, a);
+    write(&mut y, b);
+    x == y
+}
+
+/// Whether two bodies' children are the same, bit for bit (no allocation for the usual
+/// none: this runs for every body of every snapshot and checksum).
+fn same_splits(a: &[Split], b: &[Split]) -> bool {
+    (a.is_empty() && b.is_empty()) || same_bits(a, b, |s, x| s.splits(x))
+}
+
+fn write_lifetime(s: &mut impl Sink, l: Option<u32>) {
+    s.bool(l.is_some());
+    if let Some(l) = l {
+        s.u32(l);
+    }
+}
+
+fn read_lifetime(r: &mut Reader) -> Result<Option<u32>, SnapshotError> {
+    Ok(if r.bool()? { Some(r.u32()?) } else { None })
+}
+
+fn write_motion(s: &mut impl Sink, m: &Motion, game_data: bool) {
+    s.vec2(m.force);
+    s.controller(m.controller.as_ref());
+    s.inputs(&m.inputs);
+    s.bool(m.grounded);
+    s.bool(m.on_static);
+    s.opt_entity(m.carrier);
+    s.bool(m.still);
+    s.bool(m.frozen);
+    s.bool(m.asleep);
+    s.u32(m.rest_frames);
+    if game_data {
+        s.u128(m.user_data);
+    }
+}
+
+fn read_motion(r: &mut Reader) -> Result<Motion, SnapshotError> {
+    Ok(Motion {
+        force: r.vec2()?,
+        controller: r.controller()?,
+        inputs: r.inputs()?,
+        grounded: r.bool()?,
+        on_static: r.bool()?,
+        carrier: r.opt_entity()?,
+        still: r.bool()?,
+        frozen: r.bool()?,
+        asleep: r.bool()?,
+        rest_frames: r.u32()?,
+        user_data: r.u128()?,
+    })
+}
+
+fn read_groups(
+    r: &mut Reader,
+    mask: u8,
+    motions: &mut Vec<Motion>,
+) -> Result<Delta, SnapshotError> {
+    let mut d = Delta::default();
+    if mask & group::POSITION != 0 {
+        d.position = r.vec2()?;
+    }
+    if mask & group::ANGLE != 0 {
+        d.angle = r.f64()?;
+    }
+    if mask & group::VELOCITY != 0 {
+        d.velocity = r.vec2()?;
+    }
+    if mask & group::SPIN != 0 {
+        d.spin = r.f64()?;
+    }
+    if mask & group::LIFETIME != 0 {
+        d.lifetime = read_lifetime(r)?;
+    }
+    if mask & group::MOTION != 0 {
+        d.motion = motions.len() as u32;
+        motions.push(read_motion(r)?);
+    }
+    Ok(d)
+}
+
+fn read_whole(r: &mut Reader, layers: usize) -> Result<Whole, SnapshotError> {
+    let entity = r.entity()?;
+    let layer = r.u8()?;
+    if usize::from(layer) >= layers {
+        return Err(bad("a body's layer"));
+    }
+    let kind = match r.u8()? {
+        0 => BodyKind::Dynamic,
+        1 => BodyKind::Static,
+        2 => BodyKind::Kinematic,
+        _ => return Err(bad("a body's kind")),
+    };
+    let mut w = Whole {
+        entity,
+        layer,
+        kind,
+        position: r.vec2()?,
+        angle: r.f64()?,
+        shape: r.shape()?,
+        name: r.str()?,
+        row: None,
+    };
+    if !r.bool()? {
+        let def = BodyDef {
+            kind,
+            ..BodyDef::default()
+        };
+        if !World::makes_scenery(&def) {
+            return Err(bad("scenery that is not static"));
+        }
+        return Ok(w);
+    }
+    w.row = Some(WholeRow {
+        mass: r.f64()?,
+        velocity: r.vec2()?,
+        spin: r.f64()?,
+        gravity_scale: r.f64()?,
+        lifetime: read_lifetime(r)?,
+        split: r.splits()?,
+        motion: read_motion(r)?,
+        turned: r.bool()?,
+    });
+    Ok(w)
 }
 
 fn kind_tag(k: BodyKind) -> u8 {
