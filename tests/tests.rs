@@ -25,6 +25,7 @@ mod serve_session;
 mod serve_siege;
 mod serve_ws;
 mod stress;
+mod sweep_cli;
 mod threads;
 mod touch_log;
 mod util;
