@@ -18,8 +18,11 @@ pub struct Measures {
     pub position_max: f64,
     /// Root mean square of every named body's position error at every compared time.
     pub position_rms: f64,
-    /// The body with the largest error (empty when none was compared).
+    /// The body with the largest error (empty when every error is 0).
     pub worst_body: String,
+    /// Named moving bodies alive at a compared time in one run and not in the other (a
+    /// ship destroyed in one run only): their positions can't be compared.
+    pub bodies_unmatched: u64,
     /// This run's energy at its last compared frame minus at frame 0.
     pub energy_drift: f64,
     /// Largest `|E_run − E_reference|` at a compared time.
@@ -86,8 +89,14 @@ pub fn measure(run: &Trace, reference: &Trace, bounds: Option<&WorldBounds>) -> 
         let (mut i, mut j) = (0, 0);
         while i < s.bodies.len() && j < r.bodies.len() {
             match s.bodies[i].0.cmp(&r.bodies[j].0) {
-                std::cmp::Ordering::Less => i += 1,
-                std::cmp::Ordering::Greater => j += 1,
+                std::cmp::Ordering::Less => {
+                    m.bodies_unmatched += 1;
+                    i += 1;
+                }
+                std::cmp::Ordering::Greater => {
+                    m.bodies_unmatched += 1;
+                    j += 1;
+                }
                 std::cmp::Ordering::Equal => {
                     let e = distance(s.bodies[i].1, r.bodies[j].1, bounds);
                     sum_sq += e * e;
@@ -102,6 +111,7 @@ pub fn measure(run: &Trace, reference: &Trace, bounds: Option<&WorldBounds>) -> 
                 }
             }
         }
+        m.bodies_unmatched += (s.bodies.len() - i + r.bodies.len() - j) as u64;
         m.energy_error = m.energy_error.max((s.energy - r.energy).abs());
         last_energy = Some(s.energy);
         m.false_positives += missing_from(&s.touching, &r.touching);

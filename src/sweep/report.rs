@@ -40,7 +40,7 @@ impl Row {
 
 /// The CSV's columns after the keys'.
 const COLUMNS: &str = "dt,frames,frames_rounded,step_us,wall_per_sim_s,digest,matched_frames,\
-position_max,position_rms,worst_body,energy_drift,energy_error,touch_appear,touch_vanish,\
+position_max,position_rms,worst_body,bodies_unmatched,energy_drift,energy_error,touch_appear,touch_vanish,\
 touch_moved,false_positive_contacts,false_negative_contacts";
 
 fn field(text: &str) -> String {
@@ -68,7 +68,7 @@ pub fn csv_text(keys: &[String], rows: &[Row]) -> String {
         }
         let _ = writeln!(
             s,
-            ",{},{},{},{:.3},{:e},{:016x},{},{:e},{:e},{},{:e},{:e},{},{},{},{},{}",
+            ",{},{},{},{:.3},{:e},{:016x},{},{:e},{:e},{},{},{:e},{:e},{},{},{},{},{}",
             r.dt,
             r.frames,
             r.rounded,
@@ -79,6 +79,7 @@ pub fn csv_text(keys: &[String], rows: &[Row]) -> String {
             e.position_max,
             e.position_rms,
             field(&e.worst_body),
+            e.bodies_unmatched,
             e.energy_drift,
             e.energy_error,
             e.events_appear,
@@ -110,11 +111,12 @@ pub fn table(keys: &[String], reference: &Row, rows: &[Row]) -> String {
         .unwrap_or(9);
     let _ = writeln!(
         s,
-        "{:width$}  {:>9}  {:>10}  {:>10}  {:>10}  {:>10}  {:>11}  {:>9}  {:>16}",
+        "{:width$}  {:>9}  {:>10}  {:>10}  {:>9}  {:>10}  {:>10}  {:>11}  {:>11}  {:>16}",
         "run",
         "µs/step",
         "pos max",
         "pos rms",
+        "unmatched",
         "energy err",
         "drift",
         "touch +/-/~",
@@ -125,7 +127,12 @@ pub fn table(keys: &[String], reference: &Row, rows: &[Row]) -> String {
         let e = &r.error;
         let (err, touches, contacts) = if reference {
             (
-                ["-".to_owned(), "-".to_owned(), "-".to_owned()],
+                [
+                    "-".to_owned(),
+                    "-".to_owned(),
+                    "-".to_owned(),
+                    "-".to_owned(),
+                ],
                 "-".to_owned(),
                 "-".to_owned(),
             )
@@ -134,6 +141,7 @@ pub fn table(keys: &[String], reference: &Row, rows: &[Row]) -> String {
                 [
                     format!("{:.3e}", e.position_max),
                     format!("{:.3e}", e.position_rms),
+                    e.bodies_unmatched.to_string(),
                     format!("{:.3e}", e.energy_error),
                 ],
                 format!("{}/{}/{}", e.events_appear, e.events_vanish, e.events_moved),
@@ -142,12 +150,13 @@ pub fn table(keys: &[String], reference: &Row, rows: &[Row]) -> String {
         };
         let _ = writeln!(
             s,
-            "{name:width$}  {:>9.2}  {:>10}  {:>10}  {:>10}  {:>10.3e}  {touches:>11}  \
-             {contacts:>9}  {:016x}",
+            "{name:width$}  {:>9.2}  {:>10}  {:>10}  {:>9}  {:>10}  {:>10.3e}  {touches:>11}  \
+             {contacts:>11}  {:016x}",
             r.step_seconds * 1e6,
             err[0],
             err[1],
             err[2],
+            err[3],
             e.energy_drift,
             r.digest
         );
@@ -163,7 +172,7 @@ pub fn table(keys: &[String], reference: &Row, rows: &[Row]) -> String {
     }
     s.push_str(
         "pos: named moving bodies' position error (units) at the times both runs reach; \
-         energy err: largest |E - E_ref|; drift: E(end) - E(0); touch +/-/~: touch events \
+         unmatched: named body-frames alive in one run only; energy err: largest |E - E_ref|; drift: E(end) - E(0); touch +/-/~: touch events \
          that appear, vanish, move frames; contact +/-: pair-frames in contact only in this \
          run (false positives) / only in the reference (false negatives)\n",
     );

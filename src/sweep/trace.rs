@@ -6,7 +6,7 @@
 use std::time::Instant;
 
 use ricochet_geom::Vec2;
-use ricochet_sim::{BodyKind, Entity, GameEvent, Scenario, Simulation};
+use ricochet_sim::{BodyKind, Entity, FrameOutput, GameEvent, Scenario, Simulation};
 
 use super::time::Ratio;
 
@@ -28,7 +28,9 @@ pub struct Sample {
     /// Mechanical energy of the dynamic bodies: `Σ m v²/2 − m s (g · p)` (`s` the body's
     /// gravity scale); constant forces and controllers are not in it.
     pub energy: f64,
-    /// The pairs touching at the frame's end, by names (each sorted), sorted.
+    /// The pairs in contact in the frame, by names (each sorted), sorted: those with a
+    /// contact record in it (a `destroy` pair's last frame too) and those still touching
+    /// at its end.
     pub touching: Vec<(String, String)>,
 }
 
@@ -55,7 +57,7 @@ fn pair(a: &str, b: &str) -> (String, String) {
     }
 }
 
-fn sample(sim: &Simulation) -> Sample {
+fn sample(sim: &Simulation, out: &FrameOutput) -> Sample {
     let world = sim.world();
     let g = sim.scenario().world.gravity;
     let mut energy = 0.0;
@@ -82,18 +84,36 @@ fn sample(sim: &Simulation) -> Sample {
         }
     }
     named.sort_by(|a, b| a.0.cmp(&b.0));
-    let name = |e: Entity| sim.name(e).unwrap_or("").to_owned();
     let mut touching: Vec<(String, String)> = sim
         .touching()
         .iter()
-        .map(|&(a, b)| pair(&name(a), &name(b)))
+        .copied()
+        .chain(out.contacts.iter().map(|c| (c.a, c.b)))
+        .map(|(a, b)| pair(&name_of(sim, out, a), &name_of(sim, out, b)))
         .collect();
     touching.sort();
+    // A pair is in contact or not: once per frame, whatever its records.
+    touching.dedup();
     Sample {
         bodies: named,
         energy,
         touching,
     }
+}
+
+/// A body's name; one removed this frame is only in `removed`, and a contact or a touch's
+/// end can name it.
+fn name_of(sim: &Simulation, out: &FrameOutput, e: Entity) -> String {
+    sim.name(e).map_or_else(
+        || {
+            out.removed
+                .iter()
+                .find(|r| r.entity == e)
+                .map(|r| r.name.clone())
+                .unwrap_or_default()
+        },
+        str::to_owned,
+    )
 }
 
 /// Runs `scenario` (frames 0 to `scenario.frames`) `timed` times for the wall time, then
@@ -117,19 +137,7 @@ pub fn run(scenario: &Scenario, dt: Ratio, timed: u32) -> Trace {
     let mut touches = Vec::new();
     for _ in 0..=scenario.frames {
         let out = sim.step();
-        // A body removed this frame is only in `removed`; an end can name one.
-        let name = |e: Entity| -> String {
-            sim.name(e).map_or_else(
-                || {
-                    out.removed
-                        .iter()
-                        .find(|r| r.entity == e)
-                        .map(|r| r.name.clone())
-                        .unwrap_or_default()
-                },
-                str::to_owned,
-            )
-        };
+        let name = |e: Entity| name_of(&sim, &out, e);
         for ev in &out.events {
             let (begin, a, b) = match ev {
                 GameEvent::TouchBegin { a, b, .. } => (true, a, b),
@@ -144,7 +152,7 @@ pub fn run(scenario: &Scenario, dt: Ratio, timed: u32) -> Trace {
                 },
             ));
         }
-        samples.push(sample(&sim));
+        samples.push(sample(&sim, &out));
     }
     Trace {
         dt,
