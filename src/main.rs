@@ -240,7 +240,7 @@ enum Command {
     ///
     /// Examples:
     ///   ricochet sweep scenarios/platformer.toml --set world.dt=1/30,1/60,1/120,1/240
-    ///   ricochet sweep scenarios/asteroids.toml --set 'templates.ship.shape=file,circle:1,circle:0.7'
+    ///   ricochet sweep scenarios/asteroids.toml --set 'bodies.ship.shape=file,circle:1.2,polygon:1 0;-1 1;-1 -1'
     #[command(verbatim_doc_comment)]
     Sweep(sweep::Args),
     /// Time Ricochet's full step against rapier2d's collision-only pipeline and Box2D v3 on
