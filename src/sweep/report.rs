@@ -244,7 +244,7 @@ pub fn svg_text(
     }
     let shown = series.len().min(24);
     let mut notes = vec![
-        "Points of one line: its timesteps, coarsest on the left.".to_owned(),
+        "Points of one line: its timesteps, joined coarsest to finest.".to_owned(),
         "Errors against the reference run, at the times both reach.".to_owned(),
         "Errors of exactly 0 sit on the bottom line.".to_owned(),
     ];
