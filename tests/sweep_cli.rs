@@ -292,3 +292,28 @@ fn the_csv_has_one_row_per_combination_and_shards_partition_them() {
     seen.sort_unstable();
     assert_eq!(seen, (0..6).collect::<Vec<_>>());
 }
+
+#[test]
+fn a_touch_between_two_coarse_frames_belongs_to_the_frame_after_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = write(dir.path(), "rock.toml", ROCK);
+    let (code, stdout, stderr) = sweep(
+        dir.path(),
+        &file,
+        &["--set", "world.dt=1/8", "--reference", "world.dt=1/24"],
+        "t.csv",
+    );
+    assert_eq!(code, 0, "{stdout}{stderr}");
+    let rows = read_csv(&dir.path().join("t.csv"));
+    // At 1/24 s the probe (x = 3.0625 - t) first overlaps the square (x < 1.25) at frame 44,
+    // t = 1.833 s; at 1/8 s at frame 15, t = 1.875 s: the first coarse frame at or after it,
+    // so the begin has not moved. The coarse frames meet every 3rd fine one; both runs are
+    // in contact at 45 and 48 (coarse 15 and 16) and apart at 42 (coarse 14).
+    let row = &rows[0];
+    assert_eq!(row["frames"], "16");
+    assert_eq!(num(row, "matched_frames"), 17.0);
+    assert_eq!(num(row, "touch_moved"), 0.0);
+    assert_eq!(num(row, "touch_appear") + num(row, "touch_vanish"), 0.0);
+    assert_eq!(num(row, "false_positive_contacts"), 0.0);
+    assert_eq!(num(row, "false_negative_contacts"), 0.0);
+}
