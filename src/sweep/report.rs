@@ -267,39 +267,64 @@ pub fn svg_text(
     })
 }
 
-/// The one-line summary.
+/// The one-line summary: the largest position error and the most false contacts, with the
+/// runs that have them, and the fastest step.
 #[must_use]
 pub fn summary(rows: &[Row], keys: &[String], shard: Option<(usize, usize)>) -> String {
-    let worst = rows
-        .iter()
-        .max_by(|a, b| a.error.position_max.total_cmp(&b.error.position_max));
-    let fastest = rows
-        .iter()
-        .min_by(|a, b| a.wall_per_second().total_cmp(&b.wall_per_second()));
+    let label = |r: &Row| {
+        keys.iter()
+            .zip(&r.values)
+            .map(|(k, v)| format!("{k}={v}"))
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
     let mut s = format!("sweep: {} runs", rows.len());
     if let Some((k, n)) = shard {
         let _ = write!(s, " (shard {k}/{n})");
     }
-    if let Some(w) = worst {
-        let label: Vec<String> = keys
-            .iter()
-            .zip(&w.values)
-            .map(|(k, v)| format!("{k}={v}"))
-            .collect();
+    let worst = rows
+        .iter()
+        .filter(|r| r.error.position_max != 0.0)
+        .max_by(|a, b| a.error.position_max.total_cmp(&b.error.position_max));
+    match worst {
+        Some(w) => {
+            let _ = write!(
+                s,
+                "; largest position error {:.3e} ({}, {})",
+                w.error.position_max,
+                w.error.worst_body,
+                label(w)
+            );
+        }
+        None => s.push_str("; no position error"),
+    }
+    let false_contacts = |r: &Row| r.error.false_positives + r.error.false_negatives;
+    match rows
+        .iter()
+        .filter(|r| false_contacts(r) > 0)
+        .max_by_key(|r| false_contacts(r))
+    {
+        Some(f) => {
+            let _ = write!(
+                s,
+                "; most false contacts {} + {} ({})",
+                f.error.false_positives,
+                f.error.false_negatives,
+                label(f)
+            );
+        }
+        None => s.push_str("; no false contact"),
+    }
+    if let Some(f) = rows
+        .iter()
+        .min_by(|a, b| a.wall_per_second().total_cmp(&b.wall_per_second()))
+    {
         let _ = write!(
             s,
-            "; largest position error {:.3e} ({}, {})",
-            w.error.position_max,
-            if w.error.worst_body.is_empty() {
-                "no body"
-            } else {
-                &w.error.worst_body
-            },
-            label.join(" ")
+            "; fastest {:.2} µs/step ({})",
+            f.step_seconds * 1e6,
+            label(f)
         );
-    }
-    if let Some(f) = fastest {
-        let _ = write!(s, "; fastest {:.2} µs/step", f.step_seconds * 1e6);
     }
     s
 }
