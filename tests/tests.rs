@@ -26,6 +26,7 @@ mod serve_siege;
 mod serve_ws;
 mod stress;
 mod suite_cli;
+mod sweep_cli;
 mod threads;
 mod touch_log;
 mod util;
