@@ -5,10 +5,11 @@ BENCHMARKS.md, and the cluster run of scripts/cluster-ci.sh).
     python3 scripts/gen_suite.py N DIR [--frames F]
 
 Variant i is shipped scenario i mod S (the S files of scenarios/*.toml, sorted), cut to F
-frames (default 60: one second at 60 Hz, its later script events dropped), with every `velocity = [x, y]` and `gravity = [x, y]` line scaled by
-1 + (i // S) / 1000, so no two variants record the same log. It writes DIR/NAME-IIII.toml
-and nothing else: bless them with `ricochet test DIR --golden GOLDENS --bless`. The same N
-and F always give the same files.
+frames (default 60: one second at 60 Hz; its later script events dropped), with every
+`velocity = [x, y]` and `gravity = [x, y]` line scaled by 1 + (i // S) / 1000, so no two
+variants record the same log. It writes DIR/NAME-IIII.toml and nothing else: bless them
+with `ricochet test DIR --bless` (goldens in recordings/ beside DIR). The same N and F
+always give the same files.
 """
 
 import argparse
@@ -17,7 +18,8 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-VELOCITY = re.compile(r"^(\s*(?:velocity|gravity)\s*=\s*)\[\s*([-0-9.eE+]+)\s*,\s*([-0-9.eE+]+)\s*\]", re.M)
+NUMBER = r"\s*([-0-9.eE+]+)\s*"
+VELOCITY = re.compile(rf"^(\s*(?:velocity|gravity)\s*=\s*)\[{NUMBER},{NUMBER}\]", re.M)
 FRAMES = re.compile(r"^frames\s*=\s*\d+", re.M)
 NAME = re.compile(r'^name\s*=\s*"[^"]*"', re.M)
 INLINE_EVENT = re.compile(r"^\s*\{\s*frame\s*=\s*(\d+)")
