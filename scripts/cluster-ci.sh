@@ -14,9 +14,9 @@ ricochet=${1:-$root/target/debug/ricochet}
 [ -x "$ricochet" ] || { echo "no ricochet binary at $ricochet: cargo build first" >&2; exit 1; }
 
 # The package and its pinned dependencies (python/pyproject.toml, python/constraints.txt),
-# in a venv reinstalled when either changes.
+# in a venv reinstalled when either, or the package's code, changes.
 venv="$root/target/cluster-venv"
-pins=$(cat python/pyproject.toml python/constraints.txt)
+pins=$(cat python/pyproject.toml python/constraints.txt python/src/ricochet_dask/*.py)
 if [ "$(cat "$venv/pins.txt" 2>/dev/null || true)" != "$pins" ]; then
     rm -rf "$venv"
     python3 -m venv "$venv"
