@@ -325,6 +325,7 @@ Examples:
   ricochet test --shard 0/4               the first of 4 slices (a job array's task)
   ricochet test --keep fresh              keep the fresh logs, then:
   ricochet diff recordings/level.mcap fresh/level.mcap
+  ricochet test --cluster tcp://127.0.0.1:8786 --verify   on a Dask cluster
 
 See docs/suites.md: the result line of one item, Slurm and Kubernetes examples.")]
     Test {
@@ -355,6 +356,15 @@ See docs/suites.md: the result line of one item, Slurm and Kubernetes examples."
         /// Keep the fresh logs in this folder, as NAME.mcap (created if missing).
         #[arg(long, value_name = "DIR", conflicts_with = "item")]
         keep: Option<PathBuf>,
+        /// Run the scenarios on this Dask distributed cluster's workers (tcp://HOST:PORT
+        /// of its scheduler) instead of local processes; needs `pip install ./python`
+        /// (docs/suites.md).
+        #[arg(long, value_name = "tcp://HOST:PORT", conflicts_with = "item")]
+        cluster: Option<String>,
+        /// With --cluster: re-run one item in ten on a second worker and fail any whose
+        /// digests differ, naming both workers.
+        #[arg(long, requires = "cluster")]
+        verify: bool,
         /// Run one scenario and print its result as one JSON line (docs/suites.md): what
         /// each of the runner's processes, or a cluster worker, runs.
         #[arg(long, value_name = "SCENARIO", hide = true)]
@@ -462,6 +472,8 @@ fn main() -> ExitCode {
             junit,
             shard,
             keep,
+            cluster,
+            verify,
             ..
         } => suite::run(&suite::Options {
             paths,
@@ -471,6 +483,7 @@ fn main() -> ExitCode {
             junit,
             shard,
             keep,
+            cluster: cluster.map(|scheduler| suite::cluster::Cluster { scheduler, verify }),
         }),
         Command::Bench {
             scenes,

@@ -5,6 +5,7 @@ mod accuracy;
 mod bad_scenarios;
 mod bench_cli;
 mod channel_schemas;
+mod cluster_cli;
 mod collide_cli;
 mod collision_cases;
 mod damaged_logs;

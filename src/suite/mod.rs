@@ -7,6 +7,7 @@
 //! the same bytes with any `-j` and shards concatenate to the whole suite. Then the summary
 //! `N passed, M failed`, and `--junit` (`junit.rs`).
 
+pub mod cluster;
 pub mod item;
 mod junit;
 mod pool;
@@ -47,6 +48,8 @@ pub struct Options {
     pub shard: Option<Shard>,
     /// Keep the fresh logs in this folder (NAME.mcap); default: a temporary folder.
     pub keep: Option<PathBuf>,
+    /// Run the items on this Dask cluster instead of local processes (`cluster.rs`).
+    pub cluster: Option<cluster::Cluster>,
 }
 
 /// Sets a flag on Ctrl-C, SIGTERM and SIGHUP. If a handler can't be installed, the signal
@@ -206,7 +209,7 @@ pub fn run(opts: &Options) -> anyhow::Result<ExitCode> {
     let mut results: Vec<Option<ItemResult>> = vec![None; items.len()];
     let mut printed = 0;
     let mut write_error = None;
-    let started_count = pool::run(items.len(), jobs, &stop, argv, |i, r| {
+    let on_done = |i, r| {
         results[i] = Some(r);
         if let Some(b) = &bar {
             b.inc(1);
@@ -222,7 +225,17 @@ pub fn run(opts: &Options) -> anyhow::Result<ExitCode> {
             }
             printed += 1;
         }
-    })?;
+    };
+    let started_count = match &opts.cluster {
+        None => pool::run(items.len(), jobs, &stop, argv, on_done)?,
+        Some(c) => match cluster::run(c, items.len(), &stop, argv, on_done) {
+            Ok(n) => n,
+            Err(e) => {
+                out::error(&format!("error: {e}"));
+                return Ok(ExitCode::from(2));
+            }
+        },
+    };
     if let Some(b) = bar {
         b.finish_and_clear();
     }
@@ -249,11 +262,14 @@ pub fn run(opts: &Options) -> anyhow::Result<ExitCode> {
         .shard
         .map_or_else(String::new, |s| format!(" (shard {s})"));
     out::note(&format!(
-        "{} scenario{}{shard} in {:.1} s, {} at a time",
+        "{} scenario{}{shard} in {:.1} s, {}",
         done.len(),
         if done.len() == 1 { "" } else { "s" },
         started.elapsed().as_secs_f64(),
-        jobs.min(items.len()).max(1)
+        opts.cluster.as_ref().map_or_else(
+            || format!("{} at a time", jobs.min(items.len()).max(1)),
+            |c| format!("on the cluster at {}", c.scheduler)
+        )
     ))?;
     if interrupted {
         let stopped = done
