@@ -16,6 +16,9 @@ pub(super) struct LocalBounds {
     /// Good at every angle (a shape that turning does not change, or a body that has turned
     /// and is bounded by the disc that holds it at every angle).
     any_angle: bool,
+    /// `turning_keeps_bounds` of the shape they were computed for, kept so that a snapshot
+    /// asks it of 10,000 bodies without looking a shape up (it fits in the padding).
+    keeps: bool,
     bounds: Bounds,
 }
 
@@ -54,6 +57,7 @@ impl LocalBounds {
         LocalBounds {
             angle,
             any_angle: true,
+            keeps: turning_keeps_bounds(shape),
             bounds: Bounds {
                 min: Vec2::splat(-r),
                 max: Vec2::splat(r),
@@ -61,12 +65,12 @@ impl LocalBounds {
         }
     }
 
-    /// Whether the bounds of a body of `shape` at `angle` are (or, at their next use,
+    /// Whether the bounds of the body, at `angle`, are (or, at their next use,
     /// become) the any-angle square of [`LocalBounds::turned`]: the body turned since they
     /// were computed exactly. False for a shape that turning does not change. A snapshot
     /// keeps this bit: the broad phase's candidates, counted in `Stats`, depend on it.
-    pub(super) fn has_turned(&self, shape: &Shape, angle: f64) -> bool {
-        (self.any_angle || self.angle.to_bits() != angle.to_bits()) && !turning_keeps_bounds(shape)
+    pub(super) fn has_turned(&self, angle: f64) -> bool {
+        (self.any_angle || self.angle.to_bits() != angle.to_bits()) && !self.keeps
     }
 
     /// Bounds that [`LocalBounds::has_turned`] tells `turned` of, for `shape` at `angle`.
@@ -79,9 +83,11 @@ impl LocalBounds {
     }
 
     pub(super) fn new(shape: &Shape, angle: f64) -> LocalBounds {
+        let keeps = turning_keeps_bounds(shape);
         LocalBounds {
             angle,
-            any_angle: turning_keeps_bounds(shape),
+            any_angle: keeps,
+            keeps,
             bounds: shape.bounds(&Pose::new(Vec2::ZERO, angle)),
         }
     }

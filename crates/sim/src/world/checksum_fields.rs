@@ -154,7 +154,7 @@ fn change(sim: &mut Simulation, field: &str, i: usize) {
         "rest_frames" => rest_frames[r] += 1,
         // A triangle's bounds: exact at its angle, or the any-angle square once it turned.
         "local_bounds" => {
-            let turned = local_bounds[r].has_turned(&w.shapes.get(w.shape_id[i]).0, w.angle[i]);
+            let turned = local_bounds[r].has_turned(w.angle[i]);
             local_bounds[r] = LocalBounds::restored(&triangle(), w.angle[i], !turned);
         }
         _ => change_other(sim, field, i),

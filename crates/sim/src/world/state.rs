@@ -154,7 +154,7 @@ impl World {
     fn turned(&self, i: usize) -> bool {
         match self.row[i] {
             NO_ROW => false,
-            r => self.rows.local_bounds[r as usize].has_turned(self.shape(i), self.angle[i]),
+            r => self.rows.local_bounds[r as usize].has_turned(self.angle[i]),
         }
     }
 
@@ -570,7 +570,7 @@ impl World {
             let lb = &mut self.rows.local_bounds[r];
             // Bounds that tell `turned` as they should are what a restore would build: an
             // exact box at another angle becomes the square at its next use.
-            if lb.has_turned(shape, angle) != turned {
+            if lb.has_turned(angle) != turned {
                 *lb = LocalBounds::restored(shape, angle, turned);
             }
         }
