@@ -16,7 +16,7 @@ use tokio_tungstenite::tungstenite::Message;
 
 use crate::serve_client::*;
 
-/// The server's per-client byte budget and its room for answers (src/serve/hub.rs).
+/// The server's per-client byte budget and its room for answers (crates/serve/src/hub.rs).
 pub(crate) const CLIENT_BUDGET: u64 = 8 << 20;
 pub(crate) const ANSWER_ROOM: u64 = 1 << 20;
 

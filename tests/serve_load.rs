@@ -1,6 +1,6 @@
 //! `/load` under hostile paths (issue 20): a symlink inside the server's directory that
 //! points out of it, and a file past the size cap, are refused with a named error; a file
-//! inside loads. (Devices and FIFOs: the unit test in src/serve/load_path.rs.)
+//! inside loads. (Devices and FIFOs: the unit test in crates/serve/src/load_path.rs.)
 
 use std::process::Command;
 

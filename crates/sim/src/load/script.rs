@@ -70,7 +70,7 @@ pub(crate) fn script(
                 action,
             })
         };
-        // As strict as a body's values and a live input's (src/session.rs): finite, and
+        // As strict as a body's values and a live input's (crates/record/src/session.rs): finite, and
         // within the coordinates the geometry accepts.
         let v = |f: &str, v: [f64; 2]| {
             if !v.iter().all(|x| finite(*x)) {
