@@ -39,14 +39,14 @@
 //!
 //! `world/checksum_fields.rs` changes every field marked "in `checksum`" in turn and checks
 //! that the checksum changes (its list is checked against this table, and it destructures
-//! `Rows`); `world/state.rs` destructures `Rows` too: a new column fails to compile until it
+//! `Rows`); `world/state/` destructures `Rows` too: a new column fails to compile until it
 //! is placed in both.
 //!
 //! # The baseline
 //!
 //! A simulation keeps a copy of its world as it was built, before the first step (shared
 //! by its clones; it costs as much memory as that world). A snapshot writes the bodies as
-//! they differ from it (`world/state.rs`): runs of bodies kept or dropped, a mask of the
+//! they differ from it (`world/state/`): runs of bodies kept or dropped, a mask of the
 //! field groups that changed, and whole records for bodies spawned later or redefined. A
 //! drifting asteroid costs 25 bytes (its position and angle), a tile that did not move
 //! nothing. The encoding is a function of the state alone (never of interned ids or row
@@ -248,7 +248,7 @@ struct State {
 }
 
 /// The world as the simulation was built, before its first step: what a snapshot's bodies
-/// are written against (`world/state.rs`). Shared by the simulation's clones.
+/// are written against (`world/state/`). Shared by the simulation's clones.
 #[derive(Debug)]
 pub(crate) struct Baseline {
     world: World,
