@@ -63,6 +63,22 @@ class ScratchArgv(unittest.TestCase):
         self.assertIsNone(task.result_line("\n \n"))
 
 
+class WriteLog(unittest.TestCase):
+    """`--fetch-logs`: the bytes land in the item's own --out folder, relative to --cwd."""
+
+    def test_the_bytes_go_to_the_out_folder_and_the_line_says_so(self):
+        import base64
+        import tempfile
+
+        with tempfile.TemporaryDirectory() as cwd:
+            argv = ["test", "--item", "s/a.toml", "--out", "kept"]
+            line = {"index": 0, "result": {"log": "/worker/scratch/a.mcap"}}
+            client.write_log(cwd, argv, line, base64.b64encode(b"MCAP bytes").decode())
+            self.assertEqual(Path(cwd, "kept", "a.mcap").read_bytes(), b"MCAP bytes")
+            self.assertEqual(line["result"]["log"], "kept/a.mcap")
+            self.assertEqual(sorted(p.name for p in Path(cwd, "kept").iterdir()), ["a.mcap"])
+
+
 class RerunState(unittest.TestCase):
     def test_waits_while_its_worker_is_there(self):
         self.assertEqual(verify.rerun_state("A", "B", ["A", "B"], 1.0, 10.0), ("wait", None))

@@ -347,3 +347,65 @@ pub fn run(opts: &Options) -> anyhow::Result<ExitCode> {
         ExitCode::from(1)
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use item::{Digest, Verdict};
+
+    fn result(hash: &str) -> ItemResult {
+        ItemResult {
+            format: item::FORMAT,
+            scenario: "s/a.toml".to_owned(),
+            name: "a".to_owned(),
+            verdict: Verdict::Ok,
+            line: "ok".to_owned(),
+            digest: Some(Digest {
+                frames: 600,
+                bodies: 6,
+                hash: hash.to_owned(),
+            }),
+            first: None,
+            log: None,
+        }
+    }
+
+    /// `--verify` on two workers that disagree: the item fails, and the worker whose digest
+    /// the golden `.digest` file holds is named, whichever ran first.
+    #[test]
+    fn a_disagreement_names_the_worker_the_golden_digest_agrees_with() {
+        let dir = tempfile::tempdir().unwrap();
+        let golden = Digest {
+            frames: 600,
+            bodies: 6,
+            hash: "00aa".to_owned(),
+        };
+        std::fs::write(dir.path().join("a.digest"), golden.text()).unwrap();
+        let line = |first: &str, again: &str| {
+            let r = from_cluster(
+                Path::new("s/a.toml"),
+                Some(dir.path()),
+                cluster::Returned::Unverified {
+                    result: result(first),
+                    why: "the workers disagree".to_owned(),
+                    first: "tcp://w:1".to_owned(),
+                    again: Some(("tcp://w:2".to_owned(), result(again))),
+                },
+            );
+            assert_eq!(r.verdict, Verdict::Error);
+            r.line
+        };
+        assert_eq!(
+            line("00aa", "0000"),
+            "error: --verify: the workers disagree (the golden digest agrees with tcp://w:1)"
+        );
+        assert_eq!(
+            line("0000", "00aa"),
+            "error: --verify: the workers disagree (the golden digest agrees with tcp://w:2)"
+        );
+        assert_eq!(
+            line("0000", "1111"),
+            "error: --verify: the workers disagree (the golden digest agrees with neither)"
+        );
+    }
+}
