@@ -365,6 +365,11 @@ See docs/suites.md: the result line of one item, Slurm and Kubernetes examples."
         /// digests differ, naming both workers.
         #[arg(long, requires = "cluster")]
         verify: bool,
+        /// With --cluster and --keep: copy each fresh log's bytes back from its worker into
+        /// the --keep folder, for workers that don't share a filesystem with this machine.
+        /// Without it, a worker keeps the log at the --keep path on its own filesystem.
+        #[arg(long, requires_all = ["cluster", "keep"])]
+        fetch_logs: bool,
         /// Run one scenario and print its result as one JSON line (docs/suites.md): what
         /// each of the runner's processes, or a cluster worker, runs.
         #[arg(long, value_name = "SCENARIO", hide = true)]
@@ -474,6 +479,7 @@ fn main() -> ExitCode {
             keep,
             cluster,
             verify,
+            fetch_logs,
             ..
         } => suite::run(&suite::Options {
             paths,
@@ -483,7 +489,11 @@ fn main() -> ExitCode {
             junit,
             shard,
             keep,
-            cluster: cluster.map(|scheduler| suite::cluster::Cluster { scheduler, verify }),
+            cluster: cluster.map(|scheduler| suite::cluster::Cluster {
+                verify,
+                fetch_logs,
+                ..suite::cluster::Cluster::new(scheduler)
+            }),
         }),
         Command::Bench {
             scenes,

@@ -317,3 +317,85 @@ fn a_touch_between_two_coarse_frames_belongs_to_the_frame_after_it() {
     assert_eq!(num(row, "false_positive_contacts"), 0.0);
     assert_eq!(num(row, "false_negative_contacts"), 0.0);
 }
+
+/// `sweep --item` (what a cluster worker runs, issue #23): each combination's JSON line
+/// holds the row the local sweep writes, the reference's is the run with the same values,
+/// and an index past the end is named. Untimed (`--repeat 0`), two local sweeps write the
+/// same bytes, which is what `sweep --cluster`'s merge is compared with in
+/// scripts/cluster-ci.sh.
+#[test]
+fn sweep_items_print_the_rows_of_the_local_sweep() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = write(dir.path(), "rock.toml", ROCK);
+    let file = file.to_str().unwrap();
+    let set = [
+        "--set",
+        "world.dt=1/8,1/16",
+        "--set",
+        "bodies.rock.shape=file,circle:0.9",
+        "--repeat",
+        "0",
+    ];
+    let local = |name: &str| {
+        let csv = dir.path().join(name);
+        let mut args = vec!["sweep", file];
+        args.extend(set);
+        args.extend(["--csv", csv.to_str().unwrap()]);
+        let out = ricochet(&args, b"");
+        assert_eq!(out.status.code(), Some(0), "{out:?}");
+        csv
+    };
+    let (a, b) = (local("a.csv"), local("b.csv"));
+    assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+    let svg = |p: &Path| std::fs::read(p.with_extension("svg")).unwrap();
+    assert_eq!(svg(&a), svg(&b));
+    let rows = read_csv(&a);
+    assert_eq!(rows.len(), 4);
+
+    let item = |which: &str| {
+        let mut args = vec!["sweep", file];
+        args.extend(set);
+        args.extend(["--item", which]);
+        let out = ricochet(&args, b"");
+        let line: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap_or_else(|e| {
+            panic!("{e}: {}", String::from_utf8_lossy(&out.stdout));
+        });
+        (out.status.code(), line)
+    };
+    for (i, row) in rows.iter().enumerate() {
+        assert_eq!(row["step_us"], "", "untimed");
+        let (code, line) = item(&i.to_string());
+        assert_eq!(code, Some(0));
+        assert_eq!(line["format"], 1);
+        assert_eq!(line["reference"], false);
+        let r = &line["row"];
+        assert_eq!(r["index"], i);
+        assert_eq!(r["values"][0], row["world.dt"].as_str());
+        assert_eq!(r["values"][1], row["bodies.rock.shape"].as_str());
+        assert_eq!(r["digest"], row["digest"].as_str());
+        assert_eq!(r["step_seconds"], "NaN");
+        let exact = |v: &serde_json::Value| v.as_str().unwrap().parse::<f64>().unwrap();
+        assert_eq!(exact(&r["error"]["position_max"]), num(row, "position_max"));
+        assert_eq!(
+            r["error"]["false_positives"].as_u64().unwrap().to_string(),
+            row["false_positive_contacts"]
+        );
+    }
+    // The reference: the file at the finest dt, which is combination 2 (1/16, file).
+    let (code, line) = item("reference");
+    assert_eq!(code, Some(0));
+    assert_eq!(line["reference"], true);
+    assert_eq!(line["row"]["digest"], rows[2]["digest"].as_str());
+    assert_eq!(rows[2]["position_max"], "0e0");
+
+    let mut args = vec!["sweep", file];
+    args.extend(set);
+    args.extend(["--item", "4"]);
+    let out = ricochet(&args, b"");
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("--item 4: the sweep has 4 combinations (0 to 3)"),
+        "{stderr}"
+    );
+}

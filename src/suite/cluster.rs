@@ -1,5 +1,6 @@
-//! `ricochet test --cluster tcp://HOST:PORT`: the items run on a Dask distributed cluster
-//! instead of local processes (`pool.rs`), with the same argv and the same result lines.
+//! `ricochet test --cluster tcp://HOST:PORT` and `ricochet sweep --cluster …`: the items run
+//! on a Dask distributed cluster instead of local processes (`pool.rs`), with the same argv
+//! and the same result lines (`test --item`'s `ItemResult`, `sweep --item`'s row).
 //!
 //! Ricochet does not schedule anything itself. It starts `python3 -m ricochet_dask` (the
 //! package in `python/`, `pip install ./python`), writes one `{"argv": [...]}` line per item
@@ -8,7 +9,9 @@
 //! and reruns a killed worker's items elsewhere. The merge stays here and in `mod.rs`: the
 //! lines come back in any order and are put in item order, so the output is the same bytes
 //! as a local run. `--verify` re-runs a sample of the items on a second worker (chosen by the
-//! package), and an item whose two digests differ fails, naming both workers.
+//! package), and an item whose two digests differ fails, naming both workers. A re-run whose
+//! worker leaves is moved to another one, and one that does not finish within
+//! [`Cluster::verify_timeout`] fails the item, named: `--verify` never waits forever.
 //!
 //! Every worker runs this same binary at this same absolute path, with the scenarios, the
 //! goldens and the logs' folder at the same paths: one machine, or a shared filesystem.
@@ -16,15 +19,14 @@
 use std::ffi::OsString;
 use std::io::{BufRead, BufReader, Write};
 use std::net::{TcpStream, ToSocketAddrs};
-use std::path::PathBuf;
 use std::process::{Child, Command, Stdio};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc;
 use std::time::Duration;
 
 use serde::Deserialize;
+use serde::de::DeserializeOwned;
 
-use super::item::{FORMAT, ItemResult, Verdict, name_of};
 use crate::out::escape_controls;
 
 /// The Python that runs the package: `RICOCHET_PYTHON` if set (a venv's
@@ -48,6 +50,57 @@ pub struct Cluster {
     pub scheduler: String,
     /// Re-run a sample of the items on a second worker and require identical digests.
     pub verify: bool,
+    /// With `verify`: how long a re-run may take, from when it is handed to its worker,
+    /// before the item fails with a named error.
+    pub verify_timeout: Duration,
+    /// Copy each fresh log's bytes back from the worker (`ricochet test --keep DIR
+    /// --fetch-logs`); otherwise a result names the log's path on the worker.
+    pub fetch_logs: bool,
+}
+
+impl Cluster {
+    /// A cluster run at `scheduler`, without `--verify` or fetched logs.
+    #[must_use]
+    pub fn new(scheduler: String) -> Cluster {
+        Cluster {
+            scheduler,
+            verify: false,
+            verify_timeout: VERIFY_TIMEOUT,
+            fetch_logs: false,
+        }
+    }
+}
+
+/// The default of [`Cluster::verify_timeout`]: far longer than any item of a test suite
+/// should take, short enough that a lost re-run ends the run the same hour.
+pub const VERIFY_TIMEOUT: Duration = Duration::from_secs(600);
+
+/// A result line the cluster carries back: `--verify` compares the digests of two runs.
+pub trait ResultLine: DeserializeOwned {
+    /// What `--verify` compares between the two runs of an item, as the error shows it.
+    fn digest_text(&self) -> String;
+}
+
+/// What became of one item on the cluster.
+#[derive(Debug)]
+pub enum Returned<R> {
+    /// Its result line (and, when it was sampled, the second run's digest was the same).
+    Line(R),
+    /// Its result line, but `--verify` failed: the second run's digest differs, or it
+    /// could not re-run. `why` names both workers; `first` is the first run's.
+    Unverified {
+        /// The first run's line.
+        result: R,
+        /// `the workers disagree: A computed X, B computed Y`, or why there is no re-run
+        /// (as the package wrote it: escape it before printing).
+        why: String,
+        /// The worker of the first run.
+        first: String,
+        /// The second run's worker and line, when it returned one that reads.
+        again: Option<(String, R)>,
+    },
+    /// No result line: why (`on the cluster: …`).
+    Failed(String),
 }
 
 /// Why a cluster run could not start or finish (exit code 2).
@@ -117,36 +170,37 @@ impl std::error::Error for ClusterError {}
 #[derive(Deserialize)]
 struct Verified {
     worker: Option<String>,
-    result: Option<ItemResult>,
+    result: Option<serde_json::Value>,
     error: Option<String>,
 }
 
-/// One line of the package's stdout.
+/// One line of the package's stdout. The results are read into the item's own line type
+/// in [`merge`], so a worker's line that does not read (another `ricochet` on that node) is
+/// named rather than dropped.
 #[derive(Deserialize)]
 struct Line {
     index: usize,
     worker: Option<String>,
-    result: Option<ItemResult>,
+    result: Option<serde_json::Value>,
     verified: Option<Verified>,
     error: Option<String>,
 }
 
-/// Runs `args(i)` (the argv of `ricochet test --item`) for every item `i` in `0..count` on
-/// the cluster, calling `done(i, result)` as each finishes (in any order), like
-/// `pool::run`. When `stop` is set (Ctrl-C) the package is stopped and the items still out
-/// get no result. Returns how many results came back.
-pub fn run(
+/// Runs `args(i)` (the argv of one `ricochet … --item` process) for every item `i` in
+/// `0..count` on the cluster, calling `done(i, returned)` as each finishes (in any order),
+/// like `pool::run`. When `stop` is set (Ctrl-C) the package is stopped and the items still
+/// out get no result. Returns how many results came back.
+pub fn run<R: ResultLine>(
     cluster: &Cluster,
     count: usize,
     stop: &AtomicBool,
-    args: impl Fn(usize) -> (PathBuf, Vec<OsString>),
-    mut done: impl FnMut(usize, ItemResult),
+    args: impl Fn(usize) -> Vec<OsString>,
+    mut done: impl FnMut(usize, Returned<R>),
 ) -> Result<usize, ClusterError> {
     reach(&cluster.scheduler)?;
     let mut input = String::new();
     for i in 0..count {
         let argv = args(i)
-            .1
             .into_iter()
             .map(|a| a.into_string().map_err(ClusterError::NotUtf8))
             .collect::<Result<Vec<String>, _>>()?;
@@ -164,7 +218,13 @@ pub fn run(
         .arg("--cwd")
         .arg(&cwd);
     if cluster.verify {
-        command.arg("--verify");
+        command
+            .arg("--verify")
+            .arg("--verify-timeout")
+            .arg(cluster.verify_timeout.as_secs_f64().to_string());
+    }
+    if cluster.fetch_logs {
+        command.arg("--fetch-logs");
     }
     let mut child = command
         .stdin(Stdio::piped())
@@ -215,8 +275,7 @@ pub fn run(
                 }
                 received[line.index] = true;
                 got += 1;
-                let (scenario, _) = args(line.index);
-                done(line.index, merge(&scenario, line));
+                done(line.index, merge(line));
             }
             Err(mpsc::RecvTimeoutError::Timeout) => {}
             Err(mpsc::RecvTimeoutError::Disconnected) => break,
@@ -248,8 +307,10 @@ pub fn run(
         });
     }
     for (i, _) in received.iter().enumerate().filter(|(_, r)| !**r) {
-        let (scenario, _) = args(i);
-        done(i, error(&scenario, "the cluster returned no result for it"));
+        done(
+            i,
+            Returned::Failed("the cluster returned no result for it".to_owned()),
+        );
         got += 1;
     }
     Ok(got)
@@ -290,82 +351,67 @@ fn stop_child(child: &mut Child) {
     let _ = child.kill();
 }
 
-/// The item's result from the package's line: its own result line, failed when `--verify`
-/// found the second worker's digest different (both workers named) or could not re-run it.
-fn merge(scenario: &std::path::Path, line: Line) -> ItemResult {
-    let Some(mut result) = line.result else {
+/// The item's outcome from the package's line: its own result line, unverified when
+/// `--verify` found the second worker's digest different (both workers named) or could not
+/// re-run it.
+fn merge<R: ResultLine>(line: Line) -> Returned<R> {
+    let first = line.worker.unwrap_or_else(|| "a worker".to_owned());
+    let Some(result) = line.result else {
         let why = line.error.unwrap_or_else(|| "no result".to_owned());
-        return error(scenario, &format!("on the cluster: {why}"));
+        return Returned::Failed(format!("on the cluster: {}", escape_controls(why.trim())));
+    };
+    let result = match R::deserialize(result) {
+        Ok(r) => r,
+        Err(e) => {
+            return Returned::Failed(format!(
+                "on the cluster: the result line from {} does not read ({}): is its ricochet \
+                 this one?",
+                escape_controls(&first),
+                escape_controls(&e.to_string())
+            ));
+        }
     };
     let Some(verified) = line.verified else {
-        return result;
+        return Returned::Line(result);
     };
-    let first = line.worker.unwrap_or_else(|| "a worker".to_owned());
     let second = verified
         .worker
         .unwrap_or_else(|| "another worker".to_owned());
-    let line = match (&verified.result, &verified.error) {
-        (Some(again), _) if again.digest == result.digest => return result,
-        (Some(again), _) => {
-            let hash = |r: &ItemResult| {
-                r.digest.as_ref().map_or_else(
-                    || format!("no digest ({})", r.line),
-                    |d| format!("frames {} bodies {} hash {}", d.frames, d.bodies, d.hash),
-                )
-            };
-            let golden = if result.verdict == Verdict::Ok {
-                format!(" (the golden agrees with {first})")
-            } else {
-                String::new()
-            };
-            format!(
-                "error: --verify: the workers disagree: {first} computed {}, {second} \
-                 computed {}{golden}",
-                hash(&result),
-                hash(again)
-            )
+    let again = verified.result.map(R::deserialize);
+    let why = match (&again, &verified.error) {
+        (Some(Err(e)), _) => format!(
+            "the re-run's line from {second} does not read ({e}): is its ricochet this one?"
+        ),
+        (Some(Ok(again)), _) if again.digest_text() == result.digest_text() => {
+            return Returned::Line(result);
         }
-        (None, Some(why)) => format!("error: --verify: the re-run failed: {why}"),
-        (None, None) => "error: --verify: the re-run returned nothing".to_owned(),
+        (Some(Ok(again)), _) => format!(
+            "the workers disagree: {first} computed {}, {second} computed {}",
+            result.digest_text(),
+            again.digest_text()
+        ),
+        (None, Some(why)) => format!("the re-run failed: {why}"),
+        (None, None) => "the re-run returned nothing".to_owned(),
     };
-    result.verdict = Verdict::Error;
-    result.line = escape_controls(&line);
-    result
-}
-
-/// An [`Verdict::Error`] result for an item the cluster returned no result line for.
-fn error(scenario: &std::path::Path, why: &str) -> ItemResult {
-    ItemResult {
-        format: FORMAT,
-        scenario: scenario.display().to_string(),
-        name: name_of(scenario),
-        verdict: Verdict::Error,
-        line: format!("error: {}", escape_controls(why.trim())),
-        digest: None,
-        first: None,
-        log: None,
+    Returned::Unverified {
+        result,
+        why,
+        first,
+        again: again.and_then(Result::ok).map(|a| (second, a)),
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::suite::item::Digest;
 
-    fn result(hash: &str) -> ItemResult {
-        ItemResult {
-            format: FORMAT,
-            scenario: "s/a.toml".to_owned(),
-            name: "a".to_owned(),
-            verdict: Verdict::Ok,
-            line: "ok".to_owned(),
-            digest: Some(Digest {
-                frames: 600,
-                bodies: 6,
-                hash: hash.to_owned(),
-            }),
-            first: None,
-            log: None,
+    /// A result line with only a digest.
+    #[derive(Deserialize, Debug, PartialEq)]
+    struct Hashed(String);
+
+    impl ResultLine for Hashed {
+        fn digest_text(&self) -> String {
+            format!("hash {}", self.0)
         }
     }
 
@@ -373,10 +419,10 @@ mod tests {
         Line {
             index: 0,
             worker: Some("tcp://127.0.0.1:1".to_owned()),
-            result: Some(result(first)),
+            result: Some(serde_json::json!(first)),
             verified: Some(Verified {
                 worker: Some("tcp://127.0.0.1:2".to_owned()),
-                result: Some(result(again)),
+                result: Some(serde_json::json!(again)),
                 error: None,
             }),
             error: None,
@@ -384,25 +430,54 @@ mod tests {
     }
 
     #[test]
-    fn equal_digests_on_two_workers_keep_the_verdict() {
-        let r = merge(std::path::Path::new("s/a.toml"), line("00aa", "00aa"));
-        assert_eq!((r.verdict, r.line.as_str()), (Verdict::Ok, "ok"));
+    fn equal_digests_on_two_workers_keep_the_line() {
+        let r: Returned<Hashed> = merge(line("00aa", "00aa"));
+        assert!(matches!(r, Returned::Line(Hashed(h)) if h == "00aa"));
     }
 
     #[test]
-    fn a_worker_that_computes_differently_fails_the_item_and_is_named() {
-        let r = merge(std::path::Path::new("s/a.toml"), line("00aa", "00ab"));
-        assert_eq!(r.verdict, Verdict::Error);
+    fn a_worker_that_computes_differently_is_named() {
+        let Returned::<Hashed>::Unverified {
+            result,
+            why,
+            first,
+            again,
+        } = merge(line("00aa", "00ab"))
+        else {
+            panic!("verified although the digests differ");
+        };
+        assert_eq!(result, Hashed("00aa".to_owned()));
+        assert_eq!(first, "tcp://127.0.0.1:1");
         assert_eq!(
-            r.line,
-            "error: --verify: the workers disagree: tcp://127.0.0.1:1 computed frames 600 \
-             bodies 6 hash 00aa, tcp://127.0.0.1:2 computed frames 600 bodies 6 hash 00ab \
-             (the golden agrees with tcp://127.0.0.1:1)"
+            again,
+            Some(("tcp://127.0.0.1:2".to_owned(), Hashed("00ab".to_owned())))
+        );
+        assert_eq!(
+            why,
+            "the workers disagree: tcp://127.0.0.1:1 computed hash 00aa, tcp://127.0.0.1:2 \
+             computed hash 00ab"
         );
     }
 
     #[test]
-    fn an_item_without_a_result_is_an_error_saying_why() {
+    fn a_re_run_that_timed_out_is_unverified_saying_why() {
+        let mut l = line("00aa", "00aa");
+        l.verified = Some(Verified {
+            worker: Some("tcp://127.0.0.1:2".to_owned()),
+            result: None,
+            error: Some("no result from tcp://127.0.0.1:2 in 5 s".to_owned()),
+        });
+        let Returned::<Hashed>::Unverified { why, .. } = merge(l) else {
+            panic!("verified without a second run");
+        };
+        assert_eq!(
+            why,
+            "the re-run failed: no result from tcp://127.0.0.1:2 in 5 s"
+        );
+    }
+
+    #[test]
+    fn an_item_without_a_result_fails_saying_why() {
         let l = Line {
             index: 0,
             worker: None,
@@ -410,11 +485,22 @@ mod tests {
             verified: None,
             error: Some("KilledWorker: 3 workers died".to_owned()),
         };
-        let r = merge(std::path::Path::new("s/a.toml"), l);
-        assert_eq!(r.verdict, Verdict::Error);
-        assert_eq!(
-            r.line,
-            "error: on the cluster: KilledWorker: 3 workers died"
+        assert!(matches!(
+            merge::<Hashed>(l),
+            Returned::Failed(why) if why == "on the cluster: KilledWorker: 3 workers died"
+        ));
+    }
+
+    #[test]
+    fn a_line_another_ricochet_wrote_is_named_with_its_worker() {
+        let mut l = line("00aa", "00aa");
+        l.result = Some(serde_json::json!({"format": 99}));
+        let Returned::<Hashed>::Failed(why) = merge(l) else {
+            panic!("a line that does not read was taken");
+        };
+        assert!(
+            why.starts_with("on the cluster: the result line from tcp://127.0.0.1:1 does not read"),
+            "{why}"
         );
     }
 

@@ -96,6 +96,16 @@ pub struct First {
     pub now: String,
 }
 
+impl super::cluster::ResultLine for ItemResult {
+    /// `frames N bodies N hash X`, or `no digest (LINE)` for a run that did not end.
+    fn digest_text(&self) -> String {
+        self.digest.as_ref().map_or_else(
+            || format!("no digest ({})", self.line),
+            |d| format!("frames {} bodies {} hash {}", d.frames, d.bodies, d.hash),
+        )
+    }
+}
+
 impl From<Divergence> for First {
     fn from(d: Divergence) -> Self {
         First {

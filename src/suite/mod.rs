@@ -137,6 +137,57 @@ fn gather(paths: &[PathBuf], golden: Option<&Path>) -> Result<Vec<PathBuf>, Stri
     Ok(items)
 }
 
+/// An item's result from the cluster: `--verify`'s failure and a missing result line are
+/// `error` verdicts whose line says why. Of two workers that disagree, the one whose digest
+/// the golden digest file holds is named as agreeing with it: two runs alone can't say
+/// which node computes differently, and a node's own verdict is its own word.
+fn from_cluster(
+    scenario: &Path,
+    golden: Option<&Path>,
+    returned: cluster::Returned<ItemResult>,
+) -> ItemResult {
+    match returned {
+        cluster::Returned::Line(r) => r,
+        cluster::Returned::Unverified {
+            mut result,
+            why,
+            first,
+            again,
+        } => {
+            let dir = golden.map_or_else(|| default_golden(scenario), Path::to_owned);
+            let kept = std::fs::read_to_string(dir.join(format!("{}.digest", name_of(scenario))));
+            let text = |r: &ItemResult| r.digest.as_ref().map(item::Digest::text);
+            let golden = match (kept, &again) {
+                (Ok(kept), Some((second, again))) => {
+                    let agree: Vec<&str> = [(first.as_str(), &result), (second.as_str(), again)]
+                        .into_iter()
+                        .filter(|(_, r)| text(r).as_deref() == Some(kept.as_str()))
+                        .map(|(w, _)| w)
+                        .collect();
+                    match agree[..] {
+                        [w] => format!(" (the golden digest agrees with {w})"),
+                        _ => " (the golden digest agrees with neither)".to_owned(),
+                    }
+                }
+                _ => String::new(),
+            };
+            result.verdict = item::Verdict::Error;
+            result.line = out::escape_controls(&format!("error: --verify: {why}{golden}"));
+            result
+        }
+        cluster::Returned::Failed(why) => ItemResult {
+            format: item::FORMAT,
+            scenario: scenario.display().to_string(),
+            name: name_of(scenario),
+            verdict: item::Verdict::Error,
+            line: format!("error: {why}"),
+            digest: None,
+            first: None,
+            log: None,
+        },
+    }
+}
+
 /// `ricochet test`: exit code 0 all passed, 1 any failed, 2 bad input, 130 interrupted.
 pub fn run(opts: &Options) -> anyhow::Result<ExitCode> {
     let items = match gather(&opts.paths, opts.golden.as_deref()) {
@@ -209,7 +260,7 @@ pub fn run(opts: &Options) -> anyhow::Result<ExitCode> {
     let mut results: Vec<Option<ItemResult>> = vec![None; items.len()];
     let mut printed = 0;
     let mut write_error = None;
-    let on_done = |i, r| {
+    let mut on_done = |i, r| {
         results[i] = Some(r);
         if let Some(b) = &bar {
             b.inc(1);
@@ -228,7 +279,13 @@ pub fn run(opts: &Options) -> anyhow::Result<ExitCode> {
     };
     let started_count = match &opts.cluster {
         None => pool::run(items.len(), jobs, &stop, argv, on_done)?,
-        Some(c) => match cluster::run(c, items.len(), &stop, argv, on_done) {
+        Some(c) => match cluster::run(
+            c,
+            items.len(),
+            &stop,
+            |i| argv(i).1,
+            |i, returned| on_done(i, from_cluster(&items[i], opts.golden.as_deref(), returned)),
+        ) {
             Ok(n) => n,
             Err(e) => {
                 out::error(&format!("error: {e}"));
@@ -289,4 +346,66 @@ pub fn run(opts: &Options) -> anyhow::Result<ExitCode> {
     } else {
         ExitCode::from(1)
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use item::{Digest, Verdict};
+
+    fn result(hash: &str) -> ItemResult {
+        ItemResult {
+            format: item::FORMAT,
+            scenario: "s/a.toml".to_owned(),
+            name: "a".to_owned(),
+            verdict: Verdict::Ok,
+            line: "ok".to_owned(),
+            digest: Some(Digest {
+                frames: 600,
+                bodies: 6,
+                hash: hash.to_owned(),
+            }),
+            first: None,
+            log: None,
+        }
+    }
+
+    /// `--verify` on two workers that disagree: the item fails, and the worker whose digest
+    /// the golden `.digest` file holds is named, whichever ran first.
+    #[test]
+    fn a_disagreement_names_the_worker_the_golden_digest_agrees_with() {
+        let dir = tempfile::tempdir().unwrap();
+        let golden = Digest {
+            frames: 600,
+            bodies: 6,
+            hash: "00aa".to_owned(),
+        };
+        std::fs::write(dir.path().join("a.digest"), golden.text()).unwrap();
+        let line = |first: &str, again: &str| {
+            let r = from_cluster(
+                Path::new("s/a.toml"),
+                Some(dir.path()),
+                cluster::Returned::Unverified {
+                    result: result(first),
+                    why: "the workers disagree".to_owned(),
+                    first: "tcp://w:1".to_owned(),
+                    again: Some(("tcp://w:2".to_owned(), result(again))),
+                },
+            );
+            assert_eq!(r.verdict, Verdict::Error);
+            r.line
+        };
+        assert_eq!(
+            line("00aa", "0000"),
+            "error: --verify: the workers disagree (the golden digest agrees with tcp://w:1)"
+        );
+        assert_eq!(
+            line("0000", "00aa"),
+            "error: --verify: the workers disagree (the golden digest agrees with tcp://w:2)"
+        );
+        assert_eq!(
+            line("0000", "1111"),
+            "error: --verify: the workers disagree (the golden digest agrees with neither)"
+        );
+    }
 }

@@ -5,18 +5,21 @@ use std::collections::BTreeMap;
 
 use ricochet_geom::Vec2;
 use ricochet_sim::WorldBounds;
+use serde::{Deserialize, Serialize};
 
 use super::time::FrameMap;
 use super::trace::{Touch, Trace};
 
 /// The error of one run against the reference.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Measures {
     /// Frames of the run compared (at a time the reference reaches).
     pub matched_frames: u64,
     /// Largest position error of any named moving body at any compared time, units.
+    #[serde(with = "super::item::exact")]
     pub position_max: f64,
     /// Root mean square of every named body's position error at every compared time.
+    #[serde(with = "super::item::exact")]
     pub position_rms: f64,
     /// The body with the largest error (empty when every error is 0).
     pub worst_body: String,
@@ -24,8 +27,10 @@ pub struct Measures {
     /// ship destroyed in one run only): their positions can't be compared.
     pub bodies_unmatched: u64,
     /// This run's energy at its last compared frame minus at frame 0.
+    #[serde(with = "super::item::exact")]
     pub energy_drift: f64,
     /// Largest `|E_run − E_reference|` at a compared time.
+    #[serde(with = "super::item::exact")]
     pub energy_error: f64,
     /// Touch events (begin or end, by the pair's names) the run has and the reference not.
     pub events_appear: u64,

@@ -4,8 +4,17 @@
 //! reference run; [`trace`] steps a run, [`error`] measures it against the reference,
 //! [`report`] prints and writes the result. Frame counts keep their time in seconds when
 //! the timestep changes, and runs are compared at the times both reach ([`time`]).
+//!
+//! `--cluster` runs each combination, and the reference, as an item process (`--item`,
+//! [`item`]) on a Dask cluster, like `ricochet test --cluster`; the rows come back in any
+//! order and are put in combination order here. An item measures against the reference, so
+//! each combination's item runs the reference again, untimed: the reference's trace (every
+//! frame's positions, energy and contacts) would otherwise have to travel between workers
+//! in a format of its own, and it costs one untimed run per combination. The reference's
+//! own item gives its step time and digest.
 
 mod error;
+mod item;
 mod report;
 mod set;
 mod shape;
@@ -20,7 +29,9 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use ricochet_sim::{Scenario, load_scenario};
 use toml_edit::DocumentMut;
 
+use crate::suite::cluster::{self, Cluster, Returned};
 use crate::{files, out};
+use item::Which;
 use set::{Setting, Sweep, Target};
 use time::Ratio;
 
@@ -55,10 +66,27 @@ pub struct Args {
     /// the shards' rows back in order.
     #[arg(long, value_name = "K/N")]
     pub shard: Option<String>,
-    /// Timed runs per combination; the step time is their median.
+    /// Timed runs per combination; the step time is their median. 0: no timing (the
+    /// step-time columns are empty and the chart's x axis is steps per simulated second),
+    /// so the CSV and SVG are the same bytes on every run, machine or cluster.
     #[arg(long, default_value_t = 3, value_name = "N",
-          value_parser = clap::value_parser!(u32).range(1..=100))]
+          value_parser = clap::value_parser!(u32).range(0..=100))]
     pub repeat: u32,
+    /// Run the combinations (and the reference) on this Dask distributed cluster's workers
+    /// (tcp://HOST:PORT of its scheduler), one item each, like `ricochet test --cluster`;
+    /// needs `pip install ./python` (docs/suites.md). The rows are merged in combination
+    /// order: the same CSV and SVG as a local run (step times aside).
+    #[arg(long, value_name = "tcp://HOST:PORT", conflicts_with = "item")]
+    pub cluster: Option<String>,
+    /// With --cluster: re-run one item in ten on a second worker and fail (exit code 1,
+    /// nothing written) if any digests differ, naming both workers.
+    #[arg(long, requires = "cluster")]
+    pub verify: bool,
+    /// Run one combination (its index, from 0) or `reference`, and print its row as one
+    /// JSON line (docs/suites.md): what a cluster worker runs.
+    #[arg(long, value_name = "N|reference", hide = true,
+          conflicts_with_all = ["csv", "svg", "shard"])]
+    pub item: Option<Which>,
 }
 
 /// Bad input: printed, exit code 2.
@@ -240,6 +268,62 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
             runs.push((index, texts, v));
         }
     }
+    let bounds = original.world.bounds;
+    let row = |index, values, v: &Variant, t: &trace::Trace, r: &trace::Trace| report::Row {
+        index,
+        values,
+        dt: v.dt,
+        frames: v.scenario.frames,
+        rounded: v.rounded,
+        step_seconds: t.step_seconds,
+        digest: t.digest,
+        error: error::measure(t, r, v.scenario.world.bounds.as_ref()),
+    };
+    let reference_values_text: Vec<String> = sweeps
+        .iter()
+        .map(|s| {
+            reference_values
+                .iter()
+                .rfind(|(t, _)| **t == s.target)
+                .map_or("file", |(_, v)| v.text())
+                .to_owned()
+        })
+        .collect();
+    let reference_row = |t: &trace::Trace| report::Row {
+        index: 0,
+        values: reference_values_text.clone(),
+        dt: reference.dt,
+        frames: reference.scenario.frames,
+        rounded: reference.rounded,
+        step_seconds: t.step_seconds,
+        digest: t.digest,
+        error: error::measure(t, t, bounds.as_ref()),
+    };
+
+    if let Some(which) = args.item {
+        return match which {
+            Which::Reference => {
+                let t = trace::run(&reference.scenario, reference.dt, args.repeat);
+                item::print(true, reference_row(&t))?;
+                Ok(ExitCode::SUCCESS)
+            }
+            Which::Combination(i) => {
+                let Some((index, values, v)) = runs.into_iter().find(|r| r.0 == i) else {
+                    return Ok(bad(&format!(
+                        "--item {i}: the sweep has {} combinations (0 to {})",
+                        all.len(),
+                        all.len().saturating_sub(1)
+                    )));
+                };
+                // Untimed: only its trace is needed, to measure against.
+                let r = trace::run(&reference.scenario, reference.dt, 0);
+                let t = trace::run(&v.scenario, v.dt, args.repeat);
+                item::print(false, row(index, values, &v, &t, &r))?;
+                Ok(ExitCode::SUCCESS)
+            }
+        };
+    }
+
     let csv = args
         .csv
         .clone()
@@ -252,61 +336,54 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
         files::check_writable(path)?;
     }
 
-    let bar = if std::io::IsTerminal::is_terminal(&std::io::stderr()) {
-        ProgressBar::with_draw_target(Some(runs.len() as u64 + 1), ProgressDrawTarget::stderr())
-    } else {
-        ProgressBar::hidden()
+    let (reference_row, rows) = match &args.cluster {
+        Some(scheduler) => {
+            let cluster = Cluster {
+                verify: args.verify,
+                ..Cluster::new(scheduler.clone())
+            };
+            match on_cluster(args, &keys, &cluster, &runs) {
+                Ok(Some(done)) => done,
+                Ok(None) => return Ok(ExitCode::from(1)),
+                Err(e) => {
+                    out::error(&format!("error: {e}"));
+                    return Ok(ExitCode::from(2));
+                }
+            }
+        }
+        None => {
+            let bar = if std::io::IsTerminal::is_terminal(&std::io::stderr()) {
+                ProgressBar::with_draw_target(
+                    Some(runs.len() as u64 + 1),
+                    ProgressDrawTarget::stderr(),
+                )
+            } else {
+                ProgressBar::hidden()
+            };
+            bar.set_style(
+                ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}")
+                    .context("progress bar template")?,
+            );
+            bar.set_message(format!("reference {reference_label}"));
+            let ref_trace = trace::run(&reference.scenario, reference.dt, args.repeat);
+            bar.inc(1);
+            let mut rows = Vec::new();
+            for (index, values, v) in runs {
+                bar.set_message(
+                    keys.iter()
+                        .zip(&values)
+                        .map(|(k, v)| format!("{k}={v}"))
+                        .collect::<Vec<_>>()
+                        .join(" "),
+                );
+                let t = trace::run(&v.scenario, v.dt, args.repeat);
+                rows.push(row(index, values, &v, &t, &ref_trace));
+                bar.inc(1);
+            }
+            bar.finish_and_clear();
+            (reference_row(&ref_trace), rows)
+        }
     };
-    bar.set_style(
-        ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}")
-            .context("progress bar template")?,
-    );
-    bar.set_message(format!("reference {reference_label}"));
-    let bounds = original.world.bounds;
-    let ref_trace = trace::run(&reference.scenario, reference.dt, args.repeat);
-    bar.inc(1);
-    let reference_row = report::Row {
-        index: 0,
-        values: sweeps
-            .iter()
-            .map(|s| {
-                reference_values
-                    .iter()
-                    .rfind(|(t, _)| **t == s.target)
-                    .map_or("file", |(_, v)| v.text())
-                    .to_owned()
-            })
-            .collect(),
-        dt: reference.dt,
-        frames: reference.scenario.frames,
-        rounded: reference.rounded,
-        step_seconds: ref_trace.step_seconds,
-        digest: ref_trace.digest,
-        error: error::measure(&ref_trace, &ref_trace, bounds.as_ref()),
-    };
-    let mut rows = Vec::new();
-    for (index, values, v) in runs {
-        bar.set_message(
-            keys.iter()
-                .zip(&values)
-                .map(|(k, v)| format!("{k}={v}"))
-                .collect::<Vec<_>>()
-                .join(" "),
-        );
-        let t = trace::run(&v.scenario, v.dt, args.repeat);
-        rows.push(report::Row {
-            index,
-            values,
-            dt: v.dt,
-            frames: v.scenario.frames,
-            rounded: v.rounded,
-            step_seconds: t.step_seconds,
-            digest: t.digest,
-            error: error::measure(&t, &ref_trace, v.scenario.world.bounds.as_ref()),
-        });
-        bar.inc(1);
-    }
-    bar.finish_and_clear();
 
     out::print(&report::table(&keys, &reference_row, &rows))?;
     files::write(&csv, report::csv_text(&keys, &rows).as_bytes())?;
@@ -321,4 +398,82 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
         svg.display()
     ))?;
     Ok(ExitCode::SUCCESS)
+}
+
+/// The sweep's runs as items on the cluster: the reference, then each combination of
+/// `runs` (this shard's). Returns the reference's row and the combinations' rows in
+/// combination order; `None` when an item failed or `--verify` caught a disagreement
+/// (printed, one line each, naming the item and the workers).
+fn on_cluster(
+    args: &Args,
+    keys: &[String],
+    cluster: &Cluster,
+    runs: &[(usize, Vec<String>, Variant)],
+) -> Result<Option<(report::Row, Vec<report::Row>)>, cluster::ClusterError> {
+    let which = |i: usize| match i {
+        0 => Which::Reference,
+        _ => Which::Combination(runs[i - 1].0),
+    };
+    let argv = |i: usize| {
+        let mut a: Vec<std::ffi::OsString> =
+            vec!["sweep".into(), args.scenario.clone().into_os_string()];
+        for s in &args.set {
+            a.extend(["--set".into(), s.into()]);
+        }
+        for r in &args.reference {
+            a.extend(["--reference".into(), r.into()]);
+        }
+        a.extend([
+            "--repeat".into(),
+            args.repeat.to_string().into(),
+            "--item".into(),
+            which(i).to_string().into(),
+        ]);
+        a
+    };
+    let stop = std::sync::atomic::AtomicBool::new(false);
+    let mut lines: Vec<Option<item::ItemLine>> = vec![None; runs.len() + 1];
+    let mut failures = Vec::new();
+    cluster::run(
+        cluster,
+        runs.len() + 1,
+        &stop,
+        argv,
+        |i, returned: Returned<item::ItemLine>| {
+            let name = match which(i) {
+                Which::Reference => "the reference".to_owned(),
+                Which::Combination(c) => {
+                    let values = keys.iter().zip(&runs[i - 1].1);
+                    let label: Vec<String> = values.map(|(k, v)| format!("{k}={v}")).collect();
+                    format!("item {c} ({})", label.join(" "))
+                }
+            };
+            match returned {
+                Returned::Line(l) if l.reference == (i == 0) => lines[i] = Some(l),
+                Returned::Line(_) => {
+                    failures.push(format!("{name}: the worker returned another item's line"));
+                }
+                Returned::Unverified { why, .. } => {
+                    failures.push(format!("{name}: --verify: {why}"))
+                }
+                Returned::Failed(why) => failures.push(format!("{name}: {why}")),
+            }
+        },
+    )?;
+    if !failures.is_empty() {
+        for f in &failures {
+            out::error(&format!("error: {}", out::escape_controls(f)));
+        }
+        out::error(&format!(
+            "error: {} of {} items failed on the cluster; nothing was written",
+            failures.len(),
+            runs.len() + 1
+        ));
+        return Ok(None);
+    }
+    let mut rows = lines.into_iter().map(|l| l.map(|l| l.row));
+    let Some(Some(reference)) = rows.next() else {
+        return Ok(None);
+    };
+    Ok(Some((reference, rows.flatten().collect())))
 }

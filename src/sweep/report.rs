@@ -5,26 +5,30 @@
 use std::fmt::Write as _;
 
 use ricochet_study::accuracy::chart::{Dash, LogLog, Series, build, draw};
+use serde::{Deserialize, Serialize};
 
 use super::error::Measures;
 use super::time::Ratio;
 
-/// One run of the sweep, measured.
-#[derive(Clone, Debug)]
+/// One run of the sweep, measured (also the `row` of `sweep --item`'s line, `item.rs`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Row {
     /// Its index among all the sweep's combinations (the same in every shard).
     pub index: usize,
     /// Each `--set` key's value for it, as written, in the order of the keys.
     pub values: Vec<String>,
     /// Its timestep.
+    #[serde(with = "super::item::ratio")]
     pub dt: Ratio,
     /// Steps after frame 0.
     pub frames: u64,
     /// Frame counts of the file that did not rescale to a whole frame (rounded).
     pub rounded: u64,
-    /// Median wall seconds per step.
+    /// Median wall seconds per step; NaN when not timed (`--repeat 0`).
+    #[serde(with = "super::item::exact")]
     pub step_seconds: f64,
     /// The final [`ricochet_sim::World::digest`].
+    #[serde(with = "super::item::hex")]
     pub digest: u64,
     /// Its error against the reference.
     pub error: Measures,
@@ -66,14 +70,21 @@ pub fn csv_text(keys: &[String], rows: &[Row]) -> String {
         for v in &r.values {
             let _ = write!(s, ",{}", field(v));
         }
+        // Not timed (`--repeat 0`): empty, so the file is the same bytes on every run.
+        let (step, wall) = if r.step_seconds.is_nan() {
+            (String::new(), String::new())
+        } else {
+            (
+                format!("{:.3}", r.step_seconds * 1e6),
+                format!("{:e}", r.wall_per_second()),
+            )
+        };
         let _ = writeln!(
             s,
-            ",{},{},{},{:.3},{:e},{:016x},{},{:e},{:e},{},{},{:e},{:e},{},{},{},{},{}",
+            ",{},{},{},{step},{wall},{:016x},{},{:e},{:e},{},{},{:e},{:e},{},{},{},{},{}",
             r.dt,
             r.frames,
             r.rounded,
-            r.step_seconds * 1e6,
-            r.wall_per_second(),
             r.digest,
             e.matched_frames,
             e.position_max,
@@ -125,6 +136,11 @@ pub fn table(keys: &[String], reference: &Row, rows: &[Row]) -> String {
     );
     let line = |s: &mut String, name: &str, r: &Row, reference: bool| {
         let e = &r.error;
+        let step = if r.step_seconds.is_nan() {
+            "-".to_owned()
+        } else {
+            format!("{:.2}", r.step_seconds * 1e6)
+        };
         let (err, touches, contacts) = if reference {
             (
                 [
@@ -150,15 +166,9 @@ pub fn table(keys: &[String], reference: &Row, rows: &[Row]) -> String {
         };
         let _ = writeln!(
             s,
-            "{name:width$}  {:>9.2}  {:>10}  {:>10}  {:>9}  {:>10}  {:>10.3e}  {touches:>11}  \
+            "{name:width$}  {step:>9}  {:>10}  {:>10}  {:>9}  {:>10}  {:>10.3e}  {touches:>11}  \
              {contacts:>11}  {:016x}",
-            r.step_seconds * 1e6,
-            err[0],
-            err[1],
-            err[2],
-            err[3],
-            e.energy_drift,
-            r.digest
+            err[0], err[1], err[2], err[3], e.energy_drift, r.digest
         );
     };
     line(
@@ -211,6 +221,16 @@ pub fn svg_text(
     let any_false = rows
         .iter()
         .any(|r| r.error.false_positives + r.error.false_negatives > 0);
+    // Without step times (`--repeat 0`) the cost axis is the steps per simulated second,
+    // which the same run gives on any machine.
+    let timed = rows.iter().all(|r| !r.step_seconds.is_nan());
+    let cost = |r: &Row| {
+        if timed {
+            r.wall_per_second()
+        } else {
+            1.0 / r.dt.seconds()
+        }
+    };
     let mut series = Vec::new();
     for (name, group) in &groups {
         let mut group = group.clone();
@@ -234,10 +254,7 @@ pub fn svg_text(
             series.push(Series {
                 legend: format!("{prefix}{what}"),
                 dash,
-                points: group
-                    .iter()
-                    .map(|r| (r.wall_per_second(), get(&r.error)))
-                    .collect(),
+                points: group.iter().map(|r| (cost(r), get(&r.error))).collect(),
                 open: Vec::new(),
             });
         }
@@ -260,7 +277,12 @@ pub fn svg_text(
             "ricochet sweep {scenario}: error against run time ({} build)",
             build()
         ),
-        x_label: "wall seconds per simulated second (log scale)".to_owned(),
+        x_label: if timed {
+            "wall seconds per simulated second (log scale)"
+        } else {
+            "steps per simulated second (log scale; not timed, --repeat 0)"
+        }
+        .to_owned(),
         y_label: "error against the reference run (log scale)".to_owned(),
         series,
         notes,
@@ -317,6 +339,7 @@ pub fn summary(rows: &[Row], keys: &[String], shard: Option<(usize, usize)>) -> 
     }
     if let Some(f) = rows
         .iter()
+        .filter(|r| !r.step_seconds.is_nan())
         .min_by(|a, b| a.wall_per_second().total_cmp(&b.wall_per_second()))
     {
         let _ = write!(

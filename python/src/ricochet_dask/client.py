@@ -1,4 +1,5 @@
-"""`python3 -m ricochet_dask`: maps `ricochet test` items over a Dask cluster.
+"""`python3 -m ricochet_dask`: maps `ricochet test` and `ricochet sweep` items over a Dask
+cluster.
 
 The protocol (stdin and stdout JSON lines) is in the package's docstring. Exit codes:
 0 every item has its line, 2 bad input, 3 `distributed` is not installed, 4 the scheduler
@@ -10,6 +11,7 @@ import base64
 import json
 import os
 import sys
+import time
 import uuid
 
 from ricochet_dask import task, verify
@@ -30,7 +32,17 @@ def parse_args(argv):
     p.add_argument("--cwd", required=True, help="folder the items' paths are relative to")
     p.add_argument("--retries", type=int, default=2, help="Dask retries of a crashed item")
     p.add_argument("--verify", action="store_true", help="re-run a sample on other workers")
-    p.add_argument("--fetch-logs", action="store_true", help="copy fresh logs back")
+    p.add_argument(
+        "--verify-timeout",
+        type=float,
+        default=600.0,
+        help="seconds a re-run may take on its worker before the item fails",
+    )
+    p.add_argument(
+        "--fetch-logs",
+        action="store_true",
+        help="copy each fresh log's bytes back into the item's --out folder",
+    )
     p.add_argument("--timeout", type=float, default=10.0, help="seconds to connect")
     return p.parse_args(argv)
 
@@ -75,6 +87,42 @@ def main(argv=None):
         return run(client, as_completed, items, args)
 
 
+# How often the loop looks for finished items; the scheduler is asked for its workers at
+# most every WORKERS_EVERY seconds, and only while a verification re-run is out.
+POLL = 0.05
+WORKERS_EVERY = 0.5
+
+
+class Rerun:
+    """A verification re-run pinned to one worker: the first run's line, where it runs
+    now, and when it was handed to that worker (time.monotonic())."""
+
+    def __init__(self, i, line, worker, started, attempt):
+        self.i = i
+        self.line = line
+        self.worker = worker
+        self.started = started
+        self.attempt = attempt
+
+
+def write_log(cwd, argv, line, log_bytes):
+    """`--fetch-logs`: the log's bytes into the item's own `--out` folder (as this machine
+    sees it), and the result's `log` pointed there."""
+    out = argv[argv.index("--out") + 1] if "--out" in argv[:-1] else None
+    log = line["result"].get("log")
+    if out is None or not log:
+        return
+    path = os.path.join(out, os.path.basename(log))
+    full = os.path.join(cwd, path)
+    os.makedirs(os.path.dirname(full) or ".", exist_ok=True)
+    # Through a temporary file renamed into place, like every file Ricochet writes.
+    tmp = f"{full}.part-{os.getpid()}"
+    with open(tmp, "wb") as f:
+        f.write(base64.b64decode(log_bytes))
+    os.replace(tmp, full)
+    line["result"]["log"] = path
+
+
 def run(client, as_completed, items, args):
     workers = client.scheduler_info()["workers"]
     if args.verify and len(workers) < 2:
@@ -86,8 +134,6 @@ def run(client, as_completed, items, args):
         return 5
     run_id = uuid.uuid4().hex[:8]
     index = {}
-    rerun_of = {}
-    firsts = {}
     for i, argv in enumerate(items):
         fut = client.submit(
             task.run_item,
@@ -102,37 +148,9 @@ def run(client, as_completed, items, args):
         index[fut] = i
     checked = set(verify.sample(len(items))) if args.verify else set()
     done = as_completed(list(index))
-    for fut in done:
-        if fut in rerun_of:
-            i = rerun_of[fut]
-            first = firsts.pop(i)
-            try:
-                again = fut.result()
-                first["verified"] = {"worker": again["worker"], "result": json.loads(again["line"])}
-            except Exception as e:  # noqa: BLE001 (any failure of the task is reported)
-                first["verified"] = {"error": f"{type(e).__name__}: {e}"}
-            emit(first)
-            continue
-        i = index[fut]
-        try:
-            r = fut.result()
-            line = {"index": i, "worker": r["worker"], "result": json.loads(r["line"])}
-        except Exception as e:  # noqa: BLE001
-            emit({"index": i, "error": f"{type(e).__name__}: {e}"})
-            continue
-        if r.get("log_bytes") and line["result"].get("log"):
-            path = os.path.join(args.cwd, line["result"]["log"])
-            os.makedirs(os.path.dirname(path) or ".", exist_ok=True)
-            with open(path, "wb") as f:
-                f.write(base64.b64decode(r["log_bytes"]))
-        if i not in checked:
-            emit(line)
-            continue
-        other = verify.other_worker(client.scheduler_info()["workers"], r["worker"])
-        if other is None:
-            line["verified"] = {"error": f"no worker other than {r['worker']} is left"}
-            emit(line)
-            continue
+    reruns = {}
+
+    def pin(i, line, worker, attempt):
         again = client.submit(
             task.run_item,
             args.exe,
@@ -140,12 +158,73 @@ def run(client, as_completed, items, args):
             items[i],
             True,
             False,
-            key=f"ricochet-verify-{run_id}-{i}",
-            workers=[other],
+            key=f"ricochet-verify-{run_id}-{i}-{attempt}",
+            workers=[worker],
             allow_other_workers=False,
             retries=args.retries,
         )
-        rerun_of[again] = i
-        firsts[i] = line
-        done.add(again)
+        reruns[again] = Rerun(i, line, worker, time.monotonic(), attempt)
+
+    asked = 0.0
+    live = list(workers)
+    while not done.is_empty() or reruns:
+        moved = False
+        for fut in done.next_batch(block=False):
+            moved = True
+            i = index[fut]
+            try:
+                r = fut.result()
+                line = {"index": i, "worker": r["worker"], "result": json.loads(r["line"])}
+            except Exception as e:  # noqa: BLE001 (any failure of the task is reported)
+                emit({"index": i, "error": f"{type(e).__name__}: {e}"})
+                continue
+            if r.get("log_bytes"):
+                write_log(args.cwd, items[i], line, r["log_bytes"])
+            if i not in checked:
+                emit(line)
+                continue
+            live = list(client.scheduler_info()["workers"])
+            other = verify.other_worker(live, r["worker"])
+            if other is None:
+                line["verified"] = {"error": f"no worker other than {r['worker']} is left"}
+                emit(line)
+                continue
+            pin(i, line, other, 0)
+        if reruns and time.monotonic() - asked >= WORKERS_EVERY:
+            asked = time.monotonic()
+            live = list(client.scheduler_info()["workers"])
+        for fut, rerun in list(reruns.items()):
+            line = rerun.line
+            if fut.done():
+                moved = True
+                del reruns[fut]
+                try:
+                    again = fut.result()
+                    line["verified"] = {
+                        "worker": again["worker"],
+                        "result": json.loads(again["line"]),
+                    }
+                except Exception as e:  # noqa: BLE001
+                    line["verified"] = {"worker": rerun.worker, "error": f"{type(e).__name__}: {e}"}
+                emit(line)
+                continue
+            action, detail = verify.rerun_state(
+                line["worker"],
+                rerun.worker,
+                live,
+                time.monotonic() - rerun.started,
+                args.verify_timeout,
+            )
+            if action == "wait":
+                continue
+            moved = True
+            del reruns[fut]
+            fut.cancel()
+            if action == "move":
+                pin(rerun.i, line, detail, rerun.attempt + 1)
+            else:
+                line["verified"] = {"worker": rerun.worker, "error": detail}
+                emit(line)
+        if not moved:
+            time.sleep(POLL)
     return 0

@@ -22,3 +22,23 @@ def other_worker(workers, first):
         return None
     later = [w for w in others if w > first]
     return later[0] if later else others[0]
+
+
+def rerun_state(first, pinned, live, waited, timeout):
+    """What to do with a re-run pinned to `pinned` that has not finished after `waited`
+    seconds on it, the first run having been on `first` and `live` the workers now:
+
+    - `("wait", None)`;
+    - `("move", WORKER)`: `pinned` left the cluster (a pinned task would wait for it
+      forever), so the re-run goes to WORKER, another live worker than `first`;
+    - `("fail", WHY)`: it took longer than `timeout` seconds, or no worker but `first` is
+      left; WHY names the worker.
+    """
+    if waited > timeout:
+        return ("fail", f"no result from {pinned} in {timeout:g} s (--verify-timeout)")
+    if pinned in live:
+        return ("wait", None)
+    other = other_worker(live, first)
+    if other is None:
+        return ("fail", f"{pinned} left the cluster and no worker other than {first} is left")
+    return ("move", other)
