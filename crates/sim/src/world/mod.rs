@@ -36,6 +36,7 @@ mod bounds;
 #[cfg(test)]
 mod checksum_fields;
 mod measures;
+mod motion;
 mod rows;
 mod sleep;
 mod state;
@@ -43,6 +44,7 @@ mod state;
 pub(crate) use state::Bodies;
 
 use bounds::LocalBounds;
+use motion::any_in_blocks;
 use rows::Rows;
 
 /// What a controller's inputs currently are.
@@ -521,121 +523,7 @@ impl World {
     /// Whether any body has a constant force (scenery has none).
     #[must_use]
     pub fn any_force(&self) -> bool {
-        // In blocks without an early exit inside, which the compiler unrolls: a scan of
-        // 10,000 zero forces every frame is most of what it costs.
-        self.rows
-            .force
-            .chunks(16)
-            .any(|c| c.iter().fold(false, |any, f| any | (*f != Vec2::ZERO)))
-    }
-
-    /// Counts down every lifetime of a body not frozen, and lists the bodies whose lifetime
-    /// ran out, in id order.
-    pub(crate) fn count_down_lifetimes(&mut self, expired: &mut Vec<Entity>) {
-        // Scenery has no lifetime, so the rows are every body that may have one: walked in
-        // row order (two narrow columns, no gather through the dense index), the few that
-        // ran out then sorted into id order.
-        let rows = &mut self.rows;
-        for ((l, &frozen), &e) in rows.lifetime.iter_mut().zip(&rows.frozen).zip(&rows.entity) {
-            if let Some(l) = l
-                && !frozen
-            {
-                *l = l.saturating_sub(1);
-                if *l == 0 {
-                    expired.push(e);
-                }
-            }
-        }
-        expired.sort_unstable();
-    }
-
-    /// The `forces` stage's `v += (force + thrust + g * (m * gravity_scale)) / m * dt` for
-    /// every active dynamic body, `thrust` giving a controlled body's engine force from its
-    /// controller, inputs and angle (zero for a body without a controller). The columns
-    /// are read by row directly: one pass, no per-column check for scenery.
-    pub(crate) fn accelerate(
-        &mut self,
-        dt: f64,
-        g: Vec2,
-        thrust: impl Fn(&Controller, &Inputs, f64) -> Vec2,
-    ) {
-        let (row, rows, kind, angle) = (&self.row, &mut self.rows, &self.kind, &self.angle);
-        for &i in &self.active {
-            let i = i as usize;
-            if kind[i] != BodyKind::Dynamic {
-                continue;
-            }
-            let r = row[i] as usize;
-            let m = rows.mass[r];
-            let push = match &rows.controller[r] {
-                Some(c) => thrust(c, &rows.inputs[r], angle[i]),
-                None => Vec2::ZERO,
-            };
-            let sum = rows.force[r] + push + g * (m * rows.gravity_scale[r]);
-            let a = sum / m;
-            rows.velocity[r] += a * dt;
-        }
-    }
-
-    /// Whether an active dynamic body's thrust input is on.
-    pub(crate) fn any_thrust_input(&self) -> bool {
-        let inputs = &self.rows.inputs;
-        self.any_active_row(|r| inputs[r].thrust, |i| self.kind[i] == BodyKind::Dynamic)
-    }
-
-    /// Whether an active body is grounded.
-    pub(crate) fn any_active_grounded(&self) -> bool {
-        let grounded = &self.rows.grounded;
-        self.any_active_row(|r| grounded[r], |_| true)
-    }
-
-    /// Whether an active body has a controller.
-    pub(crate) fn any_active_controller(&self) -> bool {
-        let controller = &self.rows.controller;
-        self.any_active_row(|r| controller[r].is_some(), |_| true)
-    }
-
-    /// Whether an active body `i` ([`World::active`]) with `also(i)` has `on(row)`. The rows
-    /// are scanned first, in order and in blocks without an early exit inside: no row with
-    /// `on` (the usual answer) means no active body with it, and costs no gather through
-    /// the active list. Only when a row has it are the active bodies asked, one by one.
-    fn any_active_row(&self, on: impl Fn(usize) -> bool, also: impl Fn(usize) -> bool) -> bool {
-        let n = self.rows.entity.len();
-        let some_row = (0..n).step_by(16).any(|from| {
-            let to = (from + 16).min(n);
-            (from..to).fold(false, |any, r| any | on(r))
-        });
-        some_row
-            && self.active.iter().any(|&i| {
-                let i = i as usize;
-                also(i) && on(self.row[i] as usize)
-            })
-    }
-
-    /// `x += vx * dt`, `y += vy * dt` and `angle += angular_velocity * dt` for every active
-    /// body, each where its flag says: the `move_x`, `move_y` and `turn` stages in one pass,
-    /// for a scene with no per-axis pass between them (so no body has a carrier). Each
-    /// body's arithmetic is the stages' own, and no body's depends on another's, so the
-    /// result is the same bits as three passes.
-    pub(crate) fn integrate(&mut self, dt: f64, x: bool, y: bool, turn: bool) {
-        let (row, rows) = (&self.row, &self.rows);
-        let (position, angle) = (&mut self.position, &mut self.angle);
-        for &i in &self.active {
-            let i = i as usize;
-            // Moving bodies always have a row.
-            let r = row[i] as usize;
-            let v = rows.velocity[r];
-            let p = &mut position[i];
-            if x {
-                p.x += v.x * dt;
-            }
-            if y {
-                p.y += v.y * dt;
-            }
-            if turn {
-                angle[i] += rows.angular_velocity[r] * dt;
-            }
-        }
+        any_in_blocks(&self.rows.force, |f| *f != Vec2::ZERO)
     }
 
     /// Whether any body has a lifetime.
