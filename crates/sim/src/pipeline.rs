@@ -24,7 +24,11 @@
 //! | `touch` | the pairs touching at the end of the frame; `touch_begin` / `touch_end` events for the pairs that started or stopped (`docs/touches.md`) |
 //!
 //! The motion stages visit only the *active* bodies ([`World::active`]): moving, not frozen,
-//! not asleep. Static bodies are never visited after they are indexed.
+//! not asleep. Static bodies are never visited after they are indexed. In a scene without
+//! per-axis layer pairs (`resolve_x` and `resolve_y` never have work), `move_x`, `move_y`
+//! and `turn` are one pass over the active bodies (`Simulation::run_motion`): each body's
+//! arithmetic is the same, so the result is the same bits, and each stage is still counted
+//! as run or skipped on its own.
 //!
 //! Riders (`stages/carry.rs`): a dynamic box that a kinematic box (or a box riding one)
 //! held up in the last `resolve_y` is carried by that kinematic body's `v * dt` in `move_x`
@@ -56,6 +60,15 @@ const FRAME_ZERO: [Stage; 5] = [
     Stage::Detect,
     Stage::Lifetimes,
     Stage::Touch,
+];
+
+/// The stages [`Simulation::run_motion`] runs in one pass, in their order.
+const MOTION: [Stage; 5] = [
+    Stage::MoveX,
+    Stage::ResolveX,
+    Stage::MoveY,
+    Stage::ResolveY,
+    Stage::Turn,
 ];
 
 /// A running simulation.
@@ -325,6 +338,29 @@ impl Simulation {
         }
     }
 
+    /// `move_x`, `resolve_x`, `move_y`, `resolve_y` and `turn` of a scene without per-axis
+    /// layer pairs, where neither `resolve` stage has work and no body has a carrier: the
+    /// three motion stages in one pass over the active bodies ([`World::integrate`]), each
+    /// part run, and counted as run or skipped, exactly when its own stage would be.
+    /// Moving changes no velocity and no body's activity, so each stage's `has_work` gives
+    /// the same answer here as in its turn.
+    fn run_motion(&mut self, out: &mut FrameOutput) {
+        let mut run = [false; MOTION.len()];
+        for (r, &stage) in run.iter_mut().zip(&MOTION) {
+            *r = self.has_work(stage, out);
+            if *r {
+                out.stats.stages_run.insert(stage);
+            } else {
+                out.stats.stages_skipped.insert(stage);
+            }
+        }
+        let [x, resolve_x, y, resolve_y, turn] = run;
+        debug_assert!(!resolve_x && !resolve_y, "no per-axis pairs, no resolve");
+        if x || y || turn {
+            self.world.integrate(self.scenario.world.dt, x, y, turn);
+        }
+    }
+
     /// Runs one frame and reports what happened.
     pub fn step(&mut self) -> FrameOutput {
         self.queries.invalidate(&self.world);
@@ -336,8 +372,18 @@ impl Simulation {
         // move, so only the moving ones need it.
         let w = &mut self.world;
         w.start_frame();
+        let mut fused = false;
         for stage in Stage::ALL {
             let allowed = self.frame > 0 || FRAME_ZERO.contains(&stage);
+            if fused && MOTION.contains(&stage) {
+                // Run (or skipped) with `move_x`.
+                continue;
+            }
+            if allowed && stage == Stage::MoveX && !self.separate.carries() {
+                fused = true;
+                self.run_motion(&mut out);
+                continue;
+            }
             if allowed && self.has_work(stage, &out) {
                 self.run(stage, &mut out);
                 out.stats.stages_run.insert(stage);

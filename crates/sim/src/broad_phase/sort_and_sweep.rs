@@ -26,8 +26,6 @@ pub(super) struct SweepList {
     /// The keys of the layer's bodies at the last update, in key order (`local` indexes it,
     /// as it does the layer's handles).
     keys: Vec<u64>,
-    /// `order[pos[local]].local == local`, so an update reads the caller's bodies in order.
-    pos: Vec<u32>,
     /// The widest body's `max.x - min.x` (at least 0; NaN ignored).
     width: f64,
 }
@@ -93,27 +91,28 @@ impl SweepList {
         bodies: &[BodyEntry],
         scratch: &mut Scratch,
     ) -> u64 {
-        // The usual case: the same bodies as last time. One pass in the caller's order.
-        if self.keys.len() == handles.len() {
+        // The usual case: the same bodies as last time. The keys compared in the caller's
+        // order, then the slots rewritten in list order (written in sequence, the bodies read
+        // at random: reads overlap where scattered writes queue), and sorted with nothing
+        // else to keep up to date.
+        let same = self.keys.len() == handles.len()
+            && handles
+                .iter()
+                .zip(&self.keys)
+                .all(|(&h, &k)| bodies[h as usize].key == k);
+        if same {
             let mut width: f64 = 0.0;
-            let mut same = true;
-            for (local, &h) in handles.iter().enumerate() {
-                let b = &bodies[h as usize];
-                if b.key != self.keys[local] {
-                    same = false;
-                    break;
-                }
-                self.order[self.pos[local] as usize] = Slot::new(&b.bounds, local as u32);
+            for s in &mut self.order {
+                let b = &bodies[handles[s.local as usize] as usize].bounds;
+                *s = Slot::new(b, s.local);
                 // A branch, not `f64::max`: rarely taken, and no dependency chain.
-                let w = b.bounds.max.x - b.bounds.min.x;
+                let w = b.max.x - b.min.x;
                 if w > width {
                     width = w;
                 }
             }
-            if same {
-                self.width = width;
-                return insertion_sort(&mut self.order, &mut self.pos);
-            }
+            self.width = width;
+            return sorted::insertion_sort(&mut self.order, sweep_order, |_, _| {});
         }
         // Merge the old keys with the new ones (both ascending).
         let (remap, fresh) = (&mut scratch.remap, &mut scratch.fresh);
@@ -143,8 +142,7 @@ impl SweepList {
             }
             j != NONE
         });
-        self.pos.resize(handles.len(), 0);
-        let moved = insertion_sort(&mut self.order, &mut self.pos);
+        let moved = sorted::insertion_sort(&mut self.order, sweep_order, |_, _| {});
         if !fresh.is_empty() {
             fresh.sort_unstable_by(sweep_order);
             let merged = &mut scratch.merged;
@@ -164,9 +162,6 @@ impl SweepList {
             merged.extend_from_slice(&fresh[j..]);
             std::mem::swap(&mut self.order, merged);
         }
-        for (p, s) in self.order.iter().enumerate() {
-            self.pos[s.local as usize] = p as u32;
-        }
         self.width = 0.0;
         for &h in handles {
             let b = &bodies[h as usize].bounds;
@@ -174,11 +169,6 @@ impl SweepList {
         }
         moved
     }
-}
-
-/// Insertion sort for a nearly sorted list, keeping `pos` up to date.
-fn insertion_sort(order: &mut [Slot], pos: &mut [u32]) -> u64 {
-    sorted::insertion_sort(order, sweep_order, |s, p| pos[s.local as usize] = p as u32)
 }
 
 /// Tests `p` (whose `max.x` key is `max`) against the bodies of `others` (sorted) ahead of

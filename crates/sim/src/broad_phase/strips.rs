@@ -166,29 +166,38 @@ impl StripList {
                 .iter()
                 .zip(&self.keys)
                 .all(|(&h, &k)| bodies[h as usize].key == k);
+        // The widest body (NaN ignored): a maximum, so any order gives it.
+        let widest = |w: f64, b: &Bounds| {
+            let x = b.max.x - b.min.x;
+            if x > w { x } else { w }
+        };
         if same {
-            // In list order: the slots are written in sequence, the bodies read at random.
-            for s in &mut self.order {
-                let h = handles[s.local as usize];
-                let slot = Slot::new(member(&bodies[h as usize], h), s.local, inv_h);
-                if slot.strip == s.strip && !restripped {
-                    *s = slot;
+            // In list order: the slots are written in sequence, the bodies read at random,
+            // and the width taken from the bounds already read.
+            // A body that changed strip leaves the list for `fresh`: the rest close up
+            // behind a write cursor in the same pass.
+            let (mut width, mut kept) = (0.0, 0);
+            for k in 0..self.order.len() {
+                let local = self.order[k].local;
+                let h = handles[local as usize];
+                let slot = Slot::new(member(&bodies[h as usize], h), local, inv_h);
+                width = widest(width, &slot.m.bounds);
+                if slot.strip == self.order[k].strip && !restripped {
+                    self.order[kept] = slot;
+                    kept += 1;
                 } else {
-                    s.local = NONE;
                     self.fresh.push(slot);
                 }
             }
+            self.order.truncate(kept);
+            self.width = width;
         } else {
             self.reconcile(handles, bodies, inv_h, restripped);
+            self.width = handles
+                .iter()
+                .fold(0.0, |w, &h| widest(w, &bodies[h as usize].bounds));
         }
         let reordered = !same || !self.fresh.is_empty();
-        self.width = handles
-            .iter()
-            .map(|&h| {
-                let b = &bodies[h as usize].bounds;
-                b.max.x - b.min.x
-            })
-            .fold(0.0, |w, x| if x > w { x } else { w });
         let moved = if reordered {
             self.settle()
         } else {
@@ -235,12 +244,12 @@ impl StripList {
                 self.fresh.push(slot);
             }
         }
+        self.order.retain(|s| s.local != NONE);
     }
 
-    /// Sorts `order` again: drops the slots marked `NONE`, insertion-sorts the rest (nearly
+    /// Sorts `order` again (no slot is marked `NONE` any more): insertion-sorts it (nearly
     /// sorted) and merges in `fresh` (sorted first). Returns the insertion sort's moves.
     fn settle(&mut self) -> u64 {
-        self.order.retain(|s| s.local != NONE);
         let moved = insertion_sort(&mut self.order);
         self.fresh.sort_unstable_by(strip_order);
         self.merged.clear();

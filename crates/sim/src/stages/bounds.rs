@@ -23,6 +23,11 @@ pub(crate) fn run(ctx: &mut StageCtx) {
     for k in 0..w.active().len() {
         let i = w.active()[k] as usize;
         let p = &mut w.position[i];
+        // Most bodies are inside: four comparisons (a NaN coordinate, never outside, takes
+        // the slow path and is left where it is).
+        if p.x >= b.min.x && p.x < b.max.x && p.y >= b.min.y && p.y < b.max.y {
+            continue;
+        }
         for axis in 0..2 {
             if p[axis] < b.min[axis] || p[axis] >= b.max[axis] {
                 if b.wrap {

@@ -5,11 +5,11 @@ use ricochet_geom::Vec2;
 
 use crate::def::{BodyKind, Controller, WorldDef};
 use crate::stages::carry;
-use crate::world::World;
+use crate::world::{Inputs, World};
 
 /// Whether an active body is grounded.
 pub(crate) fn has_grounded(w: &World) -> bool {
-    w.active().iter().any(|&i| w.grounded(i as usize))
+    w.any_active_grounded()
 }
 
 /// Every body starts the frame's motion airborne; `resolve_y` (a push upwards) or `detect`
@@ -26,10 +26,7 @@ pub(crate) fn unground(w: &mut World) {
 
 /// Whether an active body has a controller.
 pub(crate) fn has_controls(w: &World) -> bool {
-    w.any_controller()
-        && w.active()
-            .iter()
-            .any(|&i| w.controller(i as usize).is_some())
+    w.any_controller() && w.any_active_controller()
 }
 
 /// Inputs become velocities: a ship's turn input sets its angular velocity, a runner's or
@@ -54,10 +51,10 @@ pub(crate) fn controls(w: &mut World) {
 }
 
 /// The ship's engine force along its heading, when the engine is on.
-fn thrust(w: &World, i: usize) -> Vec2 {
-    match w.controller(i) {
-        Some(Controller::Ship { thrust, .. }) if w.inputs(i).thrust => {
-            let (s, c) = libm::sincos(w.angle[i]);
+fn thrust(controller: &Controller, inputs: &Inputs, angle: f64) -> Vec2 {
+    match controller {
+        Controller::Ship { thrust, .. } if inputs.thrust => {
+            let (s, c) = libm::sincos(angle);
             Vec2::new(c, s) * *thrust
         }
         _ => Vec2::ZERO,
@@ -75,10 +72,7 @@ pub(crate) fn has_forces(w: &World, def: &WorldDef) -> bool {
             let i = i as usize;
             dynamic(i) && w.gravity_scale(i) != 0.0
         }))
-        || (w.any_controller()
-            && w.active()
-                .iter()
-                .any(|&i| w.inputs(i as usize).thrust && dynamic(i as usize)))
+        || (w.any_controller() && w.any_thrust_input())
         // One contiguous column beats a gather through the active list; a static body's
         // force only makes the stage run for nothing.
         || w.any_force()
@@ -86,17 +80,7 @@ pub(crate) fn has_forces(w: &World, def: &WorldDef) -> bool {
 
 /// `a = sum(f) / m` with gravity as the force `m * g * gravity_scale`; `v += a * dt`.
 pub(crate) fn forces(w: &mut World, def: &WorldDef) {
-    let (dt, g) = (def.dt, def.gravity);
-    for k in 0..w.active().len() {
-        let i = w.active()[k] as usize;
-        if w.kind[i] != BodyKind::Dynamic {
-            continue;
-        }
-        let m = w.mass(i);
-        let sum = w.force(i) + thrust(w, i) + g * (m * w.gravity_scale(i));
-        let a = sum / m;
-        *w.velocity_mut(i) += a * dt;
-    }
+    w.accelerate(def.dt, def.gravity, thrust);
 }
 
 /// Whether an active body has a velocity.

@@ -36,6 +36,7 @@ mod bounds;
 #[cfg(test)]
 mod checksum_fields;
 mod measures;
+mod motion;
 mod rows;
 mod sleep;
 mod state;
@@ -43,6 +44,7 @@ mod state;
 pub(crate) use state::Bodies;
 
 use bounds::LocalBounds;
+use motion::any_in_blocks;
 use rows::Rows;
 
 /// What a controller's inputs currently are.
@@ -521,24 +523,7 @@ impl World {
     /// Whether any body has a constant force (scenery has none).
     #[must_use]
     pub fn any_force(&self) -> bool {
-        self.rows.force.iter().any(|f| *f != Vec2::ZERO)
-    }
-
-    /// Counts down every lifetime of a body not frozen, and lists the bodies whose lifetime
-    /// ran out, in id order.
-    pub(crate) fn count_down_lifetimes(&mut self, expired: &mut Vec<Entity>) {
-        for i in 0..self.len() {
-            let r = self.row[i];
-            if r == NO_ROW || self.rows.frozen[r as usize] {
-                continue;
-            }
-            if let Some(l) = &mut self.rows.lifetime[r as usize] {
-                *l = l.saturating_sub(1);
-                if *l == 0 {
-                    expired.push(self.entity[i]);
-                }
-            }
-        }
+        any_in_blocks(&self.rows.force, |f| *f != Vec2::ZERO)
     }
 
     /// Whether any body has a lifetime.

@@ -1,0 +1,123 @@
+//! The motion stages' passes over the columns, by row where the stage allows it: forces,
+//! the fused move and turn, lifetimes, and the `has_work` scans whose usual answer is no
+//! (asked of a row column in blocks first, see [`any_in_blocks`]).
+
+use ricochet_geom::Vec2;
+
+use super::{Inputs, World};
+use crate::def::{BodyKind, Controller};
+use crate::entity::Entity;
+
+impl World {
+    /// Counts down every lifetime of a body not frozen, and lists the bodies whose lifetime
+    /// ran out, in id order.
+    pub(crate) fn count_down_lifetimes(&mut self, expired: &mut Vec<Entity>) {
+        // Scenery has no lifetime, so the rows are every body that may have one: walked in
+        // row order (two narrow columns, no gather through the dense index), the few that
+        // ran out then sorted into id order.
+        let rows = &mut self.rows;
+        for ((l, &frozen), &e) in rows.lifetime.iter_mut().zip(&rows.frozen).zip(&rows.entity) {
+            if let Some(l) = l
+                && !frozen
+            {
+                *l = l.saturating_sub(1);
+                if *l == 0 {
+                    expired.push(e);
+                }
+            }
+        }
+        expired.sort_unstable();
+    }
+
+    /// The `forces` stage's `v += (force + thrust + g * (m * gravity_scale)) / m * dt` for
+    /// every active dynamic body, `thrust` giving a controlled body's engine force from its
+    /// controller, inputs and angle (zero for a body without a controller). The columns
+    /// are read by row directly: one pass, no per-column check for scenery.
+    pub(crate) fn accelerate(
+        &mut self,
+        dt: f64,
+        g: Vec2,
+        thrust: impl Fn(&Controller, &Inputs, f64) -> Vec2,
+    ) {
+        let (row, rows, kind, angle) = (&self.row, &mut self.rows, &self.kind, &self.angle);
+        for &i in &self.active {
+            let i = i as usize;
+            if kind[i] != BodyKind::Dynamic {
+                continue;
+            }
+            let r = row[i] as usize;
+            let m = rows.mass[r];
+            let push = match &rows.controller[r] {
+                Some(c) => thrust(c, &rows.inputs[r], angle[i]),
+                None => Vec2::ZERO,
+            };
+            let sum = rows.force[r] + push + g * (m * rows.gravity_scale[r]);
+            let a = sum / m;
+            rows.velocity[r] += a * dt;
+        }
+    }
+
+    /// Whether an active dynamic body's thrust input is on.
+    pub(crate) fn any_thrust_input(&self) -> bool {
+        let inputs = &self.rows.inputs;
+        any_in_blocks(inputs, |x| x.thrust)
+            && self.any_active(|i, r| self.kind[i] == BodyKind::Dynamic && inputs[r].thrust)
+    }
+
+    /// Whether an active body is grounded.
+    pub(crate) fn any_active_grounded(&self) -> bool {
+        let grounded = &self.rows.grounded;
+        any_in_blocks(grounded, |&g| g) && self.any_active(|_, r| grounded[r])
+    }
+
+    /// Whether an active body has a controller.
+    pub(crate) fn any_active_controller(&self) -> bool {
+        let controller = &self.rows.controller;
+        any_in_blocks(controller, Option::is_some)
+            && self.any_active(|_, r| controller[r].is_some())
+    }
+
+    /// Whether an active body `i` ([`World::active`]), of row `r`, has `on(i, r)`. The
+    /// callers ask the row column first ([`any_in_blocks`]): no row with it (the usual
+    /// answer) means no active body with it, and costs no gather through the active list.
+    fn any_active(&self, on: impl Fn(usize, usize) -> bool) -> bool {
+        self.active.iter().any(|&i| {
+            let i = i as usize;
+            on(i, self.row[i] as usize)
+        })
+    }
+
+    /// `x += vx * dt`, `y += vy * dt` and `angle += angular_velocity * dt` for every active
+    /// body, each where its flag says: the `move_x`, `move_y` and `turn` stages in one pass,
+    /// for a scene with no per-axis pass between them (so no body has a carrier). Each
+    /// body's arithmetic is the stages' own, and no body's depends on another's, so the
+    /// result is the same bits as three passes.
+    pub(crate) fn integrate(&mut self, dt: f64, x: bool, y: bool, turn: bool) {
+        let (row, rows) = (&self.row, &self.rows);
+        let (position, angle) = (&mut self.position, &mut self.angle);
+        for &i in &self.active {
+            let i = i as usize;
+            // Moving bodies always have a row.
+            let r = row[i] as usize;
+            let v = rows.velocity[r];
+            let p = &mut position[i];
+            if x {
+                p.x += v.x * dt;
+            }
+            if y {
+                p.y += v.y * dt;
+            }
+            if turn {
+                angle[i] += rows.angular_velocity[r] * dt;
+            }
+        }
+    }
+}
+
+/// Whether `on` holds for an item of `column`: in blocks without an early exit inside, which
+/// the compiler unrolls (the usual answer is no, after every item).
+pub(super) fn any_in_blocks<T>(column: &[T], on: impl Fn(&T) -> bool) -> bool {
+    column
+        .chunks(32)
+        .any(|c| c.iter().fold(false, |any, x| any | on(x)))
+}
