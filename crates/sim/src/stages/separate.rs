@@ -27,7 +27,7 @@
 
 use ricochet_geom::{Bounds, Primitive, Shape, Vec2, contact};
 
-use crate::broad_phase::{FixedGrid, MoverGrid};
+use crate::broad_phase::{MoverGrid, StaticBox, TileMap};
 use crate::def::{BodyKind, Controller, LayerId, Layers, Response};
 use crate::entity::Entity;
 use crate::event::GameEvent;
@@ -70,8 +70,8 @@ pub(crate) struct SeparateState {
     /// The static generation `statics` was built at.
     static_generation: Option<u64>,
     /// Static boxes of separating layers, each with its rank among all the static bodies
-    /// (its dense index follows, [`static_index`]) and its layer.
-    statics: FixedGrid,
+    /// (its dense index follows, [`static_index`]) and its layer: a tile map.
+    statics: TileMap,
     movers: MoverGrid,
     found: Vec<Obstacle>,
     /// The pass's dynamic boxes, `(lowest coordinate along the axis, dense index)`.
@@ -119,19 +119,23 @@ impl SeparateState {
             return;
         }
         self.static_generation = Some(w.static_generation());
-        self.statics = FixedGrid::default();
-        let mut boxes = Vec::new();
-        let mut rank = 0;
-        for i in 0..w.len() {
-            if w.kind[i] != BodyKind::Static {
-                continue;
-            }
-            if is_box(w.shape(i)) && self.separating[usize::from(w.layer[i])] {
-                boxes.push((box_bounds(w, i), rank, w.layer[i]));
-            }
-            rank += 1;
-        }
-        self.statics = FixedGrid::new(&boxes);
+        self.statics = TileMap::default();
+        let separating = &self.separating;
+        // Each static box of a separating layer, with its rank among the static bodies (the
+        // tile map reads them a few times instead of copying a million of them).
+        let boxes = || {
+            (0..w.len())
+                .filter(|&i| w.kind[i] == BodyKind::Static)
+                .enumerate()
+                .filter(|&(_, i)| is_box(w.shape(i)) && separating[usize::from(w.layer[i])])
+                .map(|(rank, i)| StaticBox {
+                    bounds: box_bounds(w, i),
+                    centre: on_origin(w, i).map(|half| (w.position[i], half)),
+                    handle: rank as u32,
+                    tag: w.layer[i],
+                })
+        };
+        self.statics = TileMap::new(boxes);
     }
 }
 
@@ -144,6 +148,15 @@ fn box_bounds(w: &World, i: usize) -> Bounds {
             Bounds::around(w.position[i], b.half_extents)
         }
         s => s.bounds(&w.pose(i)),
+    }
+}
+
+/// The half extents of box `i` when it sits on its body's origin: then its bounds are
+/// `Bounds::around(position, half)` ([`box_bounds`]).
+fn on_origin(w: &World, i: usize) -> Option<Vec2> {
+    match w.shape(i) {
+        Shape::Primitive(Primitive::Aabb(b)) if b.center == Vec2::ZERO => Some(b.half_extents),
+        _ => None,
     }
 }
 
@@ -423,7 +436,7 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
 /// (flush on it, still overlapping `bj`: a push from another dynamic body never moves a box
 /// into a static one, as along the normal, `push.rs`).
 fn statics_win(
-    statics: &FixedGrid,
+    statics: &TileMap,
     (w, layers): (&World, &Layers),
     (i, bi, bj): (usize, &Bounds, &Bounds),
     axis: usize,
@@ -449,7 +462,7 @@ fn statics_win(
 /// by more than [`SLOP`] (a static box it overlaps now is not in its way: the pass pushes it
 /// out of that one at its turn).
 fn clear_way(
-    statics: &FixedGrid,
+    statics: &TileMap,
     (w, layers): (&World, &Layers),
     (i, bi): (usize, &Bounds),
     axis: usize,
