@@ -80,6 +80,10 @@ pub(crate) struct SeparateState {
     extents: Vec<f64>,
     /// Sleeping boxes pushed against, woken after the pass.
     woken: Vec<usize>,
+    /// The pass's contacts' `(a, b)` and places, to sort them.
+    keys: Vec<(Entity, Entity, u32)>,
+    /// The pass's contacts, while they are put in order.
+    records: Vec<ContactRecord>,
 }
 
 /// A box that may stop the one being settled: its dense index, bounds and layer (static
@@ -220,6 +224,9 @@ fn obstacles(st: &mut SeparateState, w: &World, q: &Bounds, from: u32, found: &m
             });
         }
     });
+    if st.movers.is_empty() {
+        return finish(found);
+    }
     st.movers.query(q, |i| {
         if i >= from {
             found.push(Obstacle {
@@ -230,8 +237,28 @@ fn obstacles(st: &mut SeparateState, w: &World, q: &Bounds, from: u32, found: &m
             });
         }
     });
+    finish(found);
+}
+
+/// Sorts the obstacles found by index and drops repeats.
+fn finish(found: &mut Vec<Obstacle>) {
     found.sort_unstable_by_key(|o| o.index);
     found.dedup_by_key(|o| o.index);
+}
+
+/// By layer, whether a box of it may stop one of the pass's settling boxes (`order`): some
+/// settling box's layer `separate`s from it.
+fn solid_layers(w: &World, layers: &Layers, order: &[(f64, u32)]) -> Vec<bool> {
+    let n = layers.names().len();
+    let mut settling = vec![false; n];
+    for &(_, i) in order {
+        settling[usize::from(w.layer[i as usize])] = true;
+    }
+    (0..n)
+        .map(|m| {
+            (0..n).any(|l| settling[l] && layers.response(l as u8, m as u8) == Response::Separate)
+        })
+        .collect()
 }
 
 /// One per-axis pass: settles every dynamic box along `axis`, lowest first.
@@ -259,7 +286,13 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
             extents.push((b.max - b.min).max_element());
         }
     }
-    order.sort_by(|p, q| p.0.total_cmp(&q.0).then(p.1.cmp(&q.1)));
+    // Unstable is the same order: no two keys are equal (the index breaks ties).
+    order.sort_unstable_by(|p, q| p.0.total_cmp(&q.0).then(p.1.cmp(&q.1)));
+    // The layers a moving box may be solid to: those some settling box `separate`s from. A
+    // box of any other layer is never an obstacle, so it stays out of the mover grid (the
+    // platformer's actors only `report` to each other: the grid stays empty and is never
+    // looked at).
+    let solid = solid_layers(w, layers, &order);
     // Kinematic boxes and sleeping ones are solid from the start; dynamic ones once settled.
     st.movers.reset(&mut extents, order.len());
     for &i in w.movers() {
@@ -267,6 +300,7 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
         if is_box(w.shape(k))
             && !w.frozen(k)
             && st.separating[usize::from(w.layer[k])]
+            && solid[usize::from(w.layer[k])]
             && (w.kind[k] == BodyKind::Kinematic || w.asleep(k))
         {
             st.movers.insert(&box_bounds(w, k), i);
@@ -417,7 +451,9 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
         if let Some(event) = rider(ctx.world, layers, st, &mut found, (i, axis), riding) {
             out.events.push(event);
         }
-        st.movers.insert(&box_bounds(ctx.world, i), i as u32);
+        if solid[usize::from(ctx.world.layer[i])] {
+            st.movers.insert(&box_bounds(ctx.world, i), i as u32);
+        }
     }
     for j in woken.drain(..) {
         ctx.world.wake(j);
@@ -427,7 +463,32 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
     st.extents = extents;
     st.woken = woken;
     // The log's convention: a pass's contacts sorted by (a, b).
-    out.contacts[first..].sort_by_key(|c| (c.a, c.b));
+    sort_contacts(&mut out.contacts, first, &mut st.keys, &mut st.records);
+}
+
+/// Sorts `contacts[first..]` by `(a, b)`, stably: as keys with their places (an unstable
+/// sort of unique keys), then each record moved once (a record is about 130 bytes; a sort
+/// of the records moves each `log n` times).
+fn sort_contacts(
+    contacts: &mut Vec<ContactRecord>,
+    first: usize,
+    keys: &mut Vec<(Entity, Entity, u32)>,
+    records: &mut Vec<ContactRecord>,
+) {
+    keys.clear();
+    keys.extend(
+        contacts[first..]
+            .iter()
+            .zip(0..)
+            .map(|(c, k)| (c.a, c.b, k)),
+    );
+    if keys.is_sorted() {
+        return;
+    }
+    keys.sort_unstable();
+    records.clear();
+    records.extend(contacts.drain(first..));
+    contacts.extend(keys.iter().map(|k| records[k.2 as usize].clone()));
 }
 
 /// Statics win: the push `by` along `axis` that moves box `i` (bounds `bi`) out of the
