@@ -40,7 +40,7 @@ mod rows;
 mod sleep;
 mod state;
 
-pub(crate) use state::Bodies;
+pub(crate) use state::{Bodies, PackedWorld};
 
 use bounds::LocalBounds;
 use rows::Rows;
