@@ -6,7 +6,8 @@
 //! [`World::spawn_tiles`] places them). A run of at least [`MIN_RUN`] such bodies is kept as
 //! its first id, its length and start, and its kind (what its bodies share, once per
 //! distinct kind): 32 bytes a run instead of 46 a body. Every other body keeps its
-//! every-body columns; the rows and tables are kept whole. [`PackedWorld::unpack`] gives the
+//! every-body columns; the rows and tables are kept whole, the allocator's generations
+//! run-length coded. [`PackedWorld::unpack`] gives the
 //! world back, every column bit for bit (checked by the round trip of every body when
 //! packing: a body the run's formula does not give back exactly is loose).
 
@@ -14,7 +15,7 @@ use ricochet_geom::Vec2;
 
 use super::super::{NO_ROW, World};
 use crate::def::{BodyKind, LayerId};
-use crate::entity::Entity;
+use crate::entity::{Entity, EntityAllocator};
 
 /// Scenery in a shorter run stays loose (a run costs 32 bytes, a loose body 46).
 const MIN_RUN: usize = 2;
@@ -28,6 +29,9 @@ pub(crate) struct PackedWorld {
     runs: Vec<Run>,
     /// What the bodies of a run share, each distinct one once.
     kinds: Vec<RunKind>,
+    /// The allocator's generations, run-length coded: `(generation, slots)` (a world as
+    /// built has every slot at generation 0). Its free slots are every slot not alive.
+    generations: Vec<(u32, u32)>,
 }
 
 /// Scenery bodies with consecutive ids `index..index + count`, the `k`-th at
@@ -137,7 +141,20 @@ impl World {
         }
         loose.shrink_body_columns();
         runs.shrink_to_fit();
-        PackedWorld { loose, runs, kinds }
+        loose.ids = EntityAllocator::default();
+        let mut generations: Vec<(u32, u32)> = Vec::new();
+        for &g in self.ids.generations() {
+            match generations.last_mut() {
+                Some((last, n)) if *last == g => *n += 1,
+                _ => generations.push((g, 1)),
+            }
+        }
+        PackedWorld {
+            loose,
+            runs,
+            kinds,
+            generations,
+        }
     }
 
     /// A copy of every column but the every-body ones, which are empty.
@@ -254,6 +271,12 @@ impl PackedWorld {
             w.push_body_columns(l, loose);
             loose += 1;
         }
+        let generations = self
+            .generations
+            .iter()
+            .flat_map(|&(g, n)| std::iter::repeat_n(g, n as usize))
+            .collect();
+        w.ids = EntityAllocator::from_parts(generations, w.entity.iter().map(|e| e.index));
         w
     }
 
@@ -263,6 +286,7 @@ impl PackedWorld {
         self.loose.heap_bytes()
             + self.runs.capacity() * size_of::<Run>()
             + self.kinds.capacity() * size_of::<RunKind>()
+            + self.generations.capacity() * 8
     }
 }
 
@@ -345,9 +369,14 @@ mod tests {
 
     #[test]
     fn a_packed_world_unpacks_to_every_column_bit_for_bit() {
-        let w = level();
+        let mut w = level();
         let packed = w.packed();
-        assert_same(&packed.unpack(), &w);
+        let mut unpacked = packed.unpack();
+        assert_same(&unpacked, &w);
+        // The same free slots: the next ids are the same.
+        for _ in 0..3 {
+            assert_eq!(unpacked.ids.allocate(), w.ids.allocate());
+        }
         // The rows are runs: a few loose bodies, not 80.
         assert!(packed.loose.len() < 10, "{} loose", packed.loose.len());
         assert_same(&World::new().packed().unpack(), &World::new());
