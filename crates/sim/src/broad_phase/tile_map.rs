@@ -141,7 +141,12 @@ impl TileMap {
     /// Calls `f` once with the handle, bounds and tag of every box overlapping `q` (touching
     /// counts), tiles last. Returns the box tests made.
     pub(crate) fn query(&self, q: &Bounds, mut f: impl FnMut(u32, &Bounds, u8)) -> u64 {
-        let mut tested = self.rest.query(q, &mut f);
+        // A tile map alone leaves the grid empty: not even its cell arithmetic then.
+        let mut tested = if self.rest.is_empty() {
+            0
+        } else {
+            self.rest.query(q, &mut f)
+        };
         let l = &self.lattice;
         if l.cells.is_empty() || !(q.min.x <= q.max.x && q.min.y <= q.max.y) {
             return tested;
