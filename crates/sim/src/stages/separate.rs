@@ -18,9 +18,9 @@
 //! The first lookup covers the box's start and end along the axis.
 
 //!
-//! Finding the obstacles: static boxes sit in a grid built once (rebuilt only when the static
-//! bodies change); kinematic boxes, and dynamic boxes once settled, go into a small grid
-//! rebuilt every pass. Each dynamic box looks up both and meets its obstacles in id order at
+//! Finding the obstacles: static boxes sit in a tile map built once (rebuilt only when the
+//! static bodies change: `broad_phase/tile_map.rs`); kinematic boxes, and dynamic boxes once
+//! settled, go into a small grid rebuilt every pass, if a settling box may stop on them. Each dynamic box looks up both and meets its obstacles in id order at
 //! its current position; after a push it looks again from the obstacle after the one it was
 //! pushed out of. That is exactly the order of a loop over every body, at the cost of the
 //! few it is near.
