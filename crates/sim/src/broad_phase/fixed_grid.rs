@@ -111,6 +111,11 @@ impl FixedGrid {
         g
     }
 
+    /// Whether it holds no box.
+    pub(crate) fn is_empty(&self) -> bool {
+        self.big.is_empty() && self.corner.entries.is_empty() && self.spread.entries.is_empty()
+    }
+
     /// Calls `f` once with the handle, bounds and tag of every box overlapping `q` (touching
     /// counts). Returns the box tests made.
     pub(crate) fn query(&self, q: &Bounds, mut f: impl FnMut(u32, &Bounds, u8)) -> u64 {

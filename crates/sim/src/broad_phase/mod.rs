@@ -85,6 +85,7 @@ mod static_set;
 pub(crate) mod static_tree;
 mod strips;
 mod tally;
+mod tile_map;
 
 use ricochet_geom::Bounds;
 
@@ -98,6 +99,7 @@ use sort_and_sweep::{Slot, SweepList};
 use static_set::StaticSet;
 use strips::StripList;
 use tally::Tally;
+pub(crate) use tile_map::{StaticBox, TileMap};
 
 pub use crate::def::BroadPhaseKind;
 

@@ -36,6 +36,11 @@ impl MoverGrid {
         self.cells = Cells::hashed(extents, self.buckets.len());
     }
 
+    /// Whether no box was entered since the last reset.
+    pub(crate) fn is_empty(&self) -> bool {
+        self.used.is_empty() && self.big.is_empty()
+    }
+
     /// Enters box `b` as `handle`.
     pub(crate) fn insert(&mut self, b: &Bounds, handle: u32) {
         let Some(r) = self.cells.placed(b) else {

@@ -44,8 +44,10 @@
 //!
 //! # The baseline
 //!
-//! A simulation keeps a copy of its world as it was built, before the first step (shared
-//! by its clones; it costs as much memory as that world). A snapshot writes the bodies as
+//! A simulation keeps its world as it was built, before the first step (shared by its
+//! clones), packed: scenery in runs of ids at regular places (a tile map's rows) costs 32
+//! bytes a run, not 46 a body (`world/state/packed.rs`). The first snapshot, restore or
+//! checksum unpacks it and keeps the copy. A snapshot writes the bodies as
 //! they differ from it (`world/state/`): runs of bodies kept or dropped, a mask of the
 //! field groups that changed, and whole records for bodies spawned later or redefined. A
 //! drifting asteroid costs 25 bytes (its position and angle), a tile that did not move
@@ -98,7 +100,7 @@ use crate::pipeline::Simulation;
 use crate::stages::detect::DetectState;
 use crate::stages::separate::SeparateState;
 use crate::stages::touch::TouchState;
-use crate::world::World;
+use crate::world::{PackedWorld, World};
 
 /// The version of the snapshot format [`Snapshot::to_bytes`] writes and
 /// [`Snapshot::from_bytes`] reads.
@@ -249,9 +251,15 @@ struct State {
 
 /// The world as the simulation was built, before its first step: what a snapshot's bodies
 /// are written against (`world/state/`). Shared by the simulation's clones.
+///
+/// Kept packed (`world/state/packed.rs`: a tile map's rows as runs, a few bytes a tile), and
+/// unpacked by the first snapshot, restore or checksum, which keeps the world it unpacks:
+/// a simulation that never takes one never holds a second copy of its world.
 #[derive(Debug)]
 pub(crate) struct Baseline {
-    world: World,
+    packed: PackedWorld,
+    /// The world unpacked, once a snapshot needs it.
+    world: OnceLock<World>,
     /// The scene's hash: its definition and this world (computed at the first snapshot).
     scene: OnceLock<u64>,
 }
@@ -260,9 +268,15 @@ impl Baseline {
     /// The baseline of a simulation whose world is `world` before its first step.
     pub(crate) fn new(world: &World) -> Arc<Baseline> {
         Arc::new(Baseline {
-            world: world.clone(),
+            packed: world.packed(),
+            world: OnceLock::new(),
             scene: OnceLock::new(),
         })
+    }
+
+    /// The world before the first step.
+    fn world(&self) -> &World {
+        self.world.get_or_init(|| self.packed.unpack())
     }
 }
 
@@ -275,7 +289,7 @@ impl Simulation {
             let s = &self.scenario;
             let mut h = Hasher::default();
             h.str(&format!("{:?}|{:?}|{:?}", s.world, s.templates, s.script));
-            self.baseline.world.encode(&World::new(), &mut h, true);
+            self.baseline.world().encode(&World::new(), &mut h, true);
             h.finish()
         })
     }
@@ -306,7 +320,7 @@ impl Simulation {
             s.entity(*b);
         }
         s.bool(self.touch.static_generation() != self.world.static_generation());
-        self.world.encode(&self.baseline.world, s, game_data);
+        self.world.encode(self.baseline.world(), s, game_data);
     }
 
     /// The state the next step reads, and the game's user data: every body's state (the
@@ -339,13 +353,13 @@ impl Simulation {
             });
         }
         let layers = &self.scenario.world.layers;
-        let st = s.decode(&self.baseline.world, layers.names().len())?;
+        let st = s.decode(self.baseline.world(), layers.names().len())?;
         if st.cursor > self.scenario.script.len() {
             return Err(SnapshotError::malformed("a script cursor past the script"));
         }
         self.detect = DetectState::new(layers, self.scenario.world.broad_phase);
         self.separate = SeparateState::new(layers);
-        self.world.restore_bodies(&self.baseline.world, &st.bodies);
+        self.world.restore_bodies(self.baseline.world(), &st.bodies);
         let g = self.world.static_generation();
         let seen = if st.statics_moved {
             g.wrapping_sub(1)

@@ -18,16 +18,16 @@
 //! The first lookup covers the box's start and end along the axis.
 
 //!
-//! Finding the obstacles: static boxes sit in a grid built once (rebuilt only when the static
-//! bodies change); kinematic boxes, and dynamic boxes once settled, go into a small grid
-//! rebuilt every pass. Each dynamic box looks up both and meets its obstacles in id order at
+//! Finding the obstacles: static boxes sit in a tile map built once (rebuilt only when the
+//! static bodies change: `broad_phase/tile_map.rs`); kinematic boxes, and dynamic boxes once
+//! settled, go into a small grid rebuilt every pass, if a settling box may stop on them. Each dynamic box looks up both and meets its obstacles in id order at
 //! its current position; after a push it looks again from the obstacle after the one it was
 //! pushed out of. That is exactly the order of a loop over every body, at the cost of the
 //! few it is near.
 
 use ricochet_geom::{Bounds, Primitive, Shape, Vec2, contact};
 
-use crate::broad_phase::{FixedGrid, MoverGrid};
+use crate::broad_phase::{MoverGrid, StaticBox, TileMap};
 use crate::def::{BodyKind, Controller, LayerId, Layers, Response};
 use crate::entity::Entity;
 use crate::event::GameEvent;
@@ -70,8 +70,8 @@ pub(crate) struct SeparateState {
     /// The static generation `statics` was built at.
     static_generation: Option<u64>,
     /// Static boxes of separating layers, each with its rank among all the static bodies
-    /// (its dense index follows, [`static_index`]) and its layer.
-    statics: FixedGrid,
+    /// (its dense index follows, [`static_index`]) and its layer: a tile map.
+    statics: TileMap,
     movers: MoverGrid,
     found: Vec<Obstacle>,
     /// The pass's dynamic boxes, `(lowest coordinate along the axis, dense index)`.
@@ -80,6 +80,10 @@ pub(crate) struct SeparateState {
     extents: Vec<f64>,
     /// Sleeping boxes pushed against, woken after the pass.
     woken: Vec<usize>,
+    /// The pass's contacts' `(a, b)` and places, to sort them.
+    keys: Vec<(Entity, Entity, u32)>,
+    /// The pass's contacts, while they are put in order.
+    records: Vec<ContactRecord>,
 }
 
 /// A box that may stop the one being settled: its dense index, bounds and layer (static
@@ -119,19 +123,23 @@ impl SeparateState {
             return;
         }
         self.static_generation = Some(w.static_generation());
-        self.statics = FixedGrid::default();
-        let mut boxes = Vec::new();
-        let mut rank = 0;
-        for i in 0..w.len() {
-            if w.kind[i] != BodyKind::Static {
-                continue;
-            }
-            if is_box(w.shape(i)) && self.separating[usize::from(w.layer[i])] {
-                boxes.push((box_bounds(w, i), rank, w.layer[i]));
-            }
-            rank += 1;
-        }
-        self.statics = FixedGrid::new(&boxes);
+        self.statics = TileMap::default();
+        let separating = &self.separating;
+        // Each static box of a separating layer, with its rank among the static bodies (the
+        // tile map reads them a few times instead of copying a million of them).
+        let boxes = || {
+            (0..w.len())
+                .filter(|&i| w.kind[i] == BodyKind::Static)
+                .enumerate()
+                .filter(|&(_, i)| is_box(w.shape(i)) && separating[usize::from(w.layer[i])])
+                .map(|(rank, i)| StaticBox {
+                    bounds: box_bounds(w, i),
+                    centre: on_origin(w, i).map(|half| (w.position[i], half)),
+                    handle: rank as u32,
+                    tag: w.layer[i],
+                })
+        };
+        self.statics = TileMap::new(boxes);
     }
 }
 
@@ -144,6 +152,15 @@ fn box_bounds(w: &World, i: usize) -> Bounds {
             Bounds::around(w.position[i], b.half_extents)
         }
         s => s.bounds(&w.pose(i)),
+    }
+}
+
+/// The half extents of box `i` when it sits on its body's origin: then its bounds are
+/// `Bounds::around(position, half)` ([`box_bounds`]).
+fn on_origin(w: &World, i: usize) -> Option<Vec2> {
+    match w.shape(i) {
+        Shape::Primitive(Primitive::Aabb(b)) if b.center == Vec2::ZERO => Some(b.half_extents),
+        _ => None,
     }
 }
 
@@ -207,6 +224,9 @@ fn obstacles(st: &mut SeparateState, w: &World, q: &Bounds, from: u32, found: &m
             });
         }
     });
+    if st.movers.is_empty() {
+        return finish(found);
+    }
     st.movers.query(q, |i| {
         if i >= from {
             found.push(Obstacle {
@@ -217,8 +237,28 @@ fn obstacles(st: &mut SeparateState, w: &World, q: &Bounds, from: u32, found: &m
             });
         }
     });
+    finish(found);
+}
+
+/// Sorts the obstacles found by index and drops repeats.
+fn finish(found: &mut Vec<Obstacle>) {
     found.sort_unstable_by_key(|o| o.index);
     found.dedup_by_key(|o| o.index);
+}
+
+/// By layer, whether a box of it may stop one of the pass's settling boxes (`order`): some
+/// settling box's layer `separate`s from it.
+fn solid_layers(w: &World, layers: &Layers, order: &[(f64, u32)]) -> Vec<bool> {
+    let n = layers.names().len();
+    let mut settling = vec![false; n];
+    for &(_, i) in order {
+        settling[usize::from(w.layer[i as usize])] = true;
+    }
+    (0..n)
+        .map(|m| {
+            (0..n).any(|l| settling[l] && layers.response(l as u8, m as u8) == Response::Separate)
+        })
+        .collect()
 }
 
 /// One per-axis pass: settles every dynamic box along `axis`, lowest first.
@@ -246,7 +286,13 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
             extents.push((b.max - b.min).max_element());
         }
     }
-    order.sort_by(|p, q| p.0.total_cmp(&q.0).then(p.1.cmp(&q.1)));
+    // Unstable is the same order: no two keys are equal (the index breaks ties).
+    order.sort_unstable_by(|p, q| p.0.total_cmp(&q.0).then(p.1.cmp(&q.1)));
+    // The layers a moving box may be solid to: those some settling box `separate`s from. A
+    // box of any other layer is never an obstacle, so it stays out of the mover grid (the
+    // platformer's actors only `report` to each other: the grid stays empty and is never
+    // looked at).
+    let solid = solid_layers(w, layers, &order);
     // Kinematic boxes and sleeping ones are solid from the start; dynamic ones once settled.
     st.movers.reset(&mut extents, order.len());
     for &i in w.movers() {
@@ -254,6 +300,7 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
         if is_box(w.shape(k))
             && !w.frozen(k)
             && st.separating[usize::from(w.layer[k])]
+            && solid[usize::from(w.layer[k])]
             && (w.kind[k] == BodyKind::Kinematic || w.asleep(k))
         {
             st.movers.insert(&box_bounds(w, k), i);
@@ -404,7 +451,9 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
         if let Some(event) = rider(ctx.world, layers, st, &mut found, (i, axis), riding) {
             out.events.push(event);
         }
-        st.movers.insert(&box_bounds(ctx.world, i), i as u32);
+        if solid[usize::from(ctx.world.layer[i])] {
+            st.movers.insert(&box_bounds(ctx.world, i), i as u32);
+        }
     }
     for j in woken.drain(..) {
         ctx.world.wake(j);
@@ -414,7 +463,32 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
     st.extents = extents;
     st.woken = woken;
     // The log's convention: a pass's contacts sorted by (a, b).
-    out.contacts[first..].sort_by_key(|c| (c.a, c.b));
+    sort_contacts(&mut out.contacts, first, &mut st.keys, &mut st.records);
+}
+
+/// Sorts `contacts[first..]` by `(a, b)`, stably: as keys with their places (an unstable
+/// sort of unique keys), then each record moved once (a record is about 130 bytes; a sort
+/// of the records moves each `log n` times).
+fn sort_contacts(
+    contacts: &mut Vec<ContactRecord>,
+    first: usize,
+    keys: &mut Vec<(Entity, Entity, u32)>,
+    records: &mut Vec<ContactRecord>,
+) {
+    keys.clear();
+    keys.extend(
+        contacts[first..]
+            .iter()
+            .zip(0..)
+            .map(|(c, k)| (c.a, c.b, k)),
+    );
+    if keys.is_sorted() {
+        return;
+    }
+    keys.sort_unstable();
+    records.clear();
+    records.extend(contacts.drain(first..));
+    contacts.extend(keys.iter().map(|k| records[k.2 as usize].clone()));
 }
 
 /// Statics win: the push `by` along `axis` that moves box `i` (bounds `bi`) out of the
@@ -423,7 +497,7 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
 /// (flush on it, still overlapping `bj`: a push from another dynamic body never moves a box
 /// into a static one, as along the normal, `push.rs`).
 fn statics_win(
-    statics: &FixedGrid,
+    statics: &TileMap,
     (w, layers): (&World, &Layers),
     (i, bi, bj): (usize, &Bounds, &Bounds),
     axis: usize,
@@ -449,7 +523,7 @@ fn statics_win(
 /// by more than [`SLOP`] (a static box it overlaps now is not in its way: the pass pushes it
 /// out of that one at its turn).
 fn clear_way(
-    statics: &FixedGrid,
+    statics: &TileMap,
     (w, layers): (&World, &Layers),
     (i, bi): (usize, &Bounds),
     axis: usize,

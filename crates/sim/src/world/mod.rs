@@ -41,7 +41,7 @@ mod rows;
 mod sleep;
 mod state;
 
-pub(crate) use state::Bodies;
+pub(crate) use state::{Bodies, PackedWorld};
 
 use bounds::LocalBounds;
 use motion::any_in_blocks;

@@ -29,7 +29,10 @@ use crate::entity::{Entity, EntityAllocator};
 use crate::snapshot::SnapshotError;
 use crate::snapshot::codec::{Reader, Sink};
 
+mod packed;
 mod restore;
+
+pub(crate) use packed::PackedWorld;
 
 fn bad(what: &str) -> SnapshotError {
     SnapshotError::malformed(what)
