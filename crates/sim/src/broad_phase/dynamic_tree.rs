@@ -146,6 +146,24 @@ impl DynamicTree {
         self.nodes[leaf as usize].bounds = bounds;
     }
 
+    /// Gives leaf `leaf` the box `bounds`, growing its ancestors' boxes to hold it (up to the
+    /// first that already does) and moving nothing: `O(depth)`, and the tree stays exact,
+    /// only looser until the next [`DynamicTree::rebuild`] (Box2D v3 enlarges the same way).
+    pub(super) fn enlarge(&mut self, leaf: u32, bounds: Bounds) {
+        self.nodes[leaf as usize].bounds = bounds;
+        let bits = |b: &Bounds| [b.min.x, b.min.y, b.max.x, b.max.y].map(f64::to_bits);
+        let mut at = self.nodes[leaf as usize].parent;
+        while at != NONE {
+            let n = &mut self.nodes[at as usize];
+            let grown = hull(&n.bounds, &bounds);
+            if bits(&grown) == bits(&n.bounds) {
+                break;
+            }
+            n.bounds = grown;
+            at = n.parent;
+        }
+    }
+
     /// Puts a detached leaf next to the cheapest sibling.
     fn attach(&mut self, leaf: u32) {
         if self.root == NONE {

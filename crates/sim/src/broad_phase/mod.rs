@@ -47,11 +47,12 @@
 //! - `Tree` (`dynamic_tree.rs`, `kept_tree.rs`): Box2D's dynamic tree. Per layer, a
 //!   bounding-volume tree of the moving bodies' *fat* boxes (bounds grown by a quarter of
 //!   their size), kept across calls: a body still inside its fat box costs one containment
-//!   test, and only one that left it is moved (removed, reinserted by the surface-area
-//!   heuristic, ancestors refitted and rotated); when most of a layer moved or is new, its
-//!   tree is rebuilt top-down. The static bodies get a tree of their exact boxes, built
-//!   once. Its strength: a crowd that only meets other layers (asteroids and bullets) keeps
-//!   its boxes, and each body of the small layer queries them in `O(log n)`.
+//!   test; one that left it gets a new fat box in place, its ancestors grown; new bodies
+//!   are inserted by the surface-area heuristic (ancestors refitted and rotated). The tree
+//!   is rebuilt top-down once as many leaves were re-boxed as it holds, or when most of a
+//!   layer is new. The static bodies get a tree of their exact boxes, built once. Meant
+//!   for a crowd that only meets other layers (asteroids and bullets): it keeps its boxes,
+//!   and each body of the small layer queries them in `O(log n)`.
 //!
 //! Two interacting layers, with `Grid`, `Quadtree` or `Tree`: the structure of the larger
 //! layer is queried with the bodies of the smaller, and only that structure is brought up
@@ -79,6 +80,10 @@
 //!   and bullets: the coherent sort costs about one pass over the moving bodies, and unlike
 //!   a grid it does not care how much body sizes vary; `asteroids-10000` 0.26 ms, against
 //!   0.62 with the grid).
+//!
+//! Neither `Quadtree` nor `Tree` is ever `Auto`'s pick: in the study of BENCHMARKS.md
+//! ("Broad phases: the study", `ricochet bench --broad-phases`) neither was the fastest on
+//! any scene.
 //!
 //! Each kind keeps its own structures, so a switch costs one build and nothing else.
 //!
