@@ -240,7 +240,7 @@ pub fn run_broad_phases(
 }
 
 /// The three tables (broad phase alone, whole step, memory), Markdown, `Auto`'s pick
-/// marked `*`, the best broad phase in bold.
+/// marked `†`, the best broad phase in bold.
 #[must_use]
 pub fn table(rows: &[BroadPhaseRow]) -> String {
     let mut t = String::new();
@@ -257,7 +257,7 @@ pub fn table(rows: &[BroadPhaseRow]) -> String {
     };
     head(
         &mut t,
-        "Broad phase alone, ms per frame (* = Auto's pick, bold = fastest)",
+        "Broad phase alone, ms per frame († = Auto's pick, bold = fastest)",
     );
     for r in rows {
         let best = r.best_broad_ms();
@@ -266,7 +266,7 @@ pub fn table(rows: &[BroadPhaseRow]) -> String {
             match k {
                 None => t.push_str(" – |"),
                 Some(k) => {
-                    let mark = if Some(k.kind) == r.auto { "*" } else { "" };
+                    let mark = if Some(k.kind) == r.auto { "†" } else { "" };
                     let v = format!("{:.3}{mark}", k.broad_ms);
                     if k.broad_ms <= best {
                         let _ = write!(t, " **{v}** |");
@@ -278,14 +278,14 @@ pub fn table(rows: &[BroadPhaseRow]) -> String {
         }
         t.push('\n');
     }
-    head(&mut t, "Whole step, ms per frame (* = Auto's pick)");
+    head(&mut t, "Whole step, ms per frame († = Auto's pick)");
     for r in rows {
         let _ = write!(t, "| {} | {} | {} |", r.scene, r.movers, r.statics);
         for k in &r.kinds {
             match k {
                 None => t.push_str(" – |"),
                 Some(k) => {
-                    let mark = if Some(k.kind) == r.auto { "*" } else { "" };
+                    let mark = if Some(k.kind) == r.auto { "†" } else { "" };
                     let _ = write!(t, " {:.3}{mark} |", k.step_ms);
                 }
             }
