@@ -14,7 +14,7 @@ use anyhow::{Context, bail};
 
 use crate::{files, out};
 use ricochet_scenes::bench::{DEFAULT_SCENES, Scene};
-use ricochet_study::bench::{MAX_FRAMES, Row, queries, report, run_scene, snapshots};
+use ricochet_study::bench::{MAX_FRAMES, Row, broad_phases, queries, report, run_scene, snapshots};
 
 /// Set in the environment of the process that runs one scene (`run` starts one per scene):
 /// it runs the scenes in-process and prints each result as a JSON line. Set it yourself to
@@ -171,6 +171,38 @@ pub fn run_snapshots(scenes: &[String], frames: u64) -> anyhow::Result<ExitCode>
         "{}{}\n",
         snapshots::table(&rows),
         snapshots::NOTES
+    ))?;
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `bench --broad-phases`: every broad phase on the named scenes (or
+/// [`broad_phases::DEFAULT_SCENES`]), `frames` timed frames each
+/// ([`ricochet_study::bench::broad_phases`]); prints the tables. Exit code 0, 1 when two
+/// broad phases disagree on the pairs (an error), 2 for a bad scene name or frame count.
+pub fn run_broad_phases(scenes: &[String], frames: u64) -> anyhow::Result<ExitCode> {
+    let scenes = if scenes.is_empty() {
+        broad_phases::DEFAULT_SCENES
+            .iter()
+            .map(|s| (*s).to_owned())
+            .collect()
+    } else {
+        scenes.to_vec()
+    };
+    let parsed = match parse_scenes(&scenes, frames)? {
+        Ok(parsed) => parsed,
+        Err(code) => return Ok(code),
+    };
+    let mut rows = Vec::new();
+    for (name, kind) in &parsed {
+        let row = broad_phases::run_broad_phases(name, *kind, frames, |note| {
+            let _ = out::note(&format!("bench --broad-phases: {note}"));
+        })?;
+        rows.push(row);
+    }
+    out::print(&format!(
+        "{}{}\n",
+        broad_phases::table(&rows),
+        broad_phases::NOTES
     ))?;
     Ok(ExitCode::SUCCESS)
 }

@@ -298,6 +298,15 @@ enum Command {
         /// Example: ricochet bench --snapshots asteroids-75 asteroids-10000 --frames 300
         #[arg(long, conflicts_with_all = ["record", "csv", "queries"])]
         snapshots: bool,
+        /// Measure every broad phase instead (issue #24): each scene (default: every bench
+        /// scene and crowded-10000, sparse-10000, mixed-10000) stepped --frames frames with
+        /// each broad phase forced; prints the broad phase alone and the whole step in ms
+        /// per frame, the structures' memory, the pairs per frame, and what `auto` picks.
+        /// Brute force is skipped above 4000 bodies. Build with --release.
+        ///
+        /// Example: ricochet bench --broad-phases mixed-10000 --frames 60
+        #[arg(long, conflicts_with_all = ["record", "csv", "queries", "snapshots"])]
+        broad_phases: bool,
     },
     /// Run a folder of scenarios against their golden logs: any change in your game's
     /// physics fails, with its first divergence named.
@@ -518,6 +527,12 @@ fn main() -> ExitCode {
             snapshots: true,
             ..
         } => bench::run_snapshots(&scenes, frames),
+        Command::Bench {
+            scenes,
+            frames,
+            broad_phases: true,
+            ..
+        } => bench::run_broad_phases(&scenes, frames),
         Command::Bench {
             scenes,
             frames,

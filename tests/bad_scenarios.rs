@@ -153,8 +153,8 @@ fn each_error_class_is_named_with_its_location() {
         "5:15",
         &[
             "world.broad_phase",
-            "auto, brute-force, sort-and-sweep, grid or strips",
-            "\"quadtree\"",
+            "auto, brute-force, sort-and-sweep, grid, strips, quadtree or tree",
+            "\"octree\"",
         ],
     );
     case(

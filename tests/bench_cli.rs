@@ -146,3 +146,55 @@ fn bench_snapshots_prints_bytes_and_times_for_a_small_scene() {
         assert!(t.is_finite() && *t > 0.0, "column {k}: {t}\n{stdout}");
     }
 }
+
+/// `bench --broad-phases` on tiny scenes of every family: every kind runs (brute force too,
+/// at these sizes), and every kind found the same pairs on every frame (the command fails
+/// otherwise). No time is asserted.
+#[test]
+fn bench_broad_phases_runs_every_kind_and_they_agree_on_the_pairs() {
+    let scenes = [
+        "asteroids-60",
+        "platformer-200-20",
+        "rain-60",
+        "crowded-100",
+        "sparse-100",
+        "mixed-100",
+    ];
+    let mut args = vec!["bench", "--broad-phases"];
+    args.extend(scenes);
+    args.extend(["--frames", "3"]);
+    let o = ricochet(&args, b"");
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{stdout}{stderr}");
+    for kind in [
+        "brute-force",
+        "sort-and-sweep",
+        "grid",
+        "strips",
+        "quadtree",
+        "tree",
+    ] {
+        assert!(stdout.contains(&format!(" {kind} |")), "{kind}\n{stdout}");
+    }
+    for scene in scenes {
+        // Three tables of timings and memory, and the pairs and Auto's pick.
+        let rows: Vec<&str> = stdout
+            .lines()
+            .filter(|l| l.starts_with(&format!("| {scene} |")))
+            .collect();
+        assert_eq!(rows.len(), 4, "{scene}\n{stdout}");
+        // The broad-phase table: every kind ran, Auto's pick is marked once.
+        let cells: Vec<&str> = rows[0].split('|').map(str::trim).collect();
+        assert_eq!(cells.len(), 1 + 3 + 6 + 1, "{}", rows[0]);
+        assert!(cells[4..10].iter().all(|c| *c != "–"), "{}", rows[0]);
+        assert_eq!(rows[0].matches('†').count(), 1, "{}", rows[0]);
+    }
+    // Crowded bodies overlap: pairs are found.
+    let pairs = stdout
+        .lines()
+        .find(|l| l.starts_with("| crowded-100 |") && l.split('|').count() == 6)
+        .unwrap_or_else(|| panic!("{stdout}"));
+    let per_frame: f64 = pairs.split('|').nth(2).unwrap().trim().parse().unwrap();
+    assert!(per_frame > 10.0, "{pairs}");
+}

@@ -12,6 +12,7 @@
 //! - `rain-N`: `N` shapes of all five kinds (circle, aabb, obb, capsule, polygon), spinning
 //!   and falling through `max(10, N/10)` static shapes of all five kinds; every pair `report`s
 //!   (so nothing moves anything), in a wrap-around world of side `sqrt(N) * 8`.
+//! - `crowded-N`, `sparse-N`, `mixed-N`: the broad-phase study's scenes ([`crate::crowds`]).
 
 use ricochet_geom::{Shape, Vec2};
 use ricochet_sim::{
@@ -59,6 +60,21 @@ pub enum Scene {
         /// `N`: falling shapes.
         shapes: usize,
     },
+    /// `crowded-N` ([`crate::crowds`]).
+    Crowded {
+        /// `N`: bodies.
+        bodies: usize,
+    },
+    /// `sparse-N` ([`crate::crowds`]).
+    Sparse {
+        /// `N`: bodies.
+        bodies: usize,
+    },
+    /// `mixed-N` ([`crate::crowds`]).
+    Mixed {
+        /// `N`: small bodies (the huge ones come on top).
+        bodies: usize,
+    },
 }
 
 /// A scene name that is not `asteroids-N`, `platformer-T-A` or `rain-N`; displays the reason.
@@ -74,7 +90,8 @@ impl std::fmt::Display for SceneNameError {
 impl std::error::Error for SceneNameError {}
 
 impl Scene {
-    /// Parses `asteroids-N`, `platformer-T-A` or `rain-N` (counts from 1 to [`MAX_COUNT`],
+    /// Parses `asteroids-N`, `platformer-T-A`, `rain-N`, `crowded-N`, `sparse-N` or
+    /// `mixed-N` (counts from 1 to [`MAX_COUNT`],
     /// `_` allowed between digits).
     ///
     /// # Errors
@@ -117,9 +134,13 @@ impl Scene {
                 actors: count(a)?,
             }),
             ["rain", n] => Ok(Scene::Rain { shapes: count(n)? }),
+            ["crowded", n] => Ok(Scene::Crowded { bodies: count(n)? }),
+            ["sparse", n] => Ok(Scene::Sparse { bodies: count(n)? }),
+            ["mixed", n] => Ok(Scene::Mixed { bodies: count(n)? }),
             _ => Err(SceneNameError(format!(
-                "unknown scene {name:?}: expected asteroids-N, platformer-TILES-ACTORS or rain-N \
-                 (for example asteroids-10000, platformer-10000-1000, rain-10000)"
+                "unknown scene {name:?}: expected asteroids-N, platformer-TILES-ACTORS, rain-N, \
+                 crowded-N, sparse-N or mixed-N (for example asteroids-10000, \
+                 platformer-10000-1000, rain-10000)"
             ))),
         }
     }
@@ -131,12 +152,15 @@ impl Scene {
             Scene::Asteroids { asteroids: n } => asteroids(n, frames),
             Scene::Platformer { tiles, actors } => platformer(tiles, actors, frames),
             Scene::Rain { shapes } => rain(shapes, frames),
+            Scene::Crowded { bodies } => crate::crowds::crowded(bodies, frames),
+            Scene::Sparse { bodies } => crate::crowds::sparse(bodies, frames),
+            Scene::Mixed { bodies } => crate::crowds::mixed(bodies, frames),
         }
     }
 }
 
 /// The world of every bench scene: 60 Hz, `gravity`, wrapping round the bounds `min`..`max`.
-fn wrapping_world(gravity: Vec2, min: Vec2, max: Vec2, layers: Layers) -> WorldDef {
+pub(crate) fn wrapping_world(gravity: Vec2, min: Vec2, max: Vec2, layers: Layers) -> WorldDef {
     WorldDef {
         dt: DT,
         gravity,
@@ -332,7 +356,7 @@ pub fn platformer(tiles: usize, actors: usize, frames: u64) -> Scenario {
 }
 
 /// One shape of kind `k % 5` (circle, aabb, obb, capsule, polygon) about `size` across.
-fn any_shape(rng: &mut Rng, k: usize, size: f64) -> Shape {
+pub(crate) fn any_shape(rng: &mut Rng, k: usize, size: f64) -> Shape {
     let r = |rng: &mut Rng| rng.range(0.5, 1.0) * size;
     match k % 5 {
         0 => Shape::circle(r(rng)).expect("a positive radius"),

@@ -3,7 +3,8 @@
 //! tests).
 //!
 //! **Owns:** the benchmark scenes ([`bench`](mod@bench): `asteroids-N`, `platformer-T-A`,
-//! `rain-N` and their names), the accuracy scenes and their exact answers ([`accuracy`]:
+//! `rain-N` and their names; [`crowds`]: the broad-phase study's `crowded-N`, `sparse-N`,
+//! `mixed-N`), the accuracy scenes and their exact answers ([`accuracy`]:
 //! projectile, spring and orbit, drop, the bullet field), the test scenes of tiles, boxes
 //! and balls ([`tiles`]), and the one seeded generator [`Rng`] (SplitMix64). Scenes are
 //! [`Scenario`] values built from `WorldDef`, `BodyDef` and
@@ -21,6 +22,7 @@
 
 pub mod accuracy;
 pub mod bench;
+pub mod crowds;
 mod rng;
 pub mod tiles;
 

@@ -342,6 +342,11 @@ pub enum BroadPhaseKind {
     Grid,
     /// Sort and sweep along x within horizontal strips as tall as the tallest body.
     Strips,
+    /// A loose quadtree per layer, rebuilt every call for moving bodies.
+    Quadtree,
+    /// A dynamic tree of enlarged (fat) boxes per layer, kept across calls: a body's leaf
+    /// moves only when its bounds leave its fat box.
+    Tree,
     /// Chosen per call from the number of moving and static bodies (see the module docs).
     #[default]
     Auto,
@@ -349,7 +354,7 @@ pub enum BroadPhaseKind {
 
 impl BroadPhaseKind {
     /// The name scenario files and `/stats` use: `brute-force`, `sort-and-sweep`, `grid`,
-    /// `strips`, `auto`.
+    /// `strips`, `quadtree`, `tree`, `auto`.
     #[must_use]
     pub fn name(self) -> &'static str {
         match self {
@@ -357,6 +362,8 @@ impl BroadPhaseKind {
             BroadPhaseKind::SortAndSweep => "sort-and-sweep",
             BroadPhaseKind::Grid => "grid",
             BroadPhaseKind::Strips => "strips",
+            BroadPhaseKind::Quadtree => "quadtree",
+            BroadPhaseKind::Tree => "tree",
             BroadPhaseKind::Auto => "auto",
         }
     }

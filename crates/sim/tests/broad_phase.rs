@@ -11,11 +11,13 @@ use ricochet_sim::broad_phase::{
     BodyEntry, BroadPhase, BroadPhaseKind, BroadPhaseStats, Interactions,
 };
 
-const KINDS: [BroadPhaseKind; 5] = [
+const KINDS: [BroadPhaseKind; 7] = [
     BroadPhaseKind::BruteForce,
     BroadPhaseKind::SortAndSweep,
     BroadPhaseKind::Grid,
     BroadPhaseKind::Strips,
+    BroadPhaseKind::Quadtree,
+    BroadPhaseKind::Tree,
     BroadPhaseKind::Auto,
 ];
 
@@ -322,6 +324,8 @@ fn static_bodies_are_indexed_once_while_they_do_not_change() {
         BroadPhaseKind::SortAndSweep,
         BroadPhaseKind::Grid,
         BroadPhaseKind::Strips,
+        BroadPhaseKind::Quadtree,
+        BroadPhaseKind::Tree,
     ] {
         let (mut whole, mut apart) = (BroadPhase::new(kind), BroadPhase::new(kind));
         let mut out = Vec::new();
@@ -390,6 +394,8 @@ fn a_layer_that_ignores_itself_is_never_tested_against_itself() {
         BroadPhaseKind::SortAndSweep,
         BroadPhaseKind::Grid,
         BroadPhaseKind::Strips,
+        BroadPhaseKind::Quadtree,
+        BroadPhaseKind::Tree,
     ] {
         let mut bp = BroadPhase::new(kind);
         for _ in 0..3 {
@@ -566,6 +572,8 @@ fn a_million_tile_map_matches_the_reference() {
         BroadPhaseKind::SortAndSweep,
         BroadPhaseKind::Grid,
         BroadPhaseKind::Strips,
+        BroadPhaseKind::Quadtree,
+        BroadPhaseKind::Tree,
         BroadPhaseKind::Auto,
     ];
     let mut phases: Vec<BroadPhase> = kinds.iter().map(|&k| BroadPhase::new(k)).collect();

@@ -1,5 +1,5 @@
 //! Every broad phase, forced by the scenario, gives the same simulation: the choice changes
-//! speed only. Each shipped scenario runs under all five settings and every frame's state,
+//! speed only. Each shipped scenario runs under all seven settings and every frame's state,
 //! contacts, events and removals are compared with brute force (the O(n²) reference).
 
 use ricochet_sim::broad_phase::BroadPhaseKind;
@@ -15,11 +15,13 @@ const SCENARIOS: [&str; 7] = [
     "stress/extreme-sizes.toml",
 ];
 
-const KINDS: [BroadPhaseKind; 5] = [
+const KINDS: [BroadPhaseKind; 7] = [
     BroadPhaseKind::BruteForce,
     BroadPhaseKind::SortAndSweep,
     BroadPhaseKind::Grid,
     BroadPhaseKind::Strips,
+    BroadPhaseKind::Quadtree,
+    BroadPhaseKind::Tree,
     BroadPhaseKind::Auto,
 ];
 
@@ -37,7 +39,7 @@ fn every_broad_phase_gives_the_same_simulation() {
                 Simulation::new(&s)
             })
             .collect();
-        let mut ran = [false; 5];
+        let mut ran = [false; KINDS.len()];
         for frame in 0..=200 {
             let outs: Vec<_> = sims.iter_mut().map(Simulation::step).collect();
             let reference = &outs[0];
@@ -57,7 +59,7 @@ fn every_broad_phase_gives_the_same_simulation() {
             }
         }
         assert!(
-            ran[..4].iter().all(|r| *r),
+            ran[..KINDS.len() - 1].iter().all(|r| *r),
             "{name}: detect ran under every kind"
         );
     }

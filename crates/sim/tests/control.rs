@@ -8,11 +8,13 @@ use ricochet_sim::{
     ScriptAction, ScriptInput, Simulation, WorldBounds, WorldDef,
 };
 
-const KINDS: [BroadPhaseKind; 4] = [
+const KINDS: [BroadPhaseKind; 6] = [
     BroadPhaseKind::Auto,
     BroadPhaseKind::BruteForce,
     BroadPhaseKind::SortAndSweep,
     BroadPhaseKind::Grid,
+    BroadPhaseKind::Quadtree,
+    BroadPhaseKind::Tree,
 ];
 
 fn world(kind: BroadPhaseKind, response: Response) -> WorldDef {

@@ -75,6 +75,9 @@ fn each_broad_phase_name_maps_to_its_kind() {
         ("brute-force", BroadPhaseKind::BruteForce),
         ("sort-and-sweep", BroadPhaseKind::SortAndSweep),
         ("grid", BroadPhaseKind::Grid),
+        ("strips", BroadPhaseKind::Strips),
+        ("quadtree", BroadPhaseKind::Quadtree),
+        ("tree", BroadPhaseKind::Tree),
     ] {
         let w = world(&format!("[world]\nbroad_phase = \"{name}\"\n"))
             .unwrap_or_else(|e| panic!("{name}: {e}"));
@@ -84,12 +87,21 @@ fn each_broad_phase_name_maps_to_its_kind() {
 
 #[test]
 fn broad_phase_names_are_kebab_case_only() {
-    for name in ["SortAndSweep", "sort_and_sweep", "Grid", ""] {
+    for name in [
+        "SortAndSweep",
+        "sort_and_sweep",
+        "Grid",
+        "QuadTree",
+        "dynamic-tree",
+        "",
+    ] {
         let e = rejected(&format!("[world]\nbroad_phase = \"{name}\"\n"));
         assert_eq!(e.field, "world.broad_phase", "{name}");
         assert_eq!(
             e.problem,
-            format!("expected auto, brute-force, sort-and-sweep, grid or strips, got \"{name}\"")
+            format!(
+                "expected auto, brute-force, sort-and-sweep, grid, strips, quadtree or tree, got \"{name}\""
+            )
         );
     }
 }

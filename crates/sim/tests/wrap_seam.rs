@@ -375,6 +375,8 @@ fn every_broad_phase_finds_every_pair_through_the_seam_of_a_random_crowd() {
         BroadPhaseKind::BruteForce,
         BroadPhaseKind::SortAndSweep,
         BroadPhaseKind::Grid,
+        BroadPhaseKind::Quadtree,
+        BroadPhaseKind::Tree,
         BroadPhaseKind::Auto,
     ] {
         let world = WorldDef {

@@ -1,5 +1,5 @@
 //! The per-layer-pair dispatch of the algorithms that keep structures (`SortAndSweep`,
-//! `Grid`, `Strips`): every pair of interacting moving layers through the per-call
+//! `Grid`, `Strips`, `Quadtree`, `Tree`): every pair of interacting moving layers through the per-call
 //! structures, every moving layer's dynamic bodies against every interacting static layer
 //! through the static ones, counting the layer combinations skipped.
 
@@ -26,6 +26,8 @@ impl BroadPhase {
         } else {
             let built = match kind {
                 BroadPhaseKind::SortAndSweep => &mut self.statics.built_trees,
+                BroadPhaseKind::Quadtree => &mut self.statics.built_quadtrees,
+                BroadPhaseKind::Tree => &mut self.statics.built_dynamic_trees,
                 _ => &mut self.statics.built_grids,
             };
             if !*built {
@@ -89,6 +91,9 @@ impl BroadPhase {
                 }
                 self.scratch.ranges = ranges;
             }
+            BroadPhaseKind::Quadtree | BroadPhaseKind::Tree => {
+                self.tree_pairs(kind, (a, b), bodies, out, stats);
+            }
             _ if a == b => {
                 self.ensure_grid(a, bodies);
                 stats.tested += self.grids[usize::from(a)].self_pairs(out);
@@ -130,11 +135,20 @@ impl BroadPhase {
                 continue;
             }
             let mut emit = |m: &Member| out.push((h, m.handle));
-            stats.tested += if kind == BroadPhaseKind::SortAndSweep {
-                let tree = &self.statics.trees[usize::from(b)];
-                tree.query(&q.bounds, &mut self.scratch.stack, &mut emit)
-            } else {
-                self.statics.grids[usize::from(b)].query(&q.bounds, &mut emit)
+            let st = &self.statics;
+            let nodes = &mut self.scratch.nodes;
+            stats.tested += match kind {
+                BroadPhaseKind::SortAndSweep => {
+                    let tree = &st.trees[usize::from(b)];
+                    tree.query(&q.bounds, &mut self.scratch.stack, &mut emit)
+                }
+                BroadPhaseKind::Quadtree => {
+                    st.quadtrees[usize::from(b)].query(&q.bounds, nodes, |_, m| emit(m))
+                }
+                BroadPhaseKind::Tree => {
+                    st.dynamic_trees[usize::from(b)].query(&q.bounds, nodes, |_, m| emit(m))
+                }
+                _ => st.grids[usize::from(b)].query(&q.bounds, &mut emit),
             };
         }
     }
@@ -165,5 +179,79 @@ impl BroadPhase {
                 .map(|&h| member(&bodies[h as usize], h)),
         );
         grid.build(&mut self.scratch.extents, false);
+    }
+
+    /// `Quadtree` and `Tree`: the pairs of moving layers `a` and `b`. One layer: each body
+    /// queries its layer's structure. Two: the larger layer's structure is queried with the
+    /// smaller's bodies (only the one queried is brought up to date).
+    fn tree_pairs(
+        &mut self,
+        kind: BroadPhaseKind,
+        (a, b): (u8, u8),
+        bodies: &[BodyEntry],
+        out: &mut Vec<(u32, u32)>,
+        stats: &mut BroadPhaseStats,
+    ) {
+        let (na, nb) = (self.layer_movers(a).len(), self.layer_movers(b).len());
+        let (index, query) = if na > nb { (a, b) } else { (b, a) };
+        let quad = kind == BroadPhaseKind::Quadtree;
+        if quad {
+            self.ensure_quadtree(index, bodies);
+        } else {
+            stats.resorted += self.ensure_tree(index, bodies);
+        }
+        let (qt, tree) = (
+            &self.quadtrees[usize::from(index)],
+            &self.trees[usize::from(index)],
+        );
+        let nodes = &mut self.scratch.nodes;
+        if a == b {
+            stats.tested += if quad {
+                qt.self_pairs(nodes, out)
+            } else {
+                tree.self_pairs(nodes, out)
+            };
+            return;
+        }
+        for &h in of_layer(&self.movers, &self.layer_start, query) {
+            let q = member(&bodies[h as usize], h);
+            let mut emit = |_, m: &Member| {
+                if q.dynamic || m.dynamic {
+                    out.push((q.handle, m.handle));
+                }
+            };
+            stats.tested += if quad {
+                qt.query(&q.bounds, nodes, &mut emit)
+            } else {
+                tree.query(&q.bounds, nodes, &mut emit)
+            };
+        }
+    }
+
+    /// Builds layer `l`'s quadtree of moving bodies, once per call.
+    fn ensure_quadtree(&mut self, l: u8, bodies: &[BodyEntry]) {
+        let qt = &mut self.quadtrees[usize::from(l)];
+        if qt.frame == self.frame {
+            return;
+        }
+        qt.frame = self.frame;
+        qt.members.clear();
+        qt.members.extend(
+            of_layer(&self.movers, &self.layer_start, l)
+                .iter()
+                .map(|&h| member(&bodies[h as usize], h)),
+        );
+        qt.build();
+    }
+
+    /// Brings layer `l`'s kept tree up to this call, once per call. Returns the leaves
+    /// moved, inserted or removed.
+    fn ensure_tree(&mut self, l: u8, bodies: &[BodyEntry]) -> u64 {
+        let tree = &mut self.trees[usize::from(l)];
+        if tree.frame == self.frame {
+            return 0;
+        }
+        tree.frame = self.frame;
+        tree.update(of_layer(&self.movers, &self.layer_start, l), bodies)
     }
 }

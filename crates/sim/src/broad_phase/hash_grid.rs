@@ -33,6 +33,16 @@ pub(super) struct HashGrid {
 }
 
 impl HashGrid {
+    /// Heap bytes held.
+    pub(super) fn heap_bytes(&self) -> usize {
+        self.starts.capacity() * 4
+            + self.entries.capacity() * size_of::<(i32, i32, u32)>()
+            + self.members.capacity() * size_of::<Member>()
+            + self.big.capacity() * 4
+            + self.is_big.capacity()
+            + self.ranges.capacity() * size_of::<(CellRange, u32)>()
+    }
+
     /// The entries of bucket `b`.
     fn bucket_entries(&self, b: usize) -> &[(i32, i32, u32)] {
         &self.entries[self.starts[b] as usize..self.starts[b + 1] as usize]

@@ -18,7 +18,7 @@
 //! indices and sorted.
 //!
 //! # Algorithms ([`BroadPhaseKind`])
-//! All four produce the same pairs; they differ only in speed.
+//! All six produce the same pairs; they differ only in speed.
 //! - `BruteForce` (`brute_force.rs`): every pair, `O(n²)`. The reference, and the fastest
 //!   below a few dozen bodies.
 //! - `SortAndSweep` (`sort_and_sweep.rs`): per layer, the moving bodies sorted by `min.x`,
@@ -38,6 +38,25 @@
 //!   a strip and against the next one; static bodies in lists of their own, sorted once.
 //!   Overlapping boxes are in the same or neighbouring strips, so a crowd sharing one x
 //!   range (rain) costs what its neighbours in y cost, not the whole column.
+//! - `Quadtree` (`quadtree.rs`): a loose quadtree per layer, rebuilt every call for the
+//!   moving bodies (one pass of stable partitions, `O(n log n)`), built once for the static
+//!   ones. A body sits in the one node its centre and size choose, so a few huge bodies
+//!   stay near the root and cost the small ones one test each, where they make a uniform
+//!   grid's cells huge or cover thousands of them. Each node keeps the exact hull of its
+//!   subtree, which is all a query looks at.
+//! - `Tree` (`dynamic_tree.rs`, `kept_tree.rs`): Box2D's dynamic tree. Per layer, a
+//!   bounding-volume tree of the moving bodies' *fat* boxes (bounds grown by a quarter of
+//!   their size), kept across calls: a body still inside its fat box costs one containment
+//!   test; one that left it gets a new fat box in place, its ancestors grown; new bodies
+//!   are inserted by the surface-area heuristic (ancestors refitted and rotated). The tree
+//!   is rebuilt top-down once as many leaves were re-boxed as it holds, or when most of a
+//!   layer is new. The static bodies get a tree of their exact boxes, built once. Meant
+//!   for a crowd that only meets other layers (asteroids and bullets): it keeps its boxes,
+//!   and each body of the small layer queries them in `O(log n)`.
+//!
+//! Two interacting layers, with `Grid`, `Quadtree` or `Tree`: the structure of the larger
+//! layer is queried with the bodies of the smaller, and only that structure is brought up
+//! to date.
 //!
 //! **Static bodies are inserted once** (`static_set.rs`). The structures above for static
 //! bodies are built when the static set changes, never per call; per call, only moving
@@ -62,6 +81,10 @@
 //!   a grid it does not care how much body sizes vary; `asteroids-10000` 0.26 ms, against
 //!   0.62 with the grid).
 //!
+//! Neither `Quadtree` nor `Tree` is ever `Auto`'s pick: in the study of BENCHMARKS.md
+//! ("Broad phases: the study", `ricochet bench --broad-phases`) neither was the fastest on
+//! any scene.
+//!
 //! Each kind keeps its own structures, so a switch costs one build and nothing else.
 //!
 //! # Determinism
@@ -74,11 +97,14 @@ pub const CROWD: usize = 256;
 
 mod brute_force;
 mod by_layers;
+mod dynamic_tree;
 mod fixed_grid;
 mod grid;
 mod hash_grid;
 mod interactions;
+mod kept_tree;
 mod mover_grid;
+mod quadtree;
 mod sort_and_sweep;
 mod sorted;
 mod static_set;
@@ -94,7 +120,9 @@ use crate::def::BodyKind;
 pub(crate) use fixed_grid::FixedGrid;
 use hash_grid::HashGrid;
 pub use interactions::Interactions;
+use kept_tree::KeptTree;
 pub(crate) use mover_grid::MoverGrid;
+use quadtree::Quadtree;
 use sort_and_sweep::{Slot, SweepList};
 use static_set::StaticSet;
 use strips::StripList;
@@ -163,6 +191,10 @@ pub struct BroadPhase {
     runs: Vec<(u32, u32, u8)>,
     sweeps: Vec<SweepList>,
     grids: Vec<HashGrid>,
+    /// `Quadtree`: each layer's, rebuilt per call.
+    quadtrees: Vec<Quadtree>,
+    /// `Tree`: each layer's, kept across calls.
+    trees: Vec<KeptTree>,
     /// `Strips`: each layer's moving list, each layer's static list, the strip height
     /// (`1 / H`) they share, and the static bodies' tallest height and largest coordinate.
     strips: Vec<StripList>,
@@ -182,6 +214,8 @@ struct Scratch {
     stack: Vec<(u32, u32)>,
     ranges: Vec<(u32, u32)>,
     all: Vec<(Member, u8)>,
+    /// The trees' walks.
+    nodes: Vec<u32>,
 }
 
 /// A body inside a structure: its bounds, its handle (an index into the caller's slice for a
@@ -215,6 +249,8 @@ impl BroadPhase {
             runs: Vec::new(),
             sweeps: (0..LAYERS).map(|_| SweepList::default()).collect(),
             grids: (0..LAYERS).map(|_| HashGrid::default()).collect(),
+            quadtrees: (0..LAYERS).map(|_| Quadtree::default()).collect(),
+            trees: (0..LAYERS).map(|_| KeptTree::default()).collect(),
             strips: (0..LAYERS).map(|_| StripList::default()).collect(),
             static_strips: Vec::new(),
             inv_h: 0.0,
@@ -228,6 +264,36 @@ impl BroadPhase {
     #[must_use]
     pub fn chosen(&self) -> BroadPhaseKind {
         self.chosen
+    }
+
+    /// The heap bytes held by the structures of `kind` (moving and static), or `None` for
+    /// `SortAndSweep` and `Strips`, whose lists do not report theirs, and for `Auto`. For the
+    /// broad-phase study (`ricochet bench --broad-phases`); capacities, so buffers kept for
+    /// reuse count.
+    #[must_use]
+    pub fn heap_bytes(&self, kind: BroadPhaseKind) -> Option<usize> {
+        let st = &self.statics;
+        let statics = st.keys.capacity() * 8 + st.entries.capacity() * size_of::<(Bounds, u8)>();
+        let structures = match kind {
+            BroadPhaseKind::BruteForce => self.scratch.all.capacity() * size_of::<(Member, u8)>(),
+            BroadPhaseKind::Grid => {
+                let g = |v: &[HashGrid]| v.iter().map(HashGrid::heap_bytes).sum::<usize>();
+                g(&self.grids) + g(&st.grids)
+            }
+            BroadPhaseKind::Quadtree => {
+                let q = |v: &[Quadtree]| v.iter().map(Quadtree::heap_bytes).sum::<usize>();
+                q(&self.quadtrees) + q(&st.quadtrees)
+            }
+            BroadPhaseKind::Tree => {
+                self.trees.iter().map(KeptTree::heap_bytes).sum::<usize>()
+                    + st.dynamic_trees
+                        .iter()
+                        .map(|t| t.heap_bytes())
+                        .sum::<usize>()
+            }
+            _ => return None,
+        };
+        Some(statics + structures)
     }
 
     /// Writes into `out` (cleared first) the candidate pairs among `bodies` (keys strictly

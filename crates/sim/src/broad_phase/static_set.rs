@@ -1,9 +1,11 @@
-//! The static bodies, kept from one call to the next, and their structures (a tree or a grid
-//! per layer), built when the set changes and never per call.
+//! The static bodies, kept from one call to the next, and their structures (a tree, a grid,
+//! a quadtree or a dynamic tree per layer), built when the set changes and never per call.
 
 use ricochet_geom::Bounds;
 
 use super::hash_grid::HashGrid;
+use super::kept_tree::StaticDynamicTree;
+use super::quadtree::Quadtree;
 use super::static_tree::StaticTree;
 use super::{BodyEntry, BroadPhaseKind, LAYERS, Member, STATIC_BIT, Scratch};
 
@@ -27,10 +29,15 @@ pub(super) struct StaticSet {
     /// Whether `trees` (`SortAndSweep`) and `grids` (`Grid`) hold the current set.
     pub(super) built_trees: bool,
     pub(super) built_grids: bool,
+    /// Whether `quadtrees` (`Quadtree`) and `dynamic_trees` (`Tree`) hold the current set.
+    pub(super) built_quadtrees: bool,
+    pub(super) built_dynamic_trees: bool,
     /// Whether the broad phase's static strip lists (`Strips`) hold the current set.
     pub(super) built_strips: bool,
     pub(super) trees: Vec<StaticTree>,
     pub(super) grids: Vec<HashGrid>,
+    pub(super) quadtrees: Vec<Quadtree>,
+    pub(super) dynamic_trees: Vec<StaticDynamicTree>,
 }
 
 impl StaticSet {
@@ -75,10 +82,14 @@ impl StaticSet {
             .collect();
         self.built_trees = false;
         self.built_grids = false;
+        self.built_quadtrees = false;
+        self.built_dynamic_trees = false;
         self.built_strips = false;
         // Free the old structures now: a million tiles' worth should not linger.
         self.trees = Vec::new();
         self.grids = Vec::new();
+        self.quadtrees = Vec::new();
+        self.dynamic_trees = Vec::new();
     }
 
     /// Builds the structures `kind` queries, one per layer.
@@ -93,6 +104,18 @@ impl StaticSet {
         }
         if kind == BroadPhaseKind::SortAndSweep {
             self.trees = by_layer.into_iter().map(StaticTree::new).collect();
+        } else if kind == BroadPhaseKind::Quadtree {
+            self.quadtrees = by_layer
+                .into_iter()
+                .map(|members| {
+                    let mut q = Quadtree::default();
+                    q.members = members;
+                    q.build();
+                    q
+                })
+                .collect();
+        } else if kind == BroadPhaseKind::Tree {
+            self.dynamic_trees = by_layer.into_iter().map(StaticDynamicTree::new).collect();
         } else {
             self.grids = by_layer
                 .into_iter()

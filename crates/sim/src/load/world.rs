@@ -223,11 +223,15 @@ pub(crate) fn world_settings(
             "sort-and-sweep" => BroadPhaseKind::SortAndSweep,
             "grid" => BroadPhaseKind::Grid,
             "strips" => BroadPhaseKind::Strips,
+            "quadtree" => BroadPhaseKind::Quadtree,
+            "tree" => BroadPhaseKind::Tree,
             other => {
                 return Err(ctx.err(
                     k.span(),
                     "world.broad_phase",
-                    format!("expected auto, brute-force, sort-and-sweep, grid or strips, got \"{other}\""),
+                    format!(
+                        "expected auto, brute-force, sort-and-sweep, grid, strips, quadtree or tree, got \"{other}\""
+                    ),
                 ));
             }
         };

@@ -3,8 +3,10 @@
 //! in the same process on the same frames. [`measure`](mod@measure) runs one scene;
 //! [`report`] makes the table, the CSV and each scene's contact summaries; [`queries`] is
 //! `ricochet bench --queries` (rays and box overlaps against rapier's and Box2D's queries);
-//! [`snapshots`] is `ricochet bench --snapshots` (snapshot size and round-trip times).
+//! [`snapshots`] is `ricochet bench --snapshots` (snapshot size and round-trip times);
+//! [`broad_phases`] is `ricochet bench --broad-phases` (every broad phase on every scene).
 
+pub mod broad_phases;
 pub mod measure;
 pub mod queries;
 pub mod report;
