@@ -6,7 +6,7 @@
 //! [`digest`](ricochet_sim::World::digest), so that `scripts/determinism-gate.sh` can compare
 //! the output of x86-64, aarch64 (under qemu) and wasm32 (under Node) line by line.
 //!
-//! **Never:** reads the clock, uses threads, or formats floats: every printed value is an
+//! **Never:** reads the clock or formats floats: every printed value is an
 //! integer in hex, so no platform's float formatting can hide or fake a difference.
 
 use std::fmt::Write as _;
@@ -83,15 +83,18 @@ fn tiles_balls() -> Scenario {
 /// `out`: a header `scene NAME frames N bodies B`, a line `FRAME CHECKSUM DIGEST` per frame
 /// (both 16 hex digits), and `end NAME frames N bodies B hash DIGEST`, whose last three
 /// fields are a `recordings/*.digest` file's. `each` sees the simulation after every step
-/// (the log writer uses it).
+/// (the log writer uses it). `threads` as `Simulation::set_threads` takes it: a build
+/// without `ricochet-sim`'s `parallel` feature (wasm32) uses the calling thread whatever it
+/// says, and the output is the same.
 pub fn run(
     name: &str,
     scenario: &Scenario,
-    frames: u64,
+    (frames, threads): (u64, usize),
     out: &mut String,
     mut each: impl FnMut(&Simulation, &ricochet_sim::FrameOutput),
 ) {
     let mut sim = Simulation::new(scenario);
+    sim.set_threads(threads);
     let bodies = sim.world().len();
     let _ = writeln!(out, "scene {name} frames {frames} bodies {bodies}");
     for _ in 0..=frames {

@@ -1,10 +1,13 @@
-//! `ricochet-portable [--logs DIR] [--no-scenes] SCENARIO.toml...`: steps each scenario file
+//! `ricochet-portable [--threads N] [--logs DIR] [--no-scenes] SCENARIO.toml...`: steps each scenario file
 //! (up to [`MAX_FILE_FRAMES`] frames), then the built-in scenes, printing the gate's text
 //! (see the library docs) on stdout. `scripts/determinism-gate.sh` runs it natively, under
 //! qemu-aarch64 and under Node's WASI and compares the outputs.
 //!
 //! `--logs DIR` (feature `logs`) also writes each scenario file's log to `DIR/NAME.mcap`
 //! exactly as `ricochet test` records it, to compare with `recordings/` byte for byte.
+//!
+//! `--threads N` steps on N threads where the build has `ricochet-sim`'s `parallel` feature
+//! (natively; the default is 1); the output must not change.
 //!
 //! Exit codes: 0, or 2 with a message for a file that can't be read or loaded.
 
@@ -27,7 +30,7 @@ fn main() -> ExitCode {
 
 fn main_inner() -> Result<(), String> {
     let mut args = std::env::args().skip(1);
-    let (mut logs, mut scenes, mut files) = (None, true, Vec::new());
+    let (mut logs, mut scenes, mut files, mut threads) = (None, true, Vec::new(), 1);
     while let Some(arg) = args.next() {
         match arg.as_str() {
             "--logs" => {
@@ -36,9 +39,15 @@ fn main_inner() -> Result<(), String> {
                 ))
             }
             "--no-scenes" => scenes = false,
+            "--threads" => {
+                let n = args.next().ok_or("--threads needs a count")?;
+                threads = n
+                    .parse()
+                    .map_err(|e| format!("--threads {n:?}: not a count: {e}"))?;
+            }
             _ if arg.starts_with("--") => {
                 return Err(format!(
-                    "unknown option {arg:?}; usage: [--logs DIR] [--no-scenes] SCENARIO.toml..."
+                    "unknown option {arg:?}; usage: [--threads N] [--logs DIR] [--no-scenes] SCENARIO.toml..."
                 ));
             }
             _ => files.push(PathBuf::from(arg)),
@@ -58,8 +67,8 @@ fn main_inner() -> Result<(), String> {
         let frames = scenario.frames.min(MAX_FILE_FRAMES);
         text.clear();
         match &logs {
-            Some(dir) => record(dir, &name, &scenario, frames, &mut text)?,
-            None => run(&name, &scenario, frames, &mut text, |_, _| {}),
+            Some(dir) => record(dir, &name, &scenario, (frames, threads), &mut text)?,
+            None => run(&name, &scenario, (frames, threads), &mut text, |_, _| {}),
         }
         stdout
             .lock()
@@ -69,7 +78,13 @@ fn main_inner() -> Result<(), String> {
     if scenes {
         for (name, scenario) in builtin_scenes() {
             text.clear();
-            run(&name, &scenario, scenario.frames, &mut text, |_, _| {});
+            run(
+                &name,
+                &scenario,
+                (scenario.frames, threads),
+                &mut text,
+                |_, _| {},
+            );
             stdout
                 .lock()
                 .write_all(text.as_bytes())
@@ -86,7 +101,7 @@ fn record(
     dir: &Path,
     name: &str,
     scenario: &ricochet_sim::Scenario,
-    frames: u64,
+    frames: (u64, usize),
     text: &mut String,
 ) -> Result<(), String> {
     use ricochet_record::{Channels, Recorder};
@@ -111,7 +126,7 @@ fn record(
     _dir: &Path,
     _name: &str,
     _scenario: &ricochet_sim::Scenario,
-    _frames: u64,
+    _frames: (u64, usize),
     _text: &mut String,
 ) -> Result<(), String> {
     Err("--logs needs the `logs` feature (cargo build --features logs)".into())
