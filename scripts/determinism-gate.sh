@@ -3,7 +3,7 @@
 # and wasm32, and on aarch64 the same log bytes as recordings/.
 #
 #   bash scripts/determinism-gate.sh              # what .ci/run runs
-#   bash scripts/determinism-gate.sh --self-test  # platform sin in one stage: must FAIL
+#   bash scripts/determinism-gate.sh --self-test  # platform sin_cos: must FAIL
 #
 # 1. installs Debian's Rust with its std source, the aarch64 cross gcc, qemu-user and
 #    wasi-libc (apt, once; skipped when present);
@@ -125,7 +125,7 @@ phase "done"
 
 if $self_test; then
     if [ "$verdict" -eq 0 ]; then
-        echo "self-test: platform sin in the ship's thrust was NOT caught"
+        echo "self-test: platform sin_cos (the ship's thrust, the shapes' poses) was NOT caught"
         exit 1
     fi
     echo "self-test: the gate caught platform sin (above), as it must"

@@ -37,7 +37,45 @@ pub fn builtin_scenes() -> Vec<(String, Scenario)> {
         ("rain-300".into(), rain(300, SCENE_FRAMES)),
         ("tiles-boxes".into(), tiles_boxes()),
         ("tiles-balls".into(), tiles_balls()),
+        ("ship-circling".into(), ship_circling()),
     ]
+}
+
+/// A ship that turns and thrusts for the whole run, its heading through hundreds of
+/// angles: the one place trigonometry feeds the state (thrust), exercised at every frame.
+/// The bench scenes' rotations only place shapes, whose contacts there push nothing.
+const SHIP_CIRCLING: &str = r#"
+name = "ship-circling"
+hz = 60
+frames = 300
+layers = ["ship", "bullet"]
+script = [
+  { frame = 0, action = "turn", body = "ship", input = 1 },
+  { frame = 0, action = "thrust", body = "ship", on = true },
+  { frame = 97, action = "turn", body = "ship", input = -0.37 },
+  { frame = 211, action = "turn", body = "ship", input = 0.81 },
+]
+
+[world]
+bounds = { min = [-40, -25], max = [40, 25], wrap = true }
+
+[templates.bullet]
+layer = "bullet"
+shape = { kind = "circle", radius = 0.2 }
+mass = 0.05
+
+[[bodies]]
+name = "ship"
+layer = "ship"
+shape = { kind = "polygon", vertices = [[1.2, 0.0], [-0.8, 0.7], [-0.8, -0.7]] }
+mass = 1
+controller = { kind = "ship", thrust = 12, turn_rate = 3.3, bullet = "bullet", bullet_speed = 30, muzzle = 1.5 }
+"#;
+
+/// [`SHIP_CIRCLING`], loaded.
+fn ship_circling() -> Scenario {
+    ricochet_sim::load_scenario(SHIP_CIRCLING, "ship-circling.toml")
+        .expect("the gate's built-in scene is valid")
 }
 
 /// A floor and two walls, and a column of boxes dropped at staggered x so they topple.
