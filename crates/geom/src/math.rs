@@ -23,7 +23,7 @@ impl Rot {
         if angle == 0.0 {
             return Rot::IDENTITY;
         }
-        let (s, c) = libm::sincos(angle);
+        let (s, c) = sincos(angle);
         Rot { c, s }
     }
 
@@ -81,4 +81,22 @@ pub(crate) fn cross(a: Vec2, b: Vec2) -> f64 {
 #[must_use]
 pub(crate) fn right_perp(v: Vec2) -> Vec2 {
     Vec2::new(v.y, -v.x)
+}
+
+/// `(sin, cos)` through `libm`: the same bits on every platform.
+#[cfg(not(feature = "gate-self-test-std-sin"))]
+fn sincos(angle: f64) -> (f64, f64) {
+    libm::sincos(angle)
+}
+
+/// The determinism gate's self-test only (`scripts/determinism-gate.sh --self-test`): the
+/// platform's `sin_cos` for every rotated shape, which glibc and wasm32 round differently
+/// for some angles, so the gate must fail. Never on in a real build.
+#[cfg(feature = "gate-self-test-std-sin")]
+#[expect(
+    clippy::disallowed_methods,
+    reason = "the gate's self-test puts platform trigonometry in on purpose"
+)]
+fn sincos(angle: f64) -> (f64, f64) {
+    angle.sin_cos()
 }

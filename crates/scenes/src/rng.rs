@@ -33,9 +33,10 @@ impl Rng {
         lo + (hi - lo) * self.unit()
     }
 
-    /// Uniform in `0..n` (`n` at most 2³²).
+    /// Uniform in `0..n` (`n` at most 2³²). Computed in `u64`, so the same numbers come out
+    /// where `usize` is 32 bits (wasm32), where the product would overflow.
     pub fn below(&mut self, n: usize) -> usize {
-        ((self.next_u64() >> 32) as usize * n) >> 32
+        (((self.next_u64() >> 32) * n as u64) >> 32) as usize
     }
 
     /// A random direction times `speed`.

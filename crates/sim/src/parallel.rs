@@ -11,23 +11,32 @@
 //! pair's exact contact at the poses the pass starts from. A pair whose body was pushed by an
 //! earlier pair of the same pass is tested again, in order, where it is met, exactly as
 //! with one thread.
+//!
+//! Without the `parallel` feature (on by default) there is no pool and no `rayon`: every map
+//! runs on the calling thread, which is what a pool of one thread does anyway, so the results
+//! are the same bits. That is the build for targets without threads (wasm32), which the
+//! determinism gate (`scripts/determinism-gate.sh`) checks against the threaded one.
 
+#[cfg(feature = "parallel")]
 use std::sync::Arc;
 
 /// Below this many items a map runs on the calling thread: handing work to a pool costs a
 /// few microseconds.
+#[cfg(feature = "parallel")]
 const MIN_PARALLEL: usize = 256;
 
 /// A pool of worker threads besides the calling one (none with one thread in all), shared
 /// by clones of a simulation.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Workers {
+    #[cfg(feature = "parallel")]
     pool: Option<Arc<rayon::ThreadPool>>,
 }
 
 impl Workers {
     /// `threads` threads in all, the calling one included (0 counts as 1). Without a pool
     /// (one thread, or a pool the system refuses) every map runs on the calling thread.
+    #[cfg(feature = "parallel")]
     pub(crate) fn new(threads: usize) -> Workers {
         let pool = (threads > 1)
             .then(|| {
@@ -42,16 +51,30 @@ impl Workers {
         Workers { pool }
     }
 
+    /// Without the `parallel` feature there are no workers: `threads` is ignored.
+    #[cfg(not(feature = "parallel"))]
+    pub(crate) fn new(_threads: usize) -> Workers {
+        Workers {}
+    }
+
     /// How many threads a map uses, the calling one included.
+    #[cfg(feature = "parallel")]
     pub(crate) fn threads(&self) -> usize {
         self.pool
             .as_ref()
             .map_or(1, |p| p.current_num_threads() + 1)
     }
 
+    /// How many threads a map uses: the calling one only, without the `parallel` feature.
+    #[cfg(not(feature = "parallel"))]
+    pub(crate) fn threads(&self) -> usize {
+        1
+    }
+
     /// `out` (cleared first) becomes `[f(0), f(1), ..., f(n - 1)]`, computed on the pool's
     /// threads when there are enough items: one contiguous chunk per thread, the calling
     /// thread computing the first while the workers compute the others, gathered in order.
+    #[cfg(feature = "parallel")]
     pub(crate) fn map<T, F>(&self, n: usize, f: F, out: &mut Vec<T>)
     where
         T: Send,
@@ -76,5 +99,16 @@ impl Workers {
         for part in &mut rest {
             out.append(part);
         }
+    }
+
+    /// `out` (cleared first) becomes `[f(0), f(1), ..., f(n - 1)]`, on the calling thread:
+    /// the build without the `parallel` feature.
+    #[cfg(not(feature = "parallel"))]
+    pub(crate) fn map<T, F>(&self, n: usize, f: F, out: &mut Vec<T>)
+    where
+        F: Fn(usize) -> T,
+    {
+        out.clear();
+        out.extend((0..n).map(f));
     }
 }

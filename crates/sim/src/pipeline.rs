@@ -210,7 +210,8 @@ impl Simulation {
 
     /// Runs the parallel stages on `threads` threads in all (0 or 1: the calling thread
     /// only, the default). The thread count changes the time a step takes, never its
-    /// result: every log is the same bytes with any count.
+    /// result: every log is the same bytes with any count. Without the crate's `parallel`
+    /// feature (on by default) there is only the calling thread, whatever `threads` says.
     pub fn set_threads(&mut self, threads: usize) {
         if threads != self.threads() {
             self.workers = Workers::new(threads);

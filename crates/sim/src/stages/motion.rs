@@ -54,11 +54,29 @@ pub(crate) fn controls(w: &mut World) {
 fn thrust(controller: &Controller, inputs: &Inputs, angle: f64) -> Vec2 {
     match controller {
         Controller::Ship { thrust, .. } if inputs.thrust => {
-            let (s, c) = libm::sincos(angle);
+            let (s, c) = heading(angle);
             Vec2::new(c, s) * *thrust
         }
         _ => Vec2::ZERO,
     }
+}
+
+/// `(sin, cos)` of a heading, through `libm`: the same bits on every platform.
+#[cfg(not(feature = "gate-self-test-std-sin"))]
+fn heading(angle: f64) -> (f64, f64) {
+    libm::sincos(angle)
+}
+
+/// The determinism gate's self-test only (`scripts/determinism-gate.sh --self-test`): the
+/// platform's `sin` and `cos`, which differ between glibc and wasm32 in the last bit for some
+/// angles, so the gate must fail. Never on in a real build.
+#[cfg(feature = "gate-self-test-std-sin")]
+#[expect(
+    clippy::disallowed_methods,
+    reason = "the gate's self-test puts platform trigonometry in on purpose"
+)]
+fn heading(angle: f64) -> (f64, f64) {
+    angle.sin_cos()
 }
 
 /// Whether any force (gravity, thrust, a constant force) acts on a body.
