@@ -100,8 +100,10 @@ impl<K: Ord + Clone, V> Interned<K, V> {
     }
 }
 
-/// The shapes of the world, one copy each, each with its bounds at angle 0 relative to the
-/// body (scenery's bounds). Two shapes share an id only when they are the same bit for bit
+/// The shapes of the world, one copy each with each name it goes with, each with its bounds
+/// at angle 0 relative to the body (scenery's bounds). An id is a shape and a name id
+/// together (a body's *look*): a million tiles hold one `u32` a body for both, not two.
+/// Two shapes share an id only when they are the same bit for bit
 /// (`-0.0` and `0.0` are different shapes here; `==` would call them equal): they are found
 /// by a hash of those bits ([`shape_key`]), and a candidate's bits are compared in full. The
 /// bits are not kept: a scene of 100,000 different asteroids keeps each shape once and 16
@@ -110,22 +112,32 @@ impl<K: Ord + Clone, V> Interned<K, V> {
 pub(crate) struct ShapeTable {
     /// Each id's shape and bounds (`None` once no body uses it).
     entries: Vec<Option<(Shape, Bounds)>>,
+    /// Each id's name id (in the world's name table).
+    names: Vec<u32>,
     /// How many bodies use each id.
     users: Vec<u32>,
     /// Ids no body uses, to reuse.
     free: Vec<u32>,
-    /// `(hash of the shape's bits, id)` of every shape in use.
+    /// `(hash of the shape's bits and name id, id)` of every id in use.
     ids: BTreeSet<(u64, u32)>,
     /// A candidate's bits, while comparing.
     scratch: Vec<u64>,
 }
 
 impl ShapeTable {
-    /// The id of the shape whose bits are `key` ([`shape_key`]), one more user counted;
-    /// `value` makes it (with its bounds) when it is new.
-    pub(crate) fn acquire(&mut self, key: &[u64], value: impl FnOnce() -> (Shape, Bounds)) -> u32 {
-        let hash = fnv1a(key);
+    /// The id of the shape whose bits are `key` ([`shape_key`]) with name id `name`, one
+    /// more user counted; `value` makes it (with its bounds) when it is new.
+    pub(crate) fn acquire(
+        &mut self,
+        key: &[u64],
+        name: u32,
+        value: impl FnOnce() -> (Shape, Bounds),
+    ) -> u32 {
+        let hash = fnv1a(key, name);
         for &(_, id) in self.ids.range((hash, 0)..=(hash, u32::MAX)) {
+            if self.names[id as usize] != name {
+                continue;
+            }
             let (shape, _) = self.entries[id as usize].as_ref().expect("an id in use");
             shape_key(shape, &mut self.scratch);
             if self.scratch.as_slice() == key {
@@ -137,17 +149,25 @@ impl ShapeTable {
         let id = match self.free.pop() {
             Some(id) => {
                 self.entries[id as usize] = entry;
+                self.names[id as usize] = name;
                 self.users[id as usize] = 1;
                 id
             }
             None => {
                 self.entries.push(entry);
+                self.names.push(name);
                 self.users.push(1);
                 u32::try_from(self.entries.len() - 1).expect("fewer than 2^32 distinct shapes")
             }
         };
         self.ids.insert((hash, id));
         id
+    }
+
+    /// The name id of an id.
+    #[inline]
+    pub(crate) fn name(&self, id: u32) -> u32 {
+        self.names[id as usize]
     }
 
     /// One user of `id` fewer; the shape is dropped with its last user.
@@ -158,7 +178,8 @@ impl ShapeTable {
             && let Some((shape, _)) = self.entries[id as usize].take()
         {
             shape_key(&shape, &mut self.scratch);
-            self.ids.remove(&(fnv1a(&self.scratch), id));
+            let hash = fnv1a(&self.scratch, self.names[id as usize]);
+            self.ids.remove(&(hash, id));
             self.free.push(id);
         }
     }
@@ -182,6 +203,7 @@ impl ShapeTable {
     /// Heap bytes held (a compound's parts not included).
     pub(crate) fn heap_bytes(&self) -> usize {
         self.entries.capacity() * size_of::<Option<(Shape, Bounds)>>()
+            + self.names.capacity() * 4
             + self.users.capacity() * 4
             + self.free.capacity() * 4
             // A B-tree node holds up to 11 keys; count each entry at a full node's share.
@@ -190,11 +212,11 @@ impl ShapeTable {
     }
 }
 
-/// A 64-bit FNV-1a hash of `key`'s words: fixed, so the table's layout is a function of the
-/// shapes alone (it never reaches an output anyway).
-fn fnv1a(key: &[u64]) -> u64 {
+/// A 64-bit FNV-1a hash of `key`'s words and `name`: fixed, so the table's layout is a
+/// function of the shapes and names alone (it never reaches an output anyway).
+fn fnv1a(key: &[u64], name: u32) -> u64 {
     let mut h = 0xcbf2_9ce4_8422_2325_u64;
-    for &w in key {
+    for &w in key.iter().chain([&u64::from(name)]) {
         for b in w.to_le_bytes() {
             h = (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
         }
@@ -268,7 +290,7 @@ mod tests {
         let mut key = Vec::new();
         let mut id = |t: &mut ShapeTable, s: &Shape| {
             shape_key(s, &mut key);
-            t.acquire(key.as_slice(), || {
+            t.acquire(key.as_slice(), 0, || {
                 (s.clone(), s.bounds(&ricochet_geom::Pose::default()))
             })
         };
@@ -289,5 +311,13 @@ mod tests {
         assert_eq!(c, b, "the freed id is reused");
         t.release(a);
         assert_eq!(t.get(a).0, tile, "one user left");
+        // The same shape with another name: another id, that name's.
+        shape_key(&tile, &mut key);
+        let bounds = tile.bounds(&ricochet_geom::Pose::default());
+        let named = t.acquire(key.as_slice(), 7, || (tile.clone(), bounds));
+        assert_ne!(named, a);
+        assert_eq!((&t.get(named).0, t.name(named), t.name(a)), (&tile, 7, 0));
+        let again = t.acquire(key.as_slice(), 7, || unreachable!("the id is in use"));
+        assert_eq!(again, named);
     }
 }

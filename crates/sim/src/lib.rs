@@ -132,6 +132,7 @@ mod def;
 mod entity;
 mod event;
 mod interned;
+mod limits;
 #[cfg(feature = "toml")]
 mod load;
 mod output;

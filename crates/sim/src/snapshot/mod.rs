@@ -45,8 +45,8 @@
 //! # The baseline
 //!
 //! A simulation keeps its world as it was built, before the first step (shared by its
-//! clones), packed: scenery in runs of ids at regular places (a tile map's rows) costs 32
-//! bytes a run, not 46 a body (`world/state/packed.rs`). The first snapshot, restore or
+//! clones), packed: scenery in runs of ids at regular places (a tile map's rows) costs a
+//! few bytes a run, not 42 a body (`world/state/packed.rs`). The first snapshot, restore or
 //! checksum unpacks it and keeps the copy. A snapshot writes the bodies as
 //! they differ from it (`world/state/`): runs of bodies kept or dropped, a mask of the
 //! field groups that changed, and whole records for bodies spawned later or redefined. A

@@ -193,8 +193,7 @@ fn change_other(sim: &mut Simulation, field: &str, i: usize) {
         "angle" => w.angle[i] = -0.0,
         "shape" => w.set_shape(i, &Shape::circle(0.25).expect("radius")),
         "name" => {
-            let wall = w.find("wall").expect("the wall");
-            w.name_id[i] = w.name_id[wall];
+            w.set_name(i, "wall");
         }
         "has_row" => {
             let wall = w.find("wall").expect("the wall");

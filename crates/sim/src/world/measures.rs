@@ -93,7 +93,6 @@ impl World {
             + cap(&self.position)
             + cap(&self.angle)
             + cap(&self.shape_id)
-            + cap(&self.name_id)
             + cap(&self.row)
             + self.shapes.heap_bytes()
             + compound_parts

@@ -10,9 +10,10 @@
 //! A level's tiles are most of its bodies and need almost nothing, so the columns come in
 //! two sets:
 //! - **Every body** (public `Vec`s, indexed by the dense index): `entity`, `layer`, `kind`,
-//!   `position`, `angle`; and, private, a shape id and a name id into tables holding each
-//!   distinct shape and name once ([`World::shape`], [`World::name`]), and the body's row.
-//!   46 bytes a body.
+//!   `position`, `angle`; and, private, a *look* id into a table holding each distinct
+//!   shape once for each name it goes with (the look's name an id into a table of each
+//!   distinct name once: [`World::shape`], [`World::name`]), and the body's row. 42 bytes
+//!   a body.
 //! - **Rows**, for every body that is not *scenery*: the state only moving bodies, or static
 //!   ones with a lifetime, a controller, children, or a mass, force or gravity scale other
 //!   than the defaults, have (velocity, force, lifetime, controller, inputs, carrier,
@@ -76,13 +77,12 @@ pub struct World {
     pub position: Vec<Vec2>,
     /// Angle, radians.
     pub angle: Vec<f64>,
-    /// Each body's shape in `shapes`.
+    /// Each body's look (shape and name) in `shapes`.
     shape_id: Vec<u32>,
-    /// Each body's name in `names`.
-    name_id: Vec<u32>,
     /// Each body's row in `rows`, or [`NO_ROW`] for scenery.
     row: Vec<u32>,
-    /// Every shape a body has, once, with its bounds at angle 0 relative to the body.
+    /// Every shape a body has, once for each name it goes with, with its bounds at angle 0
+    /// relative to the body.
     shapes: ShapeTable,
     /// Every name a body has, once.
     names: NameTable,
@@ -125,7 +125,6 @@ impl World {
         self.position.reserve_exact(additional);
         self.angle.reserve_exact(additional);
         self.shape_id.reserve_exact(additional);
-        self.name_id.reserve_exact(additional);
         self.row.reserve_exact(additional);
         self.ids.reserve(additional);
     }
@@ -152,7 +151,8 @@ impl World {
     #[must_use]
     pub fn find(&self, name: &str) -> Option<usize> {
         let id = self.names.id(name)?;
-        self.name_id.iter().position(|&n| n == id)
+        let shapes = &self.shapes;
+        self.shape_id.iter().position(|&s| shapes.name(s) == id)
     }
 
     /// Body `i`'s collision shape, local coordinates.
@@ -165,7 +165,7 @@ impl World {
     /// Body `i`'s name.
     #[must_use]
     pub fn name(&self, i: usize) -> &str {
-        self.names.key(self.name_id[i])
+        self.names.key(self.shapes.name(self.shape_id[i]))
     }
 
     /// Body `i`'s position at the start of the current frame (where a swept test starts).
@@ -281,10 +281,9 @@ impl World {
         let i = self.entity.partition_point(|x| *x < e);
         self.entity.insert(i, e);
         let name = self.names.acquire(def.name.as_str(), || ());
-        self.name_id.insert(i, name);
         self.layer.insert(i, def.layer);
         shape_key(&def.shape, &mut self.key);
-        let shape = self.shapes.acquire(self.key.as_slice(), || {
+        let shape = self.shapes.acquire(self.key.as_slice(), name, || {
             let zero = def.shape.bounds(&Pose::new(Vec2::ZERO, 0.0));
             (def.shape.clone(), zero)
         });
@@ -350,9 +349,9 @@ impl World {
     pub fn despawn(&mut self, i: usize) {
         let e = self.entity.remove(i);
         self.ids.free(e);
-        self.names.release(self.name_id.remove(i));
         let layer = self.layer.remove(i);
         let shape = self.shape_id.remove(i);
+        self.names.release(self.shapes.name(shape));
         if !self.shapes.get(shape).0.is_single_aabb() {
             self.non_boxes[usize::from(layer)] -= 1;
         }
@@ -434,11 +433,12 @@ impl World {
             self.non_boxes[layer] -= 1;
         }
         shape_key(shape, &mut self.key);
-        let new = self.shapes.acquire(self.key.as_slice(), || {
+        let name = self.shapes.name(old);
+        let new = self.shapes.acquire(self.key.as_slice(), name, || {
             let zero = shape.bounds(&Pose::new(Vec2::ZERO, 0.0));
             (shape.clone(), zero)
         });
-        // Acquired before the old one is released: a shape used by this body alone keeps
+        // Acquired before the old one is released: a look used by this body alone keeps
         // its id when it is given again.
         self.shapes.release(old);
         self.shape_id[i] = new;
@@ -459,6 +459,18 @@ impl World {
             self.wake(i);
             self.refresh_active();
         }
+    }
+
+    /// Renames body `i` (tests: no stage renames a body).
+    #[cfg(test)]
+    pub(crate) fn set_name(&mut self, i: usize, name: &str) {
+        let old = self.shape_id[i];
+        let id = self.names.acquire(name, || ());
+        shape_key(&self.shapes.get(old).0, &mut self.key);
+        let shape = self.shapes.get(old).clone();
+        self.shape_id[i] = self.shapes.acquire(self.key.as_slice(), id, || shape);
+        self.names.release(self.shapes.name(old));
+        self.shapes.release(old);
     }
 
     /// Sets body `i`'s [`World::user_data`] (a body of scenery is given a row first).

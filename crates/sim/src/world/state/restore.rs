@@ -200,19 +200,20 @@ impl World {
         self.insert(x.entity, &def);
         let i = self.len() - 1;
         let k = self.row_of(i);
-        let m = &row.motion;
         let rows = &mut self.rows;
         // A static body's velocity stays zero in its row as `spawn` makes it.
         rows.velocity[k] = def.velocity;
         rows.angular_velocity[k] = def.angular_velocity;
-        rows.inputs[k] = m.inputs;
-        rows.grounded[k] = m.grounded;
-        rows.on_static[k] = m.on_static;
-        rows.carrier[k] = m.carrier;
-        rows.still[k] = m.still;
-        rows.frozen[k] = m.frozen;
         rows.local_bounds[k] = LocalBounds::restored(&def.shape, def.angle, row.turned);
+        // Awake until every body is in: a static body inserted later wakes every sleeper.
+        let m = row.motion;
         sleep.push((k, m.asleep, m.rest_frames));
+        let awake = Motion {
+            asleep: false,
+            rest_frames: 0,
+            ..m
+        };
+        self.set_motion(k, &awake);
     }
 }
 
