@@ -157,22 +157,43 @@ impl Axes {
 }
 
 /// The smallest separating-axis overlap of two cores (radii not included) and the direction
-/// (from `a` to `b`) it is reached in. `None` when there is no axis at all: two coincident
-/// points.
-fn min_overlap(a: &Core, b: &Core) -> Option<(f64, Vec2)> {
+/// (from `a` to `b`) it is reached in; or, as soon as an axis's overlap is below `stop`, that
+/// axis's (the search stops there: the cores are at least that far apart). `None` when there
+/// is no axis at all: two coincident points.
+fn min_overlap(a: &Core, b: &Core, stop: f64) -> Option<(f64, Vec2)> {
     let axes = Axes::of(a, b);
     let mut best: Option<(f64, Vec2)> = None;
     for &u in &axes.axes[..axes.len] {
         let (amin, amax) = a.project(u);
         let (bmin, bmax) = b.project(u);
         // Moving b along +u by (amax - bmin) separates the cores; along -u by (bmax - amin).
-        for (overlap, dir) in [(amax - bmin, u), (bmax - amin, -u)] {
+        let (plus, minus) = (amax - bmin, bmax - amin);
+        if plus < stop {
+            return Some((plus, u));
+        }
+        if minus < stop {
+            return Some((minus, -u));
+        }
+        for (overlap, dir) in [(plus, u), (minus, -u)] {
             if best.is_none_or(|(o, _)| overlap < o) {
                 best = Some((overlap, dir));
             }
         }
     }
     best
+}
+
+/// A length far above the rounding of any projection or distance between these cores and of
+/// `threshold - ra - rb` (about 1e-16 of the largest of their coordinates and the threshold),
+/// far below any gap that matters; NaN or infinite when any of those is, so that nothing is
+/// ruled out then.
+fn margin(a: &Core, b: &Core, threshold: f64) -> f64 {
+    let size = |c: &Core| {
+        c.points()
+            .iter()
+            .fold(c.radius, |s, p| s + p.x.abs() + p.y.abs())
+    };
+    1e-9 * (1.0 + threshold.abs() + size(a) + size(b))
 }
 
 /// The closest points of two cores that do not intersect: `(distance, on_a, on_b, normal)`,
@@ -273,8 +294,44 @@ fn penetration_point(a: &Core, b: &Core, normal: Vec2) -> Vec2 {
 /// The contact of two cores in one frame. See the module docs for why it is exact.
 #[must_use]
 pub fn collide_cores(a: &Core, b: &Core) -> Contact {
+    finish(a, b, min_overlap(a, b, f64::NEG_INFINITY))
+}
+
+/// `collide_cores(a, b)`, with the same bits; or `None` when an axis alone shows that its
+/// depth is at most `threshold` (then the rest of the axes and the closest-point scan, the
+/// costly part for a pair apart, are skipped).
+///
+/// The depth of two cores is at most `ra + rb` plus the overlap along any one axis (the gap
+/// along an axis is at most the distance), so an axis whose overlap is below
+/// `threshold - ra - rb` by more than a margin rules the pair out. The margin, far above the
+/// rounding of either computation, keeps the verdict the exact algorithm's.
+pub(crate) fn collide_cores_unless(a: &Core, b: &Core, threshold: f64) -> Option<Contact> {
+    let stop = threshold - (a.radius + b.radius) - margin(a, b, threshold);
+    // The direction between the cores' centres first: for a pair apart it is usually close
+    // to the best separating axis, and one projection rules most such pairs out.
+    let u = (centre(b) - centre(a)).normalize_or_zero();
+    if u != Vec2::ZERO {
+        let ((_, amax), (bmin, _)) = (a.project(u), b.project(u));
+        if amax - bmin < stop {
+            return None;
+        }
+    }
+    let least = min_overlap(a, b, stop);
+    if least.is_some_and(|(overlap, _)| overlap < stop) {
+        return None;
+    }
+    Some(finish(a, b, least))
+}
+
+/// The mean of a core's points.
+fn centre(c: &Core) -> Vec2 {
+    c.points().iter().fold(Vec2::ZERO, |s, p| s + *p) / c.count as f64
+}
+
+/// [`collide_cores`] after the separating-axis pass found `least` (its smallest overlap).
+fn finish(a: &Core, b: &Core, least: Option<(f64, Vec2)>) -> Contact {
     let r = a.radius + b.radius;
-    let Some((overlap, dir)) = min_overlap(a, b) else {
+    let Some((overlap, dir)) = least else {
         // Two coincident points (concentric circles): every direction is equally short.
         // Pick +y, so a body spawned inside another pops up, as a platformer expects.
         return Contact {
