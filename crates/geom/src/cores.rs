@@ -32,9 +32,6 @@ pub struct Core {
     pub(crate) radius: f64,
 }
 
-/// The most candidate axes two cores can produce: 8 normals each.
-const MAX_AXES: usize = 2 * MAX_POLYGON_VERTICES;
-
 impl Core {
     pub(crate) fn point(p: Vec2, radius: f64) -> Core {
         let mut points = [Vec2::ZERO; MAX_POLYGON_VERTICES];
@@ -110,50 +107,38 @@ impl Core {
         if self.count <= 2 { 1 } else { self.count }
     }
 
-    /// Pushes this core's candidate axes: polygon edge normals, or a segment's normal and
-    /// direction (its end caps).
-    fn push_axes(&self, axes: &mut Axes) {
+    /// This core's candidate axes: polygon edge normals, or a segment's normal and direction
+    /// (its end caps), written to `segment`; none for a point.
+    fn axes<'a>(&'a self, segment: &'a mut [Vec2; 2]) -> &'a [Vec2] {
         match self.count {
-            1 => {}
+            1 => &[],
             2 => {
                 let d = (self.points[1] - self.points[0]).normalize();
-                axes.push(right_perp(d));
-                axes.push(d);
+                *segment = [right_perp(d), d];
+                segment
             }
-            n => {
-                for u in &self.normals[..n] {
-                    axes.push(*u);
-                }
-            }
+            n => &self.normals[..n],
         }
     }
 }
 
-struct Axes {
-    axes: [Vec2; MAX_AXES],
-    len: usize,
-}
-
-impl Axes {
-    fn push(&mut self, u: Vec2) {
-        if self.len < MAX_AXES && u.is_finite() {
-            self.axes[self.len] = u;
-            self.len += 1;
+/// Calls `f` on the candidate axes of a pair in order (`a`'s, `b`'s, and for two points the
+/// direction between them; a non-finite one, from a degenerate edge, left out) until it
+/// returns `Some`, and returns that. Read in place: nothing is copied.
+#[inline]
+fn each_axis<T>(a: &Core, b: &Core, mut f: impl FnMut(Vec2) -> Option<T>) -> Option<T> {
+    let (mut sa, mut sb) = ([Vec2::ZERO; 2], [Vec2::ZERO; 2]);
+    let between = (a.count == 1 && b.count == 1 && a.points[0] != b.points[0])
+        .then(|| (b.points[0] - a.points[0]).normalize());
+    let (axes_a, axes_b) = (a.axes(&mut sa), b.axes(&mut sb));
+    for &u in axes_a.iter().chain(axes_b).chain(&between) {
+        if u.is_finite()
+            && let Some(t) = f(u)
+        {
+            return Some(t);
         }
     }
-
-    fn of(a: &Core, b: &Core) -> Axes {
-        let mut axes = Axes {
-            axes: [Vec2::ZERO; MAX_AXES],
-            len: 0,
-        };
-        a.push_axes(&mut axes);
-        b.push_axes(&mut axes);
-        if a.count == 1 && b.count == 1 && a.points[0] != b.points[0] {
-            axes.push((b.points[0] - a.points[0]).normalize());
-        }
-        axes
-    }
+    None
 }
 
 /// The smallest separating-axis overlap of two cores (radii not included) and the direction
@@ -161,9 +146,8 @@ impl Axes {
 /// axis's (the search stops there: the cores are at least that far apart). `None` when there
 /// is no axis at all: two coincident points.
 fn min_overlap(a: &Core, b: &Core, stop: f64) -> Option<(f64, Vec2)> {
-    let axes = Axes::of(a, b);
     let mut best: Option<(f64, Vec2)> = None;
-    for &u in &axes.axes[..axes.len] {
+    let early = each_axis(a, b, |u| {
         let (amin, amax) = a.project(u);
         let (bmin, bmax) = b.project(u);
         // Moving b along +u by (amax - bmin) separates the cores; along -u by (bmax - amin).
@@ -179,8 +163,9 @@ fn min_overlap(a: &Core, b: &Core, stop: f64) -> Option<(f64, Vec2)> {
                 best = Some((overlap, dir));
             }
         }
-    }
-    best
+        None
+    });
+    early.or(best)
 }
 
 /// A length far above the rounding of any projection or distance between these cores and of
@@ -367,19 +352,23 @@ fn finish(a: &Core, b: &Core, least: Option<(f64, Vec2)>) -> Contact {
 #[must_use]
 pub fn overlaps_cores(a: &Core, b: &Core) -> bool {
     let r = a.radius + b.radius;
-    let axes = Axes::of(a, b);
-    if axes.len == 0 {
-        return r > 0.0;
-    }
-    let mut least = f64::INFINITY;
-    for &u in &axes.axes[..axes.len] {
+    let (mut any, mut least) = (false, f64::INFINITY);
+    let apart = each_axis(a, b, |u| {
+        any = true;
         let (amin, amax) = a.project(u);
         let (bmin, bmax) = b.project(u);
         let overlap = (amax - bmin).min(bmax - amin);
         if overlap + r <= 0.0 {
-            return false;
+            return Some(());
         }
         least = least.min(overlap);
+        None
+    });
+    if apart.is_some() {
+        return false;
+    }
+    if !any {
+        return r > 0.0;
     }
     if least >= 0.0 {
         return least + r > 0.0;
