@@ -175,7 +175,7 @@ fn the_early_out_keeps_every_shared_case_exact() {
             assert_eq!(
                 got.map(bits),
                 want.map(bits),
-                "case {} at {threshold}",
+                "case {} at {threshold:e}",
                 case.id
             );
         }
