@@ -11,7 +11,7 @@
 
 use std::collections::BTreeMap;
 
-use ricochet_geom::{Case, Pose, Vec2, contact, parse_case_file};
+use ricochet_geom::{Case, Contact, Pose, Vec2, contact, contact_deeper_than, parse_case_file};
 use serde_json::Value;
 
 use crate::util::data;
@@ -151,4 +151,33 @@ fn every_shared_case_matches_its_ground_truth() {
             .sum::<usize>();
     }
     assert_eq!(per_pair.len(), 15, "{report}");
+}
+
+/// The narrow phase's early-out (`contact_deeper_than`, what `detect` calls for pairs that
+/// don't `separate`) on the 3000 shared cases: the ground truth's overlap yes/no wherever it
+/// is not ambiguous, and `contact`'s bits wherever it answers, at thresholds around each
+/// case's own depth (one ulp either side, where a slip in its margin would show).
+#[test]
+fn the_early_out_keeps_every_shared_case_exact() {
+    let bits =
+        |c: Contact| [c.depth, c.normal.x, c.normal.y, c.point.x, c.point.y].map(f64::to_bits);
+    for (case, truth) in &load() {
+        let (a, b) = (&case.a, &case.b);
+        let exact = contact(&a.shape, &a.pose, &b.shape, &b.pose);
+        let overlap = contact_deeper_than(&a.shape, &a.pose, &b.shape, &b.pose, 0.0);
+        if truth.class != "ambiguous" {
+            assert_eq!(overlap.is_some(), truth.overlap, "case {}", case.id);
+        }
+        let d = exact.depth;
+        for threshold in [0.0, d, d.next_down(), d.next_up(), d - 1e-6, d + 1e-6] {
+            let want = (d > threshold).then_some(exact);
+            let got = contact_deeper_than(&a.shape, &a.pose, &b.shape, &b.pose, threshold);
+            assert_eq!(
+                got.map(bits),
+                want.map(bits),
+                "case {} at {threshold:e}",
+                case.id
+            );
+        }
+    }
 }

@@ -32,9 +32,6 @@ pub struct Core {
     pub(crate) radius: f64,
 }
 
-/// The most candidate axes two cores can produce: 8 normals each.
-const MAX_AXES: usize = 2 * MAX_POLYGON_VERTICES;
-
 impl Core {
     pub(crate) fn point(p: Vec2, radius: f64) -> Core {
         let mut points = [Vec2::ZERO; MAX_POLYGON_VERTICES];
@@ -110,69 +107,78 @@ impl Core {
         if self.count <= 2 { 1 } else { self.count }
     }
 
-    /// Pushes this core's candidate axes: polygon edge normals, or a segment's normal and
-    /// direction (its end caps).
-    fn push_axes(&self, axes: &mut Axes) {
+    /// This core's candidate axes: polygon edge normals, or a segment's normal and direction
+    /// (its end caps), written to `segment`; none for a point.
+    fn axes<'a>(&'a self, segment: &'a mut [Vec2; 2]) -> &'a [Vec2] {
         match self.count {
-            1 => {}
+            1 => &[],
             2 => {
                 let d = (self.points[1] - self.points[0]).normalize();
-                axes.push(right_perp(d));
-                axes.push(d);
+                *segment = [right_perp(d), d];
+                segment
             }
-            n => {
-                for u in &self.normals[..n] {
-                    axes.push(*u);
-                }
-            }
+            n => &self.normals[..n],
         }
     }
 }
 
-struct Axes {
-    axes: [Vec2; MAX_AXES],
-    len: usize,
-}
-
-impl Axes {
-    fn push(&mut self, u: Vec2) {
-        if self.len < MAX_AXES && u.is_finite() {
-            self.axes[self.len] = u;
-            self.len += 1;
+/// Calls `f` on the candidate axes of a pair in order (`a`'s, `b`'s, and for two points the
+/// direction between them; a non-finite one, from a degenerate edge, left out) until it
+/// returns `Some`, and returns that. Read in place: nothing is copied.
+#[inline]
+fn each_axis<T>(a: &Core, b: &Core, mut f: impl FnMut(Vec2) -> Option<T>) -> Option<T> {
+    let (mut sa, mut sb) = ([Vec2::ZERO; 2], [Vec2::ZERO; 2]);
+    let between = (a.count == 1 && b.count == 1 && a.points[0] != b.points[0])
+        .then(|| (b.points[0] - a.points[0]).normalize());
+    let (axes_a, axes_b) = (a.axes(&mut sa), b.axes(&mut sb));
+    for &u in axes_a.iter().chain(axes_b).chain(&between) {
+        if u.is_finite()
+            && let Some(t) = f(u)
+        {
+            return Some(t);
         }
     }
-
-    fn of(a: &Core, b: &Core) -> Axes {
-        let mut axes = Axes {
-            axes: [Vec2::ZERO; MAX_AXES],
-            len: 0,
-        };
-        a.push_axes(&mut axes);
-        b.push_axes(&mut axes);
-        if a.count == 1 && b.count == 1 && a.points[0] != b.points[0] {
-            axes.push((b.points[0] - a.points[0]).normalize());
-        }
-        axes
-    }
+    None
 }
 
 /// The smallest separating-axis overlap of two cores (radii not included) and the direction
-/// (from `a` to `b`) it is reached in. `None` when there is no axis at all: two coincident
-/// points.
-fn min_overlap(a: &Core, b: &Core) -> Option<(f64, Vec2)> {
-    let axes = Axes::of(a, b);
+/// (from `a` to `b`) it is reached in; or, as soon as an axis's overlap is below `stop`, that
+/// axis's (the search stops there: the cores are at least that far apart). `None` when there
+/// is no axis at all: two coincident points.
+fn min_overlap(a: &Core, b: &Core, stop: f64) -> Option<(f64, Vec2)> {
     let mut best: Option<(f64, Vec2)> = None;
-    for &u in &axes.axes[..axes.len] {
+    let early = each_axis(a, b, |u| {
         let (amin, amax) = a.project(u);
         let (bmin, bmax) = b.project(u);
         // Moving b along +u by (amax - bmin) separates the cores; along -u by (bmax - amin).
-        for (overlap, dir) in [(amax - bmin, u), (bmax - amin, -u)] {
+        let (plus, minus) = (amax - bmin, bmax - amin);
+        if plus < stop {
+            return Some((plus, u));
+        }
+        if minus < stop {
+            return Some((minus, -u));
+        }
+        for (overlap, dir) in [(plus, u), (minus, -u)] {
             if best.is_none_or(|(o, _)| overlap < o) {
                 best = Some((overlap, dir));
             }
         }
-    }
-    best
+        None
+    });
+    early.or(best)
+}
+
+/// A length far above the rounding of any projection or distance between these cores and of
+/// `threshold - ra - rb` (about 1e-16 of the largest of their coordinates and the threshold),
+/// far below any gap that matters; NaN or infinite when any of those is, so that nothing is
+/// ruled out then.
+fn margin(a: &Core, b: &Core, threshold: f64) -> f64 {
+    let size = |c: &Core| {
+        c.points()
+            .iter()
+            .fold(c.radius, |s, p| s + p.x.abs() + p.y.abs())
+    };
+    1e-9 * (1.0 + threshold.abs() + size(a) + size(b))
 }
 
 /// The closest points of two cores that do not intersect: `(distance, on_a, on_b, normal)`,
@@ -273,8 +279,44 @@ fn penetration_point(a: &Core, b: &Core, normal: Vec2) -> Vec2 {
 /// The contact of two cores in one frame. See the module docs for why it is exact.
 #[must_use]
 pub fn collide_cores(a: &Core, b: &Core) -> Contact {
+    finish(a, b, min_overlap(a, b, f64::NEG_INFINITY))
+}
+
+/// `collide_cores(a, b)`, with the same bits; or `None` when an axis alone shows that its
+/// depth is at most `threshold` (then the rest of the axes and the closest-point scan, the
+/// costly part for a pair apart, are skipped).
+///
+/// The depth of two cores is at most `ra + rb` plus the overlap along any one axis (the gap
+/// along an axis is at most the distance), so an axis whose overlap is below
+/// `threshold - ra - rb` by more than a margin rules the pair out. The margin, far above the
+/// rounding of either computation, keeps the verdict the exact algorithm's.
+pub(crate) fn collide_cores_unless(a: &Core, b: &Core, threshold: f64) -> Option<Contact> {
+    let stop = threshold - (a.radius + b.radius) - margin(a, b, threshold);
+    // The direction between the cores' centres first: for a pair apart it is usually close
+    // to the best separating axis, and one projection rules most such pairs out.
+    let u = (centre(b) - centre(a)).normalize_or_zero();
+    if u != Vec2::ZERO {
+        let ((_, amax), (bmin, _)) = (a.project(u), b.project(u));
+        if amax - bmin < stop {
+            return None;
+        }
+    }
+    let least = min_overlap(a, b, stop);
+    if least.is_some_and(|(overlap, _)| overlap < stop) {
+        return None;
+    }
+    Some(finish(a, b, least))
+}
+
+/// The mean of a core's points.
+fn centre(c: &Core) -> Vec2 {
+    c.points().iter().fold(Vec2::ZERO, |s, p| s + *p) / c.count as f64
+}
+
+/// [`collide_cores`] after the separating-axis pass found `least` (its smallest overlap).
+fn finish(a: &Core, b: &Core, least: Option<(f64, Vec2)>) -> Contact {
     let r = a.radius + b.radius;
-    let Some((overlap, dir)) = min_overlap(a, b) else {
+    let Some((overlap, dir)) = least else {
         // Two coincident points (concentric circles): every direction is equally short.
         // Pick +y, so a body spawned inside another pops up, as a platformer expects.
         return Contact {
@@ -310,19 +352,23 @@ pub fn collide_cores(a: &Core, b: &Core) -> Contact {
 #[must_use]
 pub fn overlaps_cores(a: &Core, b: &Core) -> bool {
     let r = a.radius + b.radius;
-    let axes = Axes::of(a, b);
-    if axes.len == 0 {
-        return r > 0.0;
-    }
-    let mut least = f64::INFINITY;
-    for &u in &axes.axes[..axes.len] {
+    let (mut any, mut least) = (false, f64::INFINITY);
+    let apart = each_axis(a, b, |u| {
+        any = true;
         let (amin, amax) = a.project(u);
         let (bmin, bmax) = b.project(u);
         let overlap = (amax - bmin).min(bmax - amin);
         if overlap + r <= 0.0 {
-            return false;
+            return Some(());
         }
         least = least.min(overlap);
+        None
+    });
+    if apart.is_some() {
+        return false;
+    }
+    if !any {
+        return r > 0.0;
     }
     if least >= 0.0 {
         return least + r > 0.0;

@@ -4,7 +4,8 @@
 use proptest::prelude::*;
 use ricochet_geom::pairs::collide_cores;
 use ricochet_geom::{
-    Bounds, Contact, Pose, Primitive, Shape, Vec2, contact, contact_placed, overlaps, place,
+    Bounds, Contact, Pose, Primitive, Shape, Vec2, contact, contact_deeper_than, contact_placed,
+    overlaps, place,
 };
 
 const TAU: f64 = std::f64::consts::TAU;
@@ -73,6 +74,11 @@ const EPS: f64 = 1e-11;
 fn separates(a: &Shape, pa: &Pose, b: &Shape, pb: &Pose, n: Vec2, depth: f64) -> bool {
     let moved = Pose::new(pb.position + n * depth, pb.angle);
     contact(a, pa, b, &moved).depth <= 1e-9
+}
+
+/// Every bit of a contact: `-0.0` and `0.0` differ here.
+fn bits(c: Contact) -> [u64; 5] {
+    [c.depth, c.normal.x, c.normal.y, c.point.x, c.point.y].map(f64::to_bits)
 }
 
 fn assert_unit(c: &Contact) {
@@ -167,6 +173,20 @@ proptest! {
         prop_assert!(c.depth < 0.0, "{probe} is in the shape: {c:?}, bounds {b:?}");
         // And the box is tight: the shape comes within rounding of every side.
         prop_assert!(!side_is_loose(&s, &p, &b, side), "side {side} of {b:?} is loose");
+    }
+
+    #[test]
+    fn contact_deeper_than_is_the_exact_contact_above_the_threshold(
+        a in shape(), pa in pose(), b in shape(), pb in pose(), t in -4.0f64..4.0
+    ) {
+        // The expected value is the exact algorithm without its early-out: `contact`. The
+        // thresholds straddle the depth itself by one ulp, where a rounding slip would show.
+        let c = contact(&a, &pa, &b, &pb);
+        for threshold in [0.0, t, c.depth, c.depth.next_down(), c.depth - 1e-9, f64::NEG_INFINITY] {
+            let want = (c.depth > threshold).then_some(c);
+            let got = contact_deeper_than(&a, &pa, &b, &pb, threshold);
+            prop_assert_eq!(got.map(bits), want.map(bits), "threshold {}", threshold);
+        }
     }
 
     #[test]

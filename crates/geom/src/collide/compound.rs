@@ -13,7 +13,7 @@ use crate::math::{Rot, Vec2};
 use crate::placed::{PlacedPrimitive, place_with};
 use crate::shape::Primitive;
 
-use super::{contact_placed, overlaps_placed};
+use super::{contact_placed, contact_placed_unless, overlaps_placed};
 
 /// Up to this many part pairs, every pair is tested in order: nothing to place ahead, sort
 /// or allocate (a body's shape is usually one primitive, or a handful).
@@ -48,20 +48,48 @@ impl Side<'_> {
 /// overlaps), in the pair's frame; `None` only when a side has no parts.
 pub(crate) fn deepest(a: Side<'_>, b: Side<'_>) -> Option<Contact> {
     if a.parts.len() * b.parts.len() <= ALL_PAIRS {
-        let mut best: Option<Contact> = None;
-        for pa in a.parts {
-            let pa = a.place(pa);
-            for pb in b.parts {
-                #[cfg(test)]
-                TESTED.with(|t| t.set(t.get() + 1));
-                let c = contact_placed(&pa, &b.place(pb));
-                if best.is_none_or(|best| c.depth > best.depth) {
-                    best = Some(c);
-                }
+        return every_pair(a, b, |pa, pb| Some(contact_placed(pa, pb)));
+    }
+    culled(a, b)
+}
+
+/// `deepest(a, b)` when its depth is above `threshold`, `None` otherwise, with the same bits.
+/// A part pair at most `threshold` deep can't be the deepest of a pair deeper than that, so
+/// the part pairs that an axis rules out are left out ([`contact_placed_unless`]).
+pub(crate) fn deepest_above(a: Side<'_>, b: Side<'_>, threshold: f64) -> Option<Contact> {
+    let best = if a.parts.len() * b.parts.len() <= ALL_PAIRS {
+        every_pair(a, b, |pa, pb| contact_placed_unless(pa, pb, threshold))
+    } else {
+        culled(a, b)
+    };
+    best.filter(|c| c.depth > threshold)
+}
+
+/// The deepest of `test`'s contacts over every part pair in order, the first among equals.
+#[inline]
+fn every_pair(
+    a: Side<'_>,
+    b: Side<'_>,
+    test: impl Fn(&PlacedPrimitive, &PlacedPrimitive) -> Option<Contact>,
+) -> Option<Contact> {
+    let mut best: Option<Contact> = None;
+    for pa in a.parts {
+        let pa = a.place(pa);
+        for pb in b.parts {
+            #[cfg(test)]
+            TESTED.with(|t| t.set(t.get() + 1));
+            if let Some(c) = test(&pa, &b.place(pb))
+                && best.is_none_or(|best| c.depth > best.depth)
+            {
+                best = Some(c);
             }
         }
-        return best;
     }
+    best
+}
+
+/// [`deepest`] of more than [`ALL_PAIRS`] part pairs: only those near each other are tested.
+fn culled(a: Side<'_>, b: Side<'_>) -> Option<Contact> {
     let ((pa, ba), (pb, bb)) = (a.placed(), b.placed());
     let margin = margin(&ba, &bb);
     let near = Near::new(&ba, &bb);

@@ -20,6 +20,7 @@ pub(crate) mod obb_polygon;
 pub(crate) mod polygon_polygon;
 
 use crate::contact::Contact;
+use crate::cores::collide_cores_unless;
 use crate::math::Pose;
 use crate::placed::PlacedPrimitive;
 use crate::shape::{Shape, ShapeKind};
@@ -70,6 +71,36 @@ pub fn contact_placed(a: &PlacedPrimitive, b: &PlacedPrimitive) -> Contact {
         (P::Polygon(a), P::Obb(b)) => collide_obb_polygon(b, a).flipped(),
         (P::Polygon(a), P::Capsule(b)) => collide_capsule_polygon(b, a).flipped(),
         (P::Polygon(a), P::Polygon(b)) => collide_polygon_polygon(a, b),
+    }
+}
+
+/// `contact_placed(a, b)`, with the same bits; or `None` when a separating axis alone shows
+/// that its depth is at most `threshold` (the pairings the core algorithm answers; the others
+/// are cheap and always computed).
+pub(crate) fn contact_placed_unless(
+    a: &PlacedPrimitive,
+    b: &PlacedPrimitive,
+    threshold: f64,
+) -> Option<Contact> {
+    use PlacedPrimitive as P;
+    // `contact_placed`'s calls of `collide_cores`, in the same order.
+    let cores = |x: &PlacedPrimitive, y: &PlacedPrimitive| {
+        collide_cores_unless(&x.core(), &y.core(), threshold)
+    };
+    match (a, b) {
+        (P::Circle(_), P::Circle(_) | P::Aabb(_) | P::Obb(_))
+        | (P::Aabb(_) | P::Obb(_), P::Circle(_))
+        | (P::Aabb(_), P::Aabb(_)) => Some(contact_placed(a, b)),
+        (P::Circle(_), P::Capsule(_) | P::Polygon(_))
+        | (P::Aabb(_), P::Obb(_) | P::Capsule(_) | P::Polygon(_))
+        | (P::Obb(_), P::Obb(_) | P::Capsule(_) | P::Polygon(_))
+        | (P::Capsule(_), P::Capsule(_) | P::Polygon(_))
+        | (P::Polygon(_), P::Polygon(_)) => cores(a, b),
+        (P::Obb(_), P::Aabb(_))
+        | (P::Capsule(_), P::Circle(_) | P::Aabb(_) | P::Obb(_))
+        | (P::Polygon(_), P::Circle(_) | P::Aabb(_) | P::Obb(_) | P::Capsule(_)) => {
+            cores(b, a).map(Contact::flipped)
+        }
     }
 }
 
@@ -126,6 +157,27 @@ pub fn contact(a: &Shape, pose_a: &Pose, b: &Shape, pose_b: &Pose) -> Contact {
         },
         |c| c.translated(origin),
     )
+}
+
+/// `Some(contact(a, pose_a, b, pose_b))` when its depth is above `threshold`, `None`
+/// otherwise: the same bits, cheaper for a pair apart (what a broad phase hands over when
+/// bounds overlap and shapes don't). A separating axis along which the pair is further apart
+/// than `-threshold` (plus a margin far above rounding) rules it out before the exact
+/// algorithm's closest-point scan.
+///
+/// `contact_deeper_than(.., 0.0)` is the contact of an overlapping pair, `None` for a pair
+/// apart or touching.
+#[must_use]
+pub fn contact_deeper_than(
+    a: &Shape,
+    pose_a: &Pose,
+    b: &Shape,
+    pose_b: &Pose,
+    threshold: f64,
+) -> Option<Contact> {
+    let origin = pose_a.position;
+    let (sa, sb) = sides(a, pose_a, b, pose_b);
+    compound::deepest_above(sa, sb, threshold).map(|c| c.translated(origin))
 }
 
 /// Whether two shapes at two poses overlap: any part of one with any part of the other.

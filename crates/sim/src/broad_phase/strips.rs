@@ -254,18 +254,18 @@ impl StripList {
         self.fresh.sort_unstable_by(strip_order);
         self.merged.clear();
         self.merged.reserve(self.order.len() + self.fresh.len());
-        let (mut i, mut j) = (0, 0);
-        while i < self.order.len() && j < self.fresh.len() {
-            if strip_order(&self.order[i], &self.fresh[j]) == Ordering::Less {
-                self.merged.push(self.order[i]);
-                i += 1;
-            } else {
-                self.merged.push(self.fresh[j]);
-                j += 1;
-            }
+        // A few fresh slots among thousands: each finds its place by binary search and the
+        // slots between are copied as one block. The order is total (`local` breaks ties),
+        // so this is the one merge of the two lists.
+        let mut from = 0;
+        for f in &self.fresh {
+            let rest = &self.order[from..];
+            let at = from + rest.partition_point(|s| strip_order(s, f) == Ordering::Less);
+            self.merged.extend_from_slice(&self.order[from..at]);
+            self.merged.push(*f);
+            from = at;
         }
-        self.merged.extend_from_slice(&self.order[i..]);
-        self.merged.extend_from_slice(&self.fresh[j..]);
+        self.merged.extend_from_slice(&self.order[from..]);
         std::mem::swap(&mut self.order, &mut self.merged);
         moved
     }

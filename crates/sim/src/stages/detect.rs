@@ -40,7 +40,7 @@
 //! ended its motion half the world's size or more outside it is wrapped in first
 //! (`wrap::bring_in`), so the images reach every contact whatever the speed.
 
-use ricochet_geom::{Contact, Pose, Sweep, Vec2, contact, time_of_impact};
+use ricochet_geom::{Contact, Pose, Sweep, Vec2, contact, contact_deeper_than, time_of_impact};
 
 use crate::broad_phase::{BodyEntry, BroadPhase, BroadPhaseKind, Interactions, STATIC_BIT};
 use crate::def::{BodyKind, Doomed, Layers, Response, WorldDef};
@@ -90,7 +90,7 @@ pub(crate) struct DetectState {
     /// This frame's pairs for the narrow phase (dense indices, response), their contacts at
     /// the poses the pass started from, and the bodies a response has moved since.
     plan: Vec<(usize, usize, Response)>,
-    contacts: Vec<Contact>,
+    contacts: Vec<Option<Contact>>,
     /// Per body, all false between passes (only the `moved` ones are set, then cleared).
     pushed: Vec<bool>,
     moved: Vec<usize>,
@@ -313,8 +313,8 @@ pub(crate) fn run(
         workers.map(
             plan.len(),
             |k| {
-                let (i, j, _) = plan[k];
-                contact(w.shape(i), &w.pose(i), w.shape(j), &w.pose(j))
+                let (i, j, response) = plan[k];
+                narrow(w, (i, j), response, &w.pose(j))
             },
             &mut contacts,
         );
@@ -328,7 +328,7 @@ pub(crate) fn run(
         let w = &ctx.world;
         let (pose_a, mut pose_b) = (w.pose(i), w.pose(j));
         let mut c = if pushed[i] || pushed[j] {
-            contact(w.shape(i), &pose_a, w.shape(j), &pose_b)
+            narrow(w, (i, j), response, &pose_b)
         } else {
             contacts[k]
         };
@@ -343,32 +343,33 @@ pub(crate) fn run(
             }
         };
         // A fast body against static or kinematic geometry: time of impact, then the push
-        // (`sweep_normal.rs`; not through the wrap seam).
+        // (`sweep_normal.rs`; not through the wrap seam). A `separate` pair's contact is
+        // always computed (`narrow`).
         if response == Response::Separate
+            && let Some(direct) = &c
             && st.seam.offsets(i, j).next().is_none()
-            && let Some(hit) = sweep_normal::stop(w, (i, j), &c, &mut ctx.out.stats.narrow_tests)
+            && let Some(hit) =
+                sweep_normal::stop(w, (i, j), direct, &mut ctx.out.stats.narrow_tests)
         {
             sweep_normal::apply(ctx, (i, j), &hit);
             note_pushes(ctx.world);
             continue;
         }
-        // Through the seam: `b`'s images next to `a`, the deepest (the first on a tie).
+        // Through the seam: `b`'s images next to `a`, the deepest (the first on a tie). A
+        // contact left out is no deeper than the threshold below, so it never wins over one
+        // that passes it, and when every one is left out the pair is skipped either way.
         for offset in st.seam.offsets(i, j) {
             ctx.out.stats.narrow_tests += 1;
             let image = Pose::new(w.position[j] + offset, w.angle[j]);
-            let d = contact(w.shape(i), &pose_a, w.shape(j), &image);
-            if d.depth > c.depth {
-                (c, pose_b) = (d, image);
+            if let Some(d) = narrow(w, (i, j), response, &image)
+                && c.is_none_or(|c| d.depth > c.depth)
+            {
+                (c, pose_b) = (Some(d), image);
             }
         }
-        let threshold = if response == Response::Separate {
-            SLOP
-        } else {
-            0.0
-        };
-        if c.depth <= threshold {
+        let Some(c) = c.filter(|c| c.depth > threshold(response)) else {
             continue;
-        }
+        };
         woken.extend([i, j].into_iter().filter(|&k| w.asleep(k)));
         respond(
             ctx,
@@ -411,6 +412,29 @@ pub(crate) fn run(
     doomed.dedup_by_key(|(e, _)| *e);
     for (e, by) in doomed {
         remove(ctx, e, Removal::HitBy(by), true);
+    }
+}
+
+/// The depth a contact must exceed to respond: a `separate` pair leaves [`SLOP`] of overlap.
+fn threshold(response: Response) -> f64 {
+    if response == Response::Separate {
+        SLOP
+    } else {
+        0.0
+    }
+}
+
+/// The contact of bodies `i` and `j` with `j` at `pose_b`: always for a `separate` pair (its
+/// time of impact starts from it), otherwise `None` when it is no deeper than the threshold
+/// (`contact_deeper_than`: a pair whose bounds overlap but whose shapes are apart skips the
+/// exact algorithm's closest-point scan). A contact that comes back is `contact`'s, bit for
+/// bit.
+fn narrow(w: &World, (i, j): (usize, usize), response: Response, pose_b: &Pose) -> Option<Contact> {
+    let (a, b, pose_a) = (w.shape(i), w.shape(j), w.pose(i));
+    if response == Response::Separate {
+        Some(contact(a, &pose_a, b, pose_b))
+    } else {
+        contact_deeper_than(a, &pose_a, b, pose_b, threshold(response))
     }
 }
 
