@@ -90,8 +90,12 @@ impl Lattice {
         (at.x.to_bits() == c.x.to_bits() && at.y.to_bits() == c.y.to_bits()).then_some((i, j))
     }
 
-    /// The cells along one axis whose tiles may overlap `lo..=hi` (one more each side than
-    /// the arithmetic says, for its rounding; the caller tests the bounds exactly), or `None`.
+    /// The cells along one axis whose tiles may overlap `lo..=hi`, or `None`: cell `k`'s tile
+    /// reaches `lo` when `k >= (lo - half - origin) / step` and `hi` when `k <= (hi + half -
+    /// origin) / step`. The arithmetic rounds (a tile's bounds too, by a few units in the
+    /// last place of the coordinates), so each end is widened by `slack` cells, a billionth
+    /// of the coordinates' size in cells: millions of times the rounding, far below a cell
+    /// (the caller tests the bounds exactly).
     #[inline]
     fn span(
         lo: f64,
@@ -101,12 +105,27 @@ impl Lattice {
         half: f64,
         n: usize,
     ) -> Option<(usize, usize)> {
-        let a = (lo - half - origin) / step;
-        let b = (hi + half - origin) / step;
-        // Saturating casts: an infinite query reaches the ends, NaN cannot come (the query
-        // is regular, the lattice finite).
-        let first = (a as i64).saturating_sub(1).max(0);
-        let last = (b as i64).saturating_add(1).min(n as i64 - 1);
+        let slack = 1e-9 * (1.0 + (lo.abs() + hi.abs() + origin.abs() + half + step) / step);
+        let a = (lo - half - origin) / step - slack;
+        let b = (hi + half - origin) / step + slack;
+        // Rounded by casts (`f64::ceil` and `floor` are calls on the baseline x86-64), which
+        // saturate: an infinite query reaches the ends. NaN (an infinite query minus an
+        // infinite slack) casts to 0, the first cell: never a narrower span.
+        let (ta, tb) = (a as i64, b as i64);
+        let first = if (ta as f64) < a {
+            ta.saturating_add(1)
+        } else {
+            ta
+        }
+        .max(0);
+        let last = if b.is_nan() {
+            n as i64 - 1
+        } else if (tb as f64) > b {
+            tb.saturating_sub(1)
+        } else {
+            tb
+        }
+        .min(n as i64 - 1);
         (first <= last).then_some((first as usize, last as usize))
     }
 }

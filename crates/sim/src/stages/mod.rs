@@ -10,13 +10,17 @@ use crate::output::FrameOutput;
 use crate::world::World;
 
 pub(crate) mod bounds;
+pub(crate) mod box_contact;
 pub(crate) mod carry;
 pub(crate) mod cull;
 pub(crate) mod detect;
 pub(crate) mod lifetimes;
 pub(crate) mod motion;
+pub(crate) mod obstacles;
+pub(crate) mod pass_order;
 pub(crate) mod push;
 pub(crate) mod remove;
+pub(crate) mod rider;
 pub(crate) mod script;
 pub(crate) mod separate;
 pub(crate) mod sleep;

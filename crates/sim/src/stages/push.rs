@@ -17,7 +17,7 @@ use ricochet_geom::{Shape, Sweep, Vec2, contact, time_of_impact};
 use crate::broad_phase::FixedGrid;
 use crate::def::{BodyKind, Layers, Response};
 use crate::stages::SLOP;
-use crate::stages::separate::static_index;
+use crate::stages::obstacles::static_index;
 use crate::world::World;
 
 /// How many times a clipped push is checked against the static bodies again before it is

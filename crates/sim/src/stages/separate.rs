@@ -16,24 +16,29 @@
 //! Before the pushes, a box that moved along the axis is swept (`sweep_axis.rs`): it stops
 //! flush against the first box it would have crossed, so no speed takes it through a tile.
 //! The first lookup covers the box's start and end along the axis.
-
 //!
-//! Finding the obstacles: static boxes sit in a tile map built once (rebuilt only when the
-//! static bodies change: `broad_phase/tile_map.rs`); kinematic boxes, and dynamic boxes once
-//! settled, go into a small grid rebuilt every pass, if a settling box may stop on them. Each dynamic box looks up both and meets its obstacles in id order at
-//! its current position; after a push it looks again from the obstacle after the one it was
+//! Finding the obstacles (`obstacles.rs`): static boxes sit in a tile map built once (rebuilt
+//! only when the static bodies change: `broad_phase/tile_map.rs`); kinematic boxes, and
+//! dynamic boxes once settled, go into a small grid rebuilt every pass, if a settling box may
+//! stop on them. Each dynamic box looks up both and meets its obstacles in id order at its
+//! current position; after a push it looks again from the obstacle after the one it was
 //! pushed out of. That is exactly the order of a loop over every body, at the cost of the
-//! few it is near.
+//! few it is near. The order the boxes settle in is kept from frame to frame
+//! (`pass_order.rs`), and a pair of boxes' contact is computed directly (`box_contact.rs`).
 
-use ricochet_geom::{Bounds, Primitive, Shape, Vec2, contact};
+use ricochet_geom::{Bounds, Primitive, Shape, Vec2};
 
 use crate::broad_phase::{MoverGrid, StaticBox, TileMap};
-use crate::def::{BodyKind, Controller, LayerId, Layers, Response};
-use crate::entity::Entity;
-use crate::event::GameEvent;
+use crate::def::{BodyKind, Controller, Layers, Response};
 use crate::output::{ContactRecord, Phase};
+use crate::stages::box_contact::box_contact;
+use crate::stages::obstacles::{
+    Obstacle, bounds_if_box, box_bounds, obstacles, on_origin, overlap, solid_layers, statics_win,
+};
+use crate::stages::pass_order::{self, PassOrder};
+use crate::stages::rider::rider;
 use crate::stages::sweep_axis::{self, Swept};
-use crate::stages::{SLOP, StageCtx, carry};
+use crate::stages::{SLOP, StageCtx};
 use crate::world::World;
 
 /// Whether a shape is resolved per axis: a single axis-aligned box.
@@ -70,31 +75,22 @@ pub(crate) struct SeparateState {
     /// The static generation `statics` was built at.
     static_generation: Option<u64>,
     /// Static boxes of separating layers, each with its rank among all the static bodies
-    /// (its dense index follows, [`static_index`]) and its layer: a tile map.
+    /// (its dense index follows: `obstacles::static_index`) and its layer: a tile map.
     statics: TileMap,
     movers: MoverGrid,
     found: Vec<Obstacle>,
-    /// The pass's dynamic boxes, `(lowest coordinate along the axis, dense index)`.
-    order: Vec<(f64, u32)>,
+    /// Each axis's order of the dynamic boxes, kept from the last frame.
+    orders: [PassOrder; 2],
+    /// The pass's dynamic boxes in order.
+    order: Vec<pass_order::Entry>,
     /// Their larger sides, for the mover grid's cell size.
     extents: Vec<f64>,
     /// Sleeping boxes pushed against, woken after the pass.
     woken: Vec<usize>,
-    /// The pass's contacts' `(a, b)` and places, to sort them.
-    keys: Vec<(Entity, Entity, u32)>,
+    /// The pass's contacts' `(a, b)` and places as sort keys ([`sort_contacts`]).
+    keys: Vec<u128>,
     /// The pass's contacts, while they are put in order.
     records: Vec<ContactRecord>,
-}
-
-/// A box that may stop the one being settled: its dense index, bounds and layer (static
-/// boxes come from the grid with these, so a million tiles' columns are never read).
-#[derive(Clone, Copy, Debug)]
-struct Obstacle {
-    index: u32,
-    bounds: Bounds,
-    layer: LayerId,
-    /// Whether it may have moved this frame (from the mover grid, not the static one).
-    moving: bool,
 }
 
 impl SeparateState {
@@ -143,27 +139,6 @@ impl SeparateState {
     }
 }
 
-/// The exact bounds of box `i`: bit for bit `Shape::bounds`, without its general path for a
-/// box on the body origin (the usual case).
-fn box_bounds(w: &World, i: usize) -> Bounds {
-    match w.shape(i) {
-        Shape::Primitive(Primitive::Aabb(b)) if b.center == Vec2::ZERO => {
-            // `position + 0` is `position` (up to the sign of a zero, which compares equal).
-            Bounds::around(w.position[i], b.half_extents)
-        }
-        s => s.bounds(&w.pose(i)),
-    }
-}
-
-/// The half extents of box `i` when it sits on its body's origin: then its bounds are
-/// `Bounds::around(position, half)` ([`box_bounds`]).
-fn on_origin(w: &World, i: usize) -> Option<Vec2> {
-    match w.shape(i) {
-        Shape::Primitive(Primitive::Aabb(b)) if b.center == Vec2::ZERO => Some(b.half_extents),
-        _ => None,
-    }
-}
-
 /// The push along `axis` that moves box `m` out of box `o`: the smaller overlap, signed.
 fn push_out(m: &Bounds, o: &Bounds, axis: usize) -> f64 {
     let towards_min = m.max[axis] - o.min[axis]; // push m down/left by this
@@ -183,84 +158,6 @@ fn contains(outer: &Bounds, inner: &Bounds) -> bool {
         && inner.max.y <= outer.max.y
 }
 
-/// How much `a` and `b` overlap along `axis` (negative when apart).
-fn overlap(a: &Bounds, b: &Bounds, axis: usize) -> f64 {
-    a.max[axis].min(b.max[axis]) - a.min[axis].max(b.min[axis])
-}
-
-/// The dense index of the static body of rank `s` among the static bodies: `s` plus the
-/// moving bodies before it. `movers` are the moving bodies' dense indices, ascending, so
-/// mover `k` has `movers[k] - k` static bodies before it (a non-decreasing count).
-pub(crate) fn static_index(movers: &[u32], s: u32) -> u32 {
-    // Usually every static body comes first (a level's tiles before its actors).
-    if movers.first().is_none_or(|&m| m > s) {
-        return s;
-    }
-    let (mut lo, mut hi) = (0, movers.len());
-    while lo < hi {
-        let mid = usize::midpoint(lo, hi);
-        if movers[mid] - mid as u32 <= s {
-            lo = mid + 1;
-        } else {
-            hi = mid;
-        }
-    }
-    s + lo as u32
-}
-
-/// Every body that may be an obstacle for a box with bounds `q`, as dense indices from
-/// `from` on, ascending and without repeats, into `found`.
-fn obstacles(st: &mut SeparateState, w: &World, q: &Bounds, from: u32, found: &mut Vec<Obstacle>) {
-    found.clear();
-    let movers = w.movers();
-    st.statics.query(q, |s, bounds, layer| {
-        let index = static_index(movers, s);
-        if index >= from {
-            found.push(Obstacle {
-                index,
-                bounds: *bounds,
-                layer,
-                moving: false,
-            });
-        }
-    });
-    if st.movers.is_empty() {
-        return finish(found);
-    }
-    st.movers.query(q, |i| {
-        if i >= from {
-            found.push(Obstacle {
-                index: i,
-                bounds: box_bounds(w, i as usize),
-                layer: w.layer[i as usize],
-                moving: true,
-            });
-        }
-    });
-    finish(found);
-}
-
-/// Sorts the obstacles found by index and drops repeats.
-fn finish(found: &mut Vec<Obstacle>) {
-    found.sort_unstable_by_key(|o| o.index);
-    found.dedup_by_key(|o| o.index);
-}
-
-/// By layer, whether a box of it may stop one of the pass's settling boxes (`order`): some
-/// settling box's layer `separate`s from it.
-fn solid_layers(w: &World, layers: &Layers, order: &[(f64, u32)]) -> Vec<bool> {
-    let n = layers.names().len();
-    let mut settling = vec![false; n];
-    for &(_, i) in order {
-        settling[usize::from(w.layer[i as usize])] = true;
-    }
-    (0..n)
-        .map(|m| {
-            (0..n).any(|l| settling[l] && layers.response(l as u8, m as u8) == Response::Separate)
-        })
-        .collect()
-}
-
 /// One per-axis pass: settles every dynamic box along `axis`, lowest first.
 fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
     let phase = if axis == 0 { Phase::X } else { Phase::Y };
@@ -273,29 +170,31 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
     // landing flush on the one below, with no box pushed back into what held it.
     let mut order = std::mem::take(&mut st.order);
     let mut extents = std::mem::take(&mut st.extents);
-    order.clear();
     extents.clear();
-    for &i in w.movers() {
-        let k = i as usize;
-        if !is_box(w.shape(k)) || w.frozen(k) || !st.separating[usize::from(w.layer[k])] {
-            continue;
-        }
-        let b = box_bounds(w, k);
-        if w.kind[k] == BodyKind::Dynamic && !w.asleep(k) {
-            order.push((b.min[axis], i));
+    let separating = &st.separating;
+    st.orders[axis].sort(
+        w.movers(),
+        |_, i| {
+            let k = i as usize;
+            let settles = w.kind[k] == BodyKind::Dynamic
+                && separating[usize::from(w.layer[k])]
+                && !w.frozen(k)
+                && !w.asleep(k);
+            let b = bounds_if_box(w, k).filter(|_| settles)?;
             extents.push((b.max - b.min).max_element());
-        }
-    }
-    // Unstable is the same order: no two keys are equal (the index breaks ties).
-    order.sort_unstable_by(|p, q| p.0.total_cmp(&q.0).then(p.1.cmp(&q.1)));
+            Some(b.min[axis])
+        },
+        &mut order,
+    );
     // The layers a moving box may be solid to: those some settling box `separate`s from. A
     // box of any other layer is never an obstacle, so it stays out of the mover grid (the
     // platformer's actors only `report` to each other: the grid stays empty and is never
     // looked at).
-    let solid = solid_layers(w, layers, &order);
+    let solid = solid_layers(w, layers, order.iter().map(|e| e.1));
     // Kinematic boxes and sleeping ones are solid from the start; dynamic ones once settled.
     st.movers.reset(&mut extents, order.len());
-    for &i in w.movers() {
+    let movers_solid = solid.iter().any(|&s| s);
+    for &i in w.movers().iter().filter(|_| movers_solid) {
         let k = i as usize;
         if is_box(w.shape(k))
             && !w.frozen(k)
@@ -307,9 +206,11 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
         }
     }
     let first = out.contacts.len();
+    // About one contact a box a pass: grown once, not record by record.
+    out.contacts.reserve(order.len());
     let mut found = std::mem::take(&mut st.found);
     let mut woken = std::mem::take(&mut st.woken);
-    for &(_, i) in &order {
+    for &(_, i, _) in &order {
         let i = i as usize;
         // One lookup usually does: it covers the box moved by up to its own size along the
         // axis, more than one push can move it (a push is at most the box's overlap).
@@ -329,13 +230,10 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
         // at most that, less than half the pair's size), so today's push is right for it
         // and the sweep is skipped (`sweep_axis.rs`).
         let back = ctx.world.start_position(i)[axis] - ctx.world.position[i][axis];
-        let size = {
-            let b = box_bounds(ctx.world, i);
-            b.max[axis] - b.min[axis]
-        };
-        let mut swept = 2.0 * back.abs() <= size;
+        // Its bounds, kept up to date after each push.
+        let mut bi = box_bounds(ctx.world, i);
+        let mut swept = 2.0 * back.abs() <= bi.max[axis] - bi.min[axis];
         'look: loop {
-            let bi = box_bounds(ctx.world, i);
             if !region.is_some_and(|r| contains(&r, &bi)) {
                 let mut r = bi;
                 let reach = bi.max[axis] - bi.min[axis];
@@ -353,7 +251,7 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
                 } else {
                     0
                 };
-                obstacles(st, ctx.world, &r, from, &mut found);
+                obstacles((&st.statics, &st.movers), ctx.world, &r, from, &mut found);
                 region = Some(r);
                 next = 0;
             }
@@ -417,7 +315,7 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
             // touches.
             let pair_contact = |w: &World| {
                 let (pose_a, pose_b) = (w.pose(a), w.pose(b));
-                let c = contact(w.shape(a), &pose_a, w.shape(b), &pose_b);
+                let c = box_contact(w.shape(a), &pose_a, w.shape(b), &pose_b);
                 (c, pose_a, pose_b)
             };
             let before = (!after).then(|| pair_contact(w));
@@ -445,10 +343,12 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
             });
             // The box moved: go on from the next obstacle, at its new place (after a swept
             // stop, from the first: it stands where the pass may start again).
+            bi = box_bounds(w, i);
             continue 'look;
         }
         let riding = (old_carrier, pushed_by);
-        if let Some(event) = rider(ctx.world, layers, st, &mut found, (i, axis), riding) {
+        let lookup = (&st.statics, &st.movers);
+        if let Some(event) = rider(ctx.world, layers, lookup, &mut found, (i, axis), riding) {
             out.events.push(event);
         }
         if solid[usize::from(ctx.world.layer[i])] {
@@ -468,96 +368,26 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
 
 /// Sorts `contacts[first..]` by `(a, b)`, stably: as keys with their places (an unstable
 /// sort of unique keys), then each record moved once (a record is about 130 bytes; a sort
-/// of the records moves each `log n` times).
+/// of the records moves each `log n` times). A key is `a`'s index, `b`'s index and the
+/// place in one `u128`: two live bodies never share an index, so that is the order of
+/// `(a, b)` (index, then generation) and the place, compared in one go.
 fn sort_contacts(
     contacts: &mut Vec<ContactRecord>,
     first: usize,
-    keys: &mut Vec<(Entity, Entity, u32)>,
+    keys: &mut Vec<u128>,
     records: &mut Vec<ContactRecord>,
 ) {
     keys.clear();
-    keys.extend(
-        contacts[first..]
-            .iter()
-            .zip(0..)
-            .map(|(c, k)| (c.a, c.b, k)),
-    );
+    keys.extend(contacts[first..].iter().zip(0u32..).map(|(c, k)| {
+        (u128::from(c.a.index) << 64) | (u128::from(c.b.index) << 32) | u128::from(k)
+    }));
     if keys.is_sorted() {
         return;
     }
     keys.sort_unstable();
     records.clear();
     records.extend(contacts.drain(first..));
-    contacts.extend(keys.iter().map(|k| records[k.2 as usize].clone()));
-}
-
-/// Statics win: the push `by` along `axis` that moves box `i` (bounds `bi`) out of the
-/// dynamic box `bj` by the smaller overlap, unless a static box is in its way; then out of
-/// `bj`'s other side if that way is clear, else as far as the first static box lets it go
-/// (flush on it, still overlapping `bj`: a push from another dynamic body never moves a box
-/// into a static one, as along the normal, `push.rs`).
-fn statics_win(
-    statics: &TileMap,
-    (w, layers): (&World, &Layers),
-    (i, bi, bj): (usize, &Bounds, &Bounds),
-    axis: usize,
-    by: f64,
-) -> f64 {
-    let allowed = clear_way(statics, (w, layers), (i, bi), axis, by);
-    if allowed.to_bits() == by.to_bits() {
-        return by;
-    }
-    let other_way = if by < 0.0 {
-        bj.max[axis] - bi.min[axis]
-    } else {
-        -(bi.max[axis] - bj.min[axis])
-    };
-    if clear_way(statics, (w, layers), (i, bi), axis, other_way).to_bits() == other_way.to_bits() {
-        return other_way;
-    }
-    allowed
-}
-
-/// How much of the move `by` along `axis` box `i` (bounds `bi`) can make before it meets a
-/// static box it `separate`s from: one ahead of it, overlapping its span on the other axis
-/// by more than [`SLOP`] (a static box it overlaps now is not in its way: the pass pushes it
-/// out of that one at its turn).
-fn clear_way(
-    statics: &TileMap,
-    (w, layers): (&World, &Layers),
-    (i, bi): (usize, &Bounds),
-    axis: usize,
-    by: f64,
-) -> f64 {
-    let other = 1 - axis;
-    let mut path = *bi;
-    if by < 0.0 {
-        path.min[axis] += by;
-    } else {
-        path.max[axis] += by;
-    }
-    let mut allowed = by;
-    statics.query(&path, |_, b, layer| {
-        if layers.response(w.layer[i], layer) != Response::Separate || overlap(bi, b, other) <= SLOP
-        {
-            return;
-        }
-        let gap = if by < 0.0 {
-            bi.min[axis] - b.max[axis]
-        } else {
-            b.min[axis] - bi.max[axis]
-        };
-        if gap < -SLOP {
-            return;
-        }
-        let room = gap.max(0.0);
-        allowed = if by < 0.0 {
-            allowed.max(-room)
-        } else {
-            allowed.min(room)
-        };
-    });
-    allowed
+    contacts.extend(keys.iter().map(|&k| records[k as u32 as usize].clone()));
 }
 
 /// The coordinate along `axis` that puts box `i` (bounds `bi`) flush against the sweep's
@@ -594,47 +424,4 @@ fn apply_push(w: &mut crate::World, i: usize, axis: usize, to: f64, push: f64) {
     {
         *speed = -*speed;
     }
-}
-
-/// After box `i`'s pass along `axis` (riders: `stages/carry.rs`). In `resolve_y`, a box that
-/// nothing pushed up keeps `old_carrier` if it still rests on it flush. Then, if a kinematic
-/// box moved it this frame (`pushed_by`, the first that pushed it in this pass, or the
-/// kinematic carrier it rode into the frame), and it still overlaps a static or kinematic
-/// box by more than [`SLOP`] on both axes, it had no room: the [`GameEvent::Crushed`] to
-/// raise. It is left where the pushes put it; the game decides.
-fn rider(
-    w: &mut World,
-    layers: &Layers,
-    st: &mut SeparateState,
-    found: &mut Vec<Obstacle>,
-    (i, axis): (usize, usize),
-    (old_carrier, pushed_by): (Option<Entity>, Option<usize>),
-) -> Option<GameEvent> {
-    if old_carrier.is_none() && pushed_by.is_none() {
-        // Rode nothing, pushed by no kinematic body: the usual case, nothing to do.
-        return None;
-    }
-    let bi = box_bounds(w, i);
-    if axis == 1
-        && w.carrier(i).is_none()
-        && let Some(c) = old_carrier.and_then(|e| w.index_of(e))
-        && carry::still_rides(&bi, &box_bounds(w, c))
-    {
-        *w.carrier_mut(i) = old_carrier;
-    }
-    let by = pushed_by.or_else(|| carry::kinematic_root(w, old_carrier))?;
-    obstacles(st, w, &bi, 0, found);
-    let no_room = found.iter().any(|o| {
-        let j = o.index as usize;
-        j != i
-            && w.kind[j] != BodyKind::Dynamic
-            && layers.response(w.layer[i], o.layer) == Response::Separate
-            && overlap(&bi, &o.bounds, 0) > SLOP
-            && overlap(&bi, &o.bounds, 1) > SLOP
-    });
-    no_room.then(|| GameEvent::Crushed {
-        body: w.entity[i],
-        by: w.entity[by],
-        axis: axis as u8,
-    })
 }
