@@ -1,4 +1,4 @@
-//! `SortAndSweep` for moving bodies: per layer, the moving bodies sorted by `min.x`, kept from
+//! `SortAndSweep` for moving bodies: per layer, the moving bodies sorted along x, kept from
 //! the previous call and re-sorted by insertion sort (nearly sorted: about `O(n)`; bodies that
 //! appeared are sorted apart and merged in, and a sort that moves more than `8n` places falls
 //! back to a full sort). A self-interacting layer is swept against itself. Two interacting
@@ -8,11 +8,14 @@
 //! the two orders are swept together.
 //!
 //! **Kept x ranges.** A body's place in the order is not its exact `[min.x, max.x]` but an
-//! enlarged range (the exact one widened by a quarter of its width on each side), kept from
+//! enlarged range (the exact one widened by half its width on each side), kept from
 //! call to call while the exact range stays inside it: a body that moved a little costs two
 //! comparisons and leaves the order as it was, and a call where no range was renewed sorts
 //! nothing. The enlarged ranges only choose the candidates; every candidate is tested with
-//! its exact bounds, so the pairs are exactly those of the exact ranges.
+//! its exact bounds, so the pairs are exactly those of the exact ranges. (Half a width: on
+//! asteroids-10000 a quarter renewed so many ranges a frame that the update cost more
+//! instructions than re-sorting exact ranges; half renews fewer and widens the
+//! bullets' search windows.)
 
 use std::cmp::Ordering;
 
@@ -53,7 +56,7 @@ pub(super) struct Slot {
 }
 
 impl Slot {
-    /// Body `local` with bounds `b`: its exact x range widened by a quarter of its width on
+    /// Body `local` with bounds `b`: its exact x range widened by half its width on
     /// each side (not at all when the width is not finite). Returns the slot and the width
     /// of its range.
     #[inline]
@@ -62,7 +65,7 @@ impl Slot {
         // `x - m <= x <= x + m` for `m >= 0` in any rounding, so the range holds the exact
         // one; a NaN bound stays NaN (and overlaps nothing).
         let m = if w.is_finite() && w > 0.0 {
-            w * 0.25
+            w * 0.5
         } else {
             0.0
         };
