@@ -19,15 +19,14 @@ pub(crate) fn run(ctx: &mut StageCtx) {
     let size = b.max - b.min;
     let mut gone = Vec::new();
     let w = &mut *ctx.world;
-    // Only active bodies move: static, frozen and sleeping ones stay where they were.
-    for k in 0..w.active().len() {
-        let i = w.active()[k] as usize;
+    // Only active bodies move: static, frozen and sleeping ones stay where they were. Most
+    // are inside: one tight pass finds the others (and a NaN coordinate, never outside,
+    // which the loop below leaves where it is).
+    let mut outside = Vec::new();
+    w.active_not_inside(b.min, b.max, &mut outside);
+    for i in outside {
+        let i = i as usize;
         let p = &mut w.position[i];
-        // Most bodies are inside: four comparisons (a NaN coordinate, never outside, takes
-        // the slow path and is left where it is).
-        if p.x >= b.min.x && p.x < b.max.x && p.y >= b.min.y && p.y < b.max.y {
-            continue;
-        }
         for axis in 0..2 {
             if p[axis] < b.min[axis] || p[axis] >= b.max[axis] {
                 if b.wrap {

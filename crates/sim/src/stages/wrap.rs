@@ -98,12 +98,15 @@ pub(crate) fn wrap_coordinate(p: f64, min: f64, max: f64, size: f64) -> f64 {
 pub(crate) fn bring_in(world: &WorldBounds, w: &mut World) {
     let size = world.size();
     let half = size * 0.5;
-    for k in 0..w.active().len() {
-        let i = w.active()[k] as usize;
+    // A body centred in the world sticks out by at most half its width, less than half the
+    // world's (a body wider than the world is refused at load): one tight pass finds the
+    // others.
+    let mut candidates = Vec::new();
+    w.active_not_inside(world.min, world.max, &mut candidates);
+    for i in candidates {
+        let i = i as usize;
         let p = w.position[i];
         let outside = |axis: usize| p[axis] < world.min[axis] || p[axis] >= world.max[axis];
-        // A body centred in the world sticks out by at most half its width, less than half
-        // the world's (a body wider than the world is refused at load).
         if !outside(0) && !outside(1) {
             continue;
         }

@@ -184,16 +184,27 @@ impl World {
     ) {
         out.clear();
         out.reserve(self.movers.len());
+        // Every column sliced to its exact length first: the columns of one index then share
+        // one bounds check (`i < n`, `r < m`) instead of one each.
+        let n = self.row.len();
+        let (row, position, angle) = (&self.row[..n], &self.position[..n], &self.angle[..n]);
+        let (layers, kinds, entity) = (&self.layer[..n], &self.kind[..n], &self.entity[..n]);
+        let shape_id = &self.shape_id[..n];
+        let rows = &mut self.rows;
+        let m = rows.local_bounds.len();
+        let local_bounds = &mut rows.local_bounds[..m];
+        let (start_position, frozen) = (&rows.start_position[..m], &rows.frozen[..m]);
+        let shapes = &self.shapes;
         for &i in &self.movers {
             let i = i as usize;
-            let r = self.row[i] as usize;
-            let p = self.position[i];
+            let r = row[i] as usize;
+            let p = position[i];
             // The shape table is read only when needed (a scene's shapes may all differ).
-            let (shapes, id) = (&self.shapes, self.shape_id[i]);
+            let id = shape_id[i];
             let shape = || &shapes.get(id).0;
-            let mut bounds = self.rows.local_bounds[r].at_with(shape, self.angle[i], p);
-            let layer = self.layer[i];
-            let moved = self.rows.start_position[r] - p;
+            let mut bounds = local_bounds[r].at_with(shape, angle[i], p);
+            let layer = layers[i];
+            let moved = start_position[r] - p;
             if moved != Vec2::ZERO
                 && (sweeping[usize::from(layer)]
                     || (separate_swept[usize::from(layer)]
@@ -202,14 +213,16 @@ impl World {
                 bounds = bounds.union(bounds.translated(moved));
             }
             visit(out.len(), &bounds);
+            let e = entity[i];
             out.push(BodyEntry {
-                key: self.key(i),
+                // As [`World::key`].
+                key: (u64::from(e.index) << 32) | u64::from(e.generation),
                 bounds,
                 layer,
-                kind: if self.rows.frozen[r] {
+                kind: if frozen[r] {
                     BodyKind::Kinematic
                 } else {
-                    self.kind[i]
+                    kinds[i]
                 },
             });
         }

@@ -59,16 +59,18 @@ impl World {
 
     /// Each dynamic body's world index and kinetic energy, in the order the sum adds them.
     fn energies(&self) -> impl Iterator<Item = (usize, f64)> + '_ {
+        // Sliced to their exact lengths: the columns of one index share one bounds check.
+        let n = self.kind.len();
+        let (kind, row) = (&self.kind[..n], &self.row[..n]);
+        let m = self.rows.mass.len();
+        let (mass, velocity) = (&self.rows.mass[..m], &self.rows.velocity[..m]);
         self.movers
             .iter()
             .map(|&i| i as usize)
-            .filter(|&i| self.kind[i] == BodyKind::Dynamic)
-            .map(|i| {
-                let r = self.row[i] as usize;
-                (
-                    i,
-                    0.5 * self.rows.mass[r] * self.rows.velocity[r].length_squared(),
-                )
+            .filter(move |&i| kind[i] == BodyKind::Dynamic)
+            .map(move |i| {
+                let r = row[i] as usize;
+                (i, 0.5 * mass[r] * velocity[r].length_squared())
             })
     }
 
