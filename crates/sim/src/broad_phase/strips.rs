@@ -11,9 +11,11 @@
 //! a strip holds only the bodies within `H` in y of each other.
 //!
 //! Like `SortAndSweep`, a moving list is kept from the previous call and re-sorted by
-//! insertion sort (nearly sorted: a body changes strip rarely). A slot carries its body's
-//! bounds, so a sweep reads one array in order. Static lists are sorted once, and again only
-//! when the static bodies or `H` change.
+//! insertion sort (nearly sorted: a body changes strip rarely). A slot is only the sort key
+//! and the body's index (16 bytes), so the sorts and the merge move little; once the order
+//! is settled the bounds are gathered beside it in the same order, so a sweep reads one
+//! array in sequence. Static lists are sorted once, and again only when the static bodies or
+//! `H` change.
 //!
 //! Two runs of very different sizes (a hundred actors over a floor of thousands of tiles)
 //! are not walked together: each body of the smaller one finds its candidates in the larger
@@ -31,8 +33,6 @@
 //! # Determinism
 //! Orders are by `(strip, min.x as f64::total_cmp, handle)`: a function of the input.
 
-use std::cmp::Ordering;
-
 use ricochet_geom::Bounds;
 
 use super::grid::cell_coord;
@@ -49,8 +49,11 @@ pub(super) struct StripList {
     pub(super) frame: u64,
     /// `1 / H` of the current order (0: one strip).
     inv_h: f64,
-    /// The bodies, sorted by [`strip_order`].
+    /// The bodies' sort keys, sorted.
     order: Vec<Slot>,
+    /// The bodies' bounds in `order`'s order, gathered once the order is settled: the sweeps
+    /// read this one array in sequence.
+    swept: Vec<Swept>,
     /// The keys of the list's bodies at the last update, in key order (`local` indexes it).
     keys: Vec<u64>,
     /// The widest body's `max.x - min.x` (at least 0; NaN ignored).
@@ -63,40 +66,54 @@ pub(super) struct StripList {
     merged: Vec<Slot>,
 }
 
-/// A body's place in a [`StripList`], with its bounds.
+/// A body's place in a [`StripList`] (16 bytes, so the insertion sort and the merge move a
+/// quarter of what they would with the bounds): `(strip, min.x, local)` packed into one
+/// integer whose order is the list order. From the high bits: the strip (`floor(min.y / H)`,
+/// clamped) with its sign bit flipped, `min.x` as [`order_key`], and the body's index in the
+/// list's key order, which breaks ties so the order is a function of the input.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+struct Slot(u128);
+
+impl Slot {
+    #[inline]
+    fn new(b: &Bounds, local: u32, inv_h: f64) -> Slot {
+        let strip = cell_coord(b.min.y, inv_h) as u32 ^ (1 << 31);
+        Slot(u128::from(strip) << 96 | u128::from(order_key(b.min.x)) << 32 | u128::from(local))
+    }
+
+    #[inline]
+    fn strip(self) -> i32 {
+        ((self.0 >> 96) as u32 ^ (1 << 31)) as i32
+    }
+
+    #[inline]
+    fn local(self) -> u32 {
+        self.0 as u32
+    }
+
+    /// A slot that sorts after every other (a body gone from the list).
+    const GONE: Slot = Slot(u128::MAX);
+}
+
+/// What a sweep reads of a body, in list order.
 #[derive(Clone, Copy, Debug)]
-struct Slot {
+struct Swept {
     /// `min.x` as [`order_key`].
     min: u64,
     /// `max.x + 0.0` as [`order_key`].
     max: u64,
-    /// `floor(min.y / H)`, clamped.
-    strip: i32,
-    /// The body's index in the list's key order.
-    local: u32,
     m: Member,
 }
 
-impl Slot {
+impl Swept {
     #[inline]
-    fn new(m: Member, local: u32, inv_h: f64) -> Slot {
-        Slot {
+    fn new(m: Member) -> Swept {
+        Swept {
             min: order_key(m.bounds.min.x),
             max: order_key(m.bounds.max.x + 0.0),
-            strip: cell_coord(m.bounds.min.y, inv_h),
-            local,
             m,
         }
     }
-}
-
-/// The list order; `local` (key order) breaks ties, so the order is a function of the input.
-#[inline]
-fn strip_order(a: &Slot, b: &Slot) -> Ordering {
-    a.strip
-        .cmp(&b.strip)
-        .then(a.min.cmp(&b.min))
-        .then(a.local.cmp(&b.local))
 }
 
 /// `1 / H` for bodies at most `height` tall with coordinates up to `max_abs`: `H` the least
@@ -141,9 +158,14 @@ impl StripList {
         list.order = members
             .iter()
             .enumerate()
-            .map(|(i, m)| Slot::new(*m, i as u32, inv_h))
+            .map(|(i, m)| Slot::new(&m.bounds, i as u32, inv_h))
             .collect();
-        list.order.sort_unstable_by(strip_order);
+        list.order.sort_unstable();
+        list.swept = list
+            .order
+            .iter()
+            .map(|s| Swept::new(members[s.local() as usize]))
+            .collect();
         list.width = members
             .iter()
             .map(|m| m.bounds.max.x - m.bounds.min.x)
@@ -153,10 +175,10 @@ impl StripList {
     }
 
     /// Reconciles the list with this call's bodies (`handles` into `bodies`, key order) and
-    /// strip height: bodies gone are dropped, bodies kept get their new bounds, and bodies
+    /// strip height: bodies gone are dropped, bodies kept get their new keys, and bodies
     /// new to the list or to their strip are sorted apart and merged in (a body that wraps
     /// from the bottom of the world to the top would cost an insertion sort the whole list).
-    /// Returns the insertion sort's moves.
+    /// Then the bounds are gathered in the new order. Returns the insertion sort's moves.
     pub(super) fn update(&mut self, handles: &[u32], bodies: &[BodyEntry], inv_h: f64) -> u64 {
         let restripped = self.inv_h.to_bits() != inv_h.to_bits();
         self.inv_h = inv_h;
@@ -166,23 +188,17 @@ impl StripList {
                 .iter()
                 .zip(&self.keys)
                 .all(|(&h, &k)| bodies[h as usize].key == k);
-        // The widest body (NaN ignored): a maximum, so any order gives it.
-        let widest = |w: f64, b: &Bounds| {
-            let x = b.max.x - b.min.x;
-            if x > w { x } else { w }
-        };
         if same {
-            // In list order: the slots are written in sequence, the bodies read at random,
-            // and the width taken from the bounds already read.
+            // In list order: the slots are written in sequence, the bodies read at random.
             // A body that changed strip leaves the list for `fresh`: the rest close up
             // behind a write cursor in the same pass.
-            let (mut width, mut kept) = (0.0, 0);
+            let mut kept = 0;
             for k in 0..self.order.len() {
-                let local = self.order[k].local;
-                let h = handles[local as usize];
-                let slot = Slot::new(member(&bodies[h as usize], h), local, inv_h);
-                width = widest(width, &slot.m.bounds);
-                if slot.strip == self.order[k].strip && !restripped {
+                let old = self.order[k];
+                let local = old.local();
+                let b = &bodies[handles[local as usize] as usize];
+                let slot = Slot::new(&b.bounds, local, inv_h);
+                if slot.strip() == old.strip() && !restripped {
                     self.order[kept] = slot;
                     kept += 1;
                 } else {
@@ -190,12 +206,8 @@ impl StripList {
                 }
             }
             self.order.truncate(kept);
-            self.width = width;
         } else {
             self.reconcile(handles, bodies, inv_h, restripped);
-            self.width = handles
-                .iter()
-                .fold(0.0, |w, &h| widest(w, &bodies[h as usize].bounds));
         }
         let reordered = !same || !self.fresh.is_empty();
         let moved = if reordered {
@@ -203,12 +215,13 @@ impl StripList {
         } else {
             insertion_sort(&mut self.order)
         };
+        self.gather(handles, bodies);
         self.find_runs();
         moved
     }
 
     /// [`StripList::update`] when the bodies are not the same as last time: merges the old
-    /// keys with the new ones (both ascending). Kept bodies get their new bounds in place,
+    /// keys with the new ones (both ascending). Kept bodies get their new keys in place,
     /// or go to `fresh` with the new ones when their strip changed.
     fn reconcile(&mut self, handles: &[u32], bodies: &[BodyEntry], inv_h: f64, restripped: bool) {
         self.remap.clear();
@@ -223,46 +236,46 @@ impl StripList {
                 self.remap[i] = j as u32;
                 i += 1;
             } else {
-                self.fresh.push(Slot::new(member(b, h), j as u32, inv_h));
+                self.fresh.push(Slot::new(&b.bounds, j as u32, inv_h));
             }
         }
         self.keys.clear();
         self.keys
             .extend(handles.iter().map(|&h| bodies[h as usize].key));
         for s in &mut self.order {
-            let j = self.remap[s.local as usize];
+            let j = self.remap[s.local() as usize];
             if j == NONE {
-                s.local = NONE;
+                *s = Slot::GONE;
                 continue;
             }
             let h = handles[j as usize];
-            let slot = Slot::new(member(&bodies[h as usize], h), j, inv_h);
-            if slot.strip == s.strip && !restripped {
+            let slot = Slot::new(&bodies[h as usize].bounds, j, inv_h);
+            if slot.strip() == s.strip() && !restripped {
                 *s = slot;
             } else {
-                s.local = NONE;
+                *s = Slot::GONE;
                 self.fresh.push(slot);
             }
         }
-        self.order.retain(|s| s.local != NONE);
+        self.order.retain(|&s| s != Slot::GONE);
     }
 
-    /// Sorts `order` again (no slot is marked `NONE` any more): insertion-sorts it (nearly
+    /// Sorts `order` again (no slot is [`Slot::GONE`] any more): insertion-sorts it (nearly
     /// sorted) and merges in `fresh` (sorted first). Returns the insertion sort's moves.
     fn settle(&mut self) -> u64 {
         let moved = insertion_sort(&mut self.order);
-        self.fresh.sort_unstable_by(strip_order);
+        self.fresh.sort_unstable();
         self.merged.clear();
         self.merged.reserve(self.order.len() + self.fresh.len());
         // A few fresh slots among thousands: each finds its place by binary search and the
         // slots between are copied as one block. The order is total (`local` breaks ties),
         // so this is the one merge of the two lists.
         let mut from = 0;
-        for f in &self.fresh {
+        for &f in &self.fresh {
             let rest = &self.order[from..];
-            let at = from + rest.partition_point(|s| strip_order(s, f) == Ordering::Less);
+            let at = from + rest.partition_point(|&s| s < f);
             self.merged.extend_from_slice(&self.order[from..at]);
-            self.merged.push(*f);
+            self.merged.push(f);
             from = at;
         }
         self.merged.extend_from_slice(&self.order[from..]);
@@ -270,26 +283,43 @@ impl StripList {
         moved
     }
 
+    /// Reads the bodies' bounds in list order into `swept`, and the widest body.
+    fn gather(&mut self, handles: &[u32], bodies: &[BodyEntry]) {
+        // The widest body (NaN ignored): a maximum, so any order gives it.
+        let mut width = 0.0;
+        self.swept.clear();
+        self.swept.extend(self.order.iter().map(|s| {
+            let h = handles[s.local() as usize];
+            let b = &bodies[h as usize];
+            let x = b.bounds.max.x - b.bounds.min.x;
+            if x > width {
+                width = x;
+            }
+            Swept::new(member(b, h))
+        }));
+        self.width = width;
+    }
+
     /// Finds the runs of one strip in `order`.
     fn find_runs(&mut self) {
         self.runs.clear();
         let mut last = None;
         for (k, s) in self.order.iter().enumerate() {
-            if last != Some(s.strip) {
-                self.runs.push((s.strip, k as u32));
-                last = Some(s.strip);
+            if last != Some(s.strip()) {
+                self.runs.push((s.strip(), k as u32));
+                last = Some(s.strip());
             }
         }
         self.runs.push((i32::MAX, self.order.len() as u32));
     }
 
-    /// The slots of run `r`, and its strip.
+    /// The bodies of run `r`, and its strip.
     #[inline]
-    fn run(&self, r: usize) -> (i32, &[Slot]) {
+    fn run(&self, r: usize) -> (i32, &[Swept]) {
         let (strip, start) = self.runs[r];
         (
             strip,
-            &self.order[start as usize..self.runs[r + 1].1 as usize],
+            &self.swept[start as usize..self.runs[r + 1].1 as usize],
         )
     }
 
@@ -302,7 +332,7 @@ impl StripList {
 
 /// Insertion sort for a nearly sorted list.
 fn insertion_sort(order: &mut [Slot]) -> u64 {
-    sorted::insertion_sort(order, strip_order, |_, _| {})
+    sorted::insertion_sort(order, Slot::cmp, |_, _| {})
 }
 
 /// Tests `p` and `q`, emitting the pair when one is dynamic and their bounds overlap.
@@ -320,7 +350,7 @@ fn test(p: &Member, q: &Member, out: &mut Vec<(u32, u32)>) -> u64 {
 /// Tests `p` against the slots of `others` (sorted by `min.x`) until one starts past `p`'s
 /// end along x.
 #[inline]
-fn scan(p: &Slot, others: &[Slot], out: &mut Vec<(u32, u32)>) -> u64 {
+fn scan(p: &Swept, others: &[Swept], out: &mut Vec<(u32, u32)>) -> u64 {
     let mut tested = 0;
     for s in others {
         if s.min > p.max {
@@ -332,7 +362,7 @@ fn scan(p: &Slot, others: &[Slot], out: &mut Vec<(u32, u32)>) -> u64 {
 }
 
 /// Every overlapping pair within one run.
-fn within(run: &[Slot], out: &mut Vec<(u32, u32)>) -> u64 {
+fn within(run: &[Swept], out: &mut Vec<(u32, u32)>) -> u64 {
     let mut tested = 0;
     for (k, p) in run.iter().enumerate() {
         let rest = &run[k + 1..];
@@ -344,7 +374,7 @@ fn within(run: &[Slot], out: &mut Vec<(u32, u32)>) -> u64 {
 }
 
 /// Every overlapping pair with one slot from each run, walking both in `min.x` order.
-fn merged(xs: &[Slot], ys: &[Slot], out: &mut Vec<(u32, u32)>) -> u64 {
+fn merged(xs: &[Swept], ys: &[Swept], out: &mut Vec<(u32, u32)>) -> u64 {
     let mut tested = 0;
     let (mut i, mut j) = (0, 0);
     while i < xs.len() && j < ys.len() {
@@ -365,7 +395,7 @@ fn merged(xs: &[Slot], ys: &[Slot], out: &mut Vec<(u32, u32)>) -> u64 {
 
 /// Every overlapping pair with one slot from each run, each slot of `small` finding its
 /// candidates in `large` (none wider than `width`) by binary search.
-fn searched(small: &[Slot], large: &[Slot], width: f64, out: &mut Vec<(u32, u32)>) -> u64 {
+fn searched(small: &[Swept], large: &[Swept], width: f64, out: &mut Vec<(u32, u32)>) -> u64 {
     let mut tested = 0;
     for p in small {
         let b = &p.m.bounds;
@@ -385,8 +415,8 @@ fn searched(small: &[Slot], large: &[Slot], width: f64, out: &mut Vec<(u32, u32)
 
 /// Every overlapping pair of two runs, by whichever walk is cheaper.
 fn pair_runs(
-    (xs, x_width): (&[Slot], f64),
-    (ys, y_width): (&[Slot], f64),
+    (xs, x_width): (&[Swept], f64),
+    (ys, y_width): (&[Swept], f64),
     out: &mut Vec<(u32, u32)>,
 ) -> u64 {
     let log = |n: usize| u64::from(usize::BITS - n.leading_zeros()) + 2;
