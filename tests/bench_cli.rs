@@ -208,11 +208,11 @@ fn bench_broad_phases_runs_every_kind_and_they_agree_on_the_pairs() {
         let row = summary(scene);
         let ratio: f64 = row[5].parse().unwrap_or_else(|_| panic!("{row:?}"));
         assert!(ratio >= 1.0, "{row:?}");
-        assert_eq!(
-            row[6],
-            if ratio <= 1.10 { "yes" } else { "**no**" },
-            "{row:?}"
-        );
+        // The printed ratio is rounded to two places: at 1.10 either verdict is right.
+        if (ratio - 1.10).abs() > 0.006 {
+            let verdict = if ratio < 1.10 { "yes" } else { "**no**" };
+            assert_eq!(row[6], verdict, "{row:?}");
+        }
     }
     assert!(
         stdout.contains("within 10% of the fastest broad phase on "),
