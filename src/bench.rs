@@ -61,14 +61,15 @@ pub fn bad_frames(frames: u64) -> anyhow::Result<Option<ExitCode>> {
     Ok(None)
 }
 
-/// The named scenes (or [`DEFAULT_SCENES`]), parsed, or exit code 2 after saying why (an
+/// The named scenes (or `defaults`), parsed, or exit code 2 after saying why (an
 /// unknown scene name, or a bad `--frames`).
 fn parse_scenes(
     scenes: &[String],
+    defaults: &[&str],
     frames: u64,
 ) -> anyhow::Result<Result<Vec<(String, Scene)>, ExitCode>> {
     let names: Vec<String> = if scenes.is_empty() {
-        DEFAULT_SCENES.iter().map(|s| (*s).to_owned()).collect()
+        defaults.iter().map(|s| (*s).to_owned()).collect()
     } else {
         scenes.to_vec()
     };
@@ -94,7 +95,7 @@ fn parse_scenes(
 /// not, 2 for an unknown scene name, a count past [`ricochet_scenes::bench::MAX_COUNT`], or a
 /// frame count of 0 or past [`MAX_FRAMES`].
 pub fn run(scenes: &[String], frames: u64, csv: Option<&Path>) -> anyhow::Result<ExitCode> {
-    let parsed = match parse_scenes(scenes, frames)? {
+    let parsed = match parse_scenes(scenes, &DEFAULT_SCENES, frames)? {
         Ok(parsed) => parsed,
         Err(code) => return Ok(code),
     };
@@ -133,7 +134,7 @@ pub fn run(scenes: &[String], frames: u64, csv: Option<&Path>) -> anyhow::Result
 /// ([`ricochet_study::bench::queries`]); prints the table. Exit code 0 when every answer
 /// agrees, 1 when one does not, 2 for a bad scene name or frame count.
 pub fn run_queries(scenes: &[String], frames: u64) -> anyhow::Result<ExitCode> {
-    let parsed = match parse_scenes(scenes, frames)? {
+    let parsed = match parse_scenes(scenes, &DEFAULT_SCENES, frames)? {
         Ok(parsed) => parsed,
         Err(code) => return Ok(code),
     };
@@ -153,12 +154,7 @@ pub fn run_queries(scenes: &[String], frames: u64) -> anyhow::Result<ExitCode> {
 /// at frame `frames` ([`ricochet_study::bench::snapshots`]); prints the table. Exit code 0,
 /// 2 for a bad scene name or frame count.
 pub fn run_snapshots(scenes: &[String], frames: u64) -> anyhow::Result<ExitCode> {
-    let scenes = if scenes.is_empty() {
-        vec!["asteroids-75".to_owned(), "asteroids-10000".to_owned()]
-    } else {
-        scenes.to_vec()
-    };
-    let parsed = match parse_scenes(&scenes, frames)? {
+    let parsed = match parse_scenes(scenes, &["asteroids-75", "asteroids-10000"], frames)? {
         Ok(parsed) => parsed,
         Err(code) => return Ok(code),
     };
@@ -180,15 +176,7 @@ pub fn run_snapshots(scenes: &[String], frames: u64) -> anyhow::Result<ExitCode>
 /// ([`ricochet_study::bench::broad_phases`]); prints the tables. Exit code 0, 1 when two
 /// broad phases disagree on the pairs (an error), 2 for a bad scene name or frame count.
 pub fn run_broad_phases(scenes: &[String], frames: u64) -> anyhow::Result<ExitCode> {
-    let scenes = if scenes.is_empty() {
-        broad_phases::DEFAULT_SCENES
-            .iter()
-            .map(|s| (*s).to_owned())
-            .collect()
-    } else {
-        scenes.to_vec()
-    };
-    let parsed = match parse_scenes(&scenes, frames)? {
+    let parsed = match parse_scenes(scenes, &broad_phases::DEFAULT_SCENES, frames)? {
         Ok(parsed) => parsed,
         Err(code) => return Ok(code),
     };

@@ -3,8 +3,13 @@
 //! structures, every moving layer's dynamic bodies against every interacting static layer
 //! through the static ones, counting the layer combinations skipped.
 
+use ricochet_geom::Bounds;
+
 use crate::def::BodyKind;
 
+use super::hash_grid::HashGrid;
+use super::kept_tree::KeptTree;
+use super::quadtree::Quadtree;
 use super::sort_and_sweep::{SweepView, sweep_cross, sweep_self};
 use super::{
     BodyEntry, BroadPhase, BroadPhaseKind, BroadPhaseStats, Interactions, Member, member, of_layer,
@@ -91,28 +96,7 @@ impl BroadPhase {
                 }
                 self.scratch.ranges = ranges;
             }
-            BroadPhaseKind::Quadtree | BroadPhaseKind::Tree => {
-                self.tree_pairs(kind, (a, b), bodies, out, stats);
-            }
-            _ if a == b => {
-                self.ensure_grid(a, bodies);
-                stats.tested += self.grids[usize::from(a)].self_pairs(out);
-            }
-            _ => {
-                // Query the larger layer's grid with the smaller's bodies.
-                let (na, nb) = (self.layer_movers(a).len(), self.layer_movers(b).len());
-                let (grid, query) = if na > nb { (a, b) } else { (b, a) };
-                self.ensure_grid(grid, bodies);
-                let g = &self.grids[usize::from(grid)];
-                for &h in self.layer_movers(query) {
-                    let q = member(&bodies[h as usize], h);
-                    stats.tested += g.query(&q.bounds, |m| {
-                        if q.dynamic || m.dynamic {
-                            out.push((q.handle, m.handle));
-                        }
-                    });
-                }
-            }
+            _ => self.indexed_pairs(kind, (a, b), bodies, out, stats),
         }
     }
 
@@ -165,26 +149,10 @@ impl BroadPhase {
         list.update(handles, bodies, &mut self.scratch)
     }
 
-    /// Builds layer `l`'s grid of moving bodies, once per call.
-    fn ensure_grid(&mut self, l: u8, bodies: &[BodyEntry]) {
-        let grid = &mut self.grids[usize::from(l)];
-        if grid.frame == self.frame {
-            return;
-        }
-        grid.frame = self.frame;
-        grid.members.clear();
-        grid.members.extend(
-            of_layer(&self.movers, &self.layer_start, l)
-                .iter()
-                .map(|&h| member(&bodies[h as usize], h)),
-        );
-        grid.build(&mut self.scratch.extents, false);
-    }
-
-    /// `Quadtree` and `Tree`: the pairs of moving layers `a` and `b`. One layer: each body
-    /// queries its layer's structure. Two: the larger layer's structure is queried with the
+    /// `Grid`, `Quadtree` and `Tree`: the pairs of moving layers `a` and `b`. One layer: its
+    /// structure finds its own pairs. Two: the larger layer's structure is queried with the
     /// smaller's bodies (only the one queried is brought up to date).
-    fn tree_pairs(
+    fn indexed_pairs(
         &mut self,
         kind: BroadPhaseKind,
         (a, b): (u8, u8),
@@ -194,54 +162,56 @@ impl BroadPhase {
     ) {
         let (na, nb) = (self.layer_movers(a).len(), self.layer_movers(b).len());
         let (index, query) = if na > nb { (a, b) } else { (b, a) };
-        let quad = kind == BroadPhaseKind::Quadtree;
-        if quad {
-            self.ensure_quadtree(index, bodies);
-        } else {
-            stats.resorted += self.ensure_tree(index, bodies);
-        }
-        let (qt, tree) = (
-            &self.quadtrees[usize::from(index)],
-            &self.trees[usize::from(index)],
-        );
+        let l = usize::from(index);
+        let structure = match kind {
+            BroadPhaseKind::Quadtree => {
+                let qt = &mut self.quadtrees[l];
+                if qt.frame != self.frame {
+                    qt.frame = self.frame;
+                    layer_members(
+                        &self.movers,
+                        &self.layer_start,
+                        index,
+                        bodies,
+                        &mut qt.members,
+                    );
+                    qt.build();
+                }
+                Indexed::Quadtree(qt)
+            }
+            BroadPhaseKind::Tree => {
+                stats.resorted += self.ensure_tree(index, bodies);
+                Indexed::Tree(&self.trees[l])
+            }
+            _ => {
+                let grid = &mut self.grids[l];
+                if grid.frame != self.frame {
+                    grid.frame = self.frame;
+                    layer_members(
+                        &self.movers,
+                        &self.layer_start,
+                        index,
+                        bodies,
+                        &mut grid.members,
+                    );
+                    grid.build(&mut self.scratch.extents, false);
+                }
+                Indexed::Grid(grid)
+            }
+        };
         let nodes = &mut self.scratch.nodes;
         if a == b {
-            stats.tested += if quad {
-                qt.self_pairs(nodes, out)
-            } else {
-                tree.self_pairs(nodes, out)
-            };
+            stats.tested += structure.self_pairs(nodes, out);
             return;
         }
         for &h in of_layer(&self.movers, &self.layer_start, query) {
             let q = member(&bodies[h as usize], h);
-            let mut emit = |_, m: &Member| {
+            stats.tested += structure.query(&q.bounds, nodes, |m| {
                 if q.dynamic || m.dynamic {
                     out.push((q.handle, m.handle));
                 }
-            };
-            stats.tested += if quad {
-                qt.query(&q.bounds, nodes, &mut emit)
-            } else {
-                tree.query(&q.bounds, nodes, &mut emit)
-            };
+            });
         }
-    }
-
-    /// Builds layer `l`'s quadtree of moving bodies, once per call.
-    fn ensure_quadtree(&mut self, l: u8, bodies: &[BodyEntry]) {
-        let qt = &mut self.quadtrees[usize::from(l)];
-        if qt.frame == self.frame {
-            return;
-        }
-        qt.frame = self.frame;
-        qt.members.clear();
-        qt.members.extend(
-            of_layer(&self.movers, &self.layer_start, l)
-                .iter()
-                .map(|&h| member(&bodies[h as usize], h)),
-        );
-        qt.build();
     }
 
     /// Brings layer `l`'s kept tree up to this call, once per call. Returns the leaves
@@ -253,5 +223,49 @@ impl BroadPhase {
         }
         tree.frame = self.frame;
         tree.update(of_layer(&self.movers, &self.layer_start, l), bodies)
+    }
+}
+
+/// Layer `l`'s moving bodies as members, in key order, into `members` (cleared first).
+fn layer_members(
+    movers: &[u32],
+    layer_start: &[u32],
+    l: u8,
+    bodies: &[BodyEntry],
+    members: &mut Vec<Member>,
+) {
+    members.clear();
+    members.extend(
+        of_layer(movers, layer_start, l)
+            .iter()
+            .map(|&h| member(&bodies[h as usize], h)),
+    );
+}
+
+/// One layer's structure of moving bodies, whichever kind built it.
+enum Indexed<'a> {
+    Grid(&'a HashGrid),
+    Quadtree(&'a Quadtree),
+    Tree(&'a KeptTree),
+}
+
+impl Indexed<'_> {
+    /// Calls `f` on every member overlapping `q`. Returns the members tested.
+    #[inline]
+    fn query(&self, q: &Bounds, nodes: &mut Vec<u32>, mut f: impl FnMut(&Member)) -> u64 {
+        match self {
+            Indexed::Grid(g) => g.query(q, f),
+            Indexed::Quadtree(t) => t.query(q, nodes, |_, m| f(m)),
+            Indexed::Tree(t) => t.query(q, nodes, |_, m| f(m)),
+        }
+    }
+
+    /// Every overlapping pair of the members with a dynamic one. Returns the tests.
+    fn self_pairs(&self, nodes: &mut Vec<u32>, out: &mut Vec<(u32, u32)>) -> u64 {
+        match self {
+            Indexed::Grid(g) => g.self_pairs(out),
+            Indexed::Quadtree(t) => t.self_pairs(nodes, out),
+            Indexed::Tree(t) => t.self_pairs(nodes, out),
+        }
     }
 }

@@ -167,14 +167,9 @@ impl KeptTree {
         &self,
         q: &Bounds,
         stack: &mut Vec<u32>,
-        mut f: impl FnMut(u32, &Member),
+        f: impl FnMut(u32, &Member),
     ) -> u64 {
-        self.tree.query(q, stack, |local| {
-            let m = &self.members[local as usize];
-            if m.bounds.overlaps(q) {
-                f(local, m);
-            }
-        })
+        query_exact(&self.tree, &self.members, q, stack, f)
     }
 
     /// Every overlapping pair of the layer's bodies with a dynamic one: each body queries
@@ -227,13 +222,26 @@ impl StaticDynamicTree {
         &self,
         q: &Bounds,
         stack: &mut Vec<u32>,
-        mut f: impl FnMut(u32, &Member),
+        f: impl FnMut(u32, &Member),
     ) -> u64 {
-        self.tree.query(q, stack, |i| {
-            let m = &self.members[i as usize];
-            if m.bounds.overlaps(q) {
-                f(i, m);
-            }
-        })
+        query_exact(&self.tree, &self.members, q, stack, f)
     }
+}
+
+/// Calls `f` on every member of `tree` (items index `members`) whose exact bounds overlap
+/// `q`: the tree's boxes (fat or exact) only narrow the search. Returns the members tested.
+#[inline]
+fn query_exact(
+    tree: &DynamicTree,
+    members: &[Member],
+    q: &Bounds,
+    stack: &mut Vec<u32>,
+    mut f: impl FnMut(u32, &Member),
+) -> u64 {
+    tree.query(q, stack, |i| {
+        let m = &members[i as usize];
+        if m.bounds.overlaps(q) {
+            f(i, m);
+        }
+    })
 }

@@ -68,22 +68,41 @@
 //! otherwise: with a million static tiles it costs what the moving bodies cost.
 //!
 //! # `Auto`
-//! Decided on every call from counts and the layer table only (deterministic, no timing):
-//! - at most 32 bodies in all: `BruteForce` (at most 496 tests, no structure to keep);
-//! - at least as many static as moving bodies: `Grid` (tile maps: a static cell lookup is
+//! Decided on every call (`auto.rs`) from this call's counts, layer table and moving
+//! bodies' widths, and the previous call's pick: deterministic, no timing. Only *indexed*
+//! static bodies count: the inert ones a caller keeps out (`set_inert_statics`, a tile map
+//! that only the per-axis stages meet) cost no algorithm anything, though the stats still
+//! count them.
+//! - at most 32 bodies given in all: `BruteForce` (at most 496 tests, no structure to keep);
+//! - at least as many indexed static as moving bodies: `Grid` (a static cell lookup is
 //!   `O(1)` where the static tree is `O(log n)`, and the static grid is built once);
-//! - a layer of at least [`CROWD`] moving bodies that interact with each other: `Strips` (a
-//!   crowd colliding among itself, like rain: one sort axis leaves thousands of bodies
-//!   sharing an x range to test against each other; `rain-10000` 3.5 ms a frame with
-//!   `SortAndSweep`, 1.8 with `Grid`, 1.1 with `Strips`);
+//! - a layer of at least [`CROWD`] moving bodies that interact with each other, on which
+//!   sort and sweep would test each body against at least [`STRIPS_ENTER`] others along x:
+//!   `Strips`. The estimate is `n w / X` for the layer's `n` bodies of mean width `w` over
+//!   an x span `X` (the bodies whose `min.x` falls within a body's x extent, for an even
+//!   spread), from 64 bodies evenly spaced in key order. Sort and sweep's cost grows with
+//!   it (each x-overlap is a test, reading the other body's bounds); strips test only the
+//!   neighbours in y, at a higher cost per body (bounds kept in the slots, two sort keys).
+//!   Once on `Strips`, `Auto` stays there down to three quarters of the threshold: a switch
+//!   rebuilds a list.
 //! - otherwise `SortAndSweep` (moving crowds that only meet other layers, like asteroids
-//!   and bullets: the coherent sort costs about one pass over the moving bodies, and unlike
-//!   a grid it does not care how much body sizes vary; `asteroids-10000` 0.26 ms, against
-//!   0.62 with the grid).
+//!   and bullets, and crowds spread thin along x, like a long level's actors: the coherent
+//!   sort costs about one pass over the moving bodies, and unlike a grid it does not care
+//!   how much body sizes vary).
+//!
+//! Figures behind the threshold (`ricochet bench --broad-phases`, broad phase alone, ms a
+//! frame, idle machine; estimate in brackets): the platformer's 1,000 actors along a long
+//! level, `platformer-1000000-1000` (0.28) sort and sweep 0.015 against strips 0.051, and
+//! `platformer-10000-1000` (2.9) 0.020 against 0.023; `sparse-10000` (7.5) strips 0.394
+//! against sort and sweep 0.694, `rain-10000` (16) 0.632 against 3.000. On a loaded machine,
+//! more sizes put the crossing between 3.4 (`sparse-2000`, `platformer-7000-1000`: level)
+//! and 4.3 (`sparse-3000`, `platformer-5000-1000`: strips ahead), and strips ahead from 5
+//! (`platformer-3000-1000`, `platformer-10000-3000`, `crowded-300` and up). The estimate
+//! assumes an even spread along x: a crowd in a few tight clusters far apart is
+//! underestimated, and one in a corridor one strip tall gains nothing from strips.
 //!
 //! Neither `Quadtree` nor `Tree` is ever `Auto`'s pick: in the study of BENCHMARKS.md
-//! ("Broad phases: the study", `ricochet bench --broad-phases`) neither was the fastest on
-//! any scene.
+//! ("Broad phases: the study") neither was the fastest on any scene.
 //!
 //! Each kind keeps its own structures, so a switch costs one build and nothing else.
 //!
@@ -91,10 +110,16 @@
 //! Sorting uses `f64::total_cmp` with the body's key as the tie-break, so every order is a
 //! function of the current input; the output is sorted. No hashed collection, no clock.
 
-/// Moving bodies of one layer that interact with each other, from which `Auto` takes
-/// `Strips` (see the module docs).
+/// Moving bodies of one layer that interact with each other, from which `Auto` estimates
+/// whether `Strips` pays (see the module docs).
 pub const CROWD: usize = 256;
 
+/// Sort and sweep's estimated x-overlaps per body of a crowd layer from which `Auto` takes
+/// `Strips` (see the module docs); once on `Strips`, it stays there down to three quarters
+/// of this.
+pub const STRIPS_ENTER: f64 = 4.0;
+
+mod auto;
 mod brute_force;
 mod by_layers;
 mod dynamic_tree;
@@ -125,6 +150,7 @@ pub(crate) use mover_grid::MoverGrid;
 use quadtree::Quadtree;
 use sort_and_sweep::{Slot, SweepList};
 use static_set::StaticSet;
+use static_tree::StaticTree;
 use strips::StripList;
 use tally::Tally;
 pub(crate) use tile_map::{StaticBox, TileMap};
@@ -175,6 +201,8 @@ pub struct BroadPhaseStats {
 pub struct BroadPhase {
     kind: BroadPhaseKind,
     chosen: BroadPhaseKind,
+    /// `Auto`'s last estimate of sort and sweep's x-overlaps per body (`auto.rs`).
+    overlaps: f64,
     /// Calls made, to know which per-layer structures are current.
     frame: u64,
     statics: StaticSet,
@@ -239,6 +267,7 @@ impl BroadPhase {
         BroadPhase {
             kind,
             chosen: kind,
+            overlaps: 0.0,
             frame: 0,
             statics: StaticSet::default(),
             static_rebuilds: 0,
@@ -266,10 +295,18 @@ impl BroadPhase {
         self.chosen
     }
 
-    /// The heap bytes held by the structures of `kind` (moving and static), or `None` for
-    /// `SortAndSweep` and `Strips`, whose lists do not report theirs, and for `Auto`. For the
-    /// broad-phase study (`ricochet bench --broad-phases`); capacities, so buffers kept for
-    /// reuse count.
+    /// `Auto`'s estimate, in the last call, of the x-overlaps per body sort and sweep would
+    /// test in the most crowded layer of at least [`CROWD`] moving bodies that interact with
+    /// each other: the figure it compares with [`STRIPS_ENTER`]. 0 when it did not estimate
+    /// (another rule decided first, no such layer, or not `Auto`).
+    #[must_use]
+    pub fn sweep_overlaps(&self) -> f64 {
+        self.overlaps
+    }
+
+    /// The heap bytes held by the structures of `kind` (moving and static, the stored static
+    /// bodies included), or `None` for `Auto`. For the broad-phase study (`ricochet bench
+    /// --broad-phases`); capacities, so buffers kept for reuse count.
     #[must_use]
     pub fn heap_bytes(&self, kind: BroadPhaseKind) -> Option<usize> {
         let st = &self.statics;
@@ -291,7 +328,19 @@ impl BroadPhase {
                         .map(|t| t.heap_bytes())
                         .sum::<usize>()
             }
-            _ => return None,
+            BroadPhaseKind::SortAndSweep => {
+                let sc = &self.scratch;
+                self.sweeps.iter().map(SweepList::heap_bytes).sum::<usize>()
+                    + st.trees.iter().map(StaticTree::heap_bytes).sum::<usize>()
+                    + (sc.fresh.capacity() + sc.merged.capacity()) * size_of::<Slot>()
+                    + sc.remap.capacity() * 4
+                    + (sc.ranges.capacity() + sc.stack.capacity()) * 8
+            }
+            BroadPhaseKind::Strips => {
+                let s = |v: &[StripList]| v.iter().map(StripList::heap_bytes).sum::<usize>();
+                s(&self.strips) + s(&self.static_strips)
+            }
+            BroadPhaseKind::Auto => return None,
         };
         Some(statics + structures)
     }
@@ -436,16 +485,8 @@ impl BroadPhase {
         out.clear();
         let n_movers = self.movers.len();
         let n_statics = self.statics.count();
-        let crowd = || {
-            self.mover_layers
-                .iter()
-                .any(|&l| interactions.interacts(l, l) && self.layer_movers(l).len() >= CROWD)
-        };
         let kind = match self.kind {
-            BroadPhaseKind::Auto if n_movers + n_statics <= 32 => BroadPhaseKind::BruteForce,
-            BroadPhaseKind::Auto if n_statics >= n_movers => BroadPhaseKind::Grid,
-            BroadPhaseKind::Auto if crowd() => BroadPhaseKind::Strips,
-            BroadPhaseKind::Auto => BroadPhaseKind::SortAndSweep,
+            BroadPhaseKind::Auto => self.auto_kind(bodies, interactions),
             k => k,
         };
         self.chosen = kind;

@@ -169,6 +169,11 @@ impl SweepList {
         }
         moved
     }
+
+    /// The heap bytes the list holds (capacities), for the broad-phase study.
+    pub(super) fn heap_bytes(&self) -> usize {
+        self.order.capacity() * size_of::<Slot>() + self.keys.capacity() * 8
+    }
 }
 
 /// Tests `p` (whose `max.x` key is `max`) against the bodies of `others` (sorted) ahead of

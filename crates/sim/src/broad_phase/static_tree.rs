@@ -95,6 +95,13 @@ impl StaticTree {
         }
         tested
     }
+
+    /// The heap bytes the tree holds (capacities), for the broad-phase study.
+    pub(crate) fn heap_bytes(&self) -> usize {
+        self.items.capacity() * size_of::<Member>()
+            + self.levels.capacity() * size_of::<Vec<Bounds>>()
+            + self.levels.iter().map(|l| l.capacity()).sum::<usize>() * size_of::<Bounds>()
+    }
 }
 
 impl StaticTree {

@@ -328,6 +328,16 @@ impl StripList {
     fn run_count(&self) -> usize {
         self.runs.len() - 1
     }
+
+    /// The heap bytes the list holds (capacities, its update buffers included), for the
+    /// broad-phase study.
+    pub(super) fn heap_bytes(&self) -> usize {
+        let slots = self.order.capacity() + self.fresh.capacity() + self.merged.capacity();
+        slots * size_of::<Slot>()
+            + self.keys.capacity() * 8
+            + self.runs.capacity() * size_of::<(i32, u32)>()
+            + self.remap.capacity() * 4
+    }
 }
 
 /// Insertion sort for a nearly sorted list.
