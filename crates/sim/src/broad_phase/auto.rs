@@ -1,6 +1,8 @@
 //! `Auto`'s rule: which algorithm a call runs, from this call's counts, layer table and
-//! moving bodies' widths, and the previous call's pick (deterministic, no timing). The rule
-//! and the study's figures behind it are in the module docs of `broad_phase`.
+//! moving bodies' widths alone (deterministic, no timing, no memory of earlier calls: a
+//! simulation restored from a snapshot, whose broad phase is built anew, picks what the
+//! original picked). The rule and the study's figures behind it are in the module docs of
+//! `broad_phase`.
 
 use super::{BodyEntry, BroadPhase, BroadPhaseKind, CROWD, Interactions, STRIPS_ENTER, of_layer};
 
@@ -31,14 +33,7 @@ impl BroadPhase {
                 self.overlaps = self.overlaps.max(x_overlaps(handles, bodies));
             }
         }
-        // Hysteresis: a switch costs a build (and a stale list re-sorted), so an estimate
-        // wavering around the threshold does not flip the pick every call.
-        let threshold = if self.chosen == BroadPhaseKind::Strips {
-            STRIPS_ENTER * 0.75
-        } else {
-            STRIPS_ENTER
-        };
-        if self.overlaps >= threshold {
+        if self.overlaps >= STRIPS_ENTER {
             BroadPhaseKind::Strips
         } else {
             BroadPhaseKind::SortAndSweep
@@ -245,33 +240,15 @@ mod tests {
     }
 
     #[test]
-    fn strips_is_kept_until_the_estimate_falls_to_three_quarters() {
+    fn the_pick_depends_on_this_call_alone() {
+        // A broad phase that just ran strips picks, for an input below the threshold, what
+        // a fresh one picks (a restored simulation builds its broad phase anew).
         let at = |overlaps: f64| row(N, 1.0, N as f64 / overlaps, 0, 0);
-        let (enter, leave) = (STRIPS_ENTER, STRIPS_ENTER * 0.75);
-        let mut bp = BroadPhase::new(BroadPhaseKind::Auto);
-        assert_eq!(
-            pick(&mut bp, &[], &at(enter - 0.01)),
-            BroadPhaseKind::SortAndSweep
-        );
-        assert_eq!(
-            pick(&mut bp, &[], &at(enter + 0.01)),
-            BroadPhaseKind::Strips
-        );
-        assert_eq!(
-            pick(&mut bp, &[], &at(enter - 0.01)),
-            BroadPhaseKind::Strips
-        );
-        assert_eq!(
-            pick(&mut bp, &[], &at(leave + 0.01)),
-            BroadPhaseKind::Strips
-        );
-        assert_eq!(
-            pick(&mut bp, &[], &at(leave - 0.01)),
-            BroadPhaseKind::SortAndSweep
-        );
-        assert_eq!(
-            pick(&mut bp, &[], &at(enter - 0.01)),
-            BroadPhaseKind::SortAndSweep
-        );
+        let mut warm = BroadPhase::new(BroadPhaseKind::Auto);
+        assert_eq!(pick(&mut warm, &[], &at(10.0)), BroadPhaseKind::Strips);
+        let below = at(STRIPS_ENTER - 0.01);
+        let fresh = pick(&mut BroadPhase::new(BroadPhaseKind::Auto), &[], &below);
+        assert_eq!(fresh, BroadPhaseKind::SortAndSweep);
+        assert_eq!(pick(&mut warm, &[], &below), fresh);
     }
 }

@@ -69,7 +69,9 @@
 //!
 //! # `Auto`
 //! Decided on every call (`auto.rs`) from this call's counts, layer table and moving
-//! bodies' widths, and the previous call's pick: deterministic, no timing. Only *indexed*
+//! bodies' widths alone: deterministic, no timing, and no memory of earlier calls, so a
+//! simulation restored from a snapshot (its broad phase built anew) picks what the
+//! original did. Only *indexed*
 //! static bodies count: the inert ones a caller keeps out (`set_inert_statics`, a tile map
 //! that only the per-axis stages meet) cost no algorithm anything, though the stats still
 //! count them.
@@ -83,8 +85,6 @@
 //!   spread), from 64 bodies evenly spaced in key order. Sort and sweep's cost grows with
 //!   it (each x-overlap is a test, reading the other body's bounds); strips test only the
 //!   neighbours in y, at a higher cost per body (bounds kept in the slots, two sort keys).
-//!   Once on `Strips`, `Auto` stays there down to three quarters of the threshold: a switch
-//!   rebuilds a list.
 //! - otherwise `SortAndSweep` (moving crowds that only meet other layers, like asteroids
 //!   and bullets, and crowds spread thin along x, like a long level's actors: the coherent
 //!   sort costs about one pass over the moving bodies, and unlike a grid it does not care
@@ -115,8 +115,7 @@
 pub const CROWD: usize = 256;
 
 /// Sort and sweep's estimated x-overlaps per body of a crowd layer from which `Auto` takes
-/// `Strips` (see the module docs); once on `Strips`, it stays there down to three quarters
-/// of this.
+/// `Strips` (see the module docs).
 pub const STRIPS_ENTER: f64 = 4.0;
 
 mod auto;
