@@ -266,10 +266,11 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(120))]
 
     /// The same bodies over many frames, as in a game where nothing spawns: most move a
-    /// little (inside the x range `SortAndSweep` keeps for them, or just out of it), some
-    /// stay, some jump, some grow or shrink (a range that no longer holds the body, or a
-    /// body far narrower than its range). Every frame, every kind still matches: the kept
-    /// ranges only choose candidates.
+    /// little (up to 0.01 or 0.125 along x), some stay, some jump (up to 1), some grow or
+    /// shrink by half.
+    /// Every frame, every kind still matches (a structure that keeps anything per body
+    /// from frame to frame, such as the kept tree's fat boxes, must not let it choose
+    /// pairs).
     #[test]
     fn kept_ranges_with_the_same_bodies_still_match(
         bodies in arb_scene(120),

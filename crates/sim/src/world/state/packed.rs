@@ -537,12 +537,9 @@ mod tests {
         assert_same(&World::new().packed().unpack(), &World::new());
     }
 
-    #[test]
-    fn a_tile_map_packs_to_a_few_bytes_a_tile() {
+    /// A world of unit tiles of layer 0 in `rows` (each a start and a count, one unit apart).
+    fn unit_tiles(rows: Vec<(Vec2, u32)>) -> World {
         let mut w = World::new();
-        let rows: Vec<(Vec2, u32)> = (0..100)
-            .map(|r| (Vec2::new(0.5 + f64::from(r % 8), 5.0 * f64::from(r)), 100))
-            .collect();
         w.spawn_tiles(
             &TileRows {
                 name: "tile".to_owned(),
@@ -553,6 +550,15 @@ mod tests {
             },
             |_| {},
         );
+        w
+    }
+
+    #[test]
+    fn a_tile_map_packs_to_a_few_bytes_a_tile() {
+        let rows: Vec<(Vec2, u32)> = (0..100)
+            .map(|r| (Vec2::new(0.5 + f64::from(r % 8), 5.0 * f64::from(r)), 100))
+            .collect();
+        let w = unit_tiles(rows);
         let packed = w.packed();
         assert_same(&packed.unpack(), &w);
         let columns = 42 * w.len();
@@ -572,17 +578,7 @@ mod tests {
                 rows.push((Vec2::new(0.5 + 8.0 * f64::from(s), 5.0 * f64::from(f)), 7));
             }
         }
-        let mut w = World::new();
-        w.spawn_tiles(
-            &TileRows {
-                name: "tile".to_owned(),
-                layer: 0,
-                shape: Shape::aabb(Vec2::splat(0.5)).unwrap(),
-                step: Vec2::new(1.0, 0.0),
-                rows,
-            },
-            |_| {},
-        );
+        let w = unit_tiles(rows);
         let packed = w.packed();
         assert_same(&packed.unpack(), &w);
         assert_eq!(packed.runs().count(), 2000);
