@@ -298,11 +298,13 @@ enum Command {
         /// Example: ricochet bench --snapshots asteroids-75 asteroids-10000 --frames 300
         #[arg(long, conflicts_with_all = ["record", "csv", "queries"])]
         snapshots: bool,
-        /// Measure every broad phase instead (issue #24): each scene (default: every bench
-        /// scene and crowded-10000, sparse-10000, mixed-10000) stepped --frames frames with
-        /// each broad phase forced; prints the broad phase alone and the whole step in ms
-        /// per frame, the structures' memory, the pairs per frame, and what `auto` picks.
-        /// Brute force is skipped above 4000 bodies. Build with --release.
+        /// Measure every broad phase instead, to choose `[world] broad_phase` for a scene:
+        /// each scene (default: every bench scene and crowded-10000, sparse-10000,
+        /// mixed-10000: one layer packed, spread out, or of mixed sizes) stepped --frames
+        /// frames with each broad phase forced; prints the broad phase alone and the whole
+        /// step in ms per frame, the structures' memory, the pairs per frame, what `auto`
+        /// picks and how far it is from the fastest. Brute force is skipped above 4000
+        /// bodies. Build with --release.
         ///
         /// Example: ricochet bench --broad-phases mixed-10000 --frames 60
         #[arg(long, conflicts_with_all = ["record", "csv", "queries", "snapshots"])]
