@@ -117,6 +117,7 @@ impl Identity {
 }
 
 /// Whether `a` and `b` name the same file, by resolved path or (both existing) by inode.
+#[allow(dead_code, reason = "the golden suite's guards take it up next")]
 pub fn same_file(a: &Path, b: &Path) -> bool {
     Identity::of(a).same(&Identity::of(b))
 }

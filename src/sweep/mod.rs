@@ -332,9 +332,7 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
         .svg
         .clone()
         .unwrap_or_else(|| csv.with_extension("svg"));
-    for path in [&csv, &svg] {
-        files::check_writable(path)?;
-    }
+    files::check_outputs(&[("--csv", &csv), ("--svg", &svg)], &[&args.scenario])?;
 
     let (reference_row, rows) = match &args.cluster {
         Some(scheduler) => {
@@ -386,11 +384,13 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
     };
 
     out::print(&report::table(&keys, &reference_row, &rows))?;
-    files::write(&csv, report::csv_text(&keys, &rows).as_bytes())?;
-    files::write(
-        &svg,
-        report::svg_text(&file, &keys, timestep_key, &rows).as_bytes(),
-    )?;
+    files::write_all(&[
+        (&csv, report::csv_text(&keys, &rows).as_bytes()),
+        (
+            &svg,
+            report::svg_text(&file, &keys, timestep_key, &rows).as_bytes(),
+        ),
+    ])?;
     out::print(&format!(
         "{}; wrote {} and {}\n",
         report::summary(&rows, &keys, shard),
