@@ -117,7 +117,6 @@ impl Identity {
 }
 
 /// Whether `a` and `b` name the same file, by resolved path or (both existing) by inode.
-#[allow(dead_code, reason = "the golden suite's guards take it up next")]
 pub fn same_file(a: &Path, b: &Path) -> bool {
     Identity::of(a).same(&Identity::of(b))
 }
@@ -156,6 +155,57 @@ pub fn check_outputs(outputs: &[(&str, &Path)], inputs: &[&Path]) -> anyhow::Res
 /// Writes `bytes` to `path`: to a temporary file beside it, synced, then renamed over it.
 pub fn write(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
     write_all(&[(path, bytes)])
+}
+
+/// [`write`], the bytes streamed from the file `from` rather than held in memory.
+pub fn copy(path: &Path, from: &Path) -> anyhow::Result<()> {
+    check_writable(path)?;
+    let target = target(path);
+    let mut temp = temp_in(&target)?;
+    let mut source =
+        std::fs::File::open(from).with_context(|| format!("reading {}", from.display()))?;
+    std::io::copy(&mut source, &mut temp)
+        .and_then(|_| temp.as_file().sync_all())
+        .with_context(|| format!("writing {}", path.display()))?;
+    temp.persist(&target)
+        .map_err(|e| e.error)
+        .with_context(|| format!("writing {}", path.display()))?;
+    Ok(())
+}
+
+/// The path `path` resolves to: its longest existing ancestor with every symbolic link
+/// followed, then the rest with `.` and `..` taken lexically (a part that does not exist
+/// can't be a link). Two paths to one place, existing yet or not, resolve alike.
+pub fn resolved(path: &Path) -> PathBuf {
+    let absolute = if path.is_absolute() {
+        path.to_owned()
+    } else {
+        std::env::current_dir().map_or_else(|_| path.to_owned(), |d| d.join(path))
+    };
+    let mut base = absolute.as_path();
+    let mut rest = Vec::new();
+    loop {
+        if let Ok(found) = base.canonicalize() {
+            let mut out = found;
+            for part in rest.iter().rev() {
+                match part {
+                    std::path::Component::ParentDir => {
+                        out.pop();
+                    }
+                    std::path::Component::CurDir => {}
+                    other => out.push(other.as_os_str()),
+                }
+            }
+            return out;
+        }
+        match (base.parent(), base.components().next_back()) {
+            (Some(up), Some(last)) => {
+                rest.push(last);
+                base = up;
+            }
+            _ => return absolute,
+        }
+    }
 }
 
 /// Writes every `(path, bytes)` all or nothing: each to a temporary file beside it, synced;
@@ -238,6 +288,19 @@ mod tests {
         std::fs::File::create(&b).unwrap();
         let expected = std::fs::metadata(&b).unwrap().permissions().mode() & 0o777;
         assert_eq!(mode, expected);
+    }
+
+    #[test]
+    fn paths_to_one_place_resolve_alike_whether_it_exists_or_not() {
+        let dir = tempfile::tempdir().unwrap();
+        let base = dir.path().canonicalize().unwrap();
+        std::fs::create_dir_all(base.join("s2/sub")).unwrap();
+        assert_eq!(
+            resolved(&base.join("s2/sub/../../recordings")),
+            base.join("recordings")
+        );
+        assert_eq!(resolved(&base.join("new/./a/../b")), base.join("new/b"));
+        assert_eq!(resolved(&base.join("s2/sub/..")), base.join("s2"));
     }
 
     #[test]

@@ -320,12 +320,15 @@ enum Command {
     /// /contacts, pair 6:0/9:0, depth 0.031 → 0.029` (the first divergence, as `ricochet
     /// diff` finds it), or `no golden (run with --bless)`; then `N passed, M failed`. The
     /// output is the same bytes whatever -j or --shard. Each scenario runs in its own
-    /// process, -j at a time. Ctrl-C stops: no more are started, the running ones stop at
-    /// their next frame, and no golden is left half-written.
+    /// process, -j at a time. Ctrl-C (or SIGTERM) stops: no more are started, the running
+    /// ones stop at their next frame (one still running 5 s later, blocked or stopped, is
+    /// killed), and no golden is left half-written. A scenario file is a regular file of at
+    /// most 16 MiB (16777216 bytes, as serve's /load); a larger one is a failed line.
     ///
     /// Exit code: 0 all passed, 1 any failed (a scenario that does not load is a failed
-    /// line), 2 bad input (no such path, a folder without scenarios, a bad --shard), 130
-    /// interrupted.
+    /// line), 2 bad input (no such path, a named path that is a FIFO or a device, a folder
+    /// without scenarios, two scenarios sharing a golden, a bad --shard, a --keep folder
+    /// that is a golden folder), 130 interrupted.
     #[command(after_help = "\
 Examples:
   ricochet test                           every scenarios/*.toml against recordings/
@@ -349,6 +352,8 @@ See docs/suites.md: the result line of one item, Slurm and Kubernetes examples."
         #[arg(long, value_name = "DIR")]
         golden: Option<PathBuf>,
         /// Scenarios run at once, each in its own process. Default: the number of cores.
+        /// At most as many as the open-file limit (ulimit -n) has room for, 2 descriptors
+        /// each with 16 kept free (a limit of 64 allows about 20); the others wait for a slot.
         #[arg(short, long, value_name = "N", conflicts_with = "item",
               value_parser = clap::value_parser!(u16).range(1..=256))]
         jobs: Option<u16>,
@@ -364,7 +369,9 @@ See docs/suites.md: the result line of one item, Slurm and Kubernetes examples."
         /// K+2N, ... The N shards together are the whole suite, each scenario once.
         #[arg(long, value_name = "K/N", conflicts_with = "item")]
         shard: Option<suite::shard::Shard>,
-        /// Keep the fresh logs in this folder, as NAME.mcap (created if missing).
+        /// Keep the fresh logs in this folder, as NAME.mcap (created if missing), once
+        /// compared. Refused (exit code 2) when it is, or resolves to, a golden folder, or
+        /// when two scenarios have one name.
         #[arg(long, value_name = "DIR", conflicts_with = "item")]
         keep: Option<PathBuf>,
         /// Run the scenarios on this Dask distributed cluster's workers (tcp://HOST:PORT

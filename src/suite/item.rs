@@ -8,10 +8,12 @@
 //! determinism gate). With `--bless` the goldens are written instead, each through a
 //! temporary file renamed into place.
 
+use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use ricochet_log::LogFile;
+use ricochet_serve::MAX_SCENARIO_BYTES;
 use ricochet_sim::{Simulation, load_scenario};
 use serde::{Deserialize, Serialize};
 
@@ -218,23 +220,30 @@ fn judge(
     result: &mut ItemResult,
 ) -> Result<(Verdict, String), String> {
     let path = opts.scenario;
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let text = read_scenario(path)?;
     let scenario = load_scenario(&text, &path.display().to_string()).map_err(|e| e.to_string())?;
+    drop(text);
     scenario
         .world
         .last_time_ns(scenario.frames)
         .map_err(|e| format!("{}: frames {}: {e}", path.display(), scenario.frames))?;
-    let temp;
-    let log = match opts.out {
-        Some(dir) => {
-            std::fs::create_dir_all(dir).map_err(|e| format!("--out {}: {e}", dir.display()))?;
-            dir.join(format!("{name}.mcap"))
-        }
-        None => {
-            temp = tempfile::tempdir().map_err(|e| format!("a temporary directory: {e}"))?;
-            temp.path().join(format!("{name}.mcap"))
-        }
-    };
+    let golden = opts
+        .golden
+        .map_or_else(|| default_golden(path), Path::to_owned);
+    let golden_log = golden.join(format!("{name}.mcap"));
+    let golden_digest = golden.join(format!("{name}.digest"));
+    let kept = opts.out.map(|dir| dir.join(format!("{name}.mcap")));
+    if let Some(kept) = &kept
+        && crate::files::same_file(kept, &golden_log)
+    {
+        return Err(format!(
+            "--out {}: the fresh log would replace the golden {}; keep the fresh logs in \
+             another folder",
+            kept.display(),
+            golden_log.display()
+        ));
+    }
+    let (_scratch, log) = fresh_log(opts.out)?;
     let mut recorder = Recorder::create(&log, scenario.world.dt, Channels::default())
         .map_err(|e| format!("cannot write the log: {e}"))?;
     let mut sim = Simulation::new(&scenario);
@@ -262,9 +271,6 @@ fn judge(
     recorder
         .finish()
         .map_err(|e| format!("finishing the log: {e}"))?;
-    if opts.out.is_some() {
-        result.log = Some(log.display().to_string());
-    }
     let digest = Digest {
         frames: scenario.frames,
         bodies: sim.world().len() as u64,
@@ -272,20 +278,24 @@ fn judge(
     };
     result.digest = Some(digest.clone());
 
-    let golden = opts
-        .golden
-        .map_or_else(|| default_golden(path), Path::to_owned);
-    let golden_log = golden.join(format!("{name}.mcap"));
-    let golden_digest = golden.join(format!("{name}.digest"));
-    let fresh = std::fs::read(&log).map_err(|e| format!("{}: {e}", log.display()))?;
     // Blessing needs only to know whether the golden is the same; not where it differs.
-    let log_state = compare_log(&golden_log, &log, &fresh, !opts.bless)?;
+    let log_state = compare_log(&golden_log, &log, !opts.bless)?;
     let digest_state = compare_digest(&golden_digest, &digest.text())?;
+    // Kept only once both comparisons have read the goldens, and never onto one (above).
+    let log = match kept {
+        Some(kept) => {
+            std::fs::rename(&log, &kept)
+                .map_err(|e| format!("cannot keep the fresh log as {}: {e}", kept.display()))?;
+            result.log = Some(kept.display().to_string());
+            kept
+        }
+        None => log,
+    };
     if opts.bless {
         return bless(
             stop,
             &golden,
-            (&golden_log, &fresh),
+            (&golden_log, &log),
             (&golden_digest, &digest),
             (&log_state, &digest_state),
         );
@@ -305,22 +315,137 @@ fn judge(
     })
 }
 
-/// Reads a golden file; `None` when it does not exist.
-fn read_golden(path: &Path) -> Result<Option<Vec<u8>>, String> {
-    match std::fs::read(path) {
-        Ok(b) => Ok(Some(b)),
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
-        Err(e) => Err(format!("cannot read the golden {}: {e}", path.display())),
+/// Where this item records its fresh log: a file in a scratch folder of its own (removed
+/// with the returned guard), so no two items share one, whatever their names, and the
+/// name is short whatever the scenario's. With `--out DIR` the folder is inside `DIR`, so
+/// keeping the log is a rename on one filesystem.
+fn fresh_log(out: Option<&Path>) -> Result<(tempfile::TempDir, PathBuf), String> {
+    let scratch = match out {
+        Some(dir) => {
+            std::fs::create_dir_all(dir).map_err(|e| format!("--out {}: {e}", dir.display()))?;
+            tempfile::Builder::new()
+                .prefix(".ricochet-item-")
+                .tempdir_in(dir)
+                .map_err(|e| format!("--out {}: {e}", dir.display()))?
+        }
+        None => tempfile::tempdir().map_err(|e| format!("a temporary directory: {e}"))?,
+    };
+    let log = scratch.path().join("fresh.mcap");
+    Ok((scratch, log))
+}
+
+/// Opens `path` for reading if it is a regular file: checked by name first (opening a FIFO
+/// would wait for a writer, a device may never end), then on the file opened, so what is
+/// read is what was checked. `None` when it does not exist; `what` names it in errors.
+fn open_regular(path: &Path, what: &str) -> Result<Option<std::fs::File>, String> {
+    let not_a_file = || {
+        format!(
+            "{what} {}: not a regular file (a FIFO, a device, a socket or a folder)",
+            path.display()
+        )
+    };
+    let unreadable = |e: std::io::Error| format!("cannot read {what} {}: {e}", path.display());
+    match std::fs::metadata(path) {
+        Ok(m) if !m.is_file() => return Err(not_a_file()),
+        Ok(_) => {}
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) => return Err(unreadable(e)),
     }
+    let file = std::fs::File::open(path).map_err(unreadable)?;
+    if !file.metadata().map_err(unreadable)?.is_file() {
+        return Err(not_a_file());
+    }
+    Ok(Some(file))
+}
+
+/// The scenario's text: a regular file of at most [`MAX_SCENARIO_BYTES`] (`serve`'s
+/// `/load` limit), read through a bounded reader so a file that grows while read can't
+/// take more memory.
+fn read_scenario(path: &Path) -> Result<String, String> {
+    let shown = path.display();
+    let Some(file) = open_regular(path, "the scenario")? else {
+        return Err(format!("{shown}: No such file or directory"));
+    };
+    let too_large =
+        || format!("{shown}: larger than {MAX_SCENARIO_BYTES} bytes, the most a scenario may have");
+    let len = file.metadata().map_err(|e| format!("{shown}: {e}"))?.len();
+    if len > MAX_SCENARIO_BYTES {
+        return Err(too_large());
+    }
+    let mut bytes = Vec::new();
+    file.take(MAX_SCENARIO_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| format!("{shown}: {e}"))?;
+    if bytes.len() as u64 > MAX_SCENARIO_BYTES {
+        return Err(too_large());
+    }
+    String::from_utf8(bytes).map_err(|_| format!("{shown}: not UTF-8 text"))
+}
+
+/// The most of a golden `.digest` read: its three lines take under 100 bytes, so a larger
+/// file differs whatever follows, and is never read whole.
+const DIGEST_BYTES: u64 = 4096;
+
+/// Reads a golden digest file (at most [`DIGEST_BYTES`] and one byte of it); `None` when
+/// it does not exist.
+pub(crate) fn read_golden(path: &Path) -> Result<Option<Vec<u8>>, String> {
+    let Some(file) = open_regular(path, "the golden")? else {
+        return Ok(None);
+    };
+    let mut bytes = Vec::new();
+    file.take(DIGEST_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| format!("cannot read the golden {}: {e}", path.display()))?;
+    Ok(Some(bytes))
+}
+
+/// Whether two files hold the same bytes, read a chunk at a time (never whole): memory
+/// stays flat whatever the logs' size.
+fn same_bytes(a: std::fs::File, b: std::fs::File) -> std::io::Result<bool> {
+    const CHUNK: usize = 64 << 10;
+    let (len_a, len_b) = (a.metadata()?.len(), b.metadata()?.len());
+    if len_a != len_b {
+        return Ok(false);
+    }
+    // Bounded by the length seen, should either file grow while it is read.
+    let (mut a, mut b) = (a.take(len_a), b.take(len_b));
+    let (mut x, mut y) = (vec![0; CHUNK], vec![0; CHUNK]);
+    loop {
+        let n = fill(&mut a, &mut x)?;
+        let m = fill(&mut b, &mut y)?;
+        if n != m || x[..n] != y[..m] {
+            return Ok(false);
+        }
+        if n < CHUNK {
+            return Ok(true);
+        }
+    }
+}
+
+/// Reads until `buf` is full or the end; the count read.
+fn fill(r: &mut impl Read, buf: &mut [u8]) -> std::io::Result<usize> {
+    let mut n = 0;
+    while n < buf.len() {
+        match r.read(&mut buf[n..]) {
+            Ok(0) => break,
+            Ok(k) => n += k,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(e),
+        }
+    }
+    Ok(n)
 }
 
 /// The golden log against the fresh one: equal bytes, or (with `locate`) the first
 /// divergence.
-fn compare_log(golden: &Path, log: &Path, fresh: &[u8], locate: bool) -> Result<Golden, String> {
-    let Some(kept) = read_golden(golden)? else {
+fn compare_log(golden: &Path, log: &Path, locate: bool) -> Result<Golden, String> {
+    let Some(kept) = open_regular(golden, "the golden")? else {
         return Ok(Golden::Missing);
     };
-    if kept == fresh {
+    let fresh = std::fs::File::open(log).map_err(|e| format!("{}: {e}", log.display()))?;
+    let same = same_bytes(kept, fresh)
+        .map_err(|e| format!("comparing with the golden {}: {e}", golden.display()))?;
+    if same {
         return Ok(Golden::Same);
     }
     if !locate {
@@ -386,7 +511,7 @@ fn compare_digest(golden: &Path, fresh: &str) -> Result<Golden, String> {
 fn bless(
     stop: &AtomicBool,
     dir: &Path,
-    (golden_log, fresh): (&Path, &[u8]),
+    (golden_log, fresh): (&Path, &Path),
     (golden_digest, digest): (&Path, &Digest),
     (log_state, digest_state): (&Golden, &Golden),
 ) -> Result<(Verdict, String), String> {
@@ -400,7 +525,7 @@ fn bless(
     // Each file goes through a temporary file renamed into place, so a golden is always
     // whole, the old one or the new. The digest last: a stop between the two leaves a log
     // whose digest then differs, which the next run reports.
-    crate::files::write(golden_log, fresh).map_err(|e| format!("{e:#}"))?;
+    crate::files::copy(golden_log, fresh).map_err(|e| format!("{e:#}"))?;
     crate::files::write(golden_digest, digest.text().as_bytes()).map_err(|e| format!("{e:#}"))?;
     Ok(
         if matches!(
@@ -486,6 +611,22 @@ mod tests {
         assert_eq!(g("game/scenarios/a.toml"), Path::new("game/recordings"));
         assert_eq!(g("/x/scenarios/a.toml"), Path::new("/x/recordings"));
         assert_eq!(g("a.toml"), Path::new("./../recordings"));
+    }
+
+    /// Two items with one name (`g1/scenarios/level.toml`, `g2/scenarios/level.toml`),
+    /// both recording at once into one `--out` folder or both into the temporary folder:
+    /// each has a path of its own.
+    #[test]
+    fn two_items_with_one_name_record_to_paths_of_their_own() {
+        let dir = tempfile::tempdir().unwrap();
+        for out in [Some(dir.path()), None] {
+            let (_a_scratch, a) = fresh_log(out).unwrap();
+            let (_b_scratch, b) = fresh_log(out).unwrap();
+            assert_ne!(a, b, "{out:?}");
+            std::fs::write(&a, "a").unwrap();
+            std::fs::write(&b, "b").unwrap();
+            assert_eq!(std::fs::read(&a).unwrap(), b"a");
+        }
     }
 
     #[test]

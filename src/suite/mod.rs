@@ -13,7 +13,7 @@ mod junit;
 mod pool;
 pub mod shard;
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::ffi::OsString;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -100,9 +100,16 @@ fn gather(paths: &[PathBuf], golden: Option<&Path>) -> Result<Vec<PathBuf>, Stri
     for path in paths {
         let shown = out::escape_controls(&path.display().to_string());
         let meta = std::fs::metadata(path).map_err(|e| format!("{shown}: {e}"))?;
-        if !meta.is_dir() {
+        if meta.is_file() {
             items.push(path.clone());
             continue;
+        }
+        if !meta.is_dir() {
+            // Opening a FIFO would wait for a writer; a device may never end.
+            return Err(format!(
+                "{shown}: not a regular file or a folder (a FIFO, a device or a socket); a \
+                 scenario is a TOML file"
+            ));
         }
         let mut found: Vec<PathBuf> = std::fs::read_dir(path)
             .map_err(|e| format!("{shown}: {e}"))?
@@ -119,13 +126,16 @@ fn gather(paths: &[PathBuf], golden: Option<&Path>) -> Result<Vec<PathBuf>, Stri
         items.extend(found);
     }
     items.sort_by_key(|p| (name_of(p), p.clone()));
-    items.dedup();
-    // Two scenarios with one name would share a golden: each must have its own.
+    // One file named twice (`scenarios` and `./scenarios/a.toml`) is one item.
+    let mut seen = BTreeSet::new();
+    items.retain(|p| seen.insert(crate::files::resolved(p)));
+    // Two scenarios with one name would share a golden: each must have its own. Compared
+    // by resolved folder, so `s2/sub/../x.toml` and `s1/x.toml` are caught too.
     let mut owners: BTreeMap<(PathBuf, String), &Path> = BTreeMap::new();
     for p in &items {
         let dir = golden.map_or_else(|| default_golden(p), Path::to_owned);
         let name = name_of(p);
-        if let Some(other) = owners.insert((dir.clone(), name.clone()), p) {
+        if let Some(other) = owners.insert((crate::files::resolved(&dir), name.clone()), p) {
             return Err(format!(
                 "{} and {} would share the golden {}: rename one",
                 out::escape_controls(&other.display().to_string()),
@@ -135,6 +145,40 @@ fn gather(paths: &[PathBuf], golden: Option<&Path>) -> Result<Vec<PathBuf>, Stri
         }
     }
     Ok(items)
+}
+
+/// `--keep DIR` checked against the items before any runs: `Err` (exit code 2) when a
+/// fresh log would be kept where a golden is (`DIR` is, or resolves to, a golden folder),
+/// or two items would be kept at one path (one name in two folders).
+fn check_keep(items: &[PathBuf], golden: Option<&Path>, keep: &Path) -> Result<(), String> {
+    let shown = |p: &Path| out::escape_controls(&p.display().to_string());
+    let keep_dir = crate::files::resolved(keep);
+    let mut dirs = BTreeSet::new();
+    let mut kept: BTreeMap<String, &Path> = BTreeMap::new();
+    for p in items {
+        let dir = golden.map_or_else(|| default_golden(p), Path::to_owned);
+        if dirs.insert(crate::files::resolved(&dir))
+            && (crate::files::resolved(&dir) == keep_dir || crate::files::same_file(&dir, keep))
+        {
+            return Err(format!(
+                "--keep {} is the golden folder {}: the fresh logs would replace the goldens; \
+                 keep them in another folder",
+                shown(keep),
+                shown(&dir)
+            ));
+        }
+        if let Some(other) = kept.insert(name_of(p), p) {
+            return Err(format!(
+                "--keep {}: {} and {} would both be kept as {}: run them in two runs, or \
+                 rename one",
+                shown(keep),
+                shown(other),
+                shown(p),
+                shown(&keep.join(format!("{}.mcap", name_of(p))))
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// An item's result from the cluster: `--verify`'s failure and a missing result line are
@@ -155,7 +199,11 @@ fn from_cluster(
             again,
         } => {
             let dir = golden.map_or_else(|| default_golden(scenario), Path::to_owned);
-            let kept = std::fs::read_to_string(dir.join(format!("{}.digest", name_of(scenario))));
+            let kept = item::read_golden(&dir.join(format!("{}.digest", name_of(scenario))))
+                .ok()
+                .flatten()
+                .map(|b| String::from_utf8_lossy(&b).into_owned())
+                .ok_or(());
             let text = |r: &ItemResult| r.digest.as_ref().map(item::Digest::text);
             let golden = match (kept, &again) {
                 (Ok(kept), Some((second, again))) => {
@@ -217,20 +265,19 @@ pub fn run(opts: &Options) -> anyhow::Result<ExitCode> {
         Some(s) => s.select(items),
         None => items,
     };
-    let temp;
-    let logs = match &opts.keep {
-        Some(dir) => {
-            if let Err(e) = std::fs::create_dir_all(dir) {
-                out::error(&format!("error: --keep {}: {e}", dir.display()));
-                return Ok(ExitCode::from(2));
-            }
-            dir.clone()
+    if let Some(dir) = &opts.keep {
+        if let Err(e) = check_keep(&items, opts.golden.as_deref(), dir) {
+            out::error(&format!("error: {e}"));
+            return Ok(ExitCode::from(2));
         }
-        None => {
-            temp = tempfile::tempdir()?;
-            temp.path().to_owned()
+        if let Err(e) = std::fs::create_dir_all(dir) {
+            out::error(&format!("error: --keep {}: {e}", dir.display()));
+            return Ok(ExitCode::from(2));
         }
-    };
+    }
+    // The items' temporary files go here (their TMPDIR), removed at the end even when an
+    // item's process had to be killed.
+    let scratch = tempfile::tempdir()?;
     let jobs = opts
         .jobs
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, usize::from));
@@ -247,7 +294,10 @@ pub fn run(opts: &Options) -> anyhow::Result<ExitCode> {
     let argv = |i: usize| {
         let scenario: &Path = &items[i];
         let mut a: Vec<OsString> = vec!["test".into(), "--item".into(), scenario.into()];
-        a.extend(["--out".into(), logs.clone().into_os_string()]);
+        // Each item records in a scratch folder of its own; `--out` is only where to keep.
+        if let Some(keep) = &opts.keep {
+            a.extend(["--out".into(), keep.clone().into_os_string()]);
+        }
         if let Some(g) = &opts.golden {
             a.extend(["--golden".into(), g.clone().into_os_string()]);
         }
@@ -278,7 +328,7 @@ pub fn run(opts: &Options) -> anyhow::Result<ExitCode> {
         }
     };
     let started_count = match &opts.cluster {
-        None => pool::run(items.len(), jobs, &stop, argv, on_done)?,
+        None => pool::run(items.len(), jobs, &stop, scratch.path(), argv, on_done)?,
         Some(c) => match cluster::run(
             c,
             items.len(),
@@ -324,7 +374,7 @@ pub fn run(opts: &Options) -> anyhow::Result<ExitCode> {
         if done.len() == 1 { "" } else { "s" },
         started.elapsed().as_secs_f64(),
         opts.cluster.as_ref().map_or_else(
-            || format!("{} at a time", jobs.min(items.len()).max(1)),
+            || format!("{} at a time", pool::slots(jobs).min(items.len()).max(1)),
             |c| format!("on the cluster at {}", c.scheduler)
         )
     ))?;

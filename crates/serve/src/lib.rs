@@ -35,4 +35,5 @@ mod server;
 mod services;
 mod serving;
 
+pub use load_path::MAX_SCENARIO_BYTES;
 pub use realtime::{DEFAULT_BIND, Listener, Note, Options, ServeError, Served, cpu_seconds, serve};
