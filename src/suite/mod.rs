@@ -11,6 +11,7 @@ pub mod cluster;
 pub mod item;
 mod junit;
 mod pool;
+mod read;
 pub mod shard;
 
 use std::collections::{BTreeMap, BTreeSet};
@@ -157,8 +158,9 @@ fn check_keep(items: &[PathBuf], golden: Option<&Path>, keep: &Path) -> Result<(
     let mut kept: BTreeMap<String, &Path> = BTreeMap::new();
     for p in items {
         let dir = golden.map_or_else(|| default_golden(p), Path::to_owned);
-        if dirs.insert(crate::files::resolved(&dir))
-            && (crate::files::resolved(&dir) == keep_dir || crate::files::same_file(&dir, keep))
+        let resolved = crate::files::resolved(&dir);
+        if !dirs.contains(&resolved)
+            && (resolved == keep_dir || crate::files::same_file(&dir, keep))
         {
             return Err(format!(
                 "--keep {} is the golden folder {}: the fresh logs would replace the goldens; \
@@ -167,6 +169,7 @@ fn check_keep(items: &[PathBuf], golden: Option<&Path>, keep: &Path) -> Result<(
                 shown(&dir)
             ));
         }
+        dirs.insert(resolved);
         if let Some(other) = kept.insert(name_of(p), p) {
             return Err(format!(
                 "--keep {}: {} and {} would both be kept as {}: run them in two runs, or \
@@ -199,7 +202,7 @@ fn from_cluster(
             again,
         } => {
             let dir = golden.map_or_else(|| default_golden(scenario), Path::to_owned);
-            let kept = item::read_golden(&dir.join(format!("{}.digest", name_of(scenario))))
+            let kept = read::read_golden(&dir.join(format!("{}.digest", name_of(scenario))))
                 .ok()
                 .flatten()
                 .map(|b| String::from_utf8_lossy(&b).into_owned())
