@@ -92,7 +92,8 @@ fn suite_keep_onto_the_golden_folder_is_refused_and_the_golden_left_alone() {
     .unwrap();
     let golden = dir.path().join("recordings/asteroids.mcap");
     let shipped = std::fs::read(root().join("recordings/asteroids.mcap")).unwrap();
-    for keep in ["recordings", "./scenarios/../recordings/"] {
+    std::os::unix::fs::symlink("recordings", dir.path().join("link")).unwrap();
+    for keep in ["recordings", "./scenarios/../recordings/", "link"] {
         let o = ricochet_in(dir.path(), &["test", "scenarios", "--keep", keep]);
         assert_eq!(o.status.code(), Some(2), "--keep {keep}: {}", stdout(&o));
         assert!(
@@ -103,23 +104,19 @@ fn suite_keep_onto_the_golden_folder_is_refused_and_the_golden_left_alone() {
         assert!(std::fs::read(&golden).unwrap() == shipped, "--keep {keep}");
     }
     // One item alone (as a cluster worker runs it), onto its own golden: an error line.
-    let o = ricochet_in(
-        dir.path(),
-        &[
-            "test",
-            "--item",
-            "scenarios/asteroids.toml",
-            "--out",
-            "recordings",
-        ],
-    );
-    assert_eq!(o.status.code(), Some(1));
-    assert!(
-        stdout(&o).contains("the fresh log would replace the golden"),
-        "{}",
-        stdout(&o)
-    );
-    assert!(std::fs::read(&golden).unwrap() == shipped);
+    for out in ["recordings", "link", "nowhere/../recordings"] {
+        let o = ricochet_in(
+            dir.path(),
+            &["test", "--item", "scenarios/asteroids.toml", "--out", out],
+        );
+        assert_eq!(o.status.code(), Some(1), "--out {out}");
+        assert!(
+            stdout(&o).contains("the fresh log would replace the golden"),
+            "{}",
+            stdout(&o)
+        );
+        assert!(std::fs::read(&golden).unwrap() == shipped, "--out {out}");
+    }
     // The renamed body is still found, against the golden.
     let o = ricochet_in(dir.path(), &["test", "scenarios/asteroids.toml"]);
     assert_eq!(o.status.code(), Some(1), "{}", stdout(&o));
