@@ -356,6 +356,23 @@ fn suite_a_250_byte_scenario_name_is_tested_blessed_and_kept() {
     );
     let left: Vec<_> = std::fs::read_dir(dir.path().join("k")).unwrap().collect();
     assert_eq!(left.len(), 1, "no scratch folder left: {left:?}");
+    // 255 bytes, the most a file name may have: its golden NAME.digest could not be, which
+    // its line says.
+    std::fs::remove_dir_all(dir.path().join("long")).unwrap();
+    std::fs::create_dir_all(dir.path().join("long")).unwrap();
+    let name = "n".repeat(250);
+    std::fs::write(
+        dir.path().join(format!("long/{name}.toml")),
+        with_frames("shapes.toml", 600),
+    )
+    .unwrap();
+    let o = ricochet_in(dir.path(), &["test", "long", "--golden", "g", "--bless"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stdout(&o).contains("shorten it to 248 bytes at most"),
+        "{}",
+        stdout(&o)
+    );
 }
 
 #[test]

@@ -25,6 +25,9 @@ use crate::record::Recorder;
 /// existing one bumps this.
 pub const FORMAT: u32 = 1;
 
+/// The longest file name, in bytes, on Linux's file systems.
+const NAME_MAX: usize = 255;
+
 /// What became of one scenario.
 #[derive(Serialize, Deserialize, Debug, Clone, Copy, PartialEq, Eq)]
 #[serde(rename_all = "snake_case")]
@@ -219,6 +222,17 @@ fn judge(
     result: &mut ItemResult,
 ) -> Result<(Verdict, String), String> {
     let path = opts.scenario;
+    // The longest golden name, `NAME.digest`, must be a legal file name (255 bytes on
+    // Linux's file systems): the one limit on a name that temporary names can't lift.
+    if name.len() + ".digest".len() > NAME_MAX {
+        return Err(format!(
+            "{}: a name of {} bytes makes its golden {name}.digest longer than the {NAME_MAX} \
+             bytes a file name may have; shorten it to {} bytes at most (before .toml)",
+            path.display(),
+            name.len(),
+            NAME_MAX - ".digest".len()
+        ));
+    }
     let text = read_scenario(path)?;
     let scenario = load_scenario(&text, &path.display().to_string()).map_err(|e| e.to_string())?;
     drop(text);
