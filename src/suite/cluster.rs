@@ -22,7 +22,7 @@ use std::net::{TcpStream, ToSocketAddrs};
 use std::process::{Child, Command, Stdio};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use serde::Deserialize;
 use serde::de::DeserializeOwned;
@@ -39,6 +39,17 @@ const INSTALL: &str = "install it with `pip install ./python` from Ricochet's re
 
 /// How long the scheduler has to accept a TCP connection before the run gives up.
 const CONNECT: Duration = Duration::from_secs(3);
+
+/// How long the package may take to connect to the scheduler, the TCP connect and Dask's
+/// handshake together (its `--timeout`): a port that accepts but never speaks Dask's
+/// protocol is named after this long (`ricochet test --help`).
+pub const HANDSHAKE: Duration = Duration::from_secs(10);
+
+/// How long the run waits for the package's first line (`{"connected": …}`, said once it
+/// has a client): [`HANDSHAKE`] plus time to start Python and import `distributed` (under
+/// a second on an idle machine). A package that is silent longer is killed, so no run
+/// waits forever for a Python that hangs.
+pub const FIRST_ANSWER: Duration = Duration::from_secs(HANDSHAKE.as_secs() + 20);
 
 /// How often the run looks at the stop flag while it waits for a line.
 const POLL: Duration = Duration::from_millis(50);
@@ -118,6 +129,13 @@ pub enum ClusterError {
     NoDistributed(String),
     /// An item's argument is not UTF-8 (the protocol is JSON).
     NotUtf8(OsString),
+    /// Something accepts connections at the address but no Dask scheduler answered within
+    /// [`HANDSHAKE`].
+    NoAnswer(String),
+    /// What answered at the address does not speak Dask's protocol; the reader's error.
+    NotDask(String, String),
+    /// The package said nothing within [`FIRST_ANSWER`] and was stopped.
+    Stalled(String),
     /// The package failed; its last message.
     Failed(String),
 }
@@ -158,6 +176,27 @@ impl std::fmt::Display for ClusterError {
                 f,
                 "--cluster: the path {} is not UTF-8, which the cluster's JSON can't carry",
                 escape_controls(&a.to_string_lossy())
+            ),
+            Self::NoAnswer(a) => write!(
+                f,
+                "--cluster {}: no Dask scheduler answered within {} s (something accepts \
+                 connections there: is it the scheduler's port? `dask scheduler` prints it)",
+                escape_controls(a),
+                HANDSHAKE.as_secs()
+            ),
+            Self::NotDask(a, why) => write!(
+                f,
+                "--cluster {}: is not a Dask scheduler: its answer does not read as Dask's \
+                 protocol ({})",
+                escape_controls(a),
+                escape_controls(why)
+            ),
+            Self::Stalled(a) => write!(
+                f,
+                "--cluster {}: python3 -m ricochet_dask did not connect to a Dask scheduler \
+                 within {} s; it was stopped",
+                escape_controls(a),
+                FIRST_ANSWER.as_secs()
             ),
             Self::Failed(why) => write!(f, "--cluster: {}", escape_controls(why)),
         }
@@ -216,7 +255,9 @@ pub fn run<R: ResultLine>(
         .arg("--exe")
         .arg(&exe)
         .arg("--cwd")
-        .arg(&cwd);
+        .arg(&cwd)
+        .arg("--timeout")
+        .arg(HANDSHAKE.as_secs().to_string());
     if cluster.verify {
         command
             .arg("--verify")
@@ -259,6 +300,7 @@ pub fn run<R: ResultLine>(
     let mut received = vec![false; count];
     let mut got = 0;
     let mut stopped = false;
+    let (started, mut answered, mut stalled) = (Instant::now(), false, false);
     loop {
         if stop.load(Ordering::SeqCst) {
             stopped = true;
@@ -267,6 +309,7 @@ pub fn run<R: ResultLine>(
         }
         match rx.recv_timeout(POLL) {
             Ok(text) => {
+                answered = true;
                 let Ok(line) = serde_json::from_str::<Line>(&text) else {
                     continue;
                 };
@@ -277,7 +320,13 @@ pub fn run<R: ResultLine>(
                 got += 1;
                 done(line.index, merge(line));
             }
-            Err(mpsc::RecvTimeoutError::Timeout) => {}
+            Err(mpsc::RecvTimeoutError::Timeout) => {
+                if !answered && started.elapsed() > FIRST_ANSWER {
+                    stalled = true;
+                    let _ = child.kill();
+                    break;
+                }
+            }
             Err(mpsc::RecvTimeoutError::Disconnected) => break,
         }
     }
@@ -288,6 +337,9 @@ pub fn run<R: ResultLine>(
     let stderr = errors.join().unwrap_or_default();
     if stopped {
         return Ok(got);
+    }
+    if stalled {
+        return Err(ClusterError::Stalled(cluster.scheduler.clone()));
     }
     if !status.success() {
         let last = stderr
@@ -303,6 +355,13 @@ pub fn run<R: ResultLine>(
             }
             Some(3) => ClusterError::NoDistributed(last),
             Some(4) => ClusterError::Unreachable(cluster.scheduler.clone(), last),
+            Some(6) => ClusterError::NoAnswer(cluster.scheduler.clone()),
+            Some(7) => ClusterError::NotDask(
+                cluster.scheduler.clone(),
+                last.split_once("protocol (")
+                    .map_or(last.as_str(), |(_, why)| why.trim_end_matches(')'))
+                    .to_owned(),
+            ),
             _ => ClusterError::Failed(format!("python3 -m ricochet_dask: {status}: {last}")),
         });
     }

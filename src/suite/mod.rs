@@ -155,7 +155,8 @@ fn from_cluster(
             again,
         } => {
             let dir = golden.map_or_else(|| default_golden(scenario), Path::to_owned);
-            let kept = std::fs::read_to_string(dir.join(format!("{}.digest", name_of(scenario))));
+            let kept = std::fs::read_to_string(dir.join(format!("{}.digest", name_of(scenario))))
+                .map(|k| k.replace("\r\n", "\n"));
             let text = |r: &ItemResult| r.digest.as_ref().map(item::Digest::text);
             let golden = match (kept, &again) {
                 (Ok(kept), Some((second, again))) => {
@@ -208,9 +209,9 @@ pub fn run(opts: &Options) -> anyhow::Result<ExitCode> {
         return Ok(ExitCode::from(2));
     }
     if let Some(j) = &opts.junit
-        && let Err(e) = crate::files::check_writable(j)
+        && let Err(e) = junit::check(j, &items, opts.golden.as_deref())
     {
-        out::error(&format!("error: --junit: {e:#}"));
+        out::error(&format!("error: {e:#}"));
         return Ok(ExitCode::from(2));
     }
     let items = match opts.shard {
@@ -246,10 +247,14 @@ pub fn run(opts: &Options) -> anyhow::Result<ExitCode> {
     });
     let argv = |i: usize| {
         let scenario: &Path = &items[i];
-        let mut a: Vec<OsString> = vec!["test".into(), "--item".into(), scenario.into()];
-        a.extend(["--out".into(), logs.clone().into_os_string()]);
+        // `--item=PATH`: a path that starts with `-` is still the value, and the result
+        // line names the scenario as given.
+        let mut item = OsString::from("--item=");
+        item.push(scenario);
+        let mut a: Vec<OsString> = vec!["test".into(), item];
+        a.extend(["--out".into(), not_a_flag(&logs)]);
         if let Some(g) = &opts.golden {
-            a.extend(["--golden".into(), g.clone().into_os_string()]);
+            a.extend(["--golden".into(), not_a_flag(g)]);
         }
         if opts.bless {
             a.push("--bless".into());
@@ -346,6 +351,16 @@ pub fn run(opts: &Options) -> anyhow::Result<ExitCode> {
     } else {
         ExitCode::from(1)
     })
+}
+
+/// `path` as an argument of an item's process that can't be taken for a flag: `./-x` for
+/// a relative `-x`, the same file.
+fn not_a_flag(path: &Path) -> OsString {
+    if path.as_os_str().as_encoded_bytes().starts_with(b"-") {
+        Path::new(".").join(path).into_os_string()
+    } else {
+        path.as_os_str().to_owned()
+    }
 }
 
 #[cfg(test)]
