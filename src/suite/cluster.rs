@@ -19,7 +19,7 @@
 use std::ffi::OsString;
 use std::io::{BufRead, BufReader, Write};
 use std::net::{TcpStream, ToSocketAddrs};
-use std::process::{Child, Command, Stdio};
+use std::process::{Command, Stdio};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
@@ -28,6 +28,9 @@ use serde::Deserialize;
 use serde::de::DeserializeOwned;
 
 use crate::out::escape_controls;
+
+mod child;
+use child::{stop_child, tail};
 
 /// The Python that runs the package: `RICOCHET_PYTHON` if set (a venv's
 /// `bin/python`), else `python3` on the PATH.
@@ -280,14 +283,7 @@ pub fn run<R: ResultLine>(
         let _ = stdin.write_all(input.as_bytes());
     });
     let stderr = child.stderr.take().expect("stderr is piped");
-    let errors = std::thread::spawn(move || {
-        let mut text = String::new();
-        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
-            text.push_str(&line);
-            text.push('\n');
-        }
-        text
-    });
+    let errors = std::thread::spawn(move || tail(stderr));
     let stdout = child.stdout.take().expect("stdout is piped");
     let (tx, rx) = mpsc::channel();
     std::thread::spawn(move || {
@@ -392,22 +388,6 @@ fn reach(address: &str) -> Result<(), ClusterError> {
         }
     }
     Err(ClusterError::Unreachable(address.to_owned(), why))
-}
-
-/// Ends the package on Ctrl-C: SIGINT first (its client closes and cancels the items),
-/// SIGKILL if it is still there a second later.
-fn stop_child(child: &mut Child) {
-    if let Ok(pid) = i32::try_from(child.id()) {
-        use nix::sys::signal::{Signal, kill};
-        let _ = kill(nix::unistd::Pid::from_raw(pid), Signal::SIGINT);
-    }
-    for _ in 0..20 {
-        if let Ok(Some(_)) = child.try_wait() {
-            return;
-        }
-        std::thread::sleep(POLL);
-    }
-    let _ = child.kill();
 }
 
 /// The item's outcome from the package's line: its own result line, unverified when
