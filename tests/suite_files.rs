@@ -1,7 +1,7 @@
 //! `ricochet test` and the files around it: a JUnit report that an XML parser reads whatever
 //! the names and messages hold, a `--junit` that would replace a device or one of the run's
 //! own files refused before any item, a golden digest with CRLF line ends, and scenario
-//! paths that start with `-`.
+//! paths that start with `-`; the report created with the umask's mode.
 
 use std::path::Path;
 use std::process::{Command, Output};
@@ -194,4 +194,24 @@ fn suite_scenario_and_folder_paths_that_start_with_a_dash_are_paths() {
         std::fs::read(d.join("recordings/shapes.mcap")).unwrap(),
         "the fresh log is kept in -fresh"
     );
+}
+
+#[test]
+fn suite_the_junit_report_is_created_with_the_umasks_mode() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = suite_copy();
+    // What `touch`, a shell redirect or `File::create` give under umask 022: rw-r--r--.
+    let o = Command::new("sh")
+        .args(["-c", "umask 022 && exec \"$0\" \"$@\""])
+        .arg(env!("CARGO_BIN_EXE_ricochet"))
+        .args(["test", "scenarios/level.toml", "--junit", "report.xml"])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let mode = std::fs::metadata(dir.path().join("report.xml"))
+        .unwrap()
+        .permissions()
+        .mode();
+    assert_eq!(mode & 0o777, 0o644, "{mode:o}");
 }
