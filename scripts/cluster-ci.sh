@@ -30,6 +30,10 @@ if [ "$(cat "$venv/pins.txt" 2>/dev/null || true)" != "$pins" ]; then
 fi
 timeout 120 "$venv/bin/python" -m unittest discover -s python/tests
 export RICOCHET_PYTHON="$venv/bin/python"
+# The ports that are not a scheduler (one silent, one speaking HTTP): named within 10 s, exit
+# code 2 (tests/cluster_cli.rs, which skips them without distributed and here must not).
+# The test binary is the one `cargo test` built before this step.
+RICOCHET_REQUIRE_DASK=1 timeout 300 cargo test --locked --quiet --test integration cluster_cli::
 
 work=$(mktemp -d)
 pids=()

@@ -362,7 +362,9 @@ See docs/suites.md: the result line of one item, Slurm and Kubernetes examples."
         /// (changed)` or `unchanged`.
         #[arg(long)]
         bless: bool,
-        /// Also write the results as JUnit XML here (one testcase per scenario).
+        /// Also write the results as JUnit XML here (one testcase per scenario). Refused
+        /// before any scenario runs (exit code 2) if it is a directory, a device, or one of
+        /// the run's scenarios, golden logs or digests.
         #[arg(long, value_name = "FILE", conflicts_with = "item")]
         junit: Option<PathBuf>,
         /// Run only the K-th (from 0) of N slices of the sorted scenarios: items K, K+N,
@@ -376,7 +378,9 @@ See docs/suites.md: the result line of one item, Slurm and Kubernetes examples."
         keep: Option<PathBuf>,
         /// Run the scenarios on this Dask distributed cluster's workers (tcp://HOST:PORT
         /// of its scheduler) instead of local processes; needs `pip install ./python`
-        /// (docs/suites.md).
+        /// (docs/suites.md). Nothing there, or no Dask scheduler answering within 10 s (a
+        /// port that accepts and stays silent, or speaks another protocol), is an error
+        /// before any item, exit code 2.
         #[arg(long, value_name = "tcp://HOST:PORT", conflicts_with = "item")]
         cluster: Option<String>,
         /// With --cluster: re-run one item in ten on a second worker and fail any whose

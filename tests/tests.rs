@@ -27,6 +27,7 @@ mod serve_siege;
 mod serve_ws;
 mod stress;
 mod suite_cli;
+mod suite_files;
 mod suite_hardening;
 mod sweep_cli;
 mod threads;

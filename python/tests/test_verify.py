@@ -198,6 +198,36 @@ class PinnedRerun(unittest.TestCase):
             "worker": "B", "error": "no result from B in 0.2 s (--verify-timeout)",
         })
 
+class Connect(unittest.TestCase):
+    """`client.connect`'s exit codes, with a stand-in for `distributed.Client`."""
+
+    args = argparse.Namespace(scheduler="tcp://127.0.0.1:1", timeout=5.0)
+
+    def connect(self, error):
+        def Client(*_args, **_kwargs):  # noqa: N802 (stands in for the class)
+            raise error
+
+        err = io.StringIO()
+        with contextlib.redirect_stderr(err):
+            code = client.connect(Client, self.args)
+        return code, err.getvalue()
+
+    def test_an_answer_that_is_not_dask_is_named(self):
+        # What distributed raises on a length read from HTTP's bytes.
+        code, err = self.connect(MemoryError())
+        self.assertEqual(code, 7)
+        self.assertIn("tcp://127.0.0.1:1 is not a Dask scheduler", err)
+        self.assertIn("(MemoryError)", err)
+
+    def test_a_refused_connection_is_unreachable(self):
+        code, err = self.connect(ConnectionRefusedError("refused"))
+        self.assertEqual(code, 4)
+        self.assertIn("cannot reach the Dask scheduler", err)
+
+    def test_a_client_is_returned_and_the_deadline_cancelled(self):
+        sentinel = object()
+        self.assertIs(client.connect(lambda *a, **k: sentinel, self.args), sentinel)
+
 
 if __name__ == "__main__":
     unittest.main()

@@ -19,15 +19,18 @@
 use std::ffi::OsString;
 use std::io::{BufRead, BufReader, Write};
 use std::net::{TcpStream, ToSocketAddrs};
-use std::process::{Child, Command, Stdio};
+use std::process::{Command, Stdio};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use serde::Deserialize;
 use serde::de::DeserializeOwned;
 
 use crate::out::escape_controls;
+
+mod child;
+use child::{stop_child, tail};
 
 /// The Python that runs the package: `RICOCHET_PYTHON` if set (a venv's
 /// `bin/python`), else `python3` on the PATH.
@@ -39,6 +42,17 @@ const INSTALL: &str = "install it with `pip install ./python` from Ricochet's re
 
 /// How long the scheduler has to accept a TCP connection before the run gives up.
 const CONNECT: Duration = Duration::from_secs(3);
+
+/// How long the package may take to connect to the scheduler, the TCP connect and Dask's
+/// handshake together (its `--timeout`): a port that accepts but never speaks Dask's
+/// protocol is named after this long (`ricochet test --help`).
+pub const HANDSHAKE: Duration = Duration::from_secs(10);
+
+/// How long the run waits for the package's first line (`{"connected": …}`, said once it
+/// has a client): [`HANDSHAKE`] plus time to start Python and import `distributed` (under
+/// a second on an idle machine). A package that is silent longer is killed, so no run
+/// waits forever for a Python that hangs.
+pub const FIRST_ANSWER: Duration = Duration::from_secs(HANDSHAKE.as_secs() + 20);
 
 /// How often the run looks at the stop flag while it waits for a line.
 const POLL: Duration = Duration::from_millis(50);
@@ -118,6 +132,13 @@ pub enum ClusterError {
     NoDistributed(String),
     /// An item's argument is not UTF-8 (the protocol is JSON).
     NotUtf8(OsString),
+    /// Something accepts connections at the address but no Dask scheduler answered within
+    /// [`HANDSHAKE`].
+    NoAnswer(String),
+    /// What answered at the address does not speak Dask's protocol; the reader's error.
+    NotDask(String, String),
+    /// The package said nothing within [`FIRST_ANSWER`] and was stopped.
+    Stalled(String),
     /// The package failed; its last message.
     Failed(String),
 }
@@ -158,6 +179,27 @@ impl std::fmt::Display for ClusterError {
                 f,
                 "--cluster: the path {} is not UTF-8, which the cluster's JSON can't carry",
                 escape_controls(&a.to_string_lossy())
+            ),
+            Self::NoAnswer(a) => write!(
+                f,
+                "--cluster {}: no Dask scheduler answered within {} s (something accepts \
+                 connections there: is it the scheduler's port? `dask scheduler` prints it)",
+                escape_controls(a),
+                HANDSHAKE.as_secs()
+            ),
+            Self::NotDask(a, why) => write!(
+                f,
+                "--cluster {}: is not a Dask scheduler: its answer does not read as Dask's \
+                 protocol ({})",
+                escape_controls(a),
+                escape_controls(why)
+            ),
+            Self::Stalled(a) => write!(
+                f,
+                "--cluster {}: python3 -m ricochet_dask did not connect to a Dask scheduler \
+                 within {} s; it was stopped",
+                escape_controls(a),
+                FIRST_ANSWER.as_secs()
             ),
             Self::Failed(why) => write!(f, "--cluster: {}", escape_controls(why)),
         }
@@ -216,7 +258,9 @@ pub fn run<R: ResultLine>(
         .arg("--exe")
         .arg(&exe)
         .arg("--cwd")
-        .arg(&cwd);
+        .arg(&cwd)
+        .arg("--timeout")
+        .arg(HANDSHAKE.as_secs().to_string());
     if cluster.verify {
         command
             .arg("--verify")
@@ -239,14 +283,7 @@ pub fn run<R: ResultLine>(
         let _ = stdin.write_all(input.as_bytes());
     });
     let stderr = child.stderr.take().expect("stderr is piped");
-    let errors = std::thread::spawn(move || {
-        let mut text = String::new();
-        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
-            text.push_str(&line);
-            text.push('\n');
-        }
-        text
-    });
+    let errors = std::thread::spawn(move || tail(stderr));
     let stdout = child.stdout.take().expect("stdout is piped");
     let (tx, rx) = mpsc::channel();
     std::thread::spawn(move || {
@@ -259,6 +296,7 @@ pub fn run<R: ResultLine>(
     let mut received = vec![false; count];
     let mut got = 0;
     let mut stopped = false;
+    let (started, mut answered, mut stalled) = (Instant::now(), false, false);
     loop {
         if stop.load(Ordering::SeqCst) {
             stopped = true;
@@ -267,6 +305,7 @@ pub fn run<R: ResultLine>(
         }
         match rx.recv_timeout(POLL) {
             Ok(text) => {
+                answered = true;
                 let Ok(line) = serde_json::from_str::<Line>(&text) else {
                     continue;
                 };
@@ -277,7 +316,13 @@ pub fn run<R: ResultLine>(
                 got += 1;
                 done(line.index, merge(line));
             }
-            Err(mpsc::RecvTimeoutError::Timeout) => {}
+            Err(mpsc::RecvTimeoutError::Timeout) => {
+                if !answered && started.elapsed() > FIRST_ANSWER {
+                    stalled = true;
+                    let _ = child.kill();
+                    break;
+                }
+            }
             Err(mpsc::RecvTimeoutError::Disconnected) => break,
         }
     }
@@ -288,6 +333,9 @@ pub fn run<R: ResultLine>(
     let stderr = errors.join().unwrap_or_default();
     if stopped {
         return Ok(got);
+    }
+    if stalled {
+        return Err(ClusterError::Stalled(cluster.scheduler.clone()));
     }
     if !status.success() {
         let last = stderr
@@ -303,6 +351,13 @@ pub fn run<R: ResultLine>(
             }
             Some(3) => ClusterError::NoDistributed(last),
             Some(4) => ClusterError::Unreachable(cluster.scheduler.clone(), last),
+            Some(6) => ClusterError::NoAnswer(cluster.scheduler.clone()),
+            Some(7) => ClusterError::NotDask(
+                cluster.scheduler.clone(),
+                last.split_once("protocol (")
+                    .map_or(last.as_str(), |(_, why)| why.trim_end_matches(')'))
+                    .to_owned(),
+            ),
             _ => ClusterError::Failed(format!("python3 -m ricochet_dask: {status}: {last}")),
         });
     }
@@ -333,22 +388,6 @@ fn reach(address: &str) -> Result<(), ClusterError> {
         }
     }
     Err(ClusterError::Unreachable(address.to_owned(), why))
-}
-
-/// Ends the package on Ctrl-C: SIGINT first (its client closes and cancels the items),
-/// SIGKILL if it is still there a second later.
-fn stop_child(child: &mut Child) {
-    if let Ok(pid) = i32::try_from(child.id()) {
-        use nix::sys::signal::{Signal, kill};
-        let _ = kill(nix::unistd::Pid::from_raw(pid), Signal::SIGINT);
-    }
-    for _ in 0..20 {
-        if let Ok(Some(_)) = child.try_wait() {
-            return;
-        }
-        std::thread::sleep(POLL);
-    }
-    let _ = child.kill();
 }
 
 /// The item's outcome from the package's line: its own result line, unverified when

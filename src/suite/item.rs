@@ -396,7 +396,8 @@ fn compare_digest(golden: &Path, fresh: &str) -> Result<Golden, String> {
     let Some(kept) = read_golden(golden)? else {
         return Ok(Golden::Missing);
     };
-    let kept = String::from_utf8_lossy(&kept);
+    // A digest saved with CRLF line ends (a Windows checkout) holds the same three lines.
+    let kept = String::from_utf8_lossy(&kept).replace("\r\n", "\n");
     if kept == fresh {
         return Ok(Golden::Same);
     }

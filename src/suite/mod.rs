@@ -205,7 +205,7 @@ fn from_cluster(
             let kept = read::read_golden(&dir.join(format!("{}.digest", name_of(scenario))))
                 .ok()
                 .flatten()
-                .map(|b| String::from_utf8_lossy(&b).into_owned())
+                .map(|b| String::from_utf8_lossy(&b).replace("\r\n", "\n"))
                 .ok_or(());
             let text = |r: &ItemResult| r.digest.as_ref().map(item::Digest::text);
             let golden = match (kept, &again) {
@@ -259,9 +259,9 @@ pub fn run(opts: &Options) -> anyhow::Result<ExitCode> {
         return Ok(ExitCode::from(2));
     }
     if let Some(j) = &opts.junit
-        && let Err(e) = crate::files::check_writable(j)
+        && let Err(e) = junit::check(j, &items, opts.golden.as_deref())
     {
-        out::error(&format!("error: --junit: {e:#}"));
+        out::error(&format!("error: {e:#}"));
         return Ok(ExitCode::from(2));
     }
     let items = match opts.shard {
@@ -296,13 +296,17 @@ pub fn run(opts: &Options) -> anyhow::Result<ExitCode> {
     });
     let argv = |i: usize| {
         let scenario: &Path = &items[i];
-        let mut a: Vec<OsString> = vec!["test".into(), "--item".into(), scenario.into()];
+        // `--item=PATH`: a path that starts with `-` is still the value, and the result
+        // line names the scenario as given.
+        let mut item = OsString::from("--item=");
+        item.push(scenario);
+        let mut a: Vec<OsString> = vec!["test".into(), item];
         // Each item records in a scratch folder of its own; `--out` is only where to keep.
         if let Some(keep) = &opts.keep {
-            a.extend(["--out".into(), keep.clone().into_os_string()]);
+            a.extend(["--out".into(), not_a_flag(keep)]);
         }
         if let Some(g) = &opts.golden {
-            a.extend(["--golden".into(), g.clone().into_os_string()]);
+            a.extend(["--golden".into(), not_a_flag(g)]);
         }
         if opts.bless {
             a.push("--bless".into());
@@ -399,6 +403,16 @@ pub fn run(opts: &Options) -> anyhow::Result<ExitCode> {
     } else {
         ExitCode::from(1)
     })
+}
+
+/// `path` as an argument of an item's process that can't be taken for a flag: `./-x` for
+/// a relative `-x`, the same file.
+fn not_a_flag(path: &Path) -> OsString {
+    if path.as_os_str().as_encoded_bytes().starts_with(b"-") {
+        Path::new(".").join(path).into_os_string()
+    } else {
+        path.as_os_str().to_owned()
+    }
 }
 
 #[cfg(test)]

@@ -3,7 +3,9 @@
 `ricochet test --cluster tcp://HOST:PORT` (or `ricochet sweep … --cluster …`) starts
 `python3 -m ricochet_dask`, writes one JSON line per item on its stdin (`{"argv": [...]}`:
 the arguments of one `ricochet test --item` or `ricochet sweep … --item` process) and reads
-one JSON line per item from its stdout, in the order they finish:
+one JSON line per item from its stdout, in the order they finish, after a first line
+`{"connected": ADDRESS}` once the scheduler has answered (within `--timeout`, 10 s; Ricochet
+stops a package that has said nothing 30 s after it started):
 
 - `{"index": I, "worker": ADDRESS, "result": RESULT}`: RESULT is the item's own result line
   (docs/suites.md), ADDRESS the worker that ran it;

@@ -3,7 +3,9 @@ cluster.
 
 The protocol (stdin and stdout JSON lines) is in the package's docstring. Exit codes:
 0 every item has its line, 2 bad input, 3 `distributed` is not installed, 4 the scheduler
-can't be reached, 5 `--verify` with fewer than 2 workers.
+can't be reached, 5 `--verify` with fewer than 2 workers, 6 nothing at the address answered
+as a scheduler within `--timeout` seconds (a port that accepts and stays silent), 7 what
+answered is not a Dask scheduler (its bytes don't read as Dask's protocol).
 """
 
 import argparse
@@ -11,6 +13,7 @@ import base64
 import json
 import os
 import sys
+import threading
 import time
 import uuid
 
@@ -78,13 +81,59 @@ def main(argv=None):
         return 3
     # The task goes to the workers by value: they need `distributed`, not this package.
     cloudpickle.register_pickle_by_value(task)
+    client = connect(Client, args)
+    if isinstance(client, int):
+        return client
+    # Ricochet waits a bounded time for this line: the sign that a scheduler answered.
+    emit({"connected": args.scheduler})
+    with client:
+        return run(client, as_completed, items, args)
+
+
+def connect(Client, args):
+    """The client of the scheduler at `args.scheduler`, or the exit code when there is none.
+
+    `Client(timeout=…)` bounds the TCP connect but not Dask's handshake after it: a port that
+    accepts and never speaks would hold it forever. So the whole connect is also under a
+    wall-clock deadline of `args.timeout` seconds, which ends the process (exit 6) from a
+    timer thread, since the client's own thread can't be interrupted.
+    """
+    lock = threading.Lock()
+    connected = False
+
+    def expire():
+        with lock:
+            if connected:
+                return
+            print(
+                f"error: no Dask scheduler answered at {args.scheduler} within "
+                f"{args.timeout:g} s",
+                file=sys.stderr,
+                flush=True,
+            )
+            os._exit(6)
+
+    timer = threading.Timer(args.timeout, expire)
+    timer.daemon = True
+    timer.start()
     try:
         client = Client(args.scheduler, timeout=args.timeout)
     except (OSError, TimeoutError) as e:
         print(f"error: cannot reach the Dask scheduler at {args.scheduler}: {e}", file=sys.stderr)
         return 4
-    with client:
-        return run(client, as_completed, items, args)
+    except Exception as e:  # noqa: BLE001 (bytes that are not Dask's: any error of the reader)
+        detail = f"{type(e).__name__}: {e}" if str(e) else type(e).__name__
+        print(
+            f"error: {args.scheduler} is not a Dask scheduler: its answer does not read as "
+            f"Dask's protocol ({detail})",
+            file=sys.stderr,
+        )
+        return 7
+    finally:
+        with lock:
+            connected = True
+        timer.cancel()
+    return client
 
 
 # How often the loop looks for finished items; the scheduler is asked for its workers at
