@@ -1,18 +1,17 @@
 //! `ricochet sweep`: run time against error for the user's own scenario. Each `--set` gives
 //! a key of the scenario file and values ([`set`]); their cross product is run, each
-//! combination written into the file's text and loaded like any scenario file, against one
-//! reference run; [`trace`] steps a run, [`compare`] steps it beside the reference and
-//! [`error`] measures it as both go (nothing kept per frame), [`report`] prints and writes
-//! the result. A combination's scenario is built when it runs, never all ahead. Frame counts keep their time in seconds when
-//! the timestep changes, and runs are compared at the times both reach ([`time`]).
+//! combination written into the file's text and loaded like any scenario file (built when
+//! it runs, never all ahead; at most [`MAX_COMBINATIONS`]), against one reference run.
+//! [`trace`] steps a run, [`compare`] steps it beside a run of the reference and [`error`]
+//! measures it as both go (nothing kept per frame), [`report`] prints and writes the
+//! result. Frame counts keep their time in seconds when the timestep changes, and runs are
+//! compared at the times both reach ([`time`]).
 //!
 //! `--cluster` runs each combination, and the reference, as an item process (`--item`,
 //! [`item`]) on a Dask cluster, like `ricochet test --cluster`; the rows come back in any
-//! order and are put in combination order here. An item measures against the reference, so
-//! each combination's item runs the reference again, untimed: the reference's trace (every
-//! frame's positions, energy and contacts) would otherwise have to travel between workers
-//! in a format of its own, and it costs one untimed run per combination. The reference's
-//! own item gives its step time and digest.
+//! order and are put in combination order here. An item runs the reference beside its
+//! combination, untimed, as a local sweep does; the reference's own item gives its step
+//! time, digest and drift.
 
 mod compare;
 mod error;
