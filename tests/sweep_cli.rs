@@ -483,6 +483,31 @@ fn an_overflowing_combination_is_stopped_where_run_stops_and_fails_the_sweep() {
     let summary = stdout.lines().find(|l| l.starts_with("sweep:")).unwrap();
     assert!(summary.contains("no position error"), "{summary}");
     assert!(summary.contains("2 overflowed, not measured"), "{summary}");
+
+    // A reference that overflows leaves nothing to measure against: nothing is written.
+    let csv = dir.path().join("r.csv");
+    let out = ricochet(
+        &[
+            "sweep",
+            file.to_str().unwrap(),
+            "--set",
+            "world.gravity.y=0",
+            "--reference",
+            "world.gravity.y=1.79e308",
+            "--repeat",
+            "0",
+            "--csv",
+            csv.to_str().unwrap(),
+        ],
+        b"",
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("the reference (world.gravity.y=1.79e308): frame 1:"),
+        "{stderr}"
+    );
+    assert!(!csv.exists() && !csv.with_extension("svg").exists());
 }
 
 /// A comma-separated list of `n` masses.

@@ -219,12 +219,105 @@ impl<'a> Measuring<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sweep::time::FrameMap;
 
     #[test]
     fn multisets_differ_by_what_is_left_over() {
         assert_eq!(missing_from(&[1, 2, 2, 3], &[2, 3, 4]), 2);
         assert_eq!(missing_from(&[2, 3, 4], &[1, 2, 2, 3]), 1);
         assert_eq!(missing_from::<u8>(&[], &[1]), 0);
+    }
+
+    /// The touch events as the whole-run matching counted them: per key, the n-th event
+    /// of the run against the n-th of the reference, moved when the run's frame is not
+    /// the one covering the reference's.
+    fn whole_runs(
+        run: &[(u64, Touch)],
+        reference: &[(u64, Touch)],
+        map: FrameMap,
+    ) -> (u64, u64, u64) {
+        let (mut appear, mut vanish, mut moved) = (0, 0, 0);
+        let mut keys: Vec<&Touch> = run.iter().chain(reference).map(|(_, t)| t).collect();
+        keys.sort();
+        keys.dedup();
+        for key in keys {
+            let ours: Vec<u64> = run.iter().filter(|e| &e.1 == key).map(|e| e.0).collect();
+            let theirs: Vec<u64> = reference
+                .iter()
+                .filter(|e| &e.1 == key)
+                .map(|e| e.0)
+                .collect();
+            appear += ours.len().saturating_sub(theirs.len()) as u64;
+            vanish += theirs.len().saturating_sub(ours.len()) as u64;
+            moved += ours
+                .iter()
+                .zip(&theirs)
+                .filter(|&(&f, &j)| f != map.covering_frame(j))
+                .count() as u64;
+        }
+        (appear, vanish, moved)
+    }
+
+    /// Streamed in the order `compare` steps the two runs (each reference frame before the
+    /// run frame covering it), the touch events count as matched over the whole runs.
+    #[test]
+    fn touch_events_streamed_count_as_over_the_whole_runs() {
+        use crate::sweep::time::Ratio;
+        let touch = |i: u64| Touch {
+            begin: i.is_multiple_of(2),
+            names: ("a".to_owned(), format!("b{}", i % 3)),
+        };
+        // A fixed pseudo-random sequence (a linear congruential generator), no state.
+        let mut seed = 12_345_u64;
+        let mut next = move || {
+            seed = seed
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            seed >> 33
+        };
+        let r = |n, d| Ratio::new(n, d).unwrap();
+        for (dt, dt_ref, frames, frames_ref) in [
+            (r(1, 30), r(1, 120), 40, 160),
+            (r(1, 50), r(1, 60), 50, 60),
+            (r(1, 60), r(1, 60), 30, 30),
+            (r(1, 8), r(1, 24), 16, 50),
+            (r(1, 30), r(1, 120), 40, 100),
+        ] {
+            let map = FrameMap::new(dt, dt_ref);
+            for _ in 0..50 {
+                let events = |n: u64, len: u64, next: &mut dyn FnMut() -> u64| {
+                    let mut e: Vec<(u64, Touch)> = (0..n)
+                        .map(|_| (next() % (len + 1), touch(next())))
+                        .collect();
+                    e.sort_by_key(|x| x.0);
+                    e
+                };
+                let (n, m) = (next() % 12, next() % 12);
+                let run = events(n, frames, &mut next);
+                let reference = events(m, frames_ref, &mut next);
+                let mut measuring = Measuring::new(None);
+                let mut j = 0;
+                for k in 0..=frames {
+                    while j < reference.len() && map.covering_frame(reference[j].0) <= k {
+                        let c = map.covering_frame(reference[j].0);
+                        measuring.reference_touch(c, reference[j].1.clone());
+                        j += 1;
+                    }
+                    for (_, t) in run.iter().filter(|e| e.0 == k) {
+                        measuring.run_touch(k, t.clone());
+                    }
+                }
+                for (f, t) in &reference[j..] {
+                    measuring.reference_touch(map.covering_frame(*f), t.clone());
+                }
+                let m = measuring.finish();
+                assert_eq!(
+                    (m.events_appear, m.events_vanish, m.events_moved),
+                    whole_runs(&run, &reference, map),
+                    "{run:?} against {reference:?}"
+                );
+            }
+        }
     }
 
     #[test]
