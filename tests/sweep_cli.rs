@@ -648,3 +648,41 @@ fn outputs_onto_each_other_the_scenario_or_a_fifo_are_refused() {
     left.sort();
     assert_eq!(left, ["fifo", "projectile.toml"]);
 }
+
+/// Issue #34: when the SVG could not be written (a full disk) after the CSV was, the new
+/// CSV sat beside the previous run's SVG. The pair is written all or nothing: with the
+/// file size limited to 1 KB (`ulimit -f 2`, 512-byte blocks in a POSIX sh; SIGXFSZ
+/// ignored so the write fails with EFBIG), the CSV (~440 bytes) fits and the SVG (~2.4
+/// KB) does not, and both previous files are left as they were.
+#[test]
+fn a_failed_svg_write_leaves_both_previous_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = write(dir.path(), "projectile.toml", PROJECTILE);
+    let (csv, svg) = (dir.path().join("w.csv"), dir.path().join("w.svg"));
+    std::fs::write(&csv, "old csv").unwrap();
+    std::fs::write(&svg, "old svg").unwrap();
+    let out = std::process::Command::new("sh")
+        .arg("-c")
+        .arg("trap '' XFSZ; ulimit -f 2 && exec \"$0\" \"$@\"")
+        .arg(env!("CARGO_BIN_EXE_ricochet"))
+        .args([
+            "sweep",
+            file.to_str().unwrap(),
+            "--set",
+            "world.dt=1/32,1/64",
+            "--repeat",
+            "0",
+            "--csv",
+            csv.to_str().unwrap(),
+        ])
+        .stdin(std::process::Stdio::null())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("w.svg"), "{stderr}");
+    assert_eq!(std::fs::read_to_string(&csv).unwrap(), "old csv");
+    assert_eq!(std::fs::read_to_string(&svg).unwrap(), "old svg");
+    let left = std::fs::read_dir(dir.path()).unwrap().count();
+    assert_eq!(left, 3, "a temporary file was left");
+}
