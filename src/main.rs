@@ -236,8 +236,21 @@ enum Command {
     /// simpler collider costs). Prints a table and a one-line summary; writes a CSV and an
     /// SVG chart of error against wall time per simulated second, log scales.
     ///
-    /// Exit code: 0 done, 1 a file could not be written, 2 bad input (a key or value the
-    /// scenario file refuses is reported by the loader, FILE:LINE:COLUMN).
+    /// Each run is measured as it steps beside the reference (the reference runs again
+    /// beside each combination), so memory does not grow with the frame count. At most
+    /// 100,000 combinations (the product of the --set value counts): each is a run and
+    /// a row kept for the table, CSV and chart; more is refused (exit code 2). A run that
+    /// overflows (a non-finite state, as `run` stops at it, or a non-finite energy) is
+    /// stopped and not measured: its row and the summary say at which frame.
+    ///
+    /// --csv and --svg must be two different regular files (not a device, not the
+    /// scenario); both are written, or neither.
+    ///
+    /// Exit code: 0 done, 1 a run or the reference overflowed (the measured rows are still
+    /// written, unless the reference overflowed) or a file could not be written, 2 bad
+    /// input (a key or value the scenario file refuses is reported by the loader,
+    /// FILE:LINE:COLUMN; too many combinations; an output that is a device, named twice or
+    /// the scenario).
     ///
     /// Examples:
     ///   ricochet sweep scenarios/platformer.toml --set world.dt=1/30,1/60,1/120,1/240

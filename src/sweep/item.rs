@@ -157,6 +157,7 @@ mod tests {
                 energy_error: f64::INFINITY,
                 ..Measures::default()
             },
+            overflow: None,
         };
         let line = ItemLine {
             format: FORMAT,

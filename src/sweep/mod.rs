@@ -1,18 +1,19 @@
 //! `ricochet sweep`: run time against error for the user's own scenario. Each `--set` gives
 //! a key of the scenario file and values ([`set`]); their cross product is run, each
-//! combination written into the file's text and loaded like any scenario file, against one
-//! reference run; [`trace`] steps a run, [`error`] measures it against the reference,
-//! [`report`] prints and writes the result. Frame counts keep their time in seconds when
-//! the timestep changes, and runs are compared at the times both reach ([`time`]).
+//! combination written into the file's text and loaded like any scenario file (built when
+//! it runs, never all ahead; at most [`MAX_COMBINATIONS`]), against one reference run.
+//! [`trace`] steps a run, [`compare`] steps it beside a run of the reference and [`error`]
+//! measures it as both go (nothing kept per frame), [`report`] prints and writes the
+//! result. Frame counts keep their time in seconds when the timestep changes, and runs are
+//! compared at the times both reach ([`time`]).
 //!
 //! `--cluster` runs each combination, and the reference, as an item process (`--item`,
 //! [`item`]) on a Dask cluster, like `ricochet test --cluster`; the rows come back in any
-//! order and are put in combination order here. An item measures against the reference, so
-//! each combination's item runs the reference again, untimed: the reference's trace (every
-//! frame's positions, energy and contacts) would otherwise have to travel between workers
-//! in a format of its own, and it costs one untimed run per combination. The reference's
-//! own item gives its step time and digest.
+//! order and are put in combination order here. An item runs the reference beside its
+//! combination, untimed, as a local sweep does; the reference's own item gives its step
+//! time, digest and drift.
 
+mod compare;
 mod error;
 mod item;
 mod report;
@@ -31,9 +32,11 @@ use toml_edit::DocumentMut;
 
 use crate::suite::cluster::{self, Cluster, Returned};
 use crate::{files, out};
+use compare::Stopped;
 use item::Which;
 use set::{Setting, Sweep, Target};
 use time::Ratio;
+use trace::Overflow;
 
 /// `ricochet sweep`'s arguments.
 #[derive(clap::Args, Debug)]
@@ -146,22 +149,39 @@ fn label(values: &[(&Sweep, &Setting)]) -> String {
         .join(" ")
 }
 
-/// Every combination of the sweeps' values, the first `--set` outermost.
-fn combinations(sweeps: &[Sweep]) -> Vec<Vec<usize>> {
-    let mut all = vec![Vec::new()];
-    for s in sweeps {
-        all = all
-            .into_iter()
-            .flat_map(|c: Vec<usize>| {
-                (0..s.values.len()).map(move |i| {
-                    let mut c = c.clone();
-                    c.push(i);
-                    c
-                })
-            })
-            .collect();
+/// The most combinations a sweep runs: each is a run of the scenario beside a run of the
+/// reference, and its row (about half a kilobyte) is kept for the table, the CSV and the
+/// chart, so 100,000 rows are some 50 MB and, at a millisecond a run, minutes of work.
+pub const MAX_COMBINATIONS: u64 = 100_000;
+
+/// How many combinations the sweeps cross to, if at most [`MAX_COMBINATIONS`].
+fn count(sweeps: &[Sweep]) -> Result<usize, String> {
+    let n = sweeps
+        .iter()
+        .try_fold(1u64, |n, s| n.checked_mul(s.values.len() as u64));
+    match n {
+        Some(n) if n <= MAX_COMBINATIONS => Ok(usize::try_from(n).unwrap_or(usize::MAX)),
+        _ => {
+            let sizes: Vec<String> = sweeps.iter().map(|s| s.values.len().to_string()).collect();
+            Err(format!(
+                "too many combinations: {} = {}, more than the {MAX_COMBINATIONS} a sweep runs; \
+                 sweep fewer values (shards split a sweep's runs, not this limit)",
+                sizes.join(" × "),
+                n.map_or_else(|| "more than 2^64".to_owned(), |n| n.to_string())
+            ))
+        }
     }
-    all
+}
+
+/// Combination `index`'s value of each sweep (the first `--set` outermost, the last
+/// changing fastest).
+fn combination(sweeps: &[Sweep], mut index: usize) -> Vec<usize> {
+    let mut digits = vec![0; sweeps.len()];
+    for (d, s) in digits.iter_mut().zip(sweeps).rev() {
+        *d = index % s.values.len();
+        index /= s.values.len();
+    }
+    digits
 }
 
 fn default_path(scenario: &Path, shard: Option<(usize, usize)>, ext: &str) -> PathBuf {
@@ -248,36 +268,69 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
         Err(e) => return Ok(bad(&format!("the reference ({reference_label}): {e}"))),
     };
 
-    // Every combination is checked before anything runs: a bad value fails at once.
-    let all = combinations(&sweeps);
-    let mut runs = Vec::new();
-    for (index, combo) in all.iter().enumerate() {
-        let values: Vec<(&Sweep, &Setting)> = sweeps
-            .iter()
-            .zip(combo)
-            .map(|(s, &i)| (s, &s.values[i]))
-            .collect();
-        let targets: Vec<(&Target, &Setting)> =
-            values.iter().map(|(s, v)| (&s.target, *v)).collect();
-        let v = match variant(&text, &file, file_dt, &targets) {
-            Ok(v) => v,
-            Err(e) => return Ok(bad(&format!("with {}: {e}", label(&values)))),
-        };
-        if shard.is_none_or(|(k, n)| index % n == k) {
-            let texts = values.iter().map(|(_, v)| v.text().to_owned()).collect();
-            runs.push((index, texts, v));
+    let total = match count(&sweeps) {
+        Ok(n) => n,
+        Err(e) => return Ok(bad(&format!("--set: {e}"))),
+    };
+    // Each value is checked alone (the file's own for the other keys) before anything
+    // runs, so a bad value fails at once; a combination is built only when it runs.
+    for s in &sweeps {
+        for v in &s.values {
+            if let Err(e) = variant(&text, &file, file_dt, &[(&s.target, v)]) {
+                return Ok(bad(&format!("with {}: {e}", label(&[(s, v)]))));
+            }
         }
     }
-    let bounds = original.world.bounds;
-    let row = |index, values, v: &Variant, t: &trace::Trace, r: &trace::Trace| report::Row {
-        index,
-        values,
-        dt: v.dt,
-        frames: v.scenario.frames,
-        rounded: v.rounded,
-        step_seconds: t.step_seconds,
-        digest: t.digest,
-        error: error::measure(t, r, v.scenario.world.bounds.as_ref()),
+    let values_of = |index: usize| -> Vec<(&Sweep, &Setting)> {
+        sweeps
+            .iter()
+            .zip(combination(&sweeps, index))
+            .map(|(s, i)| (s, &s.values[i]))
+            .collect()
+    };
+    let texts_of = |index: usize| -> Vec<String> {
+        values_of(index)
+            .iter()
+            .map(|(_, v)| v.text().to_owned())
+            .collect()
+    };
+    let runs: Vec<usize> = (0..total)
+        .filter(|i| shard.is_none_or(|(k, n)| i % n == k))
+        .collect();
+    let measure_row = |index: usize| -> Result<report::Row, Failed> {
+        let values = values_of(index);
+        let targets: Vec<(&Target, &Setting)> =
+            values.iter().map(|(s, v)| (&s.target, *v)).collect();
+        let v = variant(&text, &file, file_dt, &targets)
+            .map_err(|e| Failed::Bad(format!("with {}: {e}", label(&values))))?;
+        let measured = compare::measure(
+            &v.scenario,
+            v.dt,
+            &reference.scenario,
+            reference.dt,
+            v.scenario.world.bounds.as_ref(),
+        );
+        let (error, digest, overflow) = match measured {
+            Ok(m) => (m.error, m.digest, None),
+            Err(Stopped::Run(o)) => (error::Measures::default(), 0, Some(o)),
+            Err(Stopped::Reference(o)) => return Err(Failed::Reference(o)),
+        };
+        // An overflowed run is not measured, so not timed either.
+        let step_seconds = match overflow {
+            None => trace::time(&v.scenario, args.repeat),
+            Some(_) => f64::NAN,
+        };
+        Ok(report::Row {
+            index,
+            values: texts_of(index),
+            dt: v.dt,
+            frames: v.scenario.frames,
+            rounded: v.rounded,
+            step_seconds,
+            digest,
+            error,
+            overflow,
+        })
     };
     let reference_values_text: Vec<String> = sweeps
         .iter()
@@ -289,38 +342,55 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
                 .to_owned()
         })
         .collect();
-    let reference_row = |t: &trace::Trace| report::Row {
-        index: 0,
-        values: reference_values_text.clone(),
-        dt: reference.dt,
-        frames: reference.scenario.frames,
-        rounded: reference.rounded,
-        step_seconds: t.step_seconds,
-        digest: t.digest,
-        error: error::measure(t, t, bounds.as_ref()),
+    let reference_row = || {
+        let (error, digest, overflow, step_seconds) = match compare::alone(&reference.scenario) {
+            Ok(m) => (
+                m.error,
+                m.digest,
+                None,
+                trace::time(&reference.scenario, args.repeat),
+            ),
+            Err(o) => (error::Measures::default(), 0, Some(o), f64::NAN),
+        };
+        report::Row {
+            index: 0,
+            values: reference_values_text.clone(),
+            dt: reference.dt,
+            frames: reference.scenario.frames,
+            rounded: reference.rounded,
+            step_seconds,
+            digest,
+            error,
+            overflow,
+        }
+    };
+    let reference_overflowed = |o: &Overflow| {
+        out::error(&format!(
+            "error: the reference ({reference_label}): frame {}: {}; the simulation \
+             overflowed: there is nothing to measure against, nothing was written",
+            o.frame, o.what
+        ));
+        ExitCode::from(1)
     };
 
     if let Some(which) = args.item {
         return match which {
             Which::Reference => {
-                let t = trace::run(&reference.scenario, reference.dt, args.repeat);
-                item::print(true, reference_row(&t))?;
+                item::print(true, reference_row())?;
                 Ok(ExitCode::SUCCESS)
             }
-            Which::Combination(i) => {
-                let Some((index, values, v)) = runs.into_iter().find(|r| r.0 == i) else {
-                    return Ok(bad(&format!(
-                        "--item {i}: the sweep has {} combinations (0 to {})",
-                        all.len(),
-                        all.len().saturating_sub(1)
-                    )));
-                };
-                // Untimed: only its trace is needed, to measure against.
-                let r = trace::run(&reference.scenario, reference.dt, 0);
-                let t = trace::run(&v.scenario, v.dt, args.repeat);
-                item::print(false, row(index, values, &v, &t, &r))?;
-                Ok(ExitCode::SUCCESS)
-            }
+            Which::Combination(i) if i < total => match measure_row(i) {
+                Ok(row) => {
+                    item::print(false, row)?;
+                    Ok(ExitCode::SUCCESS)
+                }
+                Err(Failed::Bad(e)) => Ok(bad(&e)),
+                Err(Failed::Reference(o)) => Ok(reference_overflowed(&o)),
+            },
+            Which::Combination(i) => Ok(bad(&format!(
+                "--item {i}: the sweep has {total} combinations (0 to {})",
+                total.saturating_sub(1)
+            ))),
         };
     }
 
@@ -332,7 +402,10 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
         .svg
         .clone()
         .unwrap_or_else(|| csv.with_extension("svg"));
-    files::check_outputs(&[("--csv", &csv), ("--svg", &svg)], &[&args.scenario])?;
+    // Before any run: a device, one file named twice, or the scenario itself is bad input.
+    if let Err(e) = files::check_outputs(&[("--csv", &csv), ("--svg", &svg)], &[&args.scenario]) {
+        return Ok(bad(&format!("{e:#}")));
+    }
 
     let (reference_row, rows) = match &args.cluster {
         Some(scheduler) => {
@@ -340,7 +413,8 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
                 verify: args.verify,
                 ..Cluster::new(scheduler.clone())
             };
-            match on_cluster(args, &keys, &cluster, &runs) {
+            let named: Vec<(usize, Vec<String>)> = runs.iter().map(|&i| (i, texts_of(i))).collect();
+            match on_cluster(args, &keys, &cluster, &named) {
                 Ok(Some(done)) => done,
                 Ok(None) => return Ok(ExitCode::from(1)),
                 Err(e) => {
@@ -363,25 +437,34 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
                     .context("progress bar template")?,
             );
             bar.set_message(format!("reference {reference_label}"));
-            let ref_trace = trace::run(&reference.scenario, reference.dt, args.repeat);
+            let reference_row = reference_row();
+            if let Some(o) = &reference_row.overflow {
+                bar.finish_and_clear();
+                return Ok(reference_overflowed(o));
+            }
             bar.inc(1);
-            let mut rows = Vec::new();
-            for (index, values, v) in runs {
-                bar.set_message(
-                    keys.iter()
-                        .zip(&values)
-                        .map(|(k, v)| format!("{k}={v}"))
-                        .collect::<Vec<_>>()
-                        .join(" "),
-                );
-                let t = trace::run(&v.scenario, v.dt, args.repeat);
-                rows.push(row(index, values, &v, &t, &ref_trace));
+            let mut rows = Vec::with_capacity(runs.len());
+            for &index in &runs {
+                bar.set_message(label(&values_of(index)));
+                match measure_row(index) {
+                    Ok(row) => rows.push(row),
+                    Err(failed) => {
+                        bar.finish_and_clear();
+                        return Ok(match failed {
+                            Failed::Bad(e) => bad(&e),
+                            Failed::Reference(o) => reference_overflowed(&o),
+                        });
+                    }
+                }
                 bar.inc(1);
             }
             bar.finish_and_clear();
-            (reference_row(&ref_trace), rows)
+            (reference_row, rows)
         }
     };
+    if let Some(o) = &reference_row.overflow {
+        return Ok(reference_overflowed(o));
+    }
 
     out::print(&report::table(&keys, &reference_row, &rows))?;
     files::write_all(&[
@@ -397,7 +480,38 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
         csv.display(),
         svg.display()
     ))?;
-    Ok(ExitCode::SUCCESS)
+    // As `run` and `test`: an overflow fails the command (exit code 1), after the rows
+    // that were measured are written.
+    let mut overflowed = false;
+    for r in &rows {
+        if let Some(o) = &r.overflow {
+            overflowed = true;
+            let values: Vec<String> = keys
+                .iter()
+                .zip(&r.values)
+                .map(|(k, v)| format!("{k}={v}"))
+                .collect();
+            out::error(&format!(
+                "error: with {}: frame {}: {}; the simulation overflowed, not measured",
+                values.join(" "),
+                o.frame,
+                out::escape_controls(&o.what)
+            ));
+        }
+    }
+    Ok(if overflowed {
+        ExitCode::from(1)
+    } else {
+        ExitCode::SUCCESS
+    })
+}
+
+/// Why a combination's row could not be made.
+enum Failed {
+    /// Its scenario does not load (bad input: exit code 2).
+    Bad(String),
+    /// The reference overflowed beside it.
+    Reference(Overflow),
 }
 
 /// The sweep's runs as items on the cluster: the reference, then each combination of
@@ -408,7 +522,7 @@ fn on_cluster(
     args: &Args,
     keys: &[String],
     cluster: &Cluster,
-    runs: &[(usize, Vec<String>, Variant)],
+    runs: &[(usize, Vec<String>)],
 ) -> Result<Option<(report::Row, Vec<report::Row>)>, cluster::ClusterError> {
     let which = |i: usize| match i {
         0 => Which::Reference,

@@ -9,6 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use super::error::Measures;
 use super::time::Ratio;
+use super::trace::Overflow;
 
 /// One run of the sweep, measured (also the `row` of `sweep --item`'s line, `item.rs`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -30,8 +31,11 @@ pub struct Row {
     /// The final [`ricochet_sim::World::digest`].
     #[serde(with = "super::item::hex")]
     pub digest: u64,
-    /// Its error against the reference.
+    /// Its error against the reference (nothing when it overflowed).
     pub error: Measures,
+    /// Where it overflowed, if it did: then it was stopped there and not measured.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub overflow: Option<Overflow>,
 }
 
 impl Row {
@@ -45,7 +49,7 @@ impl Row {
 /// The CSV's columns after the keys'.
 const COLUMNS: &str = "dt,frames,frames_rounded,step_us,wall_per_sim_s,digest,matched_frames,\
 position_max,position_rms,worst_body,bodies_unmatched,energy_drift,energy_error,touch_appear,touch_vanish,\
-touch_moved,false_positive_contacts,false_negative_contacts";
+touch_moved,false_positive_contacts,false_negative_contacts,overflowed_at_frame";
 
 fn field(text: &str) -> String {
     if text.contains([',', '"', '\n', '\r']) {
@@ -69,6 +73,19 @@ pub fn csv_text(keys: &[String], rows: &[Row]) -> String {
         let _ = write!(s, "{}", r.index);
         for v in &r.values {
             let _ = write!(s, ",{}", field(v));
+        }
+        if let Some(o) = &r.overflow {
+            // Not measured: no step time, digest or error, only where it stopped.
+            let _ = writeln!(
+                s,
+                ",{},{},{},{}{}",
+                r.dt,
+                r.frames,
+                r.rounded,
+                ",".repeat(15),
+                o.frame
+            );
+            continue;
         }
         // Not timed (`--repeat 0`): empty, so the file is the same bytes on every run.
         let (step, wall) = if r.step_seconds.is_nan() {
@@ -99,6 +116,8 @@ pub fn csv_text(keys: &[String], rows: &[Row]) -> String {
             e.false_positives,
             e.false_negatives,
         );
+        // The empty last column: it did not overflow.
+        s.insert(s.len() - 1, ',');
     }
     s
 }
@@ -136,6 +155,15 @@ pub fn table(keys: &[String], reference: &Row, rows: &[Row]) -> String {
     );
     let line = |s: &mut String, name: &str, r: &Row, reference: bool| {
         let e = &r.error;
+        if let Some(o) = &r.overflow {
+            let _ = writeln!(
+                s,
+                "{name:width$}  overflowed at frame {}, not measured: {}",
+                o.frame,
+                crate::out::escape_controls(&o.what)
+            );
+            return;
+        }
         let step = if r.step_seconds.is_nan() {
             "-".to_owned()
         } else {
@@ -204,7 +232,9 @@ pub fn svg_text(
 ) -> String {
     // Groups in first-seen order: the runs that differ only in their timestep.
     let mut groups: Vec<(String, Vec<&Row>)> = Vec::new();
-    for r in rows {
+    let overflowed = rows.iter().filter(|r| r.overflow.is_some()).count();
+    let rows: Vec<&Row> = rows.iter().filter(|r| r.overflow.is_none()).collect();
+    for &r in &rows {
         let name = keys
             .iter()
             .zip(&r.values)
@@ -265,6 +295,11 @@ pub fn svg_text(
         "Errors against the reference run, at the times both reach.".to_owned(),
         "Errors of exactly 0 sit on the bottom line.".to_owned(),
     ];
+    if overflowed > 0 {
+        notes.push(format!(
+            "{overflowed} runs overflowed: not measured, not drawn (see the CSV)."
+        ));
+    }
     if shown < series.len() {
         notes.push(format!(
             "The first {shown} of {} lines; all are in the CSV.",
@@ -304,6 +339,8 @@ pub fn summary(rows: &[Row], keys: &[String], shard: Option<(usize, usize)>) -> 
     if let Some((k, n)) = shard {
         let _ = write!(s, " (shard {k}/{n})");
     }
+    let overflowed: Vec<&Row> = rows.iter().filter(|r| r.overflow.is_some()).collect();
+    let rows: Vec<&Row> = rows.iter().filter(|r| r.overflow.is_none()).collect();
     let worst = rows
         .iter()
         .filter(|r| r.error.position_max != 0.0)
@@ -347,6 +384,14 @@ pub fn summary(rows: &[Row], keys: &[String], shard: Option<(usize, usize)>) -> 
             "; fastest {:.2} µs/step ({})",
             f.step_seconds * 1e6,
             label(f)
+        );
+    }
+    if let (Some(first), n) = (overflowed.first(), overflowed.len()) {
+        let frame = first.overflow.as_ref().map_or(0, |o| o.frame);
+        let _ = write!(
+            s,
+            "; {n} overflowed, not measured (first: {} at frame {frame})",
+            label(first)
         );
     }
     s

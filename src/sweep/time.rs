@@ -136,6 +136,12 @@ impl FrameMap {
             .flatten()
     }
 
+    /// Whether the reference's frame `j` is at a time the run reaches.
+    #[must_use]
+    pub fn is_common_reference_frame(self, j: u64) -> bool {
+        j.is_multiple_of(self.a)
+    }
+
     /// The run's frame whose step covers the reference's frame `j`: the first `k` with
     /// `k · dt ≥ j · dt_ref`, `ceil(j·b / a)`. An event the reference has at frame `j`
     /// "moves" when the run has it at any other frame.
