@@ -14,9 +14,12 @@ use std::time::Duration;
 use futures_util::{SinkExt, StreamExt};
 use tokio::net::{TcpListener, TcpStream};
 use tokio::sync::oneshot;
-use tokio_tungstenite::tungstenite::Message;
+use tokio_tungstenite::WebSocketStream;
 use tokio_tungstenite::tungstenite::handshake::server::{ErrorResponse, Request, Response};
 use tokio_tungstenite::tungstenite::http::{HeaderValue, StatusCode};
+use tokio_tungstenite::tungstenite::protocol::CloseFrame;
+use tokio_tungstenite::tungstenite::protocol::frame::coding::CloseCode;
+use tokio_tungstenite::tungstenite::{Error as WsError, Message};
 
 use crate::hub::{Hub, client_queue};
 use crate::protocol::{self, ClientMessage, ServerMessage};
@@ -25,8 +28,13 @@ use crate::realtime::Note;
 /// Clients served at once; more are refused (HTTP 503).
 pub const MAX_CLIENTS: usize = 64;
 /// The largest message a client may send (a subscribe of every channel is a few hundred
-/// bytes).
-const MAX_CLIENT_MESSAGE: usize = 64 * 1024;
+/// bytes). A larger one closes the connection with status 1009 (Message Too Big) and a
+/// reason naming the limit.
+pub const MAX_CLIENT_MESSAGE: usize = 64 * 1024;
+/// How long a connection closed for a message too big is read (and what is read dropped)
+/// after the close frame, so that the kernel ends it with a FIN rather than a reset, which
+/// could discard the close frame before the client reads it.
+const CLOSE_LINGER: Duration = Duration::from_secs(1);
 
 /// Handshakes under way at once (each holds a socket and at most tungstenite's 64 KiB of
 /// request); a connection past them evicts the oldest.
@@ -177,17 +185,18 @@ async fn client(
         for text in hello {
             out.send(Message::text(text))
                 .await
-                .map_err(|e| e.to_string())?;
+                .map_err(|e| Ended::Failed(e.to_string()))?;
         }
         loop {
             tokio::select! {
                 sent = pending.recv() => match sent {
-                    Some(m) => out.send(m).await.map_err(|e| e.to_string())?,
+                    Some(m) => out.send(m).await.map_err(|e| Ended::Failed(e.to_string()))?,
                     None => return Ok(()),
                 },
                 got = incoming.next() => match got {
                     None | Some(Ok(Message::Close(_))) => return Ok(()),
-                    Some(Err(e)) => return Err(e.to_string()),
+                    Some(Err(WsError::Capacity(e))) => return Err(Ended::TooBig(e.to_string())),
+                    Some(Err(e)) => return Err(Ended::Failed(e.to_string())),
                     Some(Ok(Message::Text(text))) => {
                         if let Err(why) = handle(&hub, id, text.as_str()) {
                             let status = ServerMessage::Status { level: 2, message: &why };
@@ -207,8 +216,67 @@ async fn client(
     }
     .await;
     hub.lock().disconnect(id);
+    // Nothing more is sent to it: the queue's messages are dropped with it.
+    drop(pending);
+    let result = match result {
+        Ok(()) => Ok(()),
+        Err(Ended::Failed(e)) => Err(e),
+        Err(Ended::TooBig(e)) => {
+            if let Ok(ws) = out.reunite(incoming) {
+                close_too_big(ws).await;
+            }
+            Err(format!(
+                "{e}: closed with 1009, the most a client may send is {} KiB",
+                MAX_CLIENT_MESSAGE / 1024
+            ))
+        }
+    };
     note(&format!("serve: client {peer} disconnected"));
     result
+}
+
+/// Why a client's connection ended, but for its closing it.
+enum Ended {
+    /// A message over [`MAX_CLIENT_MESSAGE`] (tungstenite's words).
+    TooBig(String),
+    /// Reading or writing failed.
+    Failed(String),
+}
+
+/// Closes `ws` after a message over [`MAX_CLIENT_MESSAGE`]: a close frame with 1009 (Message
+/// Too Big) and the limit, then what the client still sends is read and dropped, at most
+/// for [`CLOSE_LINGER`], until it closes too.
+async fn close_too_big(mut ws: WebSocketStream<TcpStream>) {
+    let frame = CloseFrame {
+        code: CloseCode::Size,
+        reason: format!("message over {} KiB", MAX_CLIENT_MESSAGE / 1024).into(),
+    };
+    let linger = async {
+        if ws.close(Some(frame)).await.is_err() {
+            return;
+        }
+        let mut stream = ws.into_inner();
+        // A FIN after the close frame; the rest of the message too big is unread.
+        let shut = std::future::poll_fn(|cx| {
+            tokio::io::AsyncWrite::poll_shutdown(std::pin::Pin::new(&mut stream), cx)
+        });
+        if shut.await.is_err() {
+            return;
+        }
+        let mut buf = [0u8; 4096];
+        loop {
+            if stream.readable().await.is_err() {
+                return;
+            }
+            match stream.try_read(&mut buf) {
+                Ok(0) => return,
+                Ok(_) => {}
+                Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => {}
+                Err(_) => return,
+            }
+        }
+    };
+    let _ = tokio::time::timeout(CLOSE_LINGER, linger).await;
 }
 
 /// One JSON message from a client; an error is told to it as a status message.
