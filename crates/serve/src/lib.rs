@@ -35,4 +35,6 @@ mod server;
 mod services;
 mod serving;
 
-pub use realtime::{DEFAULT_BIND, Listener, Note, Options, ServeError, Served, cpu_seconds, serve};
+pub use realtime::{
+    DEFAULT_BIND, Listener, Note, Options, SPEEDS, ServeError, Served, cpu_seconds, serve,
+};
