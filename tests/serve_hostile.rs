@@ -265,3 +265,39 @@ fn a_message_over_64_kib_is_closed_with_1009_and_the_limit() {
         assert_eq!(next_json(&mut ws).await["op"], "serverInfo");
     });
 }
+
+// The 65th client was sent a status and dropped, with no close frame. It is now closed with
+// 1013 (Try Again Later, RFC 6455 §7.4.1) and the cap said; one leaving makes room.
+#[test]
+fn the_65th_client_is_told_too_many_and_closed_with_1013() {
+    use futures_util::StreamExt;
+    let server = serve(&["--paused"]);
+    runtime().block_on(async {
+        let mut admitted = Vec::new();
+        for _ in 0..64 {
+            admitted.push(open(&server, "foxglove.websocket.v1").await.0);
+        }
+        let (mut refused, _) = connect(&server.url, "foxglove.websocket.v1").await.unwrap();
+        let (level, text) = next_status(&mut refused).await;
+        assert_eq!((level, text.as_str()), (2, "too many clients"));
+        let close = tokio::time::timeout(Duration::from_secs(5), refused.next())
+            .await
+            .expect("a close frame within 5 s");
+        let Some(Ok(Message::Close(Some(frame)))) = close else {
+            panic!("a close frame, not {close:?}");
+        };
+        assert_eq!(u16::from(frame.code), 1013, "{frame:?}");
+        assert!(frame.reason.contains("at most 64"), "{frame:?}");
+        // One leaves: a new client gets in (once the server has seen it go).
+        drop(admitted.pop());
+        let deadline = Instant::now() + Duration::from_secs(5);
+        loop {
+            let (mut ws, _) = connect(&server.url, "foxglove.websocket.v1").await.unwrap();
+            if any_json(&mut ws).await["op"] == "serverInfo" {
+                break;
+            }
+            assert!(Instant::now() < deadline, "no room 5 s after a client left");
+            tokio::time::sleep(Duration::from_millis(50)).await;
+        }
+    });
+}

@@ -25,13 +25,14 @@ use crate::hub::{Hub, client_queue};
 use crate::protocol::{self, ClientMessage, ServerMessage};
 use crate::realtime::Note;
 
-/// Clients served at once; more are refused (HTTP 503).
+/// Clients served at once; more are told so (a status) and closed with 1013 (Try Again
+/// Later).
 pub const MAX_CLIENTS: usize = 64;
 /// The largest message a client may send (a subscribe of every channel is a few hundred
 /// bytes). A larger one closes the connection with status 1009 (Message Too Big) and a
 /// reason naming the limit.
 pub const MAX_CLIENT_MESSAGE: usize = 64 * 1024;
-/// How long a connection closed for a message too big is read (and what is read dropped)
+/// How long a connection closed by the server (a message too big, too many clients) is read (and what is read dropped)
 /// after the close frame, so that the kernel ends it with a FIN rather than a reset, which
 /// could discard the close frame before the client reads it.
 const CLOSE_LINGER: Duration = Duration::from_secs(1);
@@ -176,8 +177,16 @@ async fn client(
             level: 2,
             message: "too many clients",
         };
-        let _ = out.send(Message::text(status.json())).await;
-        return Err("refused: too many clients".to_owned());
+        let frame = CloseFrame {
+            code: CloseCode::Again,
+            reason: format!("too many clients, at most {MAX_CLIENTS}").into(),
+        };
+        if let Ok(ws) = out.reunite(incoming) {
+            close_with(ws, Some(Message::text(status.json())), frame).await;
+        }
+        return Err(format!(
+            "refused: too many clients, at most {MAX_CLIENTS}; closed with 1013"
+        ));
     };
     note(&format!("serve: client {peer} connected"));
     let mut limit = RateLimit::new();
@@ -222,8 +231,12 @@ async fn client(
         Ok(()) => Ok(()),
         Err(Ended::Failed(e)) => Err(e),
         Err(Ended::TooBig(e)) => {
+            let frame = CloseFrame {
+                code: CloseCode::Size,
+                reason: format!("message over {} KiB", MAX_CLIENT_MESSAGE / 1024).into(),
+            };
             if let Ok(ws) = out.reunite(incoming) {
-                close_too_big(ws).await;
+                close_with(ws, None, frame).await;
             }
             Err(format!(
                 "{e}: closed with 1009, the most a client may send is {} KiB",
@@ -243,15 +256,16 @@ enum Ended {
     Failed(String),
 }
 
-/// Closes `ws` after a message over [`MAX_CLIENT_MESSAGE`]: a close frame with 1009 (Message
-/// Too Big) and the limit, then what the client still sends is read and dropped, at most
-/// for [`CLOSE_LINGER`], until it closes too.
-async fn close_too_big(mut ws: WebSocketStream<TcpStream>) {
-    let frame = CloseFrame {
-        code: CloseCode::Size,
-        reason: format!("message over {} KiB", MAX_CLIENT_MESSAGE / 1024).into(),
-    };
+/// Closes `ws` saying why: `last` if any, then `frame` (1009 for a message over
+/// [`MAX_CLIENT_MESSAGE`], 1013 past [`MAX_CLIENTS`]); then what the client still sends is
+/// read and dropped, at most for [`CLOSE_LINGER`], until it closes too.
+async fn close_with(mut ws: WebSocketStream<TcpStream>, last: Option<Message>, frame: CloseFrame) {
     let linger = async {
+        if let Some(m) = last
+            && ws.send(m).await.is_err()
+        {
+            return;
+        }
         if ws.close(Some(frame)).await.is_err() {
             return;
         }
