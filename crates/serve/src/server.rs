@@ -32,10 +32,16 @@ pub const MAX_CLIENTS: usize = 64;
 /// bytes). A larger one closes the connection with status 1009 (Message Too Big) and a
 /// reason naming the limit.
 pub const MAX_CLIENT_MESSAGE: usize = 64 * 1024;
-/// How long a connection closed by the server (a message too big, too many clients) is read (and what is read dropped)
-/// after the close frame, so that the kernel ends it with a FIN rather than a reset, which
-/// could discard the close frame before the client reads it.
+/// How long a connection the server closes (a message too big, too many clients) is still
+/// read, what comes dropped, after the close frame: so that the kernel ends it with a FIN
+/// rather than a reset, which could discard the close frame before the client reads it.
 const CLOSE_LINGER: Duration = Duration::from_secs(1);
+/// Connections lingering at once (a socket each, for at most [`CLOSE_LINGER`]); past them,
+/// one is closed at once after its close frame, so a flood of clients past the cap holds no
+/// more sockets than before.
+const MAX_LINGERING: usize = 32;
+/// Connections lingering now.
+static LINGERING: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 
 /// Handshakes under way at once (each holds a socket and at most tungstenite's 64 KiB of
 /// request); a connection past them evicts the oldest.
@@ -270,13 +276,26 @@ async fn close_with(mut ws: WebSocketStream<TcpStream>, last: Option<Message>, f
             return;
         }
         let mut stream = ws.into_inner();
-        // A FIN after the close frame; the rest of the message too big is unread.
+        // A FIN after the close frame; what the client sent may still be unread.
         let shut = std::future::poll_fn(|cx| {
             tokio::io::AsyncWrite::poll_shutdown(std::pin::Pin::new(&mut stream), cx)
         });
         if shut.await.is_err() {
             return;
         }
+        use std::sync::atomic::Ordering::AcqRel;
+        if LINGERING.fetch_add(1, AcqRel) >= MAX_LINGERING {
+            LINGERING.fetch_sub(1, AcqRel);
+            return;
+        }
+        // Given back however the linger ends (the timeout drops this future).
+        struct Lingering;
+        impl Drop for Lingering {
+            fn drop(&mut self) {
+                LINGERING.fetch_sub(1, std::sync::atomic::Ordering::AcqRel);
+            }
+        }
+        let _lingering = Lingering;
         let mut buf = [0u8; 4096];
         loop {
             if stream.readable().await.is_err() {
