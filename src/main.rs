@@ -117,7 +117,7 @@ enum Command {
         /// no authentication.
         #[arg(long, default_value = serve::DEFAULT_BIND, value_name = "IP:PORT")]
         bind: String,
-        /// Simulation seconds per wall-clock second.
+        /// Simulation seconds per wall-clock second, 0.01 to 100 (as /speed).
         #[arg(long, default_value_t = 1.0, value_name = "X")]
         speed: f64,
         /// Stop after this many frames after frame 0 (default: run until stopped). No /step

@@ -19,7 +19,7 @@ pub struct Options<'a> {
     pub scenario: Option<&'a Path>,
     /// Address to listen on.
     pub bind: &'a str,
-    /// Simulation seconds per wall second.
+    /// Simulation seconds per wall second (0.01 to 100).
     pub speed: f64,
     /// Stop after this many frames (default: run until interrupted).
     pub frames: Option<u64>,
@@ -32,9 +32,11 @@ pub struct Options<'a> {
 /// Runs `ricochet serve`. Exit code 0 when stopped (Ctrl-C, SIGTERM, `--frames`), 2 for bad
 /// input (scenario, address, speed).
 pub fn run(o: &Options) -> anyhow::Result<ExitCode> {
-    if !(o.speed.is_finite() && o.speed > 0.0) {
+    if !(o.speed.is_finite() && ricochet_serve::SPEEDS.contains(&o.speed)) {
         out::error(&format!(
-            "error: --speed must be a positive number, got {}",
+            "error: --speed must be {} to {}, got {}",
+            ricochet_serve::SPEEDS.start(),
+            ricochet_serve::SPEEDS.end(),
             ricochet_geom::Number(o.speed)
         ));
         return Ok(ExitCode::from(2));

@@ -405,3 +405,69 @@ fn resets_while_recording_stop_at_1000_files() {
     assert_eq!(files, 1000);
     assert_eq!(replays_byte_for_byte(&dir.path().join("s-999.mcap")), 1);
 }
+
+/// What SIGTERM may take, at most, for these tests: the loop looks at its stop flag every
+/// 5 ms poll, or after a seek's 50 ms slice, then finishes a small recording and exits.
+/// 600 ms leaves more than ten slices for a loaded machine and is far under the 1.67 s a
+/// frame waits at speed 0.01 (dt 1/60 s over 0.01), which the old loop slept through whole.
+const STOP_WITHIN: Duration = Duration::from_millis(600);
+
+// Issue 34: SIGTERM took 1.3–2.0 s to stop a server, idle or asked to seek: the loop slept
+// until the next frame was due (dt / speed, 1.67 s at speed 0.01) before it looked at the
+// flag or at its clients' calls. It now sleeps a poll at a time.
+#[test]
+fn sigterm_stops_between_slow_frames_and_a_seek_asked_then_within_a_slice() {
+    // Idle between two frames: frame 0 is shown, frame 1 is due 1.67 s on.
+    let mut server = serve(&["--speed", "0.01"]);
+    std::thread::sleep(Duration::from_millis(100));
+    assert!(terminate(&mut server, STOP_WITHIN).success());
+
+    // A seek asked between two frames: it starts within a poll, and SIGTERM ends it within
+    // a slice, the recording complete up to where it got.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("s.mcap");
+    let mut server = serve(&["--speed", "0.01", "--record", out.to_str().unwrap()]);
+    runtime().block_on(async {
+        let (mut ws, services) = open(&server, "foxglove.websocket.v1").await;
+        send_call(&mut ws, &services, "/seek", 1, r#"{"frame": 100000000}"#).await;
+        tokio::time::sleep(Duration::from_millis(300)).await;
+    });
+    assert!(terminate(&mut server, STOP_WITHIN).success());
+    let frames = replays_byte_for_byte(&out);
+    assert!(frames > 1, "the frames the seek made: {frames}");
+}
+
+// A `--speed` of 1e-300 passed as "a positive number", and the loop panicked (exit 101)
+// making dt / speed a duration. The speed is now 0.01 to 100, as `/speed` and the timeline
+// take, and anything else a named error (exit 2) before the server listens.
+#[test]
+fn a_speed_out_of_range_is_refused_by_name() {
+    for speed in ["1e-300", "0.001", "101", "inf"] {
+        let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_ricochet"))
+            .args(["serve", "--bind", "127.0.0.1:0", "--speed", speed])
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        let started = Instant::now();
+        let status = loop {
+            if let Some(s) = child.try_wait().unwrap() {
+                break s;
+            }
+            if started.elapsed() > Duration::from_secs(10) {
+                let _ = child.kill();
+                let _ = child.wait();
+                panic!("--speed {speed}: still serving after 10 s");
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        };
+        let mut stderr = String::new();
+        std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut stderr).unwrap();
+        assert_eq!(status.code(), Some(2), "--speed {speed}: {stderr}");
+        assert!(
+            stderr.contains("error: --speed must be 0.01 to 100, got"),
+            "--speed {speed}: {stderr}"
+        );
+        assert!(!stderr.contains("panicked"), "{stderr}");
+    }
+}

@@ -212,3 +212,92 @@ fn a_client_that_never_reads_keeps_the_server_within_its_byte_budget() {
         drop(slow);
     });
 }
+
+/// The close frame a client gets after sending `message`, waiting at most 5 s; `None` if
+/// the connection ended without one.
+async fn close_after(ws: &mut Ws, message: Message) -> Option<(u16, String)> {
+    use futures_util::StreamExt;
+    // The server may close before the whole message is written: a failed send is seen as
+    // the missing close frame below.
+    let _ = ws.send(message).await;
+    let deadline = tokio::time::Instant::now() + Duration::from_secs(5);
+    loop {
+        match tokio::time::timeout_at(deadline, ws.next()).await {
+            Err(_) => panic!("no close frame nor end within 5 s"),
+            Ok(Some(Ok(Message::Close(frame)))) => {
+                return frame.map(|f| (u16::from(f.code), f.reason.as_str().to_owned()));
+            }
+            Ok(Some(Ok(_))) => {}
+            Ok(None | Some(Err(_))) => return None,
+        }
+    }
+}
+
+// Issue 34: a message over 64 KiB dropped the connection with neither a close frame nor a
+// reason. It is now closed with 1009 (Message Too Big, RFC 6455 §7.4.1) and the limit said,
+// for a binary message (an input) and a text one (a subscribe) alike; the server goes on.
+#[test]
+fn a_message_over_64_kib_is_closed_with_1009_and_the_limit() {
+    let server = serve(&["--paused"]);
+    runtime().block_on(async {
+        let binary = {
+            // An input on channel 5, 70 KiB in all.
+            let mut data = vec![1u8];
+            data.extend_from_slice(&5u32.to_le_bytes());
+            data.resize(70 * 1024, b' ');
+            Message::binary(data)
+        };
+        let text = {
+            let mut subscribe = String::from(r#"{"op":"subscribe","subscriptions":[]}"#);
+            subscribe.push_str(&" ".repeat(70 * 1024));
+            Message::text(subscribe)
+        };
+        for message in [binary, text] {
+            let (mut ws, _) = open(&server, "foxglove.websocket.v1").await;
+            let (code, reason) = close_after(&mut ws, message)
+                .await
+                .expect("a close frame, not a dropped connection");
+            assert_eq!(code, 1009, "{reason}");
+            assert!(reason.contains("message over 64 KiB"), "{reason}");
+        }
+        // The server still serves.
+        let (mut ws, _) = connect(&server.url, "foxglove.websocket.v1").await.unwrap();
+        assert_eq!(next_json(&mut ws).await["op"], "serverInfo");
+    });
+}
+
+// The 65th client was sent a status and dropped, with no close frame. It is now closed with
+// 1013 (Try Again Later, RFC 6455 §7.4.1) and the cap said; one leaving makes room.
+#[test]
+fn the_65th_client_is_told_too_many_and_closed_with_1013() {
+    use futures_util::StreamExt;
+    let server = serve(&["--paused"]);
+    runtime().block_on(async {
+        let mut admitted = Vec::new();
+        for _ in 0..64 {
+            admitted.push(open(&server, "foxglove.websocket.v1").await.0);
+        }
+        let (mut refused, _) = connect(&server.url, "foxglove.websocket.v1").await.unwrap();
+        let (level, text) = next_status(&mut refused).await;
+        assert_eq!((level, text.as_str()), (2, "too many clients"));
+        let close = tokio::time::timeout(Duration::from_secs(5), refused.next())
+            .await
+            .expect("a close frame within 5 s");
+        let Some(Ok(Message::Close(Some(frame)))) = close else {
+            panic!("a close frame, not {close:?}");
+        };
+        assert_eq!(u16::from(frame.code), 1013, "{frame:?}");
+        assert!(frame.reason.contains("at most 64"), "{frame:?}");
+        // One leaves: a new client gets in (once the server has seen it go).
+        drop(admitted.pop());
+        let deadline = Instant::now() + Duration::from_secs(5);
+        loop {
+            let (mut ws, _) = connect(&server.url, "foxglove.websocket.v1").await.unwrap();
+            if any_json(&mut ws).await["op"] == "serverInfo" {
+                break;
+            }
+            assert!(Instant::now() < deadline, "no room 5 s after a client left");
+            tokio::time::sleep(Duration::from_millis(50)).await;
+        }
+    });
+}

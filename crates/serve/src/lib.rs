@@ -36,4 +36,6 @@ mod services;
 mod serving;
 
 pub use load_path::MAX_SCENARIO_BYTES;
-pub use realtime::{DEFAULT_BIND, Listener, Note, Options, ServeError, Served, cpu_seconds, serve};
+pub use realtime::{
+    DEFAULT_BIND, Listener, Note, Options, SPEEDS, ServeError, Served, cpu_seconds, serve,
+};

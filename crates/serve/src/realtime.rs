@@ -25,6 +25,16 @@ use crate::{server, services};
 /// Where `serve` listens unless told: what Foxglove's "Open connection" suggests.
 pub const DEFAULT_BIND: &str = "127.0.0.1:8765";
 
+/// Simulation seconds per wall second a server may run at (`--speed`, `/speed`, the
+/// timeline): a frame's wait, dt / speed, stays a duration (1e-300 made it infinite, and
+/// the loop panicked).
+pub const SPEEDS: std::ops::RangeInclusive<f64> = 0.01..=100.0;
+
+/// The longest the loop sleeps before it looks at the stop flag and its clients' calls
+/// again (paused, or before a frame is due): what SIGTERM or a call may wait, besides a
+/// seek's or step's slice.
+const POLL: Duration = Duration::from_millis(5);
+
 /// Where a served session's messages go: the live stream, and the recording if any.
 pub(crate) struct ServeSink {
     pub(crate) live: LiveSink,
@@ -130,7 +140,7 @@ pub type Note = Arc<dyn Fn(&str) + Send + Sync>;
 
 /// How to serve.
 pub struct Options {
-    /// Simulation seconds per wall second (positive, finite).
+    /// Simulation seconds per wall second ([`SPEEDS`]: 0.01 to 100).
     pub speed: f64,
     /// Stop after this many frames after frame 0 (`None`: until stopped, at most
     /// [`ricochet_sim::MAX_FRAMES`]); no `/step` or seek goes past it either.
@@ -240,9 +250,11 @@ pub fn serve(
     o: &Options,
     stop: &AtomicBool,
 ) -> Result<Served, ServeError> {
-    if !(o.speed.is_finite() && o.speed > 0.0) {
+    if !(o.speed.is_finite() && SPEEDS.contains(&o.speed)) {
         return Err(ServeError::Options(format!(
-            "speed must be a positive number, got {}",
+            "speed must be {} to {}, got {}",
+            SPEEDS.start(),
+            SPEEDS.end(),
             ricochet_geom::Number(o.speed)
         )));
     }
@@ -343,7 +355,7 @@ fn run_loop(
             // Foxglove's timeline: speed, seek (to the frame at or before the time), play or
             // pause; every client is told the state that results.
             let speed = f64::from(request.speed);
-            if speed.is_finite() && (0.01..=100.0).contains(&speed) {
+            if speed.is_finite() && SPEEDS.contains(&speed) {
                 serving.speed = speed;
             }
             anchor = (Instant::now(), frames);
@@ -371,16 +383,26 @@ fn run_loop(
             continue;
         }
         if serving.paused {
-            std::thread::sleep(Duration::from_millis(5));
+            std::thread::sleep(POLL);
             anchor = (Instant::now(), frames);
             continue;
         }
         let n = u32::try_from(frames - anchor.1).unwrap_or(u32::MAX);
-        let step = Duration::from_secs_f64(serving.scenario.world.dt / serving.speed);
-        let due = anchor.0 + step.saturating_mul(n);
-        if let Some(wait) = due.checked_duration_since(Instant::now()) {
-            std::thread::sleep(wait);
+        // A wait past what a `Duration` or an `Instant` holds (`--frames 0` lets any dt
+        // through): never due.
+        let step = Duration::try_from_secs_f64(serving.scenario.world.dt / serving.speed)
+            .unwrap_or(Duration::MAX);
+        let due = anchor.0.checked_add(step.saturating_mul(n));
+        if let Some(wait) = due.map_or(Some(POLL), |d| d.checked_duration_since(Instant::now())) {
+            // A frame's wait is dt / speed: 1.7 s at 60 Hz and speed 0.01, 100 s at 1 Hz. It
+            // is slept a poll at a time, so that SIGTERM and the clients' calls are seen
+            // within one, not when the frame is due.
+            std::thread::sleep(wait.min(POLL));
+            if due.is_none_or(|d| Instant::now() < d) {
+                continue;
+            }
         }
+        let due = due.unwrap_or_else(Instant::now);
         lateness.add(Instant::now().saturating_duration_since(due));
         serving.frame(hub)?;
         frames += 1;

@@ -14,19 +14,34 @@ use std::time::Duration;
 use futures_util::{SinkExt, StreamExt};
 use tokio::net::{TcpListener, TcpStream};
 use tokio::sync::oneshot;
-use tokio_tungstenite::tungstenite::Message;
+use tokio_tungstenite::WebSocketStream;
 use tokio_tungstenite::tungstenite::handshake::server::{ErrorResponse, Request, Response};
 use tokio_tungstenite::tungstenite::http::{HeaderValue, StatusCode};
+use tokio_tungstenite::tungstenite::protocol::CloseFrame;
+use tokio_tungstenite::tungstenite::protocol::frame::coding::CloseCode;
+use tokio_tungstenite::tungstenite::{Error as WsError, Message};
 
 use crate::hub::{Hub, client_queue};
 use crate::protocol::{self, ClientMessage, ServerMessage};
 use crate::realtime::Note;
 
-/// Clients served at once; more are refused (HTTP 503).
+/// Clients served at once; more are told so (a status) and closed with 1013 (Try Again
+/// Later).
 pub const MAX_CLIENTS: usize = 64;
 /// The largest message a client may send (a subscribe of every channel is a few hundred
-/// bytes).
-const MAX_CLIENT_MESSAGE: usize = 64 * 1024;
+/// bytes). A larger one closes the connection with status 1009 (Message Too Big) and a
+/// reason naming the limit.
+pub const MAX_CLIENT_MESSAGE: usize = 64 * 1024;
+/// How long a connection the server closes (a message too big, too many clients) is still
+/// read, what comes dropped, after the close frame: so that the kernel ends it with a FIN
+/// rather than a reset, which could discard the close frame before the client reads it.
+const CLOSE_LINGER: Duration = Duration::from_secs(1);
+/// Connections lingering at once (a socket each, for at most [`CLOSE_LINGER`]); past them,
+/// one is closed at once after its close frame, so a flood of clients past the cap holds no
+/// more sockets than before.
+const MAX_LINGERING: usize = 32;
+/// Connections lingering now.
+static LINGERING: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 
 /// Handshakes under way at once (each holds a socket and at most tungstenite's 64 KiB of
 /// request); a connection past them evicts the oldest.
@@ -168,8 +183,16 @@ async fn client(
             level: 2,
             message: "too many clients",
         };
-        let _ = out.send(Message::text(status.json())).await;
-        return Err("refused: too many clients".to_owned());
+        let frame = CloseFrame {
+            code: CloseCode::Again,
+            reason: format!("too many clients, at most {MAX_CLIENTS}").into(),
+        };
+        if let Ok(ws) = out.reunite(incoming) {
+            close_with(ws, Some(Message::text(status.json())), frame).await;
+        }
+        return Err(format!(
+            "refused: too many clients, at most {MAX_CLIENTS}; closed with 1013"
+        ));
     };
     note(&format!("serve: client {peer} connected"));
     let mut limit = RateLimit::new();
@@ -177,17 +200,18 @@ async fn client(
         for text in hello {
             out.send(Message::text(text))
                 .await
-                .map_err(|e| e.to_string())?;
+                .map_err(|e| Ended::Failed(e.to_string()))?;
         }
         loop {
             tokio::select! {
                 sent = pending.recv() => match sent {
-                    Some(m) => out.send(m).await.map_err(|e| e.to_string())?,
+                    Some(m) => out.send(m).await.map_err(|e| Ended::Failed(e.to_string()))?,
                     None => return Ok(()),
                 },
                 got = incoming.next() => match got {
                     None | Some(Ok(Message::Close(_))) => return Ok(()),
-                    Some(Err(e)) => return Err(e.to_string()),
+                    Some(Err(WsError::Capacity(e))) => return Err(Ended::TooBig(e.to_string())),
+                    Some(Err(e)) => return Err(Ended::Failed(e.to_string())),
                     Some(Ok(Message::Text(text))) => {
                         if let Err(why) = handle(&hub, id, text.as_str()) {
                             let status = ServerMessage::Status { level: 2, message: &why };
@@ -207,8 +231,85 @@ async fn client(
     }
     .await;
     hub.lock().disconnect(id);
+    // Nothing more is sent to it: the queue's messages are dropped with it.
+    drop(pending);
+    let result = match result {
+        Ok(()) => Ok(()),
+        Err(Ended::Failed(e)) => Err(e),
+        Err(Ended::TooBig(e)) => {
+            let frame = CloseFrame {
+                code: CloseCode::Size,
+                reason: format!("message over {} KiB", MAX_CLIENT_MESSAGE / 1024).into(),
+            };
+            if let Ok(ws) = out.reunite(incoming) {
+                close_with(ws, None, frame).await;
+            }
+            Err(format!(
+                "{e}: closed with 1009, the most a client may send is {} KiB",
+                MAX_CLIENT_MESSAGE / 1024
+            ))
+        }
+    };
     note(&format!("serve: client {peer} disconnected"));
     result
+}
+
+/// Why a client's connection ended, but for its closing it.
+enum Ended {
+    /// A message over [`MAX_CLIENT_MESSAGE`] (tungstenite's words).
+    TooBig(String),
+    /// Reading or writing failed.
+    Failed(String),
+}
+
+/// Closes `ws` saying why: `last` if any, then `frame` (1009 for a message over
+/// [`MAX_CLIENT_MESSAGE`], 1013 past [`MAX_CLIENTS`]); then what the client still sends is
+/// read and dropped, at most for [`CLOSE_LINGER`], until it closes too.
+async fn close_with(mut ws: WebSocketStream<TcpStream>, last: Option<Message>, frame: CloseFrame) {
+    let linger = async {
+        if let Some(m) = last
+            && ws.send(m).await.is_err()
+        {
+            return;
+        }
+        if ws.close(Some(frame)).await.is_err() {
+            return;
+        }
+        let mut stream = ws.into_inner();
+        // A FIN after the close frame; what the client sent may still be unread.
+        let shut = std::future::poll_fn(|cx| {
+            tokio::io::AsyncWrite::poll_shutdown(std::pin::Pin::new(&mut stream), cx)
+        });
+        if shut.await.is_err() {
+            return;
+        }
+        use std::sync::atomic::Ordering::AcqRel;
+        if LINGERING.fetch_add(1, AcqRel) >= MAX_LINGERING {
+            LINGERING.fetch_sub(1, AcqRel);
+            return;
+        }
+        // Given back however the linger ends (the timeout drops this future).
+        struct Lingering;
+        impl Drop for Lingering {
+            fn drop(&mut self) {
+                LINGERING.fetch_sub(1, std::sync::atomic::Ordering::AcqRel);
+            }
+        }
+        let _lingering = Lingering;
+        let mut buf = [0u8; 4096];
+        loop {
+            if stream.readable().await.is_err() {
+                return;
+            }
+            match stream.try_read(&mut buf) {
+                Ok(0) => return,
+                Ok(_) => {}
+                Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => {}
+                Err(_) => return,
+            }
+        }
+    };
+    let _ = tokio::time::timeout(CLOSE_LINGER, linger).await;
 }
 
 /// One JSON message from a client; an error is told to it as a status message.
