@@ -528,20 +528,21 @@ fn on_cluster(
         0 => Which::Reference,
         _ => Which::Combination(runs[i - 1].0),
     };
+    // Every value as `--flag=VALUE` and the scenario after `--`: a path or a value that
+    // starts with `-` is still a value on the worker.
     let argv = |i: usize| {
-        let mut a: Vec<std::ffi::OsString> =
-            vec!["sweep".into(), args.scenario.clone().into_os_string()];
+        let mut a: Vec<std::ffi::OsString> = vec!["sweep".into()];
         for s in &args.set {
-            a.extend(["--set".into(), s.into()]);
+            a.push(format!("--set={s}").into());
         }
         for r in &args.reference {
-            a.extend(["--reference".into(), r.into()]);
+            a.push(format!("--reference={r}").into());
         }
         a.extend([
-            "--repeat".into(),
-            args.repeat.to_string().into(),
-            "--item".into(),
-            which(i).to_string().into(),
+            format!("--repeat={}", args.repeat).into(),
+            format!("--item={}", which(i)).into(),
+            "--".into(),
+            args.scenario.clone().into_os_string(),
         ]);
         a
     };
