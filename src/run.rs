@@ -51,7 +51,7 @@ pub fn run(
         return Ok(ExitCode::from(2));
     }
     if let Some(input) = path
-        && same_file(input, &output)
+        && crate::files::same_file(input, &output)
     {
         out::error(&format!(
             "error: -o {}: that is the scenario being run; choose another output file",
@@ -186,22 +186,4 @@ pub fn run(
         return Ok(ExitCode::from(1));
     }
     Ok(ExitCode::SUCCESS)
-}
-
-/// Whether `output` is the file `input` (the same path, a link to it, another name of it).
-/// An output that does not exist yet is not.
-fn same_file(input: &Path, output: &Path) -> bool {
-    match (input.canonicalize(), output.canonicalize()) {
-        (Ok(a), Ok(b)) if a == b => return true,
-        (Ok(_), Ok(_)) => {}
-        _ => return false,
-    }
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::MetadataExt;
-        if let (Ok(a), Ok(b)) = (std::fs::metadata(input), std::fs::metadata(output)) {
-            return a.dev() == b.dev() && a.ino() == b.ino();
-        }
-    }
-    false
 }
