@@ -3,7 +3,10 @@
 
 use ricochet_geom::{Shape, Vec2};
 
-pub use crate::limits::{MAX_FRAMES, MAX_MASS, MIN_MASS, RunLengthError, shape_reach};
+pub use crate::limits::{
+    MAX_CONTROLLER_VALUE, MAX_FRAMES, MAX_MASS, MIN_MASS, RunLengthError, controller_out_of_range,
+    shape_reach,
+};
 
 /// Index of a layer in [`Layers::names`].
 pub type LayerId = u8;

@@ -150,8 +150,9 @@ mod world;
 pub use action::{Action, Event, ScriptAction};
 pub use control::{ControlError, NonFinite};
 pub use def::{
-    ActiveRegion, BodyDef, BodyKind, Controller, Doomed, LayerId, Layers, MAX_FRAMES, MAX_MASS,
-    MIN_MASS, Response, RunLengthError, Split, WorldBounds, WorldDef, shape_reach,
+    ActiveRegion, BodyDef, BodyKind, Controller, Doomed, LayerId, Layers, MAX_CONTROLLER_VALUE,
+    MAX_FRAMES, MAX_MASS, MIN_MASS, Response, RunLengthError, Split, WorldBounds, WorldDef,
+    controller_out_of_range, shape_reach,
 };
 pub use entity::{Entity, EntityAllocator};
 pub use event::{FireOutcome, GameEvent, JumpOutcome, Removal, ScriptInput};

@@ -4,7 +4,7 @@
 
 use ricochet_geom::{Number, Primitive, Rot, Shape, Vec2};
 
-use crate::def::{WorldBounds, WorldDef};
+use crate::def::{Controller, WorldBounds, WorldDef};
 
 /// The lightest mass a dynamic body may have (mass units): an impulse of 1 gives it
 /// 1e12 units/s, past which every push is an overflow waiting to happen.
@@ -82,6 +82,41 @@ impl WorldDef {
             dt: self.dt,
         })
     }
+}
+
+/// The largest magnitude of a controller's values (`thrust`, `turn_rate`, `bullet_speed`,
+/// `muzzle`, `run_speed`, `jump_speed`, `speed`): [`ricochet_geom::MAX_COORDINATE`], the
+/// largest velocity a script or a client may set. A faster bullet (`bullet_speed = 5.5e20`
+/// in a damaged snapshot) only makes every frame's swept tests longer.
+pub const MAX_CONTROLLER_VALUE: f64 = ricochet_geom::MAX_COORDINATE;
+
+/// The first of a controller's values (field name, value) that is not finite or past
+/// [`MAX_CONTROLLER_VALUE`], if any: what the loader refuses, and a snapshot's restore.
+#[must_use]
+pub fn controller_out_of_range(c: &Controller) -> Option<(&'static str, f64)> {
+    let values: &[(&'static str, f64)] = match c {
+        Controller::Ship {
+            thrust,
+            turn_rate,
+            bullet_speed,
+            muzzle,
+            ..
+        } => &[
+            ("thrust", *thrust),
+            ("turn_rate", *turn_rate),
+            ("bullet_speed", *bullet_speed),
+            ("muzzle", *muzzle),
+        ],
+        Controller::Runner {
+            run_speed,
+            jump_speed,
+        } => &[("run_speed", *run_speed), ("jump_speed", *jump_speed)],
+        Controller::Walker { speed } => &[("speed", *speed)],
+    };
+    values
+        .iter()
+        .find(|(_, v)| !(v.is_finite() && v.abs() <= MAX_CONTROLLER_VALUE))
+        .copied()
 }
 
 /// How far a shape reaches from its body's origin along x and along y, at any angle of the

@@ -93,3 +93,71 @@ fn a_rollback_patches_in_place_and_costs_at_most_48_bytes_a_moving_body() {
     let again: Vec<_> = (0..40).map(|_| a.step()).collect();
     assert_eq!(first, again);
 }
+
+/// The snapshot format's checksum (module docs: XXH3-64 of every byte before it, with the
+/// format's fixed seed, "RCSN" and version 2), recomputed after an edit as an attacker can.
+fn resealed(mut bytes: Vec<u8>) -> Vec<u8> {
+    let n = bytes.len() - 8;
+    let sum = xxhash_rust::xxh3::xxh3_64_with_seed(&bytes[..n], 0x5243_534e_0000_0002);
+    bytes[n..].copy_from_slice(&sum.to_le_bytes());
+    bytes
+}
+
+/// Issue #34: one bit flipped in the ship's `bullet_speed` (30 → 30 · 2^64 ≈ 5.5e20, the
+/// exponent's 64s bit) with the checksum recomputed restored, and then each step took about
+/// a second. The loader refuses a `bullet_speed` past ±1e15; so does `restore`, naming the
+/// field, and the simulation is unchanged.
+#[test]
+fn a_restored_bullet_speed_past_the_loaders_limit_is_refused_and_nothing_changes() {
+    let mut a = sim("asteroids.toml");
+    for _ in 0..60 {
+        a.step();
+    }
+    let bytes = a.snapshot().to_bytes();
+    let thirty = 30f64.to_le_bytes();
+    let at: Vec<usize> = (0..bytes.len() - 8)
+        .filter(|&k| bytes[k..k + 8] == thirty)
+        .collect();
+    assert_eq!(
+        at.len(),
+        1,
+        "one 30.0 in the state: the ship's bullet_speed"
+    );
+    let mut flipped = bytes.clone();
+    // Bit 58 of the little-endian u64: bit 2 of its last byte.
+    flipped[at[0] + 7] ^= 1 << 2;
+    let speed = f64::from_le_bytes(flipped[at[0]..at[0] + 8].try_into().unwrap());
+    assert_eq!(speed, 30.0 * 2f64.powi(64));
+    let s = Snapshot::from_bytes(&resealed(flipped)).expect("the checksum holds");
+    let mut b = sim("asteroids.toml");
+    for _ in 0..10 {
+        b.step();
+    }
+    let (frame, sum) = (b.frame(), b.checksum());
+    match b.restore(&s) {
+        Err(ricochet_sim::SnapshotError::Malformed { what }) => {
+            assert!(what.contains("bullet_speed"), "{what}");
+        }
+        other => panic!("restored: {other:?}"),
+    }
+    assert_eq!((b.frame(), b.checksum()), (frame, sum));
+    // The same snapshot unflipped restores.
+    b.restore(&Snapshot::from_bytes(&bytes).unwrap()).unwrap();
+    assert_eq!(b.checksum(), a.checksum());
+}
+
+#[test]
+fn a_bullet_speed_past_1e15_is_refused_at_load_by_name() {
+    let path = format!(
+        "{}/../../scenarios/asteroids.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let text = std::fs::read_to_string(&path).expect("scenario file");
+    let text = text.replacen("bullet_speed = 30", "bullet_speed = 5.5e20", 1);
+    let e = load_scenario(&text, "asteroids.toml")
+        .expect_err("refused")
+        .to_string();
+    assert!(e.contains("controller.bullet_speed"), "{e}");
+    let ok = text.replacen("bullet_speed = 5.5e20", "bullet_speed = 1e15", 1);
+    assert!(load_scenario(&ok, "asteroids.toml").is_ok());
+}

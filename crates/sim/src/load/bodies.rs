@@ -4,7 +4,10 @@
 use std::collections::BTreeMap;
 use std::ops::Range;
 
-use crate::def::{BodyDef, BodyKind, Controller, Layers, MAX_MASS, MIN_MASS, Split};
+use crate::def::{
+    BodyDef, BodyKind, Controller, Layers, MAX_CONTROLLER_VALUE, MAX_MASS, MIN_MASS, Split,
+    controller_out_of_range,
+};
 use crate::load::context::{Ctx, ScenarioError, finite, unknown, vec2, within_world};
 use crate::load::file::{BodyFile, ControllerFile, SplitFile};
 use ricochet_geom::{Number, Numbers};
@@ -290,6 +293,16 @@ pub(crate) fn body_def(
             speed: num("controller.speed", *speed)?,
         }),
     };
+    if let Some((f, v)) = controller.as_ref().and_then(controller_out_of_range) {
+        return Err(fail(
+            &format!("controller.{f}"),
+            format!(
+                "{} is beyond ±{MAX_CONTROLLER_VALUE:e}, the largest controller value Ricochet \
+                 accepts (a faster bullet only makes every frame's swept tests longer)",
+                Number(v)
+            ),
+        ));
+    }
     let mut split = Vec::new();
     for (
         i,

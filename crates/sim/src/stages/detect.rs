@@ -48,6 +48,7 @@ use crate::entity::Entity;
 use crate::event::Removal;
 use crate::output::{ContactRecord, Phase};
 use crate::parallel::Workers;
+use crate::stages::far_path;
 use crate::stages::push::{Statics, separate_along_normal};
 use crate::stages::remove::remove;
 use crate::stages::separate::is_box;
@@ -459,7 +460,8 @@ fn run_swept(
     }
     let mut hits = Vec::new();
     let wrap = ctx.def.bounds.filter(|b| b.wrap);
-    let (mut offsets, mut path) = (Vec::new(), Vec::new());
+    let mut offsets = Vec::new();
+    let mut budget = far_path::CastBudget::new();
     for &(i, j) in swept {
         ctx.out.stats.narrow_tests += 1;
         let w = &ctx.world;
@@ -470,23 +472,21 @@ fn run_swept(
             angle: w.angle[k],
         };
         let mut first = time_of_impact(w.shape(i), &sweep(i), w.shape(j), &sweep(j));
-        // Through the seam: `b`'s images next to `a`, the earliest (the first on a tie);
-        // along a path longer than the world, every image it meets.
-        offsets.clear();
-        let at_start = |k: usize| {
-            let s = sweep(k);
-            (
-                w.shape(k).bounds(&Pose::new(s.start, s.angle)),
-                s.end - s.start,
-            )
-        };
+        // Along a path longer than the world, the images it meets in time order
+        // (`far_path.rs`); otherwise through the seam: `b`'s images next to `a`, the
+        // earliest (the first on a tie).
         let far = wrap.is_some_and(|b| {
-            let ((ba, da), (bb, db)) = (at_start(i), at_start(j));
-            wrap::path_offsets(&b, (&ba, da), (&bb, db), &mut path)
+            far_path::earliest(
+                &b,
+                (w.shape(i), &sweep(i)),
+                (w.shape(j), &sweep(j)),
+                &mut first,
+                &mut budget,
+                &mut ctx.out.stats.narrow_tests,
+            )
         });
-        if far {
-            offsets.extend_from_slice(&path);
-        } else {
+        offsets.clear();
+        if !far {
             offsets.extend(seam.offsets(i, j));
         }
         for &offset in &offsets {

@@ -14,6 +14,7 @@ pub(crate) mod box_contact;
 pub(crate) mod carry;
 pub(crate) mod cull;
 pub(crate) mod detect;
+pub(crate) mod far_path;
 pub(crate) mod lifetimes;
 pub(crate) mod motion;
 pub(crate) mod obstacles;

@@ -36,8 +36,9 @@
 //! body that just crossed an edge is tested where it was before. The contacts of any scene
 //! at any speed are then those of the same scene with every body wrapped into the world
 //! first. A swept pair whose path over the frame reaches two or more world sizes (a bullet
-//! faster than the world a frame) is cast at every image its path meets instead
-//! ([`path_offsets`], at most [`MAX_PATH_IMAGES`]). Not covered: a static body placed half
+//! faster than the world a frame) is cast at the images its path meets instead, in time
+//! order until its first hit, within a per-pair and a per-frame bound (`far_path.rs`).
+//! Not covered: a static body placed half
 //! the world's size or more outside (statics are never moved; scenario files refuse a
 //! static body outside a wrapping world, a scene built in code is not checked).
 
@@ -121,94 +122,6 @@ pub(crate) fn bring_in(world: &WorldBounds, w: &mut World) {
             w.wrap_to(i, q);
         }
     }
-}
-
-/// At most this many translations of `b` are cast for one swept pair whose path is longer
-/// than the world ([`path_offsets`]): those the path meets first. A longer path (a body
-/// faster than about this many world sizes a frame, along one axis) is not cast beyond
-/// them.
-pub(crate) const MAX_PATH_IMAGES: usize = 4096;
-
-/// The translations of `b` (whole world sizes, never the direct one) at which a swept
-/// pair's bounds meet along the frame's straight-line motion, into `out` in
-/// [`WorldBounds::image_offsets`]' order (by `x` steps, then `y` steps, ascending), when
-/// some is two or more world sizes away on an axis; `false` (and `out` untouched) when all
-/// are within one size, where the seam's images serve. `a` and `b` are the bodies' bounds
-/// at their start positions (end angles), `da` and `db` their motions over the frame.
-///
-/// The bounds of `b + o` meet `a`'s at some `t` in `[0, 1]` when, on each axis,
-/// `b.min - a.max + t (db - da) + o <= 0 <= b.max - a.min + t (db - da) + o`: per `x` step
-/// the `t` interval where it holds on `x` gives the `y` steps. Padded, so an extra image
-/// (whose cast finds nothing) may be listed, never one missed. At most
-/// [`MAX_PATH_IMAGES`], the first along the relative path.
-pub(crate) fn path_offsets(
-    world: &WorldBounds,
-    (a, da): (&Bounds, Vec2),
-    (b, db): (&Bounds, Vec2),
-    out: &mut Vec<Vec2>,
-) -> bool {
-    let size = world.size();
-    let d = db - da;
-    let (lo, hi) = (b.min - a.max, b.max - a.min);
-    let scale = lo.abs().max(hi.abs()).max(d.abs()).max(size).max_element();
-    let pad = 1e-9 * (1.0 + scale);
-    // The steps `k` on `axis` whose bounds meet for some `t` in `[t0, t1]`.
-    let steps = |axis: usize, t0: f64, t1: f64| -> (f64, f64) {
-        let (m0, m1) = (t0 * d[axis], t1 * d[axis]);
-        let first = ((-hi[axis] - m0.max(m1) - pad) / size[axis]).ceil();
-        let last = ((-lo[axis] - m0.min(m1) + pad) / size[axis]).floor();
-        (first, last)
-    };
-    let within = |(first, last): (f64, f64)| first >= -1.0 && last <= 1.0;
-    let (xs, ys) = (steps(0, 0.0, 1.0), steps(1, 0.0, 1.0));
-    if within(xs) && within(ys) {
-        return false;
-    }
-    // Along the relative path first: `o` falls as `t` grows when `d > 0`.
-    let ordered = |(first, last): (f64, f64), d: f64| {
-        let n = if last >= first {
-            last - first + 1.0
-        } else {
-            0.0
-        };
-        let n = n.min(MAX_PATH_IMAGES as f64) as usize;
-        (0..n).map(move |m| {
-            if d > 0.0 {
-                last - m as f64
-            } else {
-                first + m as f64
-            }
-        })
-    };
-    let mut steps_found: Vec<(f64, f64)> = Vec::new();
-    'x: for kx in ordered(xs, d.x) {
-        let o = kx * size.x;
-        let (t0, t1) = if d.x == 0.0 {
-            (0.0, 1.0)
-        } else {
-            let (p, q) = ((-hi.x - o - pad) / d.x, (-lo.x - o + pad) / d.x);
-            (p.min(q).max(0.0), p.max(q).min(1.0))
-        };
-        if t0 > t1 {
-            continue;
-        }
-        for ky in ordered(steps(1, t0, t1), d.y) {
-            if steps_found.len() == MAX_PATH_IMAGES {
-                break 'x;
-            }
-            if kx != 0.0 || ky != 0.0 {
-                steps_found.push((kx, ky));
-            }
-        }
-    }
-    steps_found.sort_by(|p, q| p.0.total_cmp(&q.0).then(p.1.total_cmp(&q.1)));
-    out.clear();
-    out.extend(
-        steps_found
-            .into_iter()
-            .map(|(kx, ky)| Vec2::new(kx * size.x, ky * size.y)),
-    );
-    true
 }
 
 /// How far `b` sticks out of the world on each axis (`>= 0`).

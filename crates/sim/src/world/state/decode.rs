@@ -3,6 +3,7 @@
 //! in range, every carrier alive) before anything is put in a world (`restore.rs`).
 
 use super::*;
+use crate::def::{MAX_CONTROLLER_VALUE, MAX_MASS, MIN_MASS, controller_out_of_range};
 use crate::snapshot::codec::Reader;
 
 fn bad(what: &str) -> SnapshotError {
@@ -120,8 +121,76 @@ impl World {
                 return Err(bad(&format!("body {k}'s carrier is not a live body")));
             }
         }
+        check_values(&b)?;
         Ok(b)
     }
+}
+
+/// What the loader would refuse in a restored body (issue #34: a snapshot whose
+/// `bullet_speed` was flipped from 30 to 5.5e20, its checksum recomputed, restored and made
+/// each step take a second): every number finite, a mass within [`MIN_MASS`] to
+/// [`MAX_MASS`], a controller's values within [`MAX_CONTROLLER_VALUE`], inputs within
+/// -1 to 1. Positions and velocities are only required to be finite: a run may carry a
+/// body past the loader's ±1e15 (an unbounded world, a velocity of 1e146), and its
+/// snapshot must restore. The world settings (`dt`, gravity, bounds) are not in a snapshot:
+/// its scene hash must match the simulation's.
+fn check_values(b: &Bodies) -> Result<(), SnapshotError> {
+    let finite = |what: &str, ok: bool| if ok { Ok(()) } else { Err(bad(what)) };
+    let motion = |m: &Motion| -> Result<(), SnapshotError> {
+        finite("a body's force is not finite", m.force.is_finite())?;
+        let input = |x: f64| (-1.0..=1.0).contains(&x);
+        finite(
+            "a body's input is not within -1 to 1",
+            input(m.inputs.turn) && input(m.inputs.run),
+        )?;
+        if let Some((f, v)) = m.controller.as_ref().and_then(controller_out_of_range) {
+            return Err(bad(&format!(
+                "controller.{f} = {} is beyond ±{MAX_CONTROLLER_VALUE:e}, the loader's limit",
+                ricochet_geom::Number(v)
+            )));
+        }
+        Ok(())
+    };
+    for d in &b.deltas {
+        finite("a body's position is not finite", d.position.is_finite())?;
+        finite("a body's angle is not finite", d.angle.is_finite())?;
+        finite("a body's velocity is not finite", d.velocity.is_finite())?;
+        finite(
+            "a body's angular velocity is not finite",
+            d.spin.is_finite(),
+        )?;
+    }
+    for m in &b.motions {
+        motion(m)?;
+    }
+    for w in &b.wholes {
+        finite("a body's position is not finite", w.position.is_finite())?;
+        finite("a body's angle is not finite", w.angle.is_finite())?;
+        let Some(row) = &w.row else { continue };
+        if !(MIN_MASS..=MAX_MASS).contains(&row.mass) {
+            return Err(bad(&format!(
+                "mass = {} is outside {MIN_MASS:e} to {MAX_MASS:e}, the loader's limits",
+                ricochet_geom::Number(row.mass)
+            )));
+        }
+        finite("a body's velocity is not finite", row.velocity.is_finite())?;
+        finite(
+            "a body's angular velocity is not finite",
+            row.spin.is_finite(),
+        )?;
+        finite(
+            "a body's gravity scale is not finite",
+            row.gravity_scale.is_finite(),
+        )?;
+        finite(
+            "a split's offset or velocity is not finite",
+            row.split
+                .iter()
+                .all(|s| s.offset.is_finite() && s.velocity.is_finite()),
+        )?;
+        motion(&row.motion)?;
+    }
+    Ok(())
 }
 
 fn read_lifetime(r: &mut Reader) -> Result<Option<u32>, SnapshotError> {
