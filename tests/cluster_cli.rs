@@ -230,10 +230,11 @@ fn bounded_test_on(address: &str, env: &[(&str, &str)]) -> Output {
     child.wait_with_output().unwrap()
 }
 
-#[test]
-fn a_port_that_accepts_and_stays_silent_is_named_not_waited_on() {
+/// Runs `test --cluster` against a loopback port that answers `reply` (nothing: silent) and
+/// checks the run is refused, exit 2, with `--cluster ADDRESS: {says}` and no item run.
+fn refused_by_a_port_that_answers(reply: &'static [u8], says: &str) {
     let Some(python) = dask_python() else { return };
-    let port = NotDask::start(b"");
+    let port = NotDask::start(reply);
     let src = root().join("python/src").display().to_string();
     let o = bounded_test_on(
         &port.address,
@@ -242,34 +243,23 @@ fn a_port_that_accepts_and_stays_silent_is_named_not_waited_on() {
     let e = stderr(&o);
     assert_eq!(o.status.code(), Some(2), "{e}");
     assert!(
-        e.contains(&format!(
-            "--cluster {}: no Dask scheduler answered within 10 s",
-            port.address
-        )),
+        e.contains(&format!("--cluster {}: {says}", port.address)),
         "{e}"
     );
     assert!(o.stdout.is_empty(), "no item ran");
 }
 
 #[test]
+fn a_port_that_accepts_and_stays_silent_is_named_not_waited_on() {
+    refused_by_a_port_that_answers(b"", "no Dask scheduler answered within 10 s");
+}
+
+#[test]
 fn a_port_that_answers_in_another_protocol_is_not_a_dask_scheduler() {
-    let Some(python) = dask_python() else { return };
-    let port = NotDask::start(b"HTTP/1.1 400 Bad Request\r\nContent-Length: 0\r\n\r\n");
-    let src = root().join("python/src").display().to_string();
-    let o = bounded_test_on(
-        &port.address,
-        &[("RICOCHET_PYTHON", &python), ("PYTHONPATH", &src)],
+    refused_by_a_port_that_answers(
+        b"HTTP/1.1 400 Bad Request\r\nContent-Length: 0\r\n\r\n",
+        "is not a Dask scheduler",
     );
-    let e = stderr(&o);
-    assert_eq!(o.status.code(), Some(2), "{e}");
-    assert!(
-        e.contains(&format!(
-            "--cluster {}: is not a Dask scheduler",
-            port.address
-        )),
-        "{e}"
-    );
-    assert!(o.stdout.is_empty(), "no item ran");
 }
 
 #[test]
