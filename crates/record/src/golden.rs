@@ -28,8 +28,9 @@ use crate::channels::Channels;
 /// Set to `1`, [`check`] records the golden instead of comparing with it.
 pub const BLESS_ENV: &str = "RICOCHET_BLESS";
 
-/// Why a golden check failed.
-#[derive(Debug, thiserror::Error)]
+/// Why a golden check failed. Its `Debug` is its message (what `.unwrap()` and `?` out of a
+/// test print): the report's lines as lines, not the fields with `\n` escapes.
+#[derive(thiserror::Error)]
 pub enum GoldenError {
     /// There is no golden log yet.
     #[error(
@@ -72,6 +73,12 @@ pub enum GoldenError {
     /// The golden could not be read (cut short, damaged, not a Ricochet log).
     #[error(transparent)]
     Diff(#[from] DiffError),
+}
+
+impl std::fmt::Debug for GoldenError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        std::fmt::Display::fmt(self, f)
+    }
 }
 
 /// Steps `sim` for frame 0 and `frames` more (as `ricochet run --frames N` does: the first

@@ -196,3 +196,31 @@ fn a_divergence_between_keyframes_names_the_body() {
     assert_eq!(first.body.as_deref(), Some(expected.as_str()), "{report}");
     assert!(report.contains(&format!(", body {expected}\n")), "{report}");
 }
+
+/// `golden::check(..).unwrap()` in a game's test (the crate doc's own example) and `?` out of
+/// a test or `main` print the error with `{:?}`: that is the message, with the report's
+/// lines as lines, not the enum's fields with `\n` escapes.
+#[test]
+fn unwrap_prints_the_message_and_the_report() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("golden/level1.mcap");
+    let mut sim = Simulation::new(&level().unwrap());
+    let err = golden::check_or_bless(&missing, &mut sim, FRAMES, false).unwrap_err();
+    assert_eq!(format!("{err:?}"), err.to_string());
+    assert!(format!("{err:?}").contains("RICOCHET_BLESS=1"), "{err:?}");
+    if let GoldenError::Missing { new, .. } = &err {
+        std::fs::remove_dir_all(new.parent().unwrap()).unwrap();
+    }
+
+    let golden = golden_copy(dir.path());
+    let mut sim = Simulation::new(&one_ulp_heavier());
+    let err = golden::check_or_bless(&golden, &mut sim, FRAMES, false).unwrap_err();
+    let shown = format!("{err:?}");
+    assert_eq!(shown, err.to_string());
+    assert!(
+        shown
+            .lines()
+            .any(|l| l.starts_with("first difference: frame 60 ")),
+        "{shown}"
+    );
+}
