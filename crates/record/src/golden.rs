@@ -115,7 +115,9 @@ pub fn check_or_bless(
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
-    if !folder.is_dir() {
+    // Only a folder that is not there at all: one that is a file, or can't be looked at, is
+    // the writer's located error below, not "no golden yet".
+    if matches!(folder.try_exists(), Ok(false)) {
         // No golden folder yet (before the first bless): the run's log can't go beside the
         // golden, and a check does not create the folder, so it goes to a temporary folder
         // that is kept and named by the error.
@@ -128,7 +130,11 @@ pub fn check_or_bless(
             })?
             .keep();
         let new = tmp.join(new_name(golden));
-        record(&new, sim, frames)?;
+        if let Err(e) = record(&new, sim, frames) {
+            // No message names the folder then: leave nothing behind.
+            let _ = std::fs::remove_dir_all(&tmp);
+            return Err(e);
+        }
         return Err(GoldenError::Missing {
             golden: golden.to_path_buf(),
             new,
