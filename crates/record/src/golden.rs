@@ -12,7 +12,9 @@
 //! is meant). The log is written to a temporary file renamed onto the golden when it is
 //! complete, so an interrupted bless leaves the old golden whole. A check that fails keeps
 //! the new log beside the golden (`level1.new.mcap`) for `ricochet diff` or Foxglove; a
-//! check that passes removes it.
+//! check that passes removes it. Before the first bless, when the golden's folder does not
+//! exist yet, a check creates no folder: the error says there is no golden yet, and keeps
+//! this run's log in a new temporary folder (`$TMPDIR/ricochet-golden-XXXXXX/`) that it names.
 
 use std::path::{Path, PathBuf};
 
@@ -26,8 +28,9 @@ use crate::channels::Channels;
 /// Set to `1`, [`check`] records the golden instead of comparing with it.
 pub const BLESS_ENV: &str = "RICOCHET_BLESS";
 
-/// Why a golden check failed.
-#[derive(Debug, thiserror::Error)]
+/// Why a golden check failed. Its `Debug` is its message (what `.unwrap()` and `?` out of a
+/// test print): the report's lines as lines, not the fields with `\n` escapes.
+#[derive(thiserror::Error)]
 pub enum GoldenError {
     /// There is no golden log yet.
     #[error(
@@ -38,7 +41,8 @@ pub enum GoldenError {
     Missing {
         /// The golden's path.
         golden: PathBuf,
-        /// Where this run's log was kept.
+        /// Where this run's log was kept: beside the golden, or, when the golden's folder
+        /// does not exist, in a new temporary folder (a check creates no golden folder).
         new: PathBuf,
     },
     /// The run's log differs from the golden.
@@ -71,6 +75,12 @@ pub enum GoldenError {
     Diff(#[from] DiffError),
 }
 
+impl std::fmt::Debug for GoldenError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        std::fmt::Display::fmt(self, f)
+    }
+}
+
 /// Steps `sim` for frame 0 and `frames` more (as `ricochet run --frames N` does: the first
 /// step of a new simulation is frame 0, its initial state), records every frame on every
 /// channel, and compares the log with the golden at `golden`: `Ok(())` when equal
@@ -100,6 +110,35 @@ pub fn check_or_bless(
             })?;
         }
         return record(golden, sim, frames);
+    }
+    let folder = match golden.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    // Only a folder that is not there at all: one that is a file, or can't be looked at, is
+    // the writer's located error below, not "no golden yet".
+    if matches!(folder.try_exists(), Ok(false)) {
+        // No golden folder yet (before the first bless): the run's log can't go beside the
+        // golden, and a check does not create the folder, so it goes to a temporary folder
+        // that is kept and named by the error.
+        let tmp = tempfile::Builder::new()
+            .prefix("ricochet-golden-")
+            .tempdir()
+            .map_err(|source| LogError::Create {
+                path: std::env::temp_dir(),
+                source,
+            })?
+            .keep();
+        let new = tmp.join(new_name(golden));
+        if let Err(e) = record(&new, sim, frames) {
+            // No message names the folder then: leave nothing behind.
+            let _ = std::fs::remove_dir_all(&tmp);
+            return Err(e);
+        }
+        return Err(GoldenError::Missing {
+            golden: golden.to_path_buf(),
+            new,
+        });
     }
     let new = new_path(golden);
     record(&new, sim, frames)?;
@@ -132,10 +171,15 @@ pub fn check_or_bless(
 
 /// Where a check keeps the run's log: `NAME.new.mcap` beside the golden `NAME.mcap`.
 fn new_path(golden: &Path) -> PathBuf {
+    golden.with_file_name(new_name(golden))
+}
+
+/// The file name of the run's log: `NAME.new.mcap` for the golden `NAME.mcap`.
+fn new_name(golden: &Path) -> String {
     let stem = golden
         .file_stem()
         .map_or_else(|| "golden".into(), |s| s.to_string_lossy());
-    golden.with_file_name(format!("{stem}.new.mcap"))
+    format!("{stem}.new.mcap")
 }
 
 /// Steps and records frame 0 to `frames` into `path` (temporary file, renamed when complete).

@@ -15,7 +15,7 @@ fn compare(
     b: &Value,
     tol: f64,
     path: &mut String,
-    body: &mut Option<String>,
+    body: &mut Option<Label>,
 ) -> Option<(String, String, String)> {
     match (a, b) {
         (Value::Number(x), Value::Number(y)) => {
@@ -62,7 +62,7 @@ fn compare(
 /// A body's id in a log: its `id` and, in logs that have one, its `generation` (a slot
 /// reused by a later body has the next generation, so id and generation name one body).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
-struct BodyId {
+pub(super) struct BodyId {
     id: u64,
     generation: Option<u64>,
 }
@@ -86,8 +86,24 @@ fn body_id(v: &Value, id: &str, generation: &str) -> Option<BodyId> {
 }
 
 /// The id of a list element that is an object with one (bodies in `/bodies`).
-fn id_of(v: &Value) -> Option<BodyId> {
+pub(super) fn id_of(v: &Value) -> Option<BodyId> {
     body_id(v, "id", "generation")
+}
+
+/// How a report names the body or pair a difference is in, and the body's id when the
+/// element lists no name (a `/bodies` delta between keyframes), for [`super::diff_files`] to
+/// find the name in an earlier message.
+pub(super) struct Label {
+    pub(super) text: String,
+    pub(super) unnamed: Option<BodyId>,
+}
+
+fn labelled(v: &Value) -> Label {
+    let unnamed = id_of(v).filter(|_| v.get("name").and_then(Value::as_str).is_none());
+    Label {
+        text: label(v),
+        unnamed,
+    }
 }
 
 fn label(v: &Value) -> String {
@@ -108,7 +124,7 @@ fn compare_arrays(
     y: &[Value],
     tol: f64,
     path: &mut String,
-    body: &mut Option<String>,
+    body: &mut Option<Label>,
 ) -> Option<(String, String, String)> {
     // Lists of bodies are matched by id (and generation), so one extra body is reported as
     // that body, not as every later element shifted by one.
@@ -125,7 +141,7 @@ fn compare_arrays(
                 Some(vb) => compare(va, vb, tol, path, body),
             };
             if found.is_some() {
-                *body = Some(label(va));
+                *body = Some(labelled(va));
                 return found;
             }
             path.truncate(len);
@@ -135,7 +151,7 @@ fn compare_arrays(
             .iter()
             .find(|v| id_of(v).is_some_and(|i| !xs.contains(&i)))
             .map(|vb| {
-                *body = Some(label(vb));
+                *body = Some(labelled(vb));
                 (
                     format!(
                         "{path}[id={}]",
@@ -151,7 +167,7 @@ fn compare_arrays(
         path.push_str(&format!("[{i}]"));
         if let Some(found) = compare(va, vb, tol, path, body) {
             if body.is_none() && !label(va).is_empty() {
-                *body = Some(label(va));
+                *body = Some(labelled(va));
             }
             return Some(found);
         }
@@ -184,11 +200,13 @@ pub(super) fn first_in_message(
     } else {
         compare(&a.data, &b.data, tol, &mut path, &mut body)
     };
+    let (body, unnamed) = body.map_or((None, None), |l| (Some(l.text), l.unnamed));
     found.map(|(field, va, vb)| Divergence {
         topic: topic.to_owned(),
         time_ns: a.log_time.min(b.log_time),
         frame: a.data.get("frame").and_then(Value::as_u64),
         body,
+        unnamed,
         field,
         a: va,
         b: vb,

@@ -11,7 +11,7 @@ use crate::{LogError, LogFile, Messages, RawMessage, escape_controls};
 
 mod fields;
 
-use fields::first_in_message;
+use fields::{BodyId, first_in_message, id_of};
 use serde::Serialize;
 use serde_json::Value;
 
@@ -37,8 +37,12 @@ pub struct Divergence {
     pub time_ns: u64,
     /// The message's `frame` field, when it has one.
     pub frame: Option<u64>,
-    /// The body the difference is in, when it is inside a list of bodies.
+    /// The body the difference is in, when it is inside a list of bodies: `id:generation
+    /// (name)`, the name found in an earlier message when the differing one lists none.
     pub body: Option<String>,
+    /// The body's id while its name is still to be found.
+    #[serde(skip)]
+    unnamed: Option<BodyId>,
     /// Path of the field inside the message (`bodies[id=4].velocity[0]`).
     pub field: String,
     /// The value in A (JSON), or a note such as `missing`.
@@ -197,6 +201,7 @@ fn diff_topic(
                     time_ns,
                     frame,
                     body: None,
+                    unnamed: None,
                     field: "message count".to_owned(),
                     a: count.messages_a.to_string(),
                     b: count.messages_b.to_string(),
@@ -348,6 +353,7 @@ fn schema_difference(a: &LogFile, b: &LogFile) -> Option<Divergence> {
             time_ns: 0,
             frame: None,
             body: None,
+            unnamed: None,
             field: "schema".to_owned(),
             a: describe(&ea, &eb),
             b: describe(&eb, &ea),
@@ -369,7 +375,43 @@ pub fn diff_files(
         report.equal = false;
         report.first = Some(d);
     }
+    if let Some(d) = report.first.as_mut()
+        && let Some(id) = d.unnamed.take()
+        && d.topic == "/bodies"
+    {
+        let name = match name_of(a, id, d.time_ns)? {
+            Some(n) => Some(n),
+            None => name_of(b, id, d.time_ns)?,
+        };
+        if let Some(name) = name {
+            d.body = Some(format!("{id} ({})", escape_controls(&name)));
+        }
+    }
     Ok(report)
+}
+
+/// The name of body `id` in `log`: a `/bodies` message lists a body's name when the body
+/// appears (and at keyframes), not in the deltas between, so it is found in the first message
+/// up to `until_ns` (the divergence's time) that lists it with one. Reads one message at a
+/// time, and usually few: a body of the initial scene is named in the first message.
+fn name_of(log: &LogFile, id: BodyId, until_ns: u64) -> Result<Option<String>, LogError> {
+    let mut messages = log.topic_messages("/bodies")?;
+    while let Some(raw) = messages.next_raw().transpose()? {
+        if raw.log_time() > until_ns {
+            break;
+        }
+        let message = messages.decode(raw)?;
+        let listed = message.data.get("bodies").and_then(Value::as_array);
+        let name = listed
+            .into_iter()
+            .flatten()
+            .filter(|b| id_of(b) == Some(id))
+            .find_map(|b| b.get("name").and_then(Value::as_str));
+        if let Some(name) = name {
+            return Ok(Some(name.to_owned()));
+        }
+    }
+    Ok(None)
 }
 
 /// The messages of two logs compared, in one pass or topic by topic.
