@@ -157,7 +157,7 @@ pub fn write(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
     write_all(&[(path, bytes)])
 }
 
-/// [`write`], the bytes streamed from the file `from` rather than held in memory.
+/// [`write()`], the bytes streamed from the file `from` rather than held in memory.
 pub fn copy(path: &Path, from: &Path) -> anyhow::Result<()> {
     check_writable(path)?;
     let target = target(path);
