@@ -185,8 +185,12 @@ impl Simulation {
         Simulation::with_world(scenario, world)
     }
 
-    /// A simulation of `scenario` with its bodies already in `world`.
-    fn with_world(scenario: Scenario, world: World) -> Simulation {
+    /// A simulation of `scenario` with its bodies already in `world`. The script is sorted
+    /// by frame, stably (events of one frame keep their order): the `script` stage reads it
+    /// in order, so an event listed after a later frame's would otherwise never run
+    /// (issue #35). A loaded scenario's script is sorted the same way already.
+    fn with_world(mut scenario: Scenario, world: World) -> Simulation {
+        scenario.script.sort_by_key(|e| e.frame);
         let baseline = crate::snapshot::Baseline::new(&world);
         let layers = &scenario.world.layers;
         Simulation {
