@@ -138,7 +138,11 @@ impl std::fmt::Debug for Simulation {
 }
 
 impl Simulation {
-    /// A simulation at the start of frame 0, with the scenario's bodies spawned in file order.
+    /// A simulation at the start of frame 0, with the scenario's bodies spawned in file order
+    /// and its script sorted by frame (stably). The scenario is trusted as given: a scene
+    /// built in code is checked as a file is by [`Simulation::try_new`] (or
+    /// [`Scenario::check`]); unchecked, a script naming no body is only a `missed` event at
+    /// its frame.
     #[must_use]
     pub fn new(scenario: &Scenario) -> Simulation {
         let mut world = World::new();
@@ -163,7 +167,9 @@ impl Simulation {
     }
 
     /// A simulation of `scenario` that takes its bodies instead of copying them: for large
-    /// scenes, where a second copy of every body would double the memory.
+    /// scenes, where a second copy of every body would double the memory. Like
+    /// [`Simulation::new`], it sorts the script and checks nothing ([`Scenario::check`]
+    /// does).
     #[must_use]
     pub fn from_scenario(mut scenario: Scenario) -> Simulation {
         let mut world = World::new();

@@ -74,6 +74,23 @@ fn a_script_naming_no_body_is_refused_before_it_runs() {
     assert!(e.problem.contains("\"plyer\""), "{e}");
 }
 
+/// Two bodies of the name an event addresses: which one it is for is ambiguous.
+#[test]
+fn a_script_naming_two_bodies_is_refused() {
+    let mut scene = player_scene();
+    scene.bodies.push(scene.bodies[0].clone());
+    scene.script = vec![input(1, "player", Action::Jump)];
+    let toml = format!(
+        "{0}[[bodies]]\nname = \"player\"\nlayer = \"a\"\n\
+         shape = {{ kind = \"circle\", radius = 0.5 }}\n\
+         [[script]]\nframe = 1\naction = \"jump\"\nbody = \"player\"\n",
+        player_toml(600)
+    );
+    let e = refused_as_the_file_is(&scene, &toml);
+    assert_eq!(e.field, "script[0].body");
+    assert!(e.problem.contains("bodies[0], bodies[1]"), "{e}");
+}
+
 #[test]
 fn values_past_the_loaders_limits_are_refused_with_its_words() {
     let mut scene = player_scene();

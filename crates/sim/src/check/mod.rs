@@ -13,8 +13,8 @@ use crate::entity::Entity;
 use crate::pipeline::Simulation;
 use crate::scenario::Scenario;
 use problems::{
-    beyond_world, controller_problem, mass_problem, no_such_name, oversized, split_problem,
-    static_outside, unknown_problem,
+    beyond_world, controller_problem, mass_problem, names_sorted, no_such_name, oversized,
+    shared_name, split_problem, static_outside, unknown_problem,
 };
 
 /// Why a scenario was rejected: by the loader (`file:line:column: field: problem`) or by
@@ -328,6 +328,12 @@ impl Scenario {
             check_body(&at, self, b, &format!("bodies[{i}]"))?;
         }
         if let Some(r) = &self.world.active_region
+            && let Some(problem) =
+                shared_name(&names_sorted(&self.bodies), &r.focus, "the one to follow")
+        {
+            return Err(at.err("world.active_region.focus", problem));
+        }
+        if let Some(r) = &self.world.active_region
             && !self.bodies.iter().any(|b| b.name == r.focus)
         {
             let mut names: Vec<&str> = self.bodies.iter().map(|b| b.name.as_str()).collect();
@@ -361,6 +367,7 @@ impl Scenario {
         }
         names.sort_unstable();
         names.dedup();
+        let by_name = names_sorted(&self.bodies);
         for (i, e) in self.script.iter().enumerate() {
             let field = format!("script[{i}]");
             if e.frame > self.frames {
@@ -375,6 +382,10 @@ impl Scenario {
             }
             match &e.action {
                 ScriptAction::Body { name, action } => {
+                    if let Some(problem) = shared_name(&by_name, name, "the one this event is for")
+                    {
+                        return Err(at.err(format!("{field}.body"), problem));
+                    }
                     if names.binary_search(&name.as_str()).is_err() {
                         return Err(at.err(format!("{field}.body"), no_such_name(name, &names)));
                     }

@@ -200,3 +200,31 @@ pub(crate) fn beyond_world(p: [f64; 2]) -> Option<String> {
         )
     })
 }
+
+/// The problem when more than one body of `bodies` has the name `name` that something
+/// addresses (`purpose`: what must name one body), `None` otherwise. `sorted` holds every
+/// body's `(name, index)`, sorted.
+pub(crate) fn shared_name(sorted: &[(&str, usize)], name: &str, purpose: &str) -> Option<String> {
+    let from = sorted.partition_point(|(n, _)| *n < name);
+    let to = sorted.partition_point(|(n, _)| *n <= name);
+    let same = &sorted[from..to];
+    (same.len() > 1).then(|| {
+        let list: Vec<String> = same.iter().map(|(_, i)| format!("bodies[{i}]")).collect();
+        format!(
+            "{} bodies are named \"{name}\" ({}): name {purpose} apart from the others",
+            same.len(),
+            list.join(", ")
+        )
+    })
+}
+
+/// Every body's `(name, index)`, sorted: what [`shared_name`] searches.
+pub(crate) fn names_sorted(bodies: &[BodyDef]) -> Vec<(&str, usize)> {
+    let mut v: Vec<(&str, usize)> = bodies
+        .iter()
+        .enumerate()
+        .map(|(i, b)| (b.name.as_str(), i))
+        .collect();
+    v.sort_unstable();
+    v
+}

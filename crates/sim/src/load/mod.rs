@@ -11,9 +11,10 @@ mod world;
 
 use std::collections::BTreeMap;
 
+use crate::check::problems::{names_sorted, shared_name};
 use crate::check::problems::{oversized, split_problem, static_outside};
 use crate::scenario::Scenario;
-use bodies::{body_def, ignored_field, merge, names_sorted, references, shared_name};
+use bodies::{body_def, ignored_field, merge, references};
 use chunks::split_bodies;
 pub use context::ScenarioError;
 use context::{Ctx, unknown};

@@ -3,8 +3,8 @@
 use std::collections::BTreeMap;
 
 use crate::action::{Action, Event, ScriptAction};
+use crate::check::problems::{names_sorted, shared_name};
 use crate::def::{BodyDef, BodyKind};
-use crate::load::bodies::{names_sorted, shared_name};
 use crate::load::context::{Ctx, ScenarioError, finite, unknown, vec2, within_world};
 use crate::load::file::{ActionFile, EventFile, ScenarioFile};
 use ricochet_geom::Number;
