@@ -102,43 +102,6 @@ fn check_world(world: &WorldDef) -> Result<(), ControlError> {
     Ok(())
 }
 
-/// `def` with its mass and controller values brought within the loader's limits, if any is
-/// past them (`None`: `def` is within them). NaN stays NaN: only [`Simulation::try_spawn`]
-/// refuses it.
-fn within_limits(def: &BodyDef) -> Option<BodyDef> {
-    use crate::def::{Controller, MAX_CONTROLLER_VALUE, MAX_MASS, MIN_MASS};
-    let c = |v: &mut f64| *v = v.clamp(-MAX_CONTROLLER_VALUE, MAX_CONTROLLER_VALUE);
-    let mass_out = !(MIN_MASS..=MAX_MASS).contains(&def.mass) && !def.mass.is_nan();
-    let controller_out = def
-        .controller
-        .as_ref()
-        .and_then(crate::def::controller_out_of_range)
-        .is_some_and(|(_, v)| !v.is_nan());
-    if !(mass_out || controller_out) {
-        return None;
-    }
-    let mut def = def.clone();
-    def.mass = def.mass.clamp(MIN_MASS, MAX_MASS);
-    match &mut def.controller {
-        Some(Controller::Ship {
-            thrust,
-            turn_rate,
-            bullet_speed,
-            muzzle,
-            ..
-        }) => [thrust, turn_rate, bullet_speed, muzzle]
-            .into_iter()
-            .for_each(c),
-        Some(Controller::Runner {
-            run_speed,
-            jump_speed,
-        }) => [run_speed, jump_speed].into_iter().for_each(c),
-        Some(Controller::Walker { speed }) => c(speed),
-        None => {}
-    }
-    Some(def)
-}
-
 fn within(field: &'static str, v: Vec2) -> Result<Vec2, ControlError> {
     if v.is_finite() && v.abs().max_element() <= ricochet_geom::MAX_COORDINATE {
         Ok(v)
@@ -171,13 +134,13 @@ impl Simulation {
     ///
     /// A mass outside [`crate::MIN_MASS`] to [`crate::MAX_MASS`] and a controller value
     /// past ±[`crate::MAX_CONTROLLER_VALUE`] are brought to the nearest limit (the loader's
-    /// limits, which [`Simulation::restore`] checks: a game's own snapshot always
-    /// restores). Anything else is taken as given. [`Simulation::try_spawn`] refuses such a
+    /// limits, which [`Simulation::restore`] checks: a game's own snapshot restores), as
+    /// for every body a simulation creates (a scene's, a script's spawn, a bullet, a
+    /// split's child). Anything else is taken as given. [`Simulation::try_spawn`] refuses such a
     /// definition instead, with the loader's error, as it refuses a non-finite value or a
     /// body too large for a wrapping world: use it for definitions built from data.
     pub fn spawn(&mut self, def: &BodyDef) -> Entity {
-        let clamped = within_limits(def);
-        let e = self.world.spawn(clamped.as_ref().unwrap_or(def));
+        let e = self.world.spawn(def);
         self.world.refresh_active();
         self.queries.invalidate(&self.world);
         e

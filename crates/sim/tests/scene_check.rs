@@ -246,3 +246,28 @@ fn a_body_spawned_past_the_limits_restores_from_its_own_snapshot() {
         load_scenario(&format!("{}mass = 1e20\n", player_toml(600)), "scene.toml").unwrap_err();
     assert_eq!((e.field.as_str(), e.problem), ("spawn.mass", file.problem));
 }
+
+/// The same for bodies a simulation creates itself, from a scene it did not check: a body
+/// of the scene and a script's spawn of a template, each of mass 1e20.
+#[test]
+fn bodies_of_an_unchecked_scene_past_the_limits_restore_from_its_snapshot() {
+    let mut scene = player_scene();
+    scene.bodies[0].mass = 1e20;
+    scene.templates.get_mut("rock").unwrap().mass = 1e20;
+    scene.script = vec![Event {
+        frame: 1,
+        action: ScriptAction::Spawn {
+            body: Box::new(scene.templates["rock"].clone()),
+            template: "rock".into(),
+        },
+    }];
+    let mut sim = Simulation::new(&scene);
+    for _ in 0..3 {
+        sim.step();
+    }
+    assert_eq!(sim.world().len(), 2);
+    let snapshot = Snapshot::from_bytes(&sim.snapshot().to_bytes()).unwrap();
+    let mut peer = Simulation::new(&scene);
+    assert_eq!(peer.restore(&snapshot), Ok(()));
+    assert_eq!(peer.checksum(), sim.checksum());
+}
