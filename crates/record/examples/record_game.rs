@@ -14,9 +14,8 @@
 
 use std::path::PathBuf;
 
-use ricochet_geom::Vec2;
 use ricochet_record::{Channels, Recorder, golden};
-use ricochet_sim::Simulation;
+use ricochet_sim::{Simulation, Vec2};
 
 // The level, shared with the crate's golden test (tests/golden.rs).
 #[path = "shared/thrown_ball.rs"]

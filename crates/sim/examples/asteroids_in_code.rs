@@ -3,10 +3,9 @@
 //!
 //! Run it with `cargo run -p ricochet-sim --example asteroids_in_code`.
 
-use ricochet_geom::{Shape, Vec2};
 use ricochet_sim::{
-    Action, BodyDef, Controller, Doomed, GameEvent, Layers, Removal, Response, Simulation,
-    WorldBounds, WorldDef,
+    Action, BodyDef, Controller, Doomed, GameEvent, Layers, Removal, Response, Shape, Simulation,
+    Vec2, WorldBounds, WorldDef,
 };
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

@@ -10,8 +10,7 @@
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
-use ricochet_geom::Shape;
-use ricochet_sim::{Action, BodyDef, Controller, Entity, Simulation, WorldDef};
+use ricochet_sim::{Action, BodyDef, Controller, Entity, Shape, Simulation, WorldDef};
 
 /// A small scene: a ship that a client steers.
 fn scene() -> Result<(Simulation, Entity), Box<dyn std::error::Error>> {

@@ -132,11 +132,13 @@ impl Simulation {
 
     /// Creates a body now; it takes the lowest free id.
     ///
-    /// The definition is trusted as given: what a scenario file's loader refuses (a mass
-    /// outside `MIN_MASS..=MAX_MASS`, a body wider or taller than a wrap world, see
-    /// [`crate::WorldBounds::oversized`]) is not refused here, since refusing would change
-    /// this signature. A game that builds definitions from untrusted data checks them
-    /// first.
+    /// A mass outside [`crate::MIN_MASS`] to [`crate::MAX_MASS`] and a controller value
+    /// past ±[`crate::MAX_CONTROLLER_VALUE`] are brought to the nearest limit (the loader's
+    /// limits, which [`Simulation::restore`] checks: a game's own snapshot restores), as
+    /// for every body a simulation creates (a scene's, a script's spawn, a bullet, a
+    /// split's child). Anything else is taken as given. [`Simulation::try_spawn`] refuses such a
+    /// definition instead, with the loader's error, as it refuses a non-finite value or a
+    /// body too large for a wrapping world: use it for definitions built from data.
     pub fn spawn(&mut self, def: &BodyDef) -> Entity {
         let e = self.world.spawn(def);
         self.world.refresh_active();

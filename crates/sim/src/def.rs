@@ -87,7 +87,8 @@ pub struct BodyDef {
     /// Dynamic, static or kinematic.
     pub kind: BodyKind,
     /// Mass of a dynamic body (default 1; a scenario file's from [`MIN_MASS`] to
-    /// [`MAX_MASS`]).
+    /// [`MAX_MASS`]; a simulation brings a mass past them to the nearest, and
+    /// [`crate::Scenario::check`] and [`crate::Simulation::try_spawn`] refuse it).
     pub mass: f64,
     /// Position.
     pub position: Vec2,

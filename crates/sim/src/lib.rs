@@ -17,10 +17,7 @@
 //! another body.
 //!
 //! ```
-//! use ricochet_geom::{Shape, Vec2};
-//! use ricochet_sim::{
-//!     Action, BodyDef, BodyKind, GameEvent, Layers, Response, ScriptInput, Simulation, WorldDef,
-//! };
+//! use ricochet_sim::prelude::*;
 //!
 //! let mut layers = Layers::new(vec!["ball".into(), "wall".into()]);
 //! layers.set(0, 1, Response::Report);
@@ -127,6 +124,7 @@
 
 mod action;
 pub mod broad_phase;
+mod check;
 mod control;
 mod def;
 mod entity;
@@ -148,6 +146,7 @@ mod stages;
 mod world;
 
 pub use action::{Action, Event, ScriptAction};
+pub use check::ScenarioError;
 pub use control::{ControlError, NonFinite};
 pub use def::{
     ActiveRegion, BodyDef, BodyKind, Controller, Doomed, LayerId, Layers, MAX_CONTROLLER_VALUE,
@@ -159,7 +158,7 @@ pub use event::{FireOutcome, GameEvent, JumpOutcome, Removal, ScriptInput};
 #[cfg(feature = "toml")]
 pub use load::file::ActionFile;
 #[cfg(feature = "toml")]
-pub use load::{ScenarioError, load_scenario};
+pub use load::load_scenario;
 pub use output::{ContactRecord, FrameOutput, Phase, RemovedBody, Stats};
 pub use pipeline::Simulation;
 pub use query::{QueryFilter, RayHit, ShapeHit};

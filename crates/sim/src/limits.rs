@@ -4,7 +4,7 @@
 
 use ricochet_geom::{Number, Primitive, Rot, Shape, Vec2};
 
-use crate::def::{Controller, WorldBounds, WorldDef};
+use crate::def::{BodyDef, Controller, WorldBounds, WorldDef};
 
 /// The lightest mass a dynamic body may have (mass units): an impulse of 1 gives it
 /// 1e12 units/s, past which every push is an overflow waiting to happen.
@@ -117,6 +117,42 @@ pub fn controller_out_of_range(c: &Controller) -> Option<(&'static str, f64)> {
         .iter()
         .find(|(_, v)| !(v.is_finite() && v.abs() <= MAX_CONTROLLER_VALUE))
         .copied()
+}
+
+/// `def` with its mass and controller values brought within the loader's limits, if any is
+/// past them (`None`: `def` is within them). NaN stays NaN: only
+/// [`crate::Simulation::try_spawn`] and [`crate::Scenario::check`] refuse it.
+pub(crate) fn within_limits(def: &BodyDef) -> Option<BodyDef> {
+    let c = |v: &mut f64| *v = v.clamp(-MAX_CONTROLLER_VALUE, MAX_CONTROLLER_VALUE);
+    let mass_out = !(MIN_MASS..=MAX_MASS).contains(&def.mass) && !def.mass.is_nan();
+    let controller_out = def
+        .controller
+        .as_ref()
+        .and_then(controller_out_of_range)
+        .is_some_and(|(_, v)| !v.is_nan());
+    if !(mass_out || controller_out) {
+        return None;
+    }
+    let mut def = def.clone();
+    def.mass = def.mass.clamp(MIN_MASS, MAX_MASS);
+    match &mut def.controller {
+        Some(Controller::Ship {
+            thrust,
+            turn_rate,
+            bullet_speed,
+            muzzle,
+            ..
+        }) => [thrust, turn_rate, bullet_speed, muzzle]
+            .into_iter()
+            .for_each(c),
+        Some(Controller::Runner {
+            run_speed,
+            jump_speed,
+        }) => [run_speed, jump_speed].into_iter().for_each(c),
+        Some(Controller::Walker { speed }) => c(speed),
+        None => {}
+    }
+    Some(def)
 }
 
 /// How far a shape reaches from its body's origin along x and along y, at any angle of the

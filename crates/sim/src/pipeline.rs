@@ -138,7 +138,11 @@ impl std::fmt::Debug for Simulation {
 }
 
 impl Simulation {
-    /// A simulation at the start of frame 0, with the scenario's bodies spawned in file order.
+    /// A simulation at the start of frame 0, with the scenario's bodies spawned in file order
+    /// and its script sorted by frame (stably). The scenario is trusted as given: a scene
+    /// built in code is checked as a file is by [`Simulation::try_new`] (or
+    /// [`Scenario::check`]); unchecked, a script naming no body is only a `missed` event at
+    /// its frame.
     #[must_use]
     pub fn new(scenario: &Scenario) -> Simulation {
         let mut world = World::new();
@@ -163,7 +167,9 @@ impl Simulation {
     }
 
     /// A simulation of `scenario` that takes its bodies instead of copying them: for large
-    /// scenes, where a second copy of every body would double the memory.
+    /// scenes, where a second copy of every body would double the memory. Like
+    /// [`Simulation::new`], it sorts the script and checks nothing ([`Scenario::check`]
+    /// does).
     #[must_use]
     pub fn from_scenario(mut scenario: Scenario) -> Simulation {
         let mut world = World::new();
@@ -185,8 +191,12 @@ impl Simulation {
         Simulation::with_world(scenario, world)
     }
 
-    /// A simulation of `scenario` with its bodies already in `world`.
-    fn with_world(scenario: Scenario, world: World) -> Simulation {
+    /// A simulation of `scenario` with its bodies already in `world`. The script is sorted
+    /// by frame, stably (events of one frame keep their order): the `script` stage reads it
+    /// in order, so an event listed after a later frame's would otherwise never run
+    /// (issue #35). A loaded scenario's script is sorted the same way already.
+    fn with_world(mut scenario: Scenario, world: World) -> Simulation {
+        scenario.script.sort_by_key(|e| e.frame);
         let baseline = crate::snapshot::Baseline::new(&world);
         let layers = &scenario.world.layers;
         Simulation {

@@ -6,6 +6,7 @@
 pub use ricochet_geom::{Bounds, Pose, Primitive, Shape, ShapeError, Vec2};
 
 pub use crate::action::{Action, Event, ScriptAction};
+pub use crate::check::ScenarioError;
 pub use crate::control::ControlError;
 pub use crate::def::{
     ActiveRegion, BodyDef, BodyKind, Controller, LayerId, Layers, Response, Split, WorldBounds,

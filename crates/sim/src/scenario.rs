@@ -10,7 +10,8 @@ use ricochet_geom::{Shape, Vec2};
 
 use crate::def::{BodyDef, LayerId, WorldDef};
 
-/// A checked scenario, ready to simulate.
+/// A scenario, ready to simulate: a loaded one is checked; one built in code is checked
+/// the same way by [`Scenario::check`] (or [`crate::Simulation::try_new`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scenario {
     /// Name for logs.
@@ -26,7 +27,9 @@ pub struct Scenario {
     pub tiles: Vec<TileRows>,
     /// Bodies at frame 0, in file order (which is their id order), after the tiles.
     pub bodies: Vec<BodyDef>,
-    /// Script events sorted by frame (file order within a frame).
+    /// Script events, in any order: a [`crate::Simulation`] built from the scenario sorts
+    /// them by frame, keeping the given order of the events of one frame (as the loader
+    /// does, with a file's order). No event is dropped for being out of order.
     pub script: Vec<Event>,
 }
 

@@ -1,8 +1,7 @@
 //! The level of `record_game.rs`, built in code: a ball thrown under gravity past a rock.
 //! Shared with `tests/golden.rs`, which checks it against its golden log.
 
-use ricochet_geom::{Shape, Vec2};
-use ricochet_sim::{Action, BodyDef, Event, Scenario, ScriptAction, WorldDef};
+use ricochet_sim::{Action, BodyDef, Event, Scenario, ScriptAction, Shape, Vec2, WorldDef};
 
 /// Gravity, units/s² (down).
 pub const GRAVITY: f64 = -10.0;

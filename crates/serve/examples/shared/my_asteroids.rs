@@ -1,8 +1,7 @@
 //! The level of `serve_game.rs`, built in code; shared with `tests/serve_game.rs`.
 
-use ricochet_geom::{Shape, Vec2};
 use ricochet_sim::{
-    BodyDef, Controller, Doomed, Layers, Response, Scenario, WorldBounds, WorldDef,
+    BodyDef, Controller, Doomed, Layers, Response, Scenario, Shape, Vec2, WorldBounds, WorldDef,
 };
 
 /// The game's level, built in code: a ship the player flies (layer 0), rocks (1) its bullets

@@ -4,75 +4,11 @@
 use std::collections::BTreeMap;
 use std::ops::Range;
 
-use crate::def::{
-    BodyDef, BodyKind, Controller, Layers, MAX_CONTROLLER_VALUE, MAX_MASS, MIN_MASS, Split,
-    controller_out_of_range,
-};
+use crate::check::problems::{controller_problem, mass_problem};
+use crate::def::{BodyDef, BodyKind, Controller, Layers, Split};
 use crate::load::context::{Ctx, ScenarioError, finite, unknown, vec2, within_world};
 use crate::load::file::{BodyFile, ControllerFile, SplitFile};
 use ricochet_geom::{Number, Numbers};
-
-/// The most bodies that destroying one body can create through its split chain (its
-/// children, their children when destroyed, and so on). Asteroids' big → 2 medium → 4 small
-/// is 6; a chain past this is almost surely a mistake, and it would multiply bodies past
-/// what a frame can hold.
-pub(crate) const MAX_SPLIT_BODIES: u64 = 65_536;
-
-/// What is wrong with the templates' split chains.
-pub(crate) enum SplitProblem {
-    /// `path` (from the template back to itself) is a cycle.
-    Cycle(Vec<String>),
-    /// Destroying one body of the template creates this many bodies, down the chain.
-    TooMany(u64),
-}
-
-/// Checks every template's split chain once (a depth-first search that visits each
-/// template a single time, so a chain of 40 templates splitting in two costs 40 visits, not
-/// 2^40): a template on a cycle (the first one found, starting from the templates in name
-/// order), or the first template in name order whose chain creates more than
-/// [`MAX_SPLIT_BODIES`] bodies, with the problem.
-pub(crate) fn split_problem(
-    templates: &BTreeMap<String, BodyDef>,
-) -> Option<(String, SplitProblem)> {
-    // Bodies created by destroying one body of each finished template (saturating).
-    let mut created: BTreeMap<&str, u64> = BTreeMap::new();
-    for start in templates.keys() {
-        // Iterative DFS: (template, next child to visit); `path` is the grey stack.
-        let mut path: Vec<(&str, usize)> = vec![(start.as_str(), 0)];
-        while let Some(&mut (at, ref mut next)) = path.last_mut() {
-            if created.contains_key(at) {
-                path.pop();
-                continue;
-            }
-            let children = templates.get(at).map_or(&[][..], |t| &t.split[..]);
-            if let Some(child) = children.get(*next) {
-                *next += 1;
-                let c = child.template.as_str();
-                if let Some(k) = path.iter().position(|(t, _)| *t == c) {
-                    let mut cycle: Vec<String> =
-                        path[k..].iter().map(|(t, _)| (*t).to_owned()).collect();
-                    cycle.push(c.to_owned());
-                    return Some((c.to_owned(), SplitProblem::Cycle(cycle)));
-                }
-                if !created.contains_key(c) {
-                    path.push((c, 0));
-                }
-                continue;
-            }
-            let total = children.iter().fold(0u64, |sum, child| {
-                let below = created.get(child.template.as_str()).copied().unwrap_or(0);
-                sum.saturating_add(below.saturating_add(1))
-            });
-            created.insert(at, total);
-            path.pop();
-        }
-        let total = created.get(start.as_str()).copied().unwrap_or(0);
-        if total > MAX_SPLIT_BODIES {
-            return Some((start.clone(), SplitProblem::TooMany(total)));
-        }
-    }
-    None
-}
 
 /// A body's fields over its template's.
 pub(crate) fn merge(body: &BodyFile, base: &BodyFile) -> BodyFile {
@@ -224,22 +160,8 @@ pub(crate) fn body_def(
         }
     };
     let mass = num("mass", b.mass.unwrap_or(1.0))?;
-    if mass <= 0.0 {
-        return Err(fail(
-            "mass",
-            format!("must be greater than 0, got {}", Number(mass)),
-        ));
-    }
-    if !(MIN_MASS..=MAX_MASS).contains(&mass) {
-        return Err(fail(
-            "mass",
-            format!(
-                "{} is outside {MIN_MASS:e} to {MAX_MASS:e}, the masses Ricochet \
-                 accepts (a heavier body's kinetic energy overflows, a lighter one's \
-                 velocity after a push)",
-                Number(mass)
-            ),
-        ));
+    if let Some(problem) = mass_problem(mass) {
+        return Err(fail("mass", problem));
     }
     let lifetime = match b.lifetime {
         None => None,
@@ -293,15 +215,8 @@ pub(crate) fn body_def(
             speed: num("controller.speed", *speed)?,
         }),
     };
-    if let Some((f, v)) = controller.as_ref().and_then(controller_out_of_range) {
-        return Err(fail(
-            &format!("controller.{f}"),
-            format!(
-                "{} is beyond ±{MAX_CONTROLLER_VALUE:e}, the largest controller value Ricochet \
-                 accepts (a faster bullet only makes every frame's swept tests longer)",
-                Number(v)
-            ),
-        ));
+    if let Some((f, problem)) = controller.as_ref().and_then(controller_problem) {
+        return Err(fail(&f, problem));
     }
     let mut split = Vec::new();
     for (
@@ -409,32 +324,4 @@ pub(crate) fn ignored_field(
             };
             Some((field, problem))
         })
-}
-
-/// The problem when more than one body of `bodies` has the name `name` that something
-/// addresses (`purpose`: what must name one body), `None` otherwise. `sorted` holds every
-/// body's `(name, index)`, sorted.
-pub(crate) fn shared_name(sorted: &[(&str, usize)], name: &str, purpose: &str) -> Option<String> {
-    let from = sorted.partition_point(|(n, _)| *n < name);
-    let to = sorted.partition_point(|(n, _)| *n <= name);
-    let same = &sorted[from..to];
-    (same.len() > 1).then(|| {
-        let list: Vec<String> = same.iter().map(|(_, i)| format!("bodies[{i}]")).collect();
-        format!(
-            "{} bodies are named \"{name}\" ({}): name {purpose} apart from the others",
-            same.len(),
-            list.join(", ")
-        )
-    })
-}
-
-/// Every body's `(name, index)`, sorted: what [`shared_name`] searches.
-pub(crate) fn names_sorted(bodies: &[BodyDef]) -> Vec<(&str, usize)> {
-    let mut v: Vec<(&str, usize)> = bodies
-        .iter()
-        .enumerate()
-        .map(|(i, b)| (b.name.as_str(), i))
-        .collect();
-    v.sort_unstable();
-    v
 }

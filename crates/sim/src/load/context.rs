@@ -4,21 +4,7 @@ use std::ops::Range;
 
 use ricochet_geom::Vec2;
 
-/// Why a scenario was rejected. Displays as `file:line:column: field: problem`.
-#[derive(Clone, Debug, PartialEq, thiserror::Error)]
-#[error("{file}:{line}:{column}: {field}{sep}{problem}", sep = if self.field.is_empty() { "" } else { ": " })]
-pub struct ScenarioError {
-    /// The file name as given.
-    pub file: String,
-    /// 1-based line.
-    pub line: usize,
-    /// 1-based column.
-    pub column: usize,
-    /// The field path (`bodies[2].layer`), empty for a syntax error.
-    pub field: String,
-    /// What is wrong and what was expected.
-    pub problem: String,
-}
+pub use crate::check::ScenarioError;
 
 pub(crate) struct Ctx<'a> {
     pub(crate) file: &'a str,
@@ -204,17 +190,9 @@ pub(crate) fn unknown<'a>(
     name: &str,
     known: impl Iterator<Item = &'a String>,
 ) -> ScenarioError {
-    let known: Vec<&str> = known.map(String::as_str).collect();
     ctx.err(
         span,
         field,
-        format!(
-            "unknown {what} \"{name}\"; known: {}",
-            if known.is_empty() {
-                "none".to_owned()
-            } else {
-                known.join(", ")
-            }
-        ),
+        crate::check::problems::unknown_problem(what, name, known),
     )
 }

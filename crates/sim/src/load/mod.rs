@@ -11,57 +11,18 @@ mod world;
 
 use std::collections::BTreeMap;
 
+use crate::check::problems::{names_sorted, shared_name};
+use crate::check::problems::{oversized, split_problem, static_outside};
 use crate::scenario::Scenario;
-use bodies::{
-    MAX_SPLIT_BODIES, SplitProblem, body_def, ignored_field, merge, names_sorted, references,
-    shared_name, split_problem,
-};
+use bodies::{body_def, ignored_field, merge, references};
 use chunks::split_bodies;
 pub use context::ScenarioError;
 use context::{Ctx, unknown};
 use file::{BodyFile, BodyTable, ScenarioFile};
-use ricochet_geom::{Number, Numbers};
 use script::script;
 use std::ops::Range;
 use toml::Spanned;
 use world::world_settings;
-
-/// The problem with a static `def` placed outside a wrapping world, if any: a static body
-/// is never wrapped (it never moves), so one outside would be met only at its images one
-/// world size away, not where the rule "contacts are those of the scene wrapped into the
-/// world" puts it.
-pub(crate) fn static_outside(world: &crate::WorldDef, def: &crate::BodyDef) -> Option<String> {
-    let bounds = world.bounds?;
-    let p = def.position;
-    let inside = (0..2).all(|axis| bounds.min[axis] <= p[axis] && p[axis] <= bounds.max[axis]);
-    (bounds.wrap && def.kind == crate::BodyKind::Static && !inside).then(|| {
-        format!(
-            "{} is outside the wrap-around world {} to {}: a static body never moves, so \
-             it is never wrapped; place it inside the world",
-            Numbers([p.x, p.y]),
-            Numbers([bounds.min.x, bounds.min.y]),
-            Numbers([bounds.max.x, bounds.max.y])
-        )
-    })
-}
-
-/// The problem with `def` in a wrapping world it is too large for
-/// ([`crate::WorldBounds::oversized`]), if any.
-fn oversized(world: &crate::WorldDef, def: &crate::BodyDef) -> Option<String> {
-    let bounds = world.bounds?;
-    let reach = bounds.oversized(&def.shape)?;
-    let size = bounds.size();
-    Some(format!(
-        "the shape reaches {} along x and {} along y from the body's position (at some \
-         angle), more than half the {} x {} wrap-around world: a body in a wrapping world \
-         must reach at most half its width and height, so that the wrap seam meets its \
-         deepest image (make the shape smaller or the world larger)",
-        Number(reach.x),
-        Number(reach.y),
-        Number(size.x),
-        Number(size.y)
-    ))
-}
 
 /// Parses and checks a scenario. `file` is only used in error messages.
 pub fn load_scenario(text: &str, file: &str) -> Result<Scenario, ScenarioError> {
@@ -149,21 +110,6 @@ fn load(text: &str, file: &str, chunked: bool) -> Result<Scenario, ScenarioError
     // A split chain must end, and not multiply bodies past what a frame can hold.
     if let Some((name, problem)) = split_problem(&templates) {
         let span = raw.templates.get(&name).map_or(0..0, Spanned::span);
-        let problem = match problem {
-            SplitProblem::Cycle(path) => format!(
-                "{} splits into itself: a split chain must end",
-                path.join(" -> ")
-            ),
-            SplitProblem::TooMany(n) => format!(
-                "destroying one {name} creates {} bodies down its split chain; at most \
-                 {MAX_SPLIT_BODIES} are allowed",
-                if n == u64::MAX {
-                    "more than 2^64".to_owned()
-                } else {
-                    n.to_string()
-                }
-            ),
-        };
         return Err(ctx.err(span, format!("templates.{name}.split"), problem));
     }
     let mut bodies = Vec::with_capacity(n_bodies);

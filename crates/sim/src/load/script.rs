@@ -3,8 +3,8 @@
 use std::collections::BTreeMap;
 
 use crate::action::{Action, Event, ScriptAction};
+use crate::check::problems::{names_sorted, shared_name};
 use crate::def::{BodyDef, BodyKind};
-use crate::load::bodies::{names_sorted, shared_name};
 use crate::load::context::{Ctx, ScenarioError, finite, unknown, vec2, within_world};
 use crate::load::file::{ActionFile, EventFile, ScenarioFile};
 use ricochet_geom::Number;
@@ -57,10 +57,7 @@ pub(crate) fn script(
             } else {
                 Err(fail(
                     "body",
-                    format!(
-                        "no body, template or spawn is named \"{name}\"; known: {}",
-                        names.join(", ")
-                    ),
+                    crate::check::problems::no_such_name(name, &names),
                 ))
             }
         };
@@ -126,7 +123,7 @@ pub(crate) fn script(
                     def.name = n.clone();
                 }
                 def.position = within_world(fail, v("position", *position)?)?;
-                if let Some(problem) = crate::load::static_outside(world, &def) {
+                if let Some(problem) = crate::check::problems::static_outside(world, &def) {
                     return Err(fail("position", problem));
                 }
                 if let Some(vel) = velocity {

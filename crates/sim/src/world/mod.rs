@@ -269,9 +269,14 @@ impl World {
     }
 
     /// Creates a body; it takes the lowest free id, and its column position follows from it.
+    /// A mass or a controller value past the loader's limits is brought to the nearest one
+    /// (as `restore` checks them: every snapshot of the world restores).
     pub fn spawn(&mut self, def: &BodyDef) -> Entity {
         let e = self.ids.allocate();
-        self.insert(e, def);
+        match crate::limits::within_limits(def) {
+            Some(within) => self.insert(e, &within),
+            None => self.insert(e, def),
+        }
         e
     }
 
