@@ -77,9 +77,9 @@ pub fn check_writable(path: &Path) -> anyhow::Result<()> {
     temp_in(&target(path)).map(drop)
 }
 
-/// One file's identity, to tell whether two paths name the same file: the resolved path
-/// (symbolic links and `..` followed, as far as the file's directory exists), and for an
-/// existing file its device and inode (hard links).
+/// One file's identity, to tell whether two paths name the same file: the [`resolved`] path
+/// (symbolic links and `..` followed, existing yet or not), and for an existing file its
+/// device and inode (hard links).
 #[derive(Debug)]
 struct Identity {
     resolved: PathBuf,
@@ -89,14 +89,7 @@ struct Identity {
 
 impl Identity {
     fn of(path: &Path) -> Self {
-        let resolved = path.canonicalize().unwrap_or_else(|_| {
-            let dir = directory(path);
-            let dir = dir.canonicalize().unwrap_or(dir);
-            match path.file_name() {
-                Some(name) => dir.join(name),
-                None => dir,
-            }
-        });
+        let resolved = resolved(path);
         Self {
             #[cfg(unix)]
             inode: {

@@ -148,6 +148,31 @@ fn suite_junit_onto_a_scenario_or_a_golden_is_refused_and_leaves_it_whole() {
 }
 
 #[test]
+fn suite_junit_onto_a_kept_log_is_refused() {
+    let dir = suite_copy();
+    // The folder of an earlier run's kept logs; this run's log is not there yet.
+    std::fs::create_dir(dir.path().join("kept")).unwrap();
+    let o = ricochet_in(
+        dir.path(),
+        &[
+            "test",
+            "scenarios/level.toml",
+            "--keep",
+            "kept",
+            "--junit",
+            "kept/../kept/level.mcap",
+        ],
+    );
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(
+        e.contains("is where --keep keeps the fresh log of scenarios/level.toml"),
+        "{e}"
+    );
+    assert!(o.stdout.is_empty(), "no item ran: {}", stdout(&o));
+}
+
+#[test]
 fn suite_a_golden_digest_with_crlf_line_ends_is_the_same_digest() {
     let dir = suite_copy();
     let digest = dir.path().join("recordings/level.digest");

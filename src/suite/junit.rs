@@ -87,7 +87,12 @@ pub fn render(suite: &str, results: &[ItemResult]) -> std::io::Result<Vec<u8>> {
 /// Fails if the report can't go to `path` (a directory, a device, no folder: see
 /// [`crate::files::check_writable`]) or if `path` is one of the run's inputs: a scenario of
 /// `items`, or its golden log or digest, which the report would overwrite. Before any item.
-pub fn check(path: &Path, items: &[PathBuf], golden: Option<&Path>) -> anyhow::Result<()> {
+pub fn check(
+    path: &Path,
+    items: &[PathBuf],
+    golden: Option<&Path>,
+    keep: Option<&Path>,
+) -> anyhow::Result<()> {
     let goldens: Vec<PathBuf> = items
         .iter()
         .flat_map(|s| {
@@ -100,7 +105,23 @@ pub fn check(path: &Path, items: &[PathBuf], golden: Option<&Path>) -> anyhow::R
         })
         .collect();
     let inputs: Vec<&Path> = items.iter().chain(&goldens).map(PathBuf::as_path).collect();
-    crate::files::check_outputs(&[("--junit", path)], &inputs)
+    crate::files::check_outputs(&[("--junit", path)], &inputs)?;
+    // The logs `--keep` writes are outputs too: the report would replace one, or it the
+    // report.
+    if let Some(keep) = keep {
+        for s in items {
+            let kept = keep.join(format!("{}.mcap", name_of(s)));
+            if crate::files::same_file(path, &kept) {
+                anyhow::bail!(
+                    "--junit {} is where --keep keeps the fresh log of {}: give the report \
+                     a path of its own",
+                    path.display(),
+                    s.display()
+                );
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Writes the report to `path` through a temporary file renamed into place.

@@ -259,7 +259,7 @@ pub fn run(opts: &Options) -> anyhow::Result<ExitCode> {
         return Ok(ExitCode::from(2));
     }
     if let Some(j) = &opts.junit
-        && let Err(e) = junit::check(j, &items, opts.golden.as_deref())
+        && let Err(e) = junit::check(j, &items, opts.golden.as_deref(), opts.keep.as_deref())
     {
         out::error(&format!("error: {e:#}"));
         return Ok(ExitCode::from(2));
