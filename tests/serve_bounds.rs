@@ -471,3 +471,44 @@ fn a_speed_out_of_range_is_refused_by_name() {
         assert!(!stderr.contains("panicked"), "{stderr}");
     }
 }
+
+/// Issue 34: twenty bullets spawned on `/input` at `[1e15, 3.7e14]` (within the ±1e15
+/// inputs take) cast each pair at thousands of wrap images, about 30 s a frame, so the
+/// server fell from 60 frames a second to none and SIGTERM took 6.8 s. A frame's cost is now
+/// bounded by the scene (`stages/far_path.rs`): sixty frames step in milliseconds. The
+/// 60 s bound is a hang detector, a thousand times what the frames need, not a timing.
+#[test]
+fn bullets_spawned_at_1e15_cost_bounded_frames_live() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("s.mcap");
+    let scenario = crate::util::root().join("scenarios/asteroids.toml");
+    let mut server = serve(&[
+        scenario.to_str().unwrap(),
+        "--paused",
+        "--record",
+        out.to_str().unwrap(),
+    ]);
+    runtime().block_on(async {
+        let (mut ws, services) = open(&server, "foxglove.websocket.v1").await;
+        advertise_input(&mut ws).await;
+        for k in 0..20 {
+            let bullet = format!(
+                r#"{{"action":"spawn","template":"bullet","name":"shot{k}","position":[0,{}],"velocity":[1e15,3.7e14]}}"#,
+                -38 + 3 * k
+            );
+            publish(&mut ws, &bullet).await;
+        }
+        tokio::time::sleep(Duration::from_millis(50)).await;
+        let stepped = tokio::time::timeout(
+            Duration::from_secs(60),
+            call_with_statuses(&mut ws, &services, "/step", 1, r#"{"frames": 60}"#),
+        )
+        .await
+        .expect("60 frames with 20 bullets at 1e15 stepped within 60 s");
+        let (answer, statuses) = stepped;
+        assert!(statuses.is_empty(), "every spawn accepted: {statuses:?}");
+        assert_eq!(answer.unwrap()["frame"], 61);
+    });
+    assert!(terminate(&mut server, Duration::from_secs(10)).success());
+    assert_eq!(replays_byte_for_byte(&out), 61, "frames 0 to 60");
+}
