@@ -13,21 +13,28 @@ use tokio_tungstenite::tungstenite::Message;
 
 use crate::serve_client::*;
 
+/// `serve scenarios/asteroids.toml --paused --record DIR/s.mcap`: the folder (kept while
+/// the test runs), the recording's path and the server.
+fn paused_asteroids_recorded() -> (tempfile::TempDir, std::path::PathBuf, Server) {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("s.mcap");
+    let scenario = crate::util::root().join("scenarios/asteroids.toml");
+    let server = serve(&[
+        scenario.to_str().unwrap(),
+        "--paused",
+        "--record",
+        out.to_str().unwrap(),
+    ]);
+    (dir, out, server)
+}
+
 /// Issue 20: `{"action":"apply_impulse","body":"ship","impulse":[1.7e308,0]}` twice killed
 /// the server ("frame 738: a value overflowed"), and its recording was deleted. Such inputs
 /// are now refused with a status, as a scenario file's ±1e15 would be; the session goes on
 /// and its recording replays.
 #[test]
 fn an_overflowing_impulse_is_refused_and_the_recording_replays() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("s.mcap");
-    let scenario = crate::util::root().join("scenarios/asteroids.toml");
-    let mut server = serve(&[
-        scenario.to_str().unwrap(),
-        "--paused",
-        "--record",
-        out.to_str().unwrap(),
-    ]);
+    let (_dir, out, mut server) = paused_asteroids_recorded();
     runtime().block_on(async {
         let (mut ws, services) = open(&server, "foxglove.websocket.v1").await;
         advertise_input(&mut ws).await;
@@ -479,15 +486,7 @@ fn a_speed_out_of_range_is_refused_by_name() {
 /// 60 s bound is a hang detector, a thousand times what the frames need, not a timing.
 #[test]
 fn bullets_spawned_at_1e15_cost_bounded_frames_live() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("s.mcap");
-    let scenario = crate::util::root().join("scenarios/asteroids.toml");
-    let mut server = serve(&[
-        scenario.to_str().unwrap(),
-        "--paused",
-        "--record",
-        out.to_str().unwrap(),
-    ]);
+    let (_dir, out, mut server) = paused_asteroids_recorded();
     runtime().block_on(async {
         let (mut ws, services) = open(&server, "foxglove.websocket.v1").await;
         advertise_input(&mut ws).await;
