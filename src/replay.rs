@@ -8,10 +8,11 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use ricochet_log::{LogFile, LogWriter};
-use ricochet_sim::load_scenario;
+use ricochet_record::replay;
+use ricochet_sim::{ScenarioGame, Simulation, load_scenario};
 
 use crate::out;
-use crate::session::{SCENARIO_ATTACHMENT, Session};
+use crate::session::SCENARIO_ATTACHMENT;
 
 /// Replays `log` into `output` (default: `NAME.replay.mcap` beside it). Exit code 0 when the
 /// replay is byte-identical to the recording, 1 when not, 2 when `log` is no session (no
@@ -24,6 +25,18 @@ pub fn run(log: &Path, output: Option<PathBuf>) -> anyhow::Result<ExitCode> {
             return Ok(ExitCode::from(2));
         }
     };
+    // A game's room records the game's name: only its own code replays it.
+    let game = replay::recorded_game(&file)?;
+    if game != ScenarioGame::NAME {
+        out::error(&format!(
+            "error: {}: recorded by the game {:?}, which `ricochet replay` does not have (it \
+             replays scenario sessions): replay it with the game's own code \
+             (`ricochet_record::replay::replay`)",
+            log.display(),
+            out::escape_controls(&game)
+        ));
+        return Ok(ExitCode::from(2));
+    }
     // A session carries the one scenario it was played from: with two, which one the
     // recording shows is unknown, and replaying either could pass or fail falsely.
     let scenarios = file
@@ -54,37 +67,15 @@ pub fn run(log: &Path, output: Option<PathBuf>) -> anyhow::Result<ExitCode> {
             return Ok(ExitCode::from(2));
         }
     };
-    let frames = file
-        .channels()
-        .find(|c| c.topic == "/stats")
-        .map_or(0, |c| c.messages);
-    let mut inputs = Vec::new();
-    if file.channels().any(|c| c.topic == "/input") {
-        for m in file.topic_messages("/input")? {
-            let m = m?;
-            let frame = m.data["frame"].as_u64().unwrap_or(0);
-            let text = m.data["text"].as_str().unwrap_or("").to_owned();
-            inputs.push((frame, text));
-        }
-    }
     let output = output.unwrap_or_else(|| log.with_extension("replay.mcap"));
     let mut writer = LogWriter::create(&output, crate::record::LIBRARY)?;
     writer.attach(SCENARIO_ATTACHMENT, "application/toml", text.as_bytes())?;
-    let mut session = Session::new(&scenario, writer)?;
-    let mut pending = inputs.iter().peekable();
-    for _ in 0..frames {
-        let next = session.next_frame();
-        while let Some((_, text)) = pending.next_if(|(f, _)| *f == next) {
-            // Refused inputs are refused again, the same way: nothing to report here.
-            let _ = session.input(text)?;
-        }
-        session.step()?;
-    }
-    session.into_sink().finish()?;
+    let replayed = replay::replay(&file, Simulation::new(&scenario), ScenarioGame, writer)?;
+    replayed.sink.finish()?;
+    let (frames, inputs) = (replayed.frames, replayed.commands);
     let same = std::fs::read(log)? == std::fs::read(&output)?;
     out::note(&format!(
-        "replayed {frames} frames and {} inputs -> {}: {}",
-        inputs.len(),
+        "replayed {frames} frames and {inputs} inputs -> {}: {}",
         output.display(),
         if same {
             "byte-identical to the recording"

@@ -8,7 +8,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use anyhow::Context;
-use ricochet_sim::Simulation;
+use ricochet_sim::{GameLoop, Overflowed, ScenarioGame, Simulation};
 
 use crate::channels::Channels;
 use crate::load::{DEFAULT_NAME, load};
@@ -117,6 +117,8 @@ pub fn run(
             std::thread::available_parallelism().map_or(1, std::num::NonZero::get)
         }),
     );
+    // `run` is the scenario's game with no commands: the frame loop every mode shares.
+    let mut game = GameLoop::new(sim, ScenarioGame);
     let mut contacts = 0u64;
     let mut peak_bodies = 0usize;
     let mut ran = 0u64;
@@ -125,19 +127,23 @@ pub fn run(
         if interrupted.load(Ordering::SeqCst) {
             break;
         }
-        let out = sim.step();
-        if let Some(bad) = sim.first_non_finite() {
-            // Nothing after an overflow can be trusted: the log ends with the last good frame.
-            overflow = Some((out.frame, bad));
-            break;
-        }
+        let out = match game.step() {
+            Ok(out) => out,
+            Err(Overflowed { frame, bad }) => {
+                // Nothing after an overflow can be trusted: the log ends with the last good
+                // frame.
+                overflow = Some((frame, bad));
+                break;
+            }
+        };
+        let sim = game.sim();
         contacts += out.contacts.len() as u64;
         peak_bodies = peak_bodies.max(sim.world().len());
         recorder
-            .record(&sim, &out)
+            .record(sim, &out)
             .with_context(|| format!("writing frame {} to {}", out.frame, output.display()))?;
         if let Some(v) = &mut validation {
-            let report = v.frame(&sim, &out);
+            let report = v.frame(sim, &out);
             recorder
                 .record_validation(crate::validate::verdict(&report))
                 .with_context(|| format!("writing frame {} to {}", out.frame, output.display()))?;
@@ -153,10 +159,11 @@ pub fn run(
     recorder
         .finish()
         .with_context(|| format!("finishing {}", output.display()))?;
+    let sim = game.sim();
     if let Some((frame, bad)) = overflow {
         out::error(&format!(
             "error: frame {frame}: {}; the simulation overflowed. {} holds {}",
-            crate::validate::describe(&sim, &bad),
+            crate::validate::describe(sim, &bad),
             output.display(),
             match frame {
                 0 => "no frame".to_owned(),

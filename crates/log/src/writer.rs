@@ -53,6 +53,30 @@ pub trait MessageSink {
         message: M,
     ) -> Result<(), LogError>;
 
+    /// Adds a channel on `topic` for JSON messages described by the JSON Schema
+    /// `schema_json` named `schema_name` (a game's own state, `/game`).
+    fn add_json_channel(
+        &mut self,
+        topic: &str,
+        schema_name: &str,
+        schema_json: &str,
+    ) -> Result<ChannelId, LogError>;
+
+    /// Writes `json`, one JSON value already encoded, on the JSON channel `channel`.
+    fn write_json_bytes(
+        &mut self,
+        channel: ChannelId,
+        time_ns: u64,
+        json: Vec<u8>,
+    ) -> Result<(), LogError>;
+
+    /// Attaches a file to a recording (the scenario, the game's name); a live stream
+    /// ignores it.
+    fn attach(&mut self, name: &str, media_type: &str, data: &[u8]) -> Result<(), LogError> {
+        let _ = (name, media_type, data);
+        Ok(())
+    }
+
     /// Writes `message` to live viewers only, never to a recording (the current state again
     /// for a viewer that just subscribed). A file ignores it.
     fn write_live<M: prost::Message + Clone + Send + 'static>(
@@ -77,6 +101,28 @@ impl MessageSink for LogWriter {
         message: M,
     ) -> Result<(), LogError> {
         LogWriter::write(self, channel, time_ns, message)
+    }
+
+    fn add_json_channel(
+        &mut self,
+        topic: &str,
+        schema_name: &str,
+        schema_json: &str,
+    ) -> Result<ChannelId, LogError> {
+        LogWriter::add_json_channel(self, topic, schema_name, schema_json)
+    }
+
+    fn attach(&mut self, name: &str, media_type: &str, data: &[u8]) -> Result<(), LogError> {
+        LogWriter::attach(self, name, media_type, data)
+    }
+
+    fn write_json_bytes(
+        &mut self,
+        channel: ChannelId,
+        time_ns: u64,
+        json: Vec<u8>,
+    ) -> Result<(), LogError> {
+        self.write_payload(channel, time_ns, Payload::Bytes(json))
     }
 }
 

@@ -20,10 +20,9 @@ use std::path::{Path, PathBuf};
 
 use ricochet_log::LogError;
 use ricochet_log::diff::{self, DiffError, Divergence};
-use ricochet_sim::Simulation;
+use ricochet_sim::{Game, Player, ScenarioGame, Simulation};
 
-use crate::Recorder;
-use crate::channels::Channels;
+use crate::session::{GameSession, StepError};
 
 /// Set to `1`, [`check`] records the golden instead of comparing with it.
 pub const BLESS_ENV: &str = "RICOCHET_BLESS";
@@ -91,8 +90,12 @@ pub fn check(
     sim: &mut Simulation,
     frames: u64,
 ) -> Result<(), GoldenError> {
-    let bless = std::env::var_os(BLESS_ENV).is_some_and(|v| v == "1");
-    check_or_bless(golden.as_ref(), sim, frames, bless)
+    check_or_bless(golden.as_ref(), sim, frames, blessing())
+}
+
+/// Whether `RICOCHET_BLESS=1` is set.
+fn blessing() -> bool {
+    std::env::var_os(BLESS_ENV).is_some_and(|v| v == "1")
 }
 
 /// [`check`], with the choice to bless given rather than read from the environment.
@@ -102,6 +105,63 @@ pub fn check_or_bless(
     frames: u64,
     bless: bool,
 ) -> Result<(), GoldenError> {
+    // The session owns the simulation it runs: lend it ours, and take it back.
+    let placeholder = Simulation::new(&ricochet_sim::Scenario::default());
+    let owned = std::mem::replace(sim, placeholder);
+    let mut back = None;
+    let verdict = compare(golden, bless, |path| {
+        let ran = run(path, owned, ScenarioGame, frames, &[], false);
+        let (sim, verdict) = match ran {
+            Ok((sim, _)) => (sim, Ok(())),
+            Err((sim, e)) => (sim, Err(e)),
+        };
+        back = Some(sim);
+        verdict
+    });
+    if let Some(s) = back {
+        *sim = s;
+    }
+    verdict
+}
+
+/// What a golden script sends a game at a frame.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Command<I> {
+    /// A player joins with this name (players are numbered 1, 2, ... in the order they join).
+    Join(String),
+    /// A player leaves.
+    Leave(Player),
+    /// A player's input ([`Player::HOST`]: from no player).
+    Input(Player, I),
+}
+
+/// A golden check of a game run: `game` on `sim`, frame 0 and `frames` more, each frame
+/// preceded by the script's commands for it (`(frame, command)`, in the script's order
+/// within a frame; the script is sorted by frame first, stably). The log holds what a
+/// served room's recording holds (`/input` with every command, `/game`), so a room's
+/// recording and a golden agree when they got the same commands. Returns the game at the
+/// end (to look at its score), else the first divergence; `RICOCHET_BLESS=1` records the
+/// golden instead.
+pub fn check_game<G: Game>(
+    golden: impl AsRef<Path>,
+    sim: Simulation,
+    game: G,
+    frames: u64,
+    script: &[(u64, Command<G::Input>)],
+) -> Result<G, GoldenError> {
+    compare(golden.as_ref(), blessing(), |path| {
+        let (_, game) = run(path, sim, game, frames, script, true).map_err(|(_, e)| e)?;
+        Ok(game)
+    })
+}
+
+/// Records the run with `record` into the right place and compares (or blesses): the shared
+/// part of [`check`] and [`check_game`]. `record` is called once.
+fn compare<R>(
+    golden: &Path,
+    bless: bool,
+    record: impl FnOnce(&Path) -> Result<R, GoldenError>,
+) -> Result<R, GoldenError> {
     if bless {
         if let Some(dir) = golden.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir).map_err(|source| LogError::Create {
@@ -109,7 +169,7 @@ pub fn check_or_bless(
                 source,
             })?;
         }
-        return record(golden, sim, frames);
+        return record(golden);
     }
     let folder = match golden.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
@@ -130,7 +190,7 @@ pub fn check_or_bless(
             })?
             .keep();
         let new = tmp.join(new_name(golden));
-        if let Err(e) = record(&new, sim, frames) {
+        if let Err(e) = record(&new) {
             // No message names the folder then: leave nothing behind.
             let _ = std::fs::remove_dir_all(&tmp);
             return Err(e);
@@ -141,7 +201,7 @@ pub fn check_or_bless(
         });
     }
     let new = new_path(golden);
-    record(&new, sim, frames)?;
+    let ran = record(&new)?;
     if !golden.exists() {
         return Err(GoldenError::Missing {
             golden: golden.to_path_buf(),
@@ -155,7 +215,7 @@ pub fn check_or_bless(
             drop(b);
             // Nothing to look at: the run is the golden.
             let _ = std::fs::remove_file(&new);
-            Ok(())
+            Ok(ran)
         }
         Some(_) => {
             let text = diff::render(&report, golden, &new);
@@ -182,21 +242,71 @@ fn new_name(golden: &Path) -> String {
     format!("{stem}.new.mcap")
 }
 
-/// Steps and records frame 0 to `frames` into `path` (temporary file, renamed when complete).
-fn record(path: &Path, sim: &mut Simulation, frames: u64) -> Result<(), GoldenError> {
-    let mut log = Recorder::create(path, sim.scenario().world.dt, Channels::default())?;
-    for _ in 0..=frames {
-        let out = sim.step();
-        if let Some(bad) = sim.first_non_finite() {
-            // Like `ricochet run`: the frame that overflowed is not written.
-            log.finish()?;
-            return Err(GoldenError::Overflow {
-                frame: out.frame,
-                what: crate::session::describe(sim, &bad),
-            });
+/// Runs `game` on `sim` for frame 0 to `frames`, the script's commands before their
+/// frames, recorded into `path` (a temporary file, renamed when complete). The simulation
+/// and the game back, with the error if one stopped it.
+#[allow(clippy::type_complexity)]
+fn run<G: Game>(
+    path: &Path,
+    sim: Simulation,
+    game: G,
+    frames: u64,
+    script: &[(u64, Command<G::Input>)],
+    record_inputs: bool,
+) -> Result<(Simulation, G), (Simulation, GoldenError)> {
+    let log = match crate::log_writer(path) {
+        Ok(log) => log,
+        Err(e) => return Err((sim, e.into())),
+    };
+    let mut session = match GameSession::start(sim, game, log, record_inputs) {
+        Ok(s) => s,
+        // The simulation went with the session: the caller gets a stand-in back.
+        Err(e) => {
+            return Err((
+                Simulation::new(&ricochet_sim::Scenario::default()),
+                e.into(),
+            ));
         }
-        log.record(sim, &out)?;
+    };
+    let mut order: Vec<&(u64, Command<G::Input>)> = script.iter().collect();
+    order.sort_by_key(|(frame, _)| *frame);
+    let mut pending = order.into_iter().peekable();
+    let mut failed = None;
+    for _ in 0..=frames {
+        let next = session.next_frame();
+        while let Some((_, command)) = pending.next_if(|(f, _)| *f <= next) {
+            let sent = match command {
+                Command::Join(name) => session.join(name).map(|_| ()),
+                Command::Leave(p) => session.leave(*p).map(|_| ()),
+                Command::Input(p, input) => session.input_typed(*p, input).map(|_| ()),
+            };
+            if let Err(e) = sent {
+                failed = Some(GoldenError::from(e));
+                break;
+            }
+        }
+        if failed.is_some() {
+            break;
+        }
+        match session.step() {
+            Ok(_) => {}
+            Err(StepError::Overflow { frame, what }) => {
+                // Like `ricochet run`: the frame that overflowed is not written.
+                failed = Some(GoldenError::Overflow { frame, what });
+                break;
+            }
+            Err(StepError::Log(e)) => {
+                failed = Some(e.into());
+                break;
+            }
+        }
     }
-    log.finish()?;
-    Ok(())
+    let (log, sim, game) = session.into_parts();
+    if let Err(e) = log.finish() {
+        return Err((sim, failed.unwrap_or(e.into())));
+    }
+    match failed {
+        Some(e) => Err((sim, e)),
+        None => Ok((sim, game)),
+    }
 }

@@ -36,8 +36,9 @@ pub mod channels;
 pub mod events;
 pub mod golden;
 mod recorder;
+pub mod replay;
 pub mod scene;
 pub mod session;
 
 pub use channels::Channels;
-pub use recorder::{INLINE_ENV, LIBRARY, Level, Recorder};
+pub use recorder::{INLINE_ENV, LIBRARY, Level, Recorder, log_writer};

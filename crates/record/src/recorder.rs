@@ -73,17 +73,22 @@ pub struct Recorder<S: MessageSink = LogWriter> {
     view: Option<(Vec2, Vec2)>,
 }
 
+/// A new log file at `path` (a temporary file renamed onto it when finished), with
+/// Ricochet's header and the writer thread (inline with [`INLINE_ENV`]).
+pub fn log_writer(path: &Path) -> Result<LogWriter, LogError> {
+    let threading = if std::env::var_os(INLINE_ENV).is_some_and(|v| v == "1") {
+        Threading::Inline
+    } else {
+        Threading::Thread
+    };
+    LogWriter::create_with(path, LIBRARY, threading)
+}
+
 impl Recorder<LogWriter> {
     /// Creates the file now (so a bad path fails before the simulation starts) and adds the
     /// chosen channels (all by default).
     pub fn create(path: &Path, dt: f64, channels: Channels) -> Result<Recorder, LogError> {
-        let threading = if std::env::var_os(INLINE_ENV).is_some_and(|v| v == "1") {
-            Threading::Inline
-        } else {
-            Threading::Thread
-        };
-        let writer = LogWriter::create_with(path, LIBRARY, threading)?;
-        Recorder::new(writer, dt, channels)
+        Recorder::new(log_writer(path)?, dt, channels)
     }
 
     /// Writes the summary and index. Called after an interrupted run too.

@@ -490,6 +490,34 @@ impl MessageSink for LiveSink {
         Ok(())
     }
 
+    fn add_json_channel(
+        &mut self,
+        topic: &str,
+        schema_name: &str,
+        schema_json: &str,
+    ) -> Result<ChannelId, LogError> {
+        let mut s = self.hub.lock();
+        if let Some(c) = s.channels.iter().find(|c| c.topic == topic) {
+            return Ok(ChannelId::from_index(c.id as u16));
+        }
+        let id = s.channels.len() as u32 + 1;
+        s.channels
+            .push(Channel::json(id, topic, schema_name, schema_json));
+        Ok(ChannelId::from_index(id as u16))
+    }
+
+    fn write_json_bytes(
+        &mut self,
+        channel: ChannelId,
+        time_ns: u64,
+        json: Vec<u8>,
+    ) -> Result<(), LogError> {
+        self.hub
+            .lock()
+            .publish(u32::from(channel.index()), time_ns, json);
+        Ok(())
+    }
+
     fn write_live<M: prost::Message + Clone + Send + 'static>(
         &mut self,
         channel: ChannelId,

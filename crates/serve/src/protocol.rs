@@ -46,6 +46,18 @@ impl Channel {
             schema_encoding: "protobuf".to_owned(),
         }
     }
+
+    /// The channel `id` on `topic`, JSON described by the JSON Schema `schema`.
+    pub fn json(id: u32, topic: &str, schema_name: &str, schema: &str) -> Channel {
+        Channel {
+            id,
+            topic: topic.to_owned(),
+            encoding: "json".to_owned(),
+            schema_name: schema_name.to_owned(),
+            schema: schema.to_owned(),
+            schema_encoding: "jsonschema".to_owned(),
+        }
+    }
 }
 
 /// A service as `advertiseServices` lists it: JSON requests and responses, each with a

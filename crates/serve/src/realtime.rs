@@ -69,6 +69,42 @@ impl MessageSink for ServeSink {
         self.live.write(channel, time_ns, message)
     }
 
+    fn add_json_channel(
+        &mut self,
+        topic: &str,
+        schema_name: &str,
+        schema_json: &str,
+    ) -> Result<ChannelId, LogError> {
+        if let Some((file, ids)) = &mut self.file {
+            let id = file.add_json_channel(topic, schema_name, schema_json)?;
+            ids.push(id);
+        }
+        self.live.add_json_channel(topic, schema_name, schema_json)
+    }
+
+    fn attach(&mut self, name: &str, media_type: &str, data: &[u8]) -> Result<(), LogError> {
+        match &mut self.file {
+            Some((file, _)) => file.attach(name, media_type, data),
+            None => Ok(()),
+        }
+    }
+
+    fn write_json_bytes(
+        &mut self,
+        channel: ChannelId,
+        time_ns: u64,
+        json: Vec<u8>,
+    ) -> Result<(), LogError> {
+        if let Some((file, ids)) = &mut self.file {
+            let id = ids[usize::from(channel.index()) - 1];
+            file.write_json_bytes(id, time_ns, json.clone())?;
+        }
+        if self.muted {
+            return Ok(());
+        }
+        self.live.write_json_bytes(channel, time_ns, json)
+    }
+
     fn write_live<M: prost::Message + Clone + Send + 'static>(
         &mut self,
         channel: ChannelId,

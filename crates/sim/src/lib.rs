@@ -129,6 +129,7 @@ mod control;
 mod def;
 mod entity;
 mod event;
+mod game;
 mod interned;
 mod limits;
 #[cfg(feature = "toml")]
@@ -155,6 +156,9 @@ pub use def::{
 };
 pub use entity::{Entity, EntityAllocator};
 pub use event::{FireOutcome, GameEvent, JumpOutcome, Removal, ScriptInput};
+pub use game::{Game, GameLoop, Overflowed, Player};
+#[cfg(feature = "toml")]
+pub use game::{MAX_INPUT_VALUE, ScenarioGame};
 #[cfg(feature = "toml")]
 pub use load::file::ActionFile;
 #[cfg(feature = "toml")]

@@ -227,7 +227,7 @@ impl<'de> Deserialize<'de> for EventFile {
 }
 
 /// What a script event does.
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Clone, Deserialize, serde::Serialize)]
 #[serde(tag = "action", rename_all = "snake_case", deny_unknown_fields)]
 pub enum ActionFile {
     /// Create a body from a template.
