@@ -149,7 +149,19 @@ pub fn check_game<G: Game>(
     frames: u64,
     script: &[(u64, Command<G::Input>)],
 ) -> Result<G, GoldenError> {
-    compare(golden.as_ref(), blessing(), |path| {
+    check_game_or_bless(golden.as_ref(), sim, game, frames, script, blessing())
+}
+
+/// [`check_game`], with the choice to bless given rather than read from the environment.
+pub fn check_game_or_bless<G: Game>(
+    golden: &Path,
+    sim: Simulation,
+    game: G,
+    frames: u64,
+    script: &[(u64, Command<G::Input>)],
+    bless: bool,
+) -> Result<G, GoldenError> {
+    compare(golden, bless, |path| {
         let (_, game) = run(path, sim, game, frames, script, true).map_err(|(_, e)| e)?;
         Ok(game)
     })
