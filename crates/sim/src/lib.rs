@@ -104,6 +104,14 @@
 //! image is seen and a ray leaving one edge goes on from the other. Bad input (a zero or
 //! non-finite direction, a negative distance) answers nothing, never a panic.
 //!
+//! # A game's rules
+//!
+//! A game with players implements [`Game`] (joins, leaves, its own typed inputs, rules
+//! before and after each step, the state its players see) and runs in a [`GameLoop`], the
+//! one frame loop that `ricochet-record` (recording, golden checks, replays) and
+//! `ricochet-serve` (rooms) drive too. [`ScenarioGame`] is the game of a scenario file.
+//! README's "Run a game" has a whole one.
+//!
 //! # Snapshots and rollback
 //!
 //! [`Simulation::snapshot`] holds everything the next step reads (every body, the pending
