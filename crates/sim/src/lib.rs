@@ -129,6 +129,7 @@ mod control;
 mod def;
 mod entity;
 mod event;
+mod history;
 mod interned;
 mod limits;
 #[cfg(feature = "toml")]
@@ -155,6 +156,8 @@ pub use def::{
 };
 pub use entity::{Entity, EntityAllocator};
 pub use event::{FireOutcome, GameEvent, JumpOutcome, Removal, ScriptInput};
+pub use history::{HistoryError, Past};
+pub use limits::MAX_HISTORY;
 #[cfg(feature = "toml")]
 pub use load::file::ActionFile;
 #[cfg(feature = "toml")]

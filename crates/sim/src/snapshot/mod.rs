@@ -370,6 +370,8 @@ impl Simulation {
         // Another world: neither tree set of the scene queries may be kept (a static
         // generation can repeat with other static bodies).
         self.queries = crate::query::index::QueryCache::default();
+        // The frames kept belong to the timeline left (`history.rs`); the length stays.
+        self.history.clear();
         self.frame = s.frame;
         self.cursor = st.cursor;
         self.pending = st.pending;

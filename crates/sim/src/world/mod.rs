@@ -42,6 +42,7 @@ mod rows;
 mod sleep;
 mod state;
 
+pub(crate) use bounds::placed;
 pub(crate) use state::{Bodies, PackedWorld};
 
 use bounds::LocalBounds;
@@ -160,6 +161,17 @@ impl World {
     #[inline]
     pub fn shape(&self, i: usize) -> &Shape {
         &self.shapes.get(self.shape_id[i]).0
+    }
+
+    /// Each body's look id (its shape and name) in [`World::shape_table`], by dense index:
+    /// what a kept frame copies (`history.rs`).
+    pub(crate) fn looks(&self) -> &[u32] {
+        &self.shape_id
+    }
+
+    /// The table the look ids index.
+    pub(crate) fn shape_table(&self) -> &ShapeTable {
+        &self.shapes
     }
 
     /// Body `i`'s name.
