@@ -3,12 +3,14 @@
 //! to 32 past collision worlds).
 //!
 //! [`Simulation::keep_history`] turns it on: from then on the end of every step copies what
-//! a query reads of each body (entity, layer, position, angle and look id, 37 bytes a
-//! body: the columns as they are, one copy each) into a ring of the last `n` frames, whose
-//! evicted frame's buffers are reused. Shapes are not copied per frame: every frame holds
-//! an `Arc` of one table of shapes by look id, made anew only when the world's shape table
-//! gave an id a new shape (a serial per id tells which), and then only that id's shape is
-//! copied. [`Simulation::past`] answers with a [`Past`], which runs the same query code as
+//! a query reads of each body into a ring of the last `n` frames, whose evicted frame's
+//! buffers are reused: positions and angles (24 bytes a body, a copy of the two columns)
+//! every frame; entities, layers and look ids (13 bytes a body) only when the world's
+//! layout serial says a body was added, removed or reshaped since the last frame kept
+//! (frames of one layout share them by `Arc`). Shapes are not copied per frame: a layout
+//! holds an `Arc` of one table of shapes by look id, made anew only when the world's shape
+//! table gave an id a new shape (a serial per id tells which), and then only that id's
+//! shape is copied. [`Simulation::past`] answers with a [`Past`], which runs the same query code as
 //! the world now (`query/`) over the kept columns; the frame's trees are built by its first
 //! query and kept with it.
 //!
@@ -68,16 +70,25 @@ pub enum HistoryError {
 /// Shapes by look id, as of some frame.
 type Looks = Vec<Option<Arc<Shape>>>;
 
+/// The columns that change only when a body is added, removed or reshaped: shared by the
+/// kept frames of one world layout ([`World::layout`]).
+#[derive(Clone, Debug, Default)]
+struct Layout {
+    /// The world's layout serial they were copied at.
+    serial: u64,
+    entity: Vec<Entity>,
+    layer: Vec<LayerId>,
+    look: Vec<u32>,
+    looks: Arc<Looks>,
+}
+
 /// One kept frame: the columns a query reads, as the end of its step left them.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Kept {
     frame: u64,
-    entity: Vec<Entity>,
-    layer: Vec<LayerId>,
+    layout: Arc<Layout>,
     position: Vec<Vec2>,
     angle: Vec<f64>,
-    look: Vec<u32>,
-    looks: Arc<Looks>,
     /// One tree over every body (static or not: a past frame never changes), and an empty
     /// set; built by the frame's first query.
     trees: OnceLock<[Arc<Trees>; 2]>,
@@ -91,16 +102,17 @@ fn copy<T: Copy>(to: &mut Vec<T>, from: &[T]) {
 
 impl Bodies for &Kept {
     fn entity(&self) -> &[Entity] {
-        &self.entity
+        &self.layout.entity
     }
 
     fn layer(&self) -> &[LayerId] {
-        &self.layer
+        &self.layout.layer
     }
 
     #[inline]
     fn shape(&self, i: usize) -> &Shape {
-        self.looks[self.look[i] as usize]
+        let l = &self.layout;
+        l.looks[l.look[i] as usize]
             .as_deref()
             .expect("a kept body's look is kept")
     }
@@ -118,11 +130,12 @@ impl Bodies for &Kept {
                     let local = self.shape(i).bounds(&Pose::new(Vec2::ZERO, self.angle[i]));
                     placed(local, self.position[i])
                 };
+                let l = &self.layout;
                 let all = Trees::over(
                     0,
-                    &self.entity,
-                    &self.layer,
-                    (0..self.entity.len()).map(|i| (i, bounds(i))),
+                    &l.entity,
+                    &l.layer,
+                    (0..l.entity.len()).map(|i| (i, bounds(i))),
                 );
                 [Arc::new(all), Arc::new(Trees::default())]
             })
@@ -142,6 +155,8 @@ pub(crate) struct History {
     looks: Arc<Looks>,
     /// The world shape table's serial of each look id in `looks`.
     serials: Vec<u64>,
+    /// The layout of the last kept frame (`None`: none since the last clear).
+    layout: Option<Arc<Layout>>,
     /// The table's [`ShapeTable::last_serial`] when `looks` was brought up to date.
     synced: u64,
 }
@@ -195,13 +210,32 @@ impl History {
         } else {
             Kept::default()
         };
+        let same = self.layout.as_ref().is_some_and(|l| {
+            l.serial == world.layout()
+                && l.entity.len() == world.len()
+                && Arc::ptr_eq(&l.looks, &self.looks)
+        });
+        if !same {
+            // The evicted frame's buffers, unless another frame still shares them.
+            let mut l = Arc::try_unwrap(std::mem::take(&mut k.layout)).unwrap_or_default();
+            l.serial = world.layout();
+            copy(&mut l.entity, &world.entity);
+            copy(&mut l.layer, &world.layer);
+            copy(&mut l.look, world.looks());
+            l.looks = Arc::clone(&self.looks);
+            self.layout = Some(Arc::new(l));
+        }
+        let layout = self.layout.as_ref().expect("set above");
+        debug_assert!(
+            layout.entity == world.entity
+                && layout.layer == world.layer
+                && layout.look == world.looks(),
+            "the world's layout serial changes with its bodies"
+        );
         k.frame = frame;
-        copy(&mut k.entity, &world.entity);
-        copy(&mut k.layer, &world.layer);
+        k.layout = Arc::clone(layout);
         copy(&mut k.position, &world.position);
         copy(&mut k.angle, &world.angle);
-        copy(&mut k.look, world.looks());
-        k.looks = Arc::clone(&self.looks);
         k.trees = OnceLock::new();
         self.frames.push_back(k);
     }
@@ -238,13 +272,13 @@ impl<'a> Past<'a> {
     /// How many bodies there were.
     #[must_use]
     pub fn len(&self) -> usize {
-        self.kept.entity.len()
+        self.kept.layout.entity.len()
     }
 
     /// Whether there were no bodies.
     #[must_use]
     pub fn is_empty(&self) -> bool {
-        self.kept.entity.is_empty()
+        self.kept.layout.entity.is_empty()
     }
 
     /// [`Simulation::cast_ray`] then.
@@ -308,9 +342,9 @@ impl Simulation {
     /// Keeps the last `n` frames from the next step on, for [`Simulation::past`] (lag
     /// compensation: a shot checked against the world as the shooter saw it). 0 turns it
     /// off and frees what was kept (the default: a step then does one branch more). A
-    /// shorter length than before drops the oldest frames. What is kept is a copy of 37
-    /// bytes a body a frame, and about 90 more a body for a frame once queried
-    /// ([`MAX_HISTORY`]'s docs). [`Simulation::restore`] clears the frames kept (the length
+    /// shorter length than before drops the oldest frames. A frame kept costs 24 to 37
+    /// bytes a body, and about 60 more once queried ([`MAX_HISTORY`]'s docs); a step about
+    /// 6% more on `asteroids-10000` at `n = 32` (BENCHMARKS.md, "Lag compensation"). [`Simulation::restore`] clears the frames kept (the length
     /// stays); the history is in no snapshot or checksum.
     ///
     /// # Errors

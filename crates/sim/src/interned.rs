@@ -137,6 +137,12 @@ pub(crate) struct ShapeTable {
 /// output, so which one a value gets does not matter for determinism.
 static NEXT_SERIAL: AtomicU64 = AtomicU64::new(1);
 
+/// A number never handed out before in this process (never 0): the serials of the shape
+/// table and of the world's layout ([`crate::World`]'s, `history.rs`).
+pub(crate) fn next_serial() -> u64 {
+    NEXT_SERIAL.fetch_add(1, Ordering::Relaxed)
+}
+
 impl ShapeTable {
     /// The id of the shape whose bits are `key` ([`shape_key`]) with name id `name`, one
     /// more user counted; `value` makes it (with its bounds) when it is new.
@@ -159,7 +165,7 @@ impl ShapeTable {
             }
         }
         let entry = Some(value());
-        let serial = NEXT_SERIAL.fetch_add(1, Ordering::Relaxed);
+        let serial = next_serial();
         self.last_serial = serial;
         let id = match self.free.pop() {
             Some(id) => {

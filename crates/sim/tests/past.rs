@@ -118,14 +118,25 @@ fn scenario(rng: &mut Rng) -> Scenario {
     }
 }
 
-/// Spawns, despawns, reshapes or moves a few bodies between two steps.
+/// Spawns, despawns, reshapes or moves a few bodies between two steps. Half the new shapes
+/// are a live body's (the world's shape table then gains nothing: only the bodies change).
 fn edit(sim: &mut Simulation, rng: &mut Rng, size: Vec2) {
-    for _ in 0..rng.below(3) {
+    for _ in 0..rng.below(4) {
         let live = sim.world().entity.clone();
         let pick = |rng: &mut Rng| live.get(rng.below(live.len().max(1))).copied();
+        let reuse = |sim: &Simulation, rng: &mut Rng| match pick(rng) {
+            Some(e) if rng.chance(0.5) => {
+                let i = sim.world().index_of(e).unwrap();
+                sim.world().shape(i).clone()
+            }
+            _ => shape(rng),
+        };
         match rng.below(4) {
             0 => {
-                let b = body(rng, size);
+                let b = BodyDef {
+                    shape: reuse(sim, rng),
+                    ..body(rng, size)
+                };
                 sim.spawn(&b);
             }
             1 => {
@@ -135,7 +146,8 @@ fn edit(sim: &mut Simulation, rng: &mut Rng, size: Vec2) {
             }
             2 => {
                 if let Some(e) = pick(rng) {
-                    sim.set_shape(e, shape(rng)).unwrap();
+                    let s = reuse(sim, rng);
+                    sim.set_shape(e, s).unwrap();
                 }
             }
             _ => {

@@ -70,8 +70,13 @@ impl Trees {
         layer: &[LayerId],
         members: impl Iterator<Item = (usize, Bounds)>,
     ) -> Trees {
-        let mut list = Vec::new();
-        let (mut entities, mut layers, mut dense) = (Vec::new(), Vec::new(), Vec::new());
+        let n = members.size_hint().0;
+        let mut list = Vec::with_capacity(n);
+        let (mut entities, mut layers, mut dense) = (
+            Vec::with_capacity(n),
+            Vec::with_capacity(n),
+            Vec::with_capacity(n),
+        );
         let mut all: Option<Bounds> = None;
         for (i, bounds) in members {
             all = Some(all.map_or(bounds, |a| a.union(bounds)));

@@ -27,7 +27,7 @@
 //! | World: `entity`, `layer`, `kind`, `position`, `angle`, `shape`, `name` | state (a script finds bodies by name) | as they differ from the baseline | yes |
 //! | World: the allocator's `generations` (its free list: every slot not alive) | state | as they differ from the baseline | yes |
 //! | World: `shapes`, `names` tables, `row`, `movers`, `active`, counters, `non_boxes`, `key` | caches of the above | no: rebuilt or patched | no |
-//! | World: `static_generation` | a counter the caches compare | no: the caches are built new | no |
+//! | World: `static_generation`, `layout` | counters the caches (and kept frames) compare | no: the caches are built new | no |
 //! | World: `reshaped` | whether a body may no longer have the baseline's shape and name: only what is compared | no | no |
 //! | Rows: `mass`, `velocity`, `angular_velocity`, `force`, `gravity_scale`, `lifetime`, `controller`, `inputs`, `grounded`, `on_static`, `carrier`, `still`, `split`, `frozen`, `asleep`, `rest_frames` | state | as they differ from the baseline | yes |
 //! | Rows: whether a static body has a row (`has_row`: scenery given one) | state of the layout | yes | yes |
