@@ -338,7 +338,9 @@ impl Simulation {
 
     /// Puts the simulation back in the state of `s`: it then steps exactly as the one `s`
     /// was taken of did from there. The broad phase and the grids are built anew. The
-    /// thread count and `capture_detect_poses` stay this simulation's.
+    /// thread count and `capture_detect_poses` stay this simulation's, and so does the
+    /// length of its history, whose frames are cleared ([`Simulation::past`]: they belong
+    /// to the timeline left).
     ///
     /// # Errors
     /// [`SnapshotError::OtherScene`] for a snapshot of another scene,
