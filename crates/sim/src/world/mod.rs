@@ -108,10 +108,10 @@ pub struct World {
     /// Whether [`World::set_shape`] ever ran: until then every body has the shape it was
     /// spawned with (a snapshot compares shapes only after it).
     reshaped: bool,
-    /// A serial ([`crate::interned::next_serial`]) given anew whenever a body is added or
-    /// removed or given another look, and by a restore: while it stays, `entity`, `layer`
-    /// and the look ids are the same, and kept frames share one copy of them
-    /// (`history.rs`). 0 in a world no body was ever added to.
+    /// Counts every body added or removed or given another look: while it stays,
+    /// `entity`, `layer` and the look ids are the same, and kept frames share one copy of
+    /// them (`history.rs`). A world a restore builds or patches takes a number never used
+    /// before ([`crate::interned::next_serial`]): it is another world.
     layout: u64,
 }
 
@@ -306,7 +306,7 @@ impl World {
     /// Creates body `e` (an id the caller took from the allocator, or a restored one) at its
     /// place in id order.
     fn insert(&mut self, e: Entity, def: &BodyDef) {
-        self.layout = crate::interned::next_serial();
+        self.layout += 1;
         let i = self.entity.partition_point(|x| *x < e);
         self.entity.insert(i, e);
         let name = self.names.acquire(def.name.as_str(), || ());
@@ -376,7 +376,7 @@ impl World {
 
     /// Removes the body at dense index `i`, keeping the order of the rest.
     pub fn despawn(&mut self, i: usize) {
-        self.layout = crate::interned::next_serial();
+        self.layout += 1;
         let e = self.entity.remove(i);
         self.ids.free(e);
         let layer = self.layer.remove(i);
@@ -456,7 +456,7 @@ impl World {
     /// [`World::static_generation`] (re-indexed by the broad phase and the per-axis stages)
     /// and wakes every sleeper, a moving body wakes.
     pub fn set_shape(&mut self, i: usize, shape: &Shape) {
-        self.layout = crate::interned::next_serial();
+        self.layout += 1;
         self.reshaped = true;
         let old = self.shape_id[i];
         let layer = usize::from(self.layer[i]);
@@ -495,7 +495,7 @@ impl World {
     /// Renames body `i` (tests: no stage renames a body).
     #[cfg(test)]
     pub(crate) fn set_name(&mut self, i: usize, name: &str) {
-        self.layout = crate::interned::next_serial();
+        self.layout += 1;
         let old = self.shape_id[i];
         let id = self.names.acquire(name, || ());
         shape_key(&self.shapes.get(old).0, &mut self.key);
