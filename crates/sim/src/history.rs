@@ -148,8 +148,9 @@ impl Bodies for &Kept {
 pub(crate) struct History {
     /// How many frames to keep (0: off).
     keep: usize,
-    /// The kept frames, oldest first, consecutive.
-    frames: VecDeque<Kept>,
+    /// The kept frames, oldest first, consecutive; shared with the simulation's clones (a
+    /// clone costs an `Arc` a frame, not a copy).
+    frames: VecDeque<Arc<Kept>>,
     /// The shapes by look id as of the last kept frame (shared with the frames that hold
     /// the same ones).
     looks: Arc<Looks>,
@@ -205,8 +206,12 @@ impl History {
     /// Keeps `world` as the end of `frame` (the next after the newest kept).
     pub(crate) fn record(&mut self, world: &World, frame: u64) {
         self.sync(world.shape_table());
+        // The evicted frame's buffers, unless a clone of the simulation still shares it.
         let mut k = if self.frames.len() >= self.keep {
-            self.frames.pop_front().unwrap_or_default()
+            self.frames
+                .pop_front()
+                .and_then(|k| Arc::try_unwrap(k).ok())
+                .unwrap_or_default()
         } else {
             Kept::default()
         };
@@ -216,7 +221,7 @@ impl History {
                 && Arc::ptr_eq(&l.looks, &self.looks)
         });
         if !same {
-            // The evicted frame's buffers, unless another frame still shares them.
+            // The evicted frame's, unless another frame still shares them.
             let mut l = Arc::try_unwrap(std::mem::take(&mut k.layout)).unwrap_or_default();
             l.serial = world.layout();
             copy(&mut l.entity, &world.entity);
@@ -237,7 +242,7 @@ impl History {
         copy(&mut k.position, &world.position);
         copy(&mut k.angle, &world.angle);
         k.trees = OnceLock::new();
-        self.frames.push_back(k);
+        self.frames.push_back(Arc::new(k));
     }
 
     /// The oldest and newest frames kept.

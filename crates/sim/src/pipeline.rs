@@ -135,6 +135,7 @@ impl std::fmt::Debug for Simulation {
             .field("touching", &self.touch.touching().len())
             .field("focus", &self.focus)
             .field("threads", &self.threads())
+            .field("kept_frames", &self.kept_frames())
             .finish_non_exhaustive()
     }
 }

@@ -478,3 +478,33 @@ fn history_is_not_in_a_snapshot_or_the_checksum() {
     assert_eq!(a.snapshot().to_bytes(), b.snapshot().to_bytes());
     assert_eq!(a.checksum(), b.checksum());
 }
+
+/// A clone shares the frames kept so far; each then keeps its own, and stepping one never
+/// changes what the other answers (the ball of `ball_scene` is at `x = f` at the end of
+/// frame `f`).
+#[test]
+fn a_clone_keeps_its_own_frames() {
+    let (mut sim, ball) = ball_scene();
+    sim.keep_history(3).unwrap();
+    for _ in 0..5 {
+        sim.step();
+    }
+    let mut clone = sim.clone();
+    for _ in 0..5 {
+        sim.step();
+    }
+    clone.set_position(ball, Vec2::new(50.0, 0.0)).unwrap();
+    clone.step();
+    let inside = |s: &Simulation, f: u64, x: f64| {
+        s.past(f)
+            .unwrap()
+            .overlap_point(Vec2::new(x, 0.0), &QueryFilter::all())
+            == [ball]
+    };
+    assert_eq!(clone.kept_frames(), Some(3..=5));
+    assert!(inside(&clone, 3, 3.0) && inside(&clone, 4, 4.0));
+    // Frame 5 of the clone: moved to x = 50, then one unit.
+    assert!(inside(&clone, 5, 51.0) && !inside(&clone, 5, 5.0));
+    assert_eq!(sim.kept_frames(), Some(7..=9));
+    assert!(inside(&sim, 7, 7.0) && inside(&sim, 9, 9.0));
+}
