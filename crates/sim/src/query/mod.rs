@@ -29,6 +29,11 @@
 //! while the static generation stays) and over the moving bodies (built on the first query
 //! after the world changed), walked along the ray or by the query's bounds (`index.rs`).
 //! Only the layers a filter accepts are visited.
+//!
+//! # Now and then
+//! Every query is written once, over a [`Bodies`] view: the world now, or a frame kept for
+//! lag compensation (`history.rs`, [`crate::Past`]), whose one tree over all its bodies is
+//! built by its first query. So a past frame answers exactly as the world restored there.
 
 mod filter;
 mod hits;
