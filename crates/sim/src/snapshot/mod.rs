@@ -36,6 +36,7 @@
 //! | Rows: `entity` (row to body) | the layout | no | no |
 //! | Rows: `user_data` | game data: no stage reads it | yes | **no** |
 //! | `baseline` (the world before the first step) | definition | its hash, in the scene's | no |
+//! | `history` (the frames kept for `Simulation::past`) | past states for queries; no step reads them | no: `restore` clears them | no |
 //!
 //! `world/checksum_fields.rs` changes every field marked "in `checksum`" in turn and checks
 //! that the checksum changes (its list is checked against this table, and it destructures
