@@ -111,6 +111,7 @@
 //! one frame loop that `ricochet-record` (recording, golden checks, replays) and
 //! `ricochet-serve` (rooms) drive too. [`ScenarioGame`] is the game of a scenario file.
 //! README's "Run a game" has a whole one.
+//!
 //! # Lag compensation
 //!
 //! A server checks a player's shot against the world as that player saw it, some frames
