@@ -49,6 +49,25 @@ impl Default for Scenario {
     }
 }
 
+/// A scenario's `[tiled]` table, checked against the scenario (its layer exists, its spawn
+/// templates exist, its scale is positive) but not against the map, which
+/// `ricochet-tiled` reads: this crate does no I/O.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TiledDef {
+    /// The map file as written, relative to the scenario file.
+    pub map: String,
+    /// World units per tile width (> 0).
+    pub units_per_tile: f64,
+    /// `solid` entries: `LAYER`, `LAYER?PROP` or `LAYER?PROP=VALUE`.
+    pub solid: Vec<String>,
+    /// `one_way` entries, same syntax.
+    pub one_way: Vec<String>,
+    /// The scenario layer the map's static bodies go to.
+    pub layer: LayerId,
+    /// Object class, type or name → template name (a template the scenario has).
+    pub spawn: BTreeMap<String, String>,
+}
+
 /// Rows of identical static bodies (a tile map's tiles): the `k`-th tile of a row starting
 /// at `start` is the body `BodyDef { name, layer, kind: Static, shape, position: start +
 /// step * k, ..BodyDef::default() }`. 24 bytes a row, however many tiles it holds.

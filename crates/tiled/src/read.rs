@@ -1,0 +1,144 @@
+//! Reading the files: each is at most [`MAX_FILE_BYTES`], JSON ones are converted to TMX text
+//! ([`crate::json`]), and compressed tile data is measured (decompressed into a counter, never
+//! kept) before the `tiled` crate decompresses it, so a small bomb cannot fill memory.
+
+use std::io::{Cursor, Read};
+use std::path::Path;
+
+use base64::Engine;
+
+use crate::{MAX_CELLS, MAX_FILE_BYTES, TiledError};
+
+/// Reads a map through the `tiled` crate, with the checks above on every file.
+pub(crate) fn load_map(path: &Path) -> Result<tiled::Map, TiledError> {
+    let file = path.display().to_string();
+    // Decompressed tile bytes of every file so far (maps and their templates).
+    let budget = std::cell::Cell::new(MAX_CELLS * 4);
+    let reader = |p: &Path| -> Result<Cursor<Vec<u8>>, std::io::Error> {
+        let text = read_file(p)?;
+        let json = matches!(
+            p.extension().and_then(|e| e.to_str()),
+            Some("json" | "tmj" | "tsj" | "tj")
+        );
+        let xml = if json {
+            crate::json::to_tmx(&text, p).map_err(std::io::Error::other)?
+        } else {
+            text
+        };
+        let used = compressed_sizes(&xml).map_err(std::io::Error::other)?;
+        if used > budget.get() {
+            return Err(std::io::Error::other(format!(
+                "its compressed tile data decompresses past {} bytes, {} cells' worth; \
+                 a map may cover at most {MAX_CELLS} cells",
+                MAX_CELLS * 4,
+                MAX_CELLS
+            )));
+        }
+        budget.set(budget.get() - used);
+        Ok(Cursor::new(xml.into_bytes()))
+    };
+    let mut loader = tiled::Loader::with_reader(reader);
+    loader.load_tmx_map(path).map_err(|e| TiledError {
+        file,
+        place: "reading".to_owned(),
+        problem: describe(&e),
+    })
+}
+
+/// The `tiled` crate's error, with its cause chain (the file it could not read and why).
+fn describe(e: &tiled::Error) -> String {
+    let mut s = e.to_string();
+    let mut src = std::error::Error::source(e);
+    while let Some(c) = src {
+        s.push_str(": ");
+        s.push_str(&c.to_string());
+        src = c.source();
+    }
+    s
+}
+
+fn read_file(p: &Path) -> Result<String, std::io::Error> {
+    let f = std::fs::File::open(p)?;
+    let mut text = String::new();
+    // One byte past the cap tells a file at the cap from a longer one.
+    f.take(MAX_FILE_BYTES + 1).read_to_string(&mut text)?;
+    if text.len() as u64 > MAX_FILE_BYTES {
+        return Err(std::io::Error::other(format!(
+            "longer than {MAX_FILE_BYTES} bytes, the most a map, tileset or template file may be"
+        )));
+    }
+    Ok(text)
+}
+
+/// The attribute `name` of the start tag `tag` (its text up to `>`), if written.
+fn attr<'a>(tag: &'a str, name: &str) -> Option<&'a str> {
+    let at = tag.find(&format!(" {name}=\""))? + name.len() + 3;
+    let rest = &tag[at..];
+    Some(&rest[..rest.find('"')?])
+}
+
+/// How many bytes every compressed `<data>` block (or each of its chunks) decompresses to,
+/// counted up to the budget and no further.
+fn compressed_sizes(xml: &str) -> Result<u64, String> {
+    let limit = MAX_CELLS * 4;
+    let mut total = 0u64;
+    let mut rest = xml;
+    while let Some(start) = rest.find("<data") {
+        rest = &rest[start..];
+        let Some(tag_end) = rest.find('>') else { break };
+        let tag = &rest[..tag_end];
+        let Some(end) = rest.find("</data>") else {
+            break;
+        };
+        let body = &rest[tag_end + 1..end];
+        rest = &rest[end..];
+        let Some(compression) = attr(tag, "compression") else {
+            continue;
+        };
+        // A finite layer's text, or each chunk's.
+        let mut blocks: Vec<&str> = Vec::new();
+        if body.contains("<chunk") {
+            let mut b = body;
+            while let Some(s) = b.find("<chunk") {
+                b = &b[s..];
+                let (Some(open), Some(close)) = (b.find('>'), b.find("</chunk>")) else {
+                    break;
+                };
+                blocks.push(&b[open + 1..close]);
+                b = &b[close..];
+            }
+        } else {
+            blocks.push(body);
+        }
+        for block in blocks {
+            let clean: String = block.chars().filter(|c| !c.is_whitespace()).collect();
+            let bytes = base64::engine::general_purpose::STANDARD
+                .decode(clean.as_bytes())
+                .map_err(|e| format!("tile data is not valid base64: {e}"))?;
+            let budget = limit.saturating_sub(total) + 1;
+            let n = match compression {
+                "zlib" => count(flate2::read::ZlibDecoder::new(&bytes[..]), budget),
+                "gzip" => count(flate2::read::GzDecoder::new(&bytes[..]), budget),
+                "zstd" => count(
+                    zstd::stream::read::Decoder::new(&bytes[..]).map_err(|e| e.to_string())?,
+                    budget,
+                ),
+                other => {
+                    return Err(format!(
+                        "tile data compression \"{other}\" is not one of zlib, gzip, zstd"
+                    ));
+                }
+            }
+            .map_err(|e| format!("tile data does not decompress ({compression}): {e}"))?;
+            total += n;
+            if total > limit {
+                return Ok(total);
+            }
+        }
+    }
+    Ok(total)
+}
+
+fn count(r: impl Read, budget: u64) -> std::io::Result<u64> {
+    std::io::copy(&mut r.take(budget), &mut std::io::sink())
+}
