@@ -145,10 +145,16 @@ fn properties(o: &Obj, out: &mut String) {
     }
     out.push_str("<properties>");
     for p in props {
+        // A bool property is `true`/`false` in TMX (elsewhere a flag is 1/0).
+        let value = match p.get("value") {
+            Some(Value::Bool(b)) => format!(" value=\"{b}\""),
+            Some(v) => format!(" value=\"{}\"", esc(&text(v))),
+            None => String::new(),
+        };
         let _ = write!(
             out,
-            "<property{}/>",
-            attrs(p, &[("name", "name"), ("type", "type"), ("value", "value")])
+            "<property{}{value}/>",
+            attrs(p, &[("name", "name"), ("type", "type")])
         );
     }
     out.push_str("</properties>");

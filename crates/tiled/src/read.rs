@@ -25,6 +25,7 @@ pub(crate) fn load_map(path: &Path) -> Result<tiled::Map, TiledError> {
         } else {
             text
         };
+        let xml = xml_tiles_to_csv(&xml);
         let used = compressed_sizes(&xml).map_err(std::io::Error::other)?;
         if used > budget.get() {
             return Err(std::io::Error::other(format!(
@@ -35,7 +36,7 @@ pub(crate) fn load_map(path: &Path) -> Result<tiled::Map, TiledError> {
             )));
         }
         budget.set(budget.get() - used);
-        Ok(Cursor::new(xml.into_bytes()))
+        Ok(Cursor::new(xml.into_owned().into_bytes()))
     };
     let mut loader = tiled::Loader::with_reader(reader);
     loader.load_tmx_map(path).map_err(|e| TiledError {
@@ -68,6 +69,55 @@ fn read_file(p: &Path) -> Result<String, std::io::Error> {
         )));
     }
     Ok(text)
+}
+
+/// The old XML tile data (`<data>` holding a `<tile gid="N"/>` per cell, the form Tiled wrote
+/// before CSV), which the `tiled` crate does not read, rewritten as the same cells in CSV.
+fn xml_tiles_to_csv(xml: &str) -> std::borrow::Cow<'_, str> {
+    if !xml.contains("<data") || !xml.contains("<tile") {
+        return xml.into();
+    }
+    let mut out = String::with_capacity(xml.len());
+    let mut rest = xml;
+    while let Some(start) = rest.find("<data") {
+        out.push_str(&rest[..start]);
+        rest = &rest[start..];
+        let (Some(tag_end), Some(end)) = (rest.find('>'), rest.find("</data>")) else {
+            break;
+        };
+        let tag = &rest[..tag_end];
+        if attr(tag, "encoding").is_some() || tag.ends_with('/') {
+            out.push_str(&rest[..end]);
+            rest = &rest[end..];
+            continue;
+        }
+        out.push_str(tag);
+        out.push_str(" encoding=\"csv\">");
+        let body = &rest[tag_end + 1..end];
+        // Each block of cells: the whole body, or each chunk's (its own tag kept).
+        let mut b = body;
+        let mut gids: Vec<&str> = Vec::new();
+        let flush = |gids: &mut Vec<&str>, out: &mut String| {
+            out.push_str(&gids.join(","));
+            gids.clear();
+        };
+        while let Some(t) = b.find('<') {
+            let Some(close) = b[t..].find('>') else { break };
+            let element = &b[t..t + close + 1];
+            if element.starts_with("<tile") {
+                gids.push(attr(element, "gid").unwrap_or("0"));
+            } else {
+                // A `<chunk ...>` or `</chunk>`: the cells so far end before it.
+                flush(&mut gids, &mut out);
+                out.push_str(element);
+            }
+            b = &b[t + close + 1..];
+        }
+        flush(&mut gids, &mut out);
+        rest = &rest[end..];
+    }
+    out.push_str(rest);
+    out.into()
 }
 
 /// The attribute `name` of the start tag `tag` (its text up to `>`), if written.

@@ -1,0 +1,284 @@
+//! `[tiled]`: maps in every form Tiled saves become static solids covering exactly the points
+//! the map's shapes cover (sampled, the answers computed here from the map's own numbers in
+//! pixels), and bad maps are located errors.
+
+mod errors;
+mod write;
+
+use std::path::Path;
+
+use ricochet_sim::{QueryFilter, Simulation, Vec2};
+use write::{Encoding, FLIP_D, FLIP_H, FLIP_V, H, Obj, TILE};
+
+/// A scenario taking its level from `map`, 1 unit a tile (10 px).
+pub fn scenario_text(map: &str, solid: &str, extra: &str) -> String {
+    format!(
+        "layers = [\"tile\", \"box\"]\n[tiled]\nmap = \"{map}\"\nsolid = {solid}\nlayer = \"tile\"\n{extra}\n\
+         [templates.box]\nlayer = \"box\"\nshape = {{ kind = \"circle\", radius = 0.2 }}\n"
+    )
+}
+
+/// Loads `dir/level.toml` as the binary does.
+pub fn load(dir: &Path) -> Result<(ricochet_sim::Scenario, ricochet_tiled::MapSummary), String> {
+    let path = dir.join("level.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let (mut s, def) = ricochet_sim::load_scenario_and_map(&text, &path.display().to_string())
+        .map_err(|e| e.to_string())?;
+    let summary = ricochet_tiled::add_map(&mut s, &def.expect("a [tiled] table"), &path)
+        .map_err(|e| e.to_string())?;
+    Ok((s, summary))
+}
+
+/// Whether tile-local pixel `(u, v)` (0..10, y down, before the flips) is in gid `g`'s shape.
+fn in_tile_shape(g: u32, u: f64, v: f64) -> bool {
+    match g {
+        1 => (0.0..=TILE).contains(&u) && (0.0..=TILE).contains(&v),
+        // Below the diagonal from (0, 10) to (10, 0).
+        2 => (0.0..=TILE).contains(&u) && (0.0..=TILE).contains(&v) && u + v >= TILE,
+        3 => (2.0..=8.0).contains(&u) && (4.0..=10.0).contains(&v),
+        _ => false,
+    }
+}
+
+/// Whether map pixel `(px, py)` is in the tile `bits` at cell `(cx, cy)`: the flips undone in
+/// the reverse of the order Tiled applies them (diagonal, then horizontal, then vertical).
+fn in_tile(cx: i32, cy: i32, bits: u32, px: f64, py: f64) -> bool {
+    let (mut u, mut v) = (px - f64::from(cx) * TILE, py - f64::from(cy) * TILE);
+    if bits & FLIP_V != 0 {
+        v = TILE - v;
+    }
+    if bits & FLIP_H != 0 {
+        u = TILE - u;
+    }
+    if bits & FLIP_D != 0 {
+        std::mem::swap(&mut u, &mut v);
+    }
+    in_tile_shape(bits & 0x0fff_ffff, u, v)
+}
+
+/// Even-odd rule.
+fn in_polygon(p: &[(f64, f64)], x: f64, y: f64) -> bool {
+    let mut inside = false;
+    for i in 0..p.len() {
+        let (a, b) = (p[i], p[(i + 1) % p.len()]);
+        if (a.1 > y) != (b.1 > y) && x < a.0 + (y - a.1) / (b.1 - a.1) * (b.0 - a.0) {
+            inside = !inside;
+        }
+    }
+    inside
+}
+
+/// Whether the object covers `(px, py)`: `Some(true)`/`Some(false)`, or `None` in an
+/// ellipse's stated tolerance band (inside the ellipse, outside its inscribed 32-gon).
+fn in_object(o: &Obj, px: f64, py: f64) -> Option<bool> {
+    Some(match o {
+        Obj::Rect { x, y, w, h, rot } => {
+            let r = -rot.to_radians();
+            let (dx, dy) = (px - x, py - y);
+            let (u, v) = (dx * r.cos() - dy * r.sin(), dx * r.sin() + dy * r.cos());
+            (0.0..=*w).contains(&u) && (0.0..=*h).contains(&v)
+        }
+        Obj::Ellipse { x, y, w, h } => {
+            let q = (((px - x - w / 2.0) / (w / 2.0)).powi(2)
+                + ((py - y - h / 2.0) / (h / 2.0)).powi(2))
+            .sqrt();
+            if w == h {
+                q <= 1.0
+            } else if q <= (std::f64::consts::PI / 32.0).cos() {
+                true
+            } else if q > 1.0 {
+                false
+            } else {
+                return None;
+            }
+        }
+        Obj::Polygon { x, y, points } => in_polygon(points, px - x, py - y),
+        Obj::Tile { x, y, w, h } => {
+            let (u, v) = ((px - x) * TILE / w, (py - (y - h)) * TILE / h);
+            in_tile_shape(2, u, v)
+        }
+    })
+}
+
+/// The map's answer at pixel `(px, py)` for its tiles moved by `(dx, dy)` cells, `None` near
+/// an edge (the answer changes within 0.02 px) or in an ellipse's tolerance band.
+fn expected(px: f64, py: f64, dx: i32, dy: i32) -> Option<bool> {
+    let at = |px: f64, py: f64| -> Option<bool> {
+        let tiles = write::tiles()
+            .iter()
+            .any(|&(x, y, g)| in_tile(x + dx, y + dy, g, px, py));
+        let mut any = tiles;
+        for o in write::objects() {
+            any |= in_object(&o, px, py)?;
+        }
+        Some(any)
+    };
+    let here = at(px, py)?;
+    for (ex, ey) in [(0.02, 0.0), (-0.02, 0.0), (0.0, 0.02), (0.0, -0.02)] {
+        if at(px + ex, py + ey)? != here {
+            return None;
+        }
+    }
+    Some(here)
+}
+
+/// Samples the map's area in pixels and compares each answer with the built scene; `dx, dy`
+/// as for [`expected`]. Returns how many points were compared.
+fn check_cover(dir: &Path, dx: i32, dy: i32) -> usize {
+    let (scenario, _) = load(dir).unwrap_or_else(|e| panic!("{e}"));
+    let sim = Simulation::new(&scenario);
+    // World = (px / 10, (H * 10 - py) / 10): 1 unit a tile, the map's bottom-left at 0.
+    let h_px = f64::from(H) * TILE;
+    let filter = QueryFilter::default();
+    let mut compared = 0;
+    let (x_lo, y_lo) = (
+        f64::from(dx.min(0)) * TILE - 5.0,
+        f64::from(dy.min(0)) * TILE - 5.0,
+    );
+    let mut py = y_lo + 0.013;
+    while py < h_px + 5.0 {
+        let mut px = x_lo + 0.017;
+        while px < 125.0 {
+            if let Some(want) = expected(px, py, dx, dy) {
+                let world = Vec2::new(px / TILE, (h_px - py) / TILE);
+                let got = !sim.overlap_point(world, &filter).is_empty();
+                assert_eq!(
+                    got,
+                    want,
+                    "{}: pixel ({px}, {py}), world {world}",
+                    dir.display()
+                );
+                compared += 1;
+            }
+            px += 0.7;
+        }
+        py += 0.7;
+    }
+    assert!(compared > 10_000, "{compared}");
+    compared
+}
+
+fn level(files: &[(&str, String)], map: &str) -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, text) in files {
+        std::fs::write(dir.path().join(name), text).unwrap();
+    }
+    std::fs::write(
+        dir.path().join("level.toml"),
+        scenario_text(map, "[\"Ground\", \"Shapes\"]", ""),
+    )
+    .unwrap();
+    dir
+}
+
+#[test]
+fn tmx_in_every_tile_encoding_covers_exactly_the_maps_shapes() {
+    let embedded = write::tileset_xml(" firstgid=\"1\"");
+    for enc in [
+        Encoding::Csv,
+        Encoding::Base64,
+        Encoding::Zlib,
+        Encoding::Gzip,
+        Encoding::Zstd,
+        Encoding::Xml,
+    ] {
+        let dir = level(&[("m.tmx", write::tmx(enc, &embedded, None))], "m.tmx");
+        check_cover(dir.path(), 0, 0);
+    }
+}
+
+#[test]
+fn tmx_with_an_external_tileset_and_a_template_covers_the_same() {
+    let tx = "<?xml version=\"1.0\"?><template><tileset firstgid=\"1\" source=\"t.tsx\"/>\
+              <object gid=\"2\" width=\"20\" height=\"20\"/></template>";
+    let dir = level(
+        &[
+            (
+                "m.tmx",
+                write::tmx(
+                    Encoding::Csv,
+                    "<tileset firstgid=\"1\" source=\"t.tsx\"/>",
+                    Some("o.tx"),
+                ),
+            ),
+            (
+                "t.tsx",
+                format!("<?xml version=\"1.0\"?>{}", write::tileset_xml("")),
+            ),
+            ("o.tx", tx.to_owned()),
+        ],
+        "m.tmx",
+    );
+    check_cover(dir.path(), 0, 0);
+}
+
+#[test]
+fn infinite_maps_with_negative_chunks_cover_the_moved_tiles() {
+    for enc in [Encoding::Csv, Encoding::Zlib] {
+        let dir = level(&[("m.tmx", write::infinite_tmx(enc, -5, -3))], "m.tmx");
+        check_cover(dir.path(), -5, -3);
+    }
+}
+
+#[test]
+fn tiled_json_maps_with_tsj_and_tj_cover_the_same() {
+    for zlib in [false, true] {
+        let dir = level(
+            &[
+                ("m.tmj", write::tmj(zlib)),
+                ("t.tsj", write::tsj()),
+                ("o.tj", write::tj()),
+            ],
+            "m.tmj",
+        );
+        check_cover(dir.path(), 0, 0);
+    }
+}
+
+#[test]
+fn whole_cell_tiles_become_tile_rows_and_spawns_become_bodies() {
+    let embedded = write::tileset_xml(" firstgid=\"1\"");
+    let mut tmx = write::tmx(Encoding::Csv, &embedded, None);
+    tmx = tmx.replace(
+        "</map>",
+        "<objectgroup name=\"Spawns\"><object id=\"50\" name=\"start\" type=\"player\" x=\"15\" y=\"35\"><point/></object>\
+         <object id=\"51\" name=\"coin\" x=\"40\" y=\"30\" width=\"10\" height=\"4\"/></objectgroup></map>",
+    );
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("m.tmx"), tmx).unwrap();
+    std::fs::write(
+        dir.path().join("level.toml"),
+        scenario_text(
+            "m.tmx",
+            "[\"Ground?solid\"]",
+            "[tiled.spawn]\nplayer = \"box\"\ncoin = \"box\"\n",
+        ),
+    )
+    .unwrap();
+    let (s, summary) = load(dir.path()).unwrap();
+    // `Ground?solid`: only gid 2's tiles (5 of them, the tileset marks them solid).
+    assert_eq!(summary.tiles, 5);
+    assert_eq!(summary.spawns.get("box"), Some(&2));
+    // The point at pixel (15, 35) → world (1.5, (80 - 35) / 10); the coin's centre (45, 32).
+    let at: Vec<Vec2> = s.bodies.iter().map(|b| b.position).collect();
+    assert_eq!(at.len(), 2);
+    for (got, want) in at.iter().zip([Vec2::new(1.5, 4.5), Vec2::new(4.5, 4.8)]) {
+        assert!((*got - want).length() < 1e-12, "{got} {want}");
+    }
+    // Without the filter, the 12 floor tiles make one row of one shape.
+    std::fs::write(
+        dir.path().join("level.toml"),
+        scenario_text("m.tmx", "[\"Ground\"]", ""),
+    )
+    .unwrap();
+    let (s, summary) = load(dir.path()).unwrap();
+    assert_eq!(summary.tiles, write::tiles().len());
+    let floor = s
+        .tiles
+        .iter()
+        .flat_map(|t| &t.rows)
+        .find(|&&(_, n)| n == 12)
+        .expect("the floor's run");
+    // Cell (0, 7)'s centre: pixel (5, 75) → world (0.5, (80 - 75) / 10).
+    assert_eq!(floor.0, Vec2::new(0.5, 0.5));
+}
