@@ -75,7 +75,10 @@ fn in_object(o: &Obj, px: f64, py: f64) -> Option<bool> {
         Obj::Rect { x, y, w, h, rot } => {
             let r = -rot.to_radians();
             let (dx, dy) = (px - x, py - y);
-            let (u, v) = (dx * r.cos() - dy * r.sin(), dx * r.sin() + dy * r.cos());
+            let (u, v) = (
+                dx * libm::cos(r) - dy * libm::sin(r),
+                dx * libm::sin(r) + dy * libm::cos(r),
+            );
             (0.0..=*w).contains(&u) && (0.0..=*h).contains(&v)
         }
         Obj::Ellipse { x, y, w, h } => {
@@ -84,7 +87,7 @@ fn in_object(o: &Obj, px: f64, py: f64) -> Option<bool> {
             .sqrt();
             if w == h {
                 q <= 1.0
-            } else if q <= (std::f64::consts::PI / 32.0).cos() {
+            } else if q <= libm::cos(std::f64::consts::PI / 32.0) {
                 true
             } else if q > 1.0 {
                 false
@@ -281,4 +284,22 @@ fn whole_cell_tiles_become_tile_rows_and_spawns_become_bodies() {
         .expect("the floor's run");
     // Cell (0, 7)'s centre: pixel (5, 75) → world (0.5, (80 - 75) / 10).
     assert_eq!(floor.0, Vec2::new(0.5, 0.5));
+}
+
+/// The shipped level: `ricochet check` says what its map became, counted from the map file
+/// (`scenarios/tiled/maps/level1.tmx`: a 20-tile floor, a 4-tile ledge, a slope tile and a
+/// 5-tile raised floor; a ramp and a boulder; three coins, an enemy and the player).
+#[test]
+fn check_summarises_the_shipped_tiled_level() {
+    let level = crate::util::root().join("scenarios/tiled/tiled_level.toml");
+    let o = crate::util::ricochet(&["check", level.to_str().unwrap()], b"");
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        out.contains(
+            "tiled map: 30 static tiles, 2 solid bodies, 0 one-way pieces, 0 chains, \
+             spawns: 3 coin, 1 enemy, 1 player"
+        ),
+        "{out}"
+    );
 }

@@ -118,6 +118,10 @@ fn map(o: &Obj, out: &mut String) -> Result<(), String> {
     if !o.contains_key("orientation") {
         a.push_str(" orientation=\"orthogonal\"");
     }
+    // The `tiled` crate requires a version; Tiled always writes one, a generator may not.
+    if !o.contains_key("version") {
+        a.push_str(" version=\"1.10\"");
+    }
     let _ = write!(out, "<map{a}>");
     properties(o, out);
     for t in array(o, "tilesets") {

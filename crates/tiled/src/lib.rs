@@ -33,6 +33,7 @@ mod build;
 pub mod json;
 mod read;
 mod shapes;
+mod tiles;
 
 use std::collections::BTreeMap;
 use std::path::Path;
