@@ -146,3 +146,21 @@ fn the_plain_loader_refuses_a_tiled_scenario_rather_than_drop_its_level() {
     assert_eq!((e.line, e.field.as_str()), (2, "tiled"));
     assert!(e.problem.contains("ricochet_tiled::add_map"), "{e}");
 }
+
+#[test]
+fn a_tile_of_no_tileset_is_named_not_dropped() {
+    // The tileset starts at gid 5: the map's gids 1 to 4 have none, in every encoding.
+    for enc in [Encoding::Csv, Encoding::Zlib, Encoding::Xml] {
+        let map = tmx(enc, &tileset_xml(" firstgid=\"5\""), None);
+        let got = check(&[("m.tmx", map)], "[\"Ground\"]", "");
+        // Row 4 (y = 4) holds the first tile in reading order: cell (3, 4), gid 1.
+        assert_error(
+            got,
+            &[
+                "m.tmx",
+                "layer \"Ground\", tile (3, 4): gid 1 has no tileset",
+                "starts at gid 5",
+            ],
+        );
+    }
+}

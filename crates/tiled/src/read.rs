@@ -27,6 +27,7 @@ pub(crate) fn load_map(path: &Path) -> Result<tiled::Map, TiledError> {
         };
         let xml = xml_tiles_to_csv(&xml);
         let used = compressed_sizes(&xml).map_err(std::io::Error::other)?;
+        gids_without_tileset(&xml).map_err(std::io::Error::other)?;
         if used > budget.get() {
             return Err(std::io::Error::other(format!(
                 "its compressed tile data decompresses past {} bytes, {} cells' worth; \
@@ -191,4 +192,121 @@ fn compressed_sizes(xml: &str) -> Result<u64, String> {
 
 fn count(r: impl Read, budget: u64) -> std::io::Result<u64> {
     std::io::copy(&mut r.take(budget), &mut std::io::sink())
+}
+
+/// A tile whose gid is below every tileset's `firstgid` (or in a map with no tileset) has no
+/// tileset: the `tiled` crate drops such a cell silently, so it is refused here, naming its
+/// layer and cell. Maps whose first tileset starts at gid 1 (Tiled's own) are not scanned.
+fn gids_without_tileset(xml: &str) -> Result<(), String> {
+    if !xml.contains("<map") {
+        return Ok(());
+    }
+    let mut first = u32::MAX;
+    let mut rest = xml;
+    while let Some(at) = rest.find("<tileset") {
+        rest = &rest[at + 8..];
+        let tag = &rest[..rest.find('>').unwrap_or(rest.len())];
+        if let Some(g) = attr(tag, "firstgid").and_then(|g| g.parse::<u32>().ok()) {
+            first = first.min(g);
+        }
+    }
+    if first <= 1 {
+        return Ok(());
+    }
+    let mut rest = xml;
+    while let Some(at) = rest.find("<layer") {
+        rest = &rest[at..];
+        let Some(tag_end) = rest.find('>') else { break };
+        let name = attr(&rest[..tag_end], "name").unwrap_or("").to_owned();
+        let width: i64 = attr(&rest[..tag_end], "width")
+            .and_then(|w| w.parse().ok())
+            .unwrap_or(1);
+        let (Some(d), Some(end)) = (rest.find("<data"), rest.find("</data>")) else {
+            break;
+        };
+        let data = &rest[d..end];
+        rest = &rest[end..];
+        let Some(dt) = data.find('>') else { continue };
+        let (tag, body) = (&data[..dt], &data[dt + 1..]);
+        // Each block: its top-left cell, its width, its text.
+        let mut blocks: Vec<(i64, i64, i64, &str)> = Vec::new();
+        if body.contains("<chunk") {
+            let mut b = body;
+            while let Some(c) = b.find("<chunk") {
+                b = &b[c..];
+                let (Some(open), Some(close)) = (b.find('>'), b.find("</chunk>")) else {
+                    break;
+                };
+                let ct = &b[..open];
+                let num = |k: &str| attr(ct, k).and_then(|v| v.parse::<i64>().ok()).unwrap_or(0);
+                blocks.push((num("x"), num("y"), num("width").max(1), &b[open + 1..close]));
+                b = &b[close..];
+            }
+        } else {
+            blocks.push((0, 0, width.max(1), body));
+        }
+        for (x0, y0, w, text) in blocks {
+            let gids = decode_gids(tag, text)?;
+            if let Some(k) = gids
+                .iter()
+                .position(|&g| g & 0x0fff_ffff != 0 && g & 0x0fff_ffff < first)
+            {
+                let k = k as i64;
+                return Err(format!(
+                    "layer \"{name}\", tile ({}, {}): gid {} has no tileset (the first starts at gid \
+                     {}); add its tileset to the map, or clear the tile",
+                    x0 + k % w,
+                    y0 + k / w,
+                    gids[k as usize] & 0x0fff_ffff,
+                    if first == u32::MAX {
+                        "none: the map has no tileset".to_owned()
+                    } else {
+                        first.to_string()
+                    }
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// One block of tile data as gids (CSV, or base64 plain or compressed; sizes already
+/// bounded by [`compressed_sizes`]).
+fn decode_gids(tag: &str, text: &str) -> Result<Vec<u32>, String> {
+    if attr(tag, "encoding") == Some("csv") {
+        return Ok(text
+            .split(',')
+            .filter_map(|v| v.trim().parse::<u32>().ok())
+            .collect());
+    }
+    let clean: String = text.chars().filter(|c| !c.is_whitespace()).collect();
+    let bytes = base64::engine::general_purpose::STANDARD
+        .decode(clean.as_bytes())
+        .map_err(|e| format!("tile data is not valid base64: {e}"))?;
+    let mut raw = Vec::new();
+    let limit = MAX_CELLS * 4;
+    let read = match attr(tag, "compression") {
+        None => {
+            raw = bytes.clone();
+            Ok(0)
+        }
+        Some("zlib") => flate2::read::ZlibDecoder::new(&bytes[..])
+            .take(limit)
+            .read_to_end(&mut raw),
+        Some("gzip") => flate2::read::GzDecoder::new(&bytes[..])
+            .take(limit)
+            .read_to_end(&mut raw),
+        Some("zstd") => zstd::stream::read::Decoder::new(&bytes[..])
+            .and_then(|d| d.take(limit).read_to_end(&mut raw)),
+        Some(other) => {
+            return Err(format!(
+                "tile data compression \"{other}\" is not one of zlib, gzip, zstd"
+            ));
+        }
+    };
+    read.map_err(|e| format!("tile data does not decompress: {e}"))?;
+    Ok(raw
+        .chunks_exact(4)
+        .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        .collect())
 }
