@@ -164,3 +164,54 @@ fn a_tile_of_no_tileset_is_named_not_dropped() {
         );
     }
 }
+
+/// The scenario's `[tiled]` table is checked with the scenario, located in its file.
+#[test]
+fn a_bad_tiled_table_is_located_in_the_scenario() {
+    let dir = tempfile::tempdir().unwrap();
+    let level = dir.path().join("level.toml");
+    for (solid, extra, wants) in [
+        (
+            "[\"Ground?\"]",
+            "",
+            &["level.toml:4:10:", "tiled.solid[0]", "LAYER?PROP=VALUE"][..],
+        ),
+        (
+            "[\"Ground\"]",
+            "units_per_tile = -1\n",
+            &["level.toml:6:", "tiled.units_per_tile", "above 0"][..],
+        ),
+        (
+            "[\"Ground\"]",
+            "[tiled.spawn]\nhero = \"nobody\"\n",
+            &["tiled.spawn.hero", "unknown template \"nobody\""][..],
+        ),
+        (
+            "[\"Ground\"]",
+            "colour = 1\n",
+            &["level.toml:6:", "unknown field `colour`"][..],
+        ),
+    ] {
+        std::fs::write(&level, super::scenario_text("m.tmx", solid, extra)).unwrap();
+        let o = crate::util::ricochet(&["check", level.to_str().unwrap()], b"");
+        assert_error(
+            (
+                o.status.code(),
+                String::from_utf8_lossy(&o.stderr).into_owned(),
+            ),
+            wants,
+        );
+    }
+    // The scenario layer the map's bodies go to must exist.
+    let text = super::scenario_text("m.tmx", "[\"Ground\"]", "")
+        .replace("layer = \"tile\"", "layer = \"floor\"");
+    std::fs::write(&level, text).unwrap();
+    let o = crate::util::ricochet(&["check", level.to_str().unwrap()], b"");
+    assert_error(
+        (
+            o.status.code(),
+            String::from_utf8_lossy(&o.stderr).into_owned(),
+        ),
+        &["tiled.layer", "unknown layer \"floor\""],
+    );
+}
