@@ -162,15 +162,15 @@ fn check_cover(dir: &Path, dx: i32, dy: i32) -> usize {
 }
 
 fn level(files: &[(&str, String)], map: &str) -> tempfile::TempDir {
+    level_with(files, map, "[\"Ground\", \"Shapes\"]")
+}
+
+fn level_with(files: &[(&str, String)], map: &str, solid: &str) -> tempfile::TempDir {
     let dir = tempfile::tempdir().unwrap();
     for (name, text) in files {
         std::fs::write(dir.path().join(name), text).unwrap();
     }
-    std::fs::write(
-        dir.path().join("level.toml"),
-        scenario_text(map, "[\"Ground\", \"Shapes\"]", ""),
-    )
-    .unwrap();
+    std::fs::write(dir.path().join("level.toml"), scenario_text(map, solid, "")).unwrap();
     dir
 }
 
@@ -302,4 +302,17 @@ fn check_summarises_the_shipped_tiled_level() {
         ),
         "{out}"
     );
+}
+
+/// A group named in `solid` takes every layer in it, offsets added (the group's and its
+/// layers'): here the group moves its layers back by the offset its tile layer adds.
+#[test]
+fn a_group_named_in_solid_takes_its_layers_with_their_offsets() {
+    let embedded = write::tileset_xml(" firstgid=\"1\"");
+    let tmx = write::tmx(Encoding::Csv, &embedded, None)
+        .replacen("<layer id=\"1\"", "<group name=\"Level\" offsetx=\"-3\" offsety=\"2\"><layer offsetx=\"3\" offsety=\"-2\" id=\"1\"", 1)
+        .replacen("<objectgroup id=\"2\" name=\"Shapes\">", "<objectgroup id=\"2\" name=\"Shapes\" offsetx=\"3\" offsety=\"-2\">", 1)
+        .replacen("</map>", "</group></map>", 1);
+    let dir = level_with(&[("m.tmx", tmx)], "m.tmx", "[\"Level\"]");
+    check_cover(dir.path(), 0, 0);
 }

@@ -23,7 +23,8 @@ pub struct Scenario {
     /// Body prototypes by name.
     pub templates: BTreeMap<String, BodyDef>,
     /// Static tiles at frame 0, spawned first (ids from 0 on), in order: a level's tiles
-    /// as a few numbers per row instead of a [`BodyDef`] each. Scenario files have none.
+    /// as a few numbers per row instead of a [`BodyDef`] each. A scenario file's come from its
+    /// Tiled map (`[tiled]`), added by `ricochet-tiled`.
     pub tiles: Vec<TileRows>,
     /// Bodies at frame 0, in file order (which is their id order), after the tiles.
     pub bodies: Vec<BodyDef>,

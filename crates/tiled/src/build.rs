@@ -363,6 +363,7 @@ pub(crate) fn build(
             layer,
             (0.0, 0.0),
             &mut entries,
+            &[],
             &mut built,
             &mut names,
         )?;
@@ -389,6 +390,7 @@ fn walk(
     layer: tiled::Layer<'_>,
     offset: (f64, f64),
     entries: &mut [Entry],
+    inherited: &[usize],
     built: &mut Built,
     names: &mut Vec<String>,
 ) -> Result<(), TiledError> {
@@ -402,12 +404,15 @@ fn walk(
             e.used = true;
         }
     }
-    let mine: Vec<&Entry> = entries.iter().filter(|e| e.layer == layer.name).collect();
+    // This layer's entries: those naming it, and those naming a group it is in.
+    let mut mine_idx: Vec<usize> = inherited.to_vec();
+    mine_idx.extend((0..entries.len()).filter(|&i| entries[i].layer == layer.name));
+    let mine: Vec<&Entry> = mine_idx.iter().map(|&i| &entries[i]).collect();
     let place = format!("layer \"{}\"", layer.name);
     match layer.layer_type() {
         LayerType::Group(g) => {
             for child in g.layers() {
-                walk(ctx, child, offset, entries, built, names)?;
+                walk(ctx, child, offset, entries, &mine_idx, built, names)?;
             }
         }
         LayerType::Objects(objects) => {

@@ -52,8 +52,12 @@ fn describe(e: &tiled::Error) -> String {
     let mut s = e.to_string();
     let mut src = std::error::Error::source(e);
     while let Some(c) = src {
-        s.push_str(": ");
-        s.push_str(&c.to_string());
+        // The crate's messages often quote their cause already.
+        let cause = c.to_string();
+        if !s.contains(&cause) {
+            s.push_str(": ");
+            s.push_str(&cause);
+        }
         src = c.source();
     }
     s
