@@ -316,3 +316,45 @@ fn a_group_named_in_solid_takes_its_layers_with_their_offsets() {
     let dir = level_with(&[("m.tmx", tmx)], "m.tmx", "[\"Level\"]");
     check_cover(dir.path(), 0, 0);
 }
+
+/// Object filters: class/type, name, and a property read from the object, then its template,
+/// then its tile's tileset entry (gid 2's says `solid = true`).
+#[test]
+fn object_filters_read_the_object_then_its_template_then_its_tile() {
+    let props = |v: &str| {
+        format!("<properties><property name=\"solid\" type=\"bool\" value=\"{v}\"/></properties>")
+    };
+    let objects = format!(
+        "<object id=\"1\" type=\"Boundaries\" x=\"0\" y=\"0\" width=\"5\" height=\"5\"/>\
+         <object id=\"2\" x=\"10\" y=\"0\" width=\"5\" height=\"5\">{}</object>\
+         <object id=\"3\" template=\"w.tx\" x=\"20\" y=\"0\"/>\
+         <object id=\"4\" gid=\"2\" x=\"30\" y=\"10\" width=\"10\" height=\"10\"/>\
+         <object id=\"5\" x=\"40\" y=\"0\" width=\"5\" height=\"5\">{}</object>\
+         <object id=\"6\" name=\"edge\" x=\"50\" y=\"0\" width=\"5\" height=\"5\"/>\
+         <object id=\"7\" template=\"w.tx\" x=\"60\" y=\"0\">{}</object>\
+         <object id=\"8\" gid=\"1\" x=\"70\" y=\"10\" width=\"10\" height=\"10\"/>",
+        props("true"),
+        props("false"),
+        props("false"),
+    );
+    let map = format!(
+        "<?xml version=\"1.0\"?><map version=\"1.10\" orientation=\"orthogonal\" width=\"10\" height=\"4\" \
+         tilewidth=\"10\" tileheight=\"10\">{}<objectgroup name=\"Objs\">{objects}</objectgroup></map>",
+        write::tileset_xml(" firstgid=\"1\"")
+    );
+    let tx = format!(
+        "<?xml version=\"1.0\"?><template><object width=\"5\" height=\"5\">{}</object></template>",
+        props("true")
+    );
+    let dir = level_with(
+        &[("m.tmx", map), ("w.tx", tx)],
+        "m.tmx",
+        "[\"Objs?type=Boundaries\", \"Objs?solid\", \"Objs?name=edge\"]",
+    );
+    let (s, summary) = load(dir.path()).unwrap();
+    // 1 (type), 2 (its own property), 3 (its template's), 4 (its tile's), 6 (name); not 5
+    // (false), 7 (its own false over its template's true), 8 (gid 1 has no property).
+    assert_eq!(summary.solids, 5);
+    let xs: Vec<f64> = s.bodies.iter().map(|b| b.position.x).collect();
+    assert_eq!(xs, [0.25, 1.25, 2.25, 3.5, 5.25]);
+}
