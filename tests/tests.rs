@@ -31,6 +31,7 @@ mod suite_files;
 mod suite_hardening;
 mod sweep_cli;
 mod threads;
+mod tiled;
 mod touch_log;
 mod util;
 mod validate_cli;
