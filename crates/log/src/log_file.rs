@@ -6,6 +6,8 @@ use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::{BufReader, Read, Seek, SeekFrom};
 use std::path::Path;
+use std::sync::mpsc::{self, Receiver, SyncSender};
+use std::thread::JoinHandle;
 
 use mcap::McapError;
 use mcap::read::Summary;
@@ -299,18 +301,29 @@ impl LogFile {
             Source::File(p) => p,
             Source::Copy(t) => t,
         };
-        let file = File::open(from).map_err(|source| LogError::Read {
+        let read_error = |source| LogError::Read {
             path: self.path.clone(),
             source,
-        })?;
+        };
+        let file = File::open(from).map_err(read_error)?;
         let options = LinearReaderOptions::default()
             .with_prevalidate_chunk_crcs(true)
             .with_validate_data_section_crc(true)
             .with_validate_summary_section_crc(true)
             .with_check_finishes_after_end_magic(true)
             .with_record_length_limit(RECORD_LIMIT);
+        let reader = mcap::io::MessageReader::new_with_options(BufReader::new(file), options);
+        // Reading (decompressing and checking the CRCs) is most of the work of comparing
+        // two logs byte for byte: each log is read on a thread of its own, a few messages
+        // ahead of its reader, so two logs are read at the same time on two cores.
+        let (sender, incoming) = mpsc::sync_channel(AHEAD);
+        let reading = std::thread::Builder::new()
+            .name("log reader".to_owned())
+            .spawn(move || read_ahead(reader, &sender))
+            .map_err(read_error)?;
         Ok(Messages {
-            reader: mcap::io::MessageReader::new_with_options(BufReader::new(file), options),
+            incoming: Some(incoming),
+            reading: Some(reading),
             topic,
             path: self.path.clone(),
             expected: self
@@ -324,6 +337,35 @@ impl LogFile {
             decoder: Decoder::default(),
         })
     }
+}
+
+/// How many messages a log's reading thread may have read that [`Messages`] has not yet
+/// taken: memory stays flat (at most this many messages, and the chunk being read).
+const AHEAD: usize = 4;
+
+/// What a log's reading thread hands over, in file order.
+enum Ahead {
+    Message(mcap::Message<'static>),
+    /// The reader's error: nothing follows it.
+    Failed(McapError),
+    /// The last record was read.
+    End,
+}
+
+/// The body of a log's reading thread: every message in turn, until the end, an error, or
+/// [`Messages`] is dropped (the send then fails).
+fn read_ahead(reader: mcap::io::MessageReader<BufReader<File>>, sender: &SyncSender<Ahead>) {
+    for message in reader {
+        let (item, last) = match message {
+            Ok(m) => (Ahead::Message(m), false),
+            Err(e) => (Ahead::Failed(e), true),
+        };
+        if sender.send(item).is_err() || last {
+            return;
+        }
+    }
+    // Nobody may be left to receive it: that is fine.
+    let _ = sender.send(Ahead::End);
 }
 
 /// Where a [`LogFile`]'s messages are read from.
@@ -340,7 +382,10 @@ enum Source {
 /// the summary's and the message counts against the statistics at the end.
 /// After an error it yields nothing more.
 pub struct Messages {
-    reader: mcap::io::MessageReader<BufReader<File>>,
+    /// The messages the reading thread has read, `None` once dropped.
+    incoming: Option<Receiver<Ahead>>,
+    /// The reading thread, joined when this is dropped.
+    reading: Option<JoinHandle<()>>,
     topic: Option<String>,
     path: std::path::PathBuf,
     expected: BTreeMap<u16, u64>,
@@ -359,7 +404,20 @@ impl Messages {
     /// decoded: to compare payloads byte for byte before decoding them.
     pub fn next_raw(&mut self) -> Option<Result<RawMessage, LogError>> {
         while !self.done {
-            let Some(message) = self.reader.next() else {
+            let received = self.incoming.as_ref().map(Receiver::recv);
+            let message = match received {
+                Some(Ok(Ahead::Message(m))) => Some(Ok(m)),
+                Some(Ok(Ahead::Failed(e))) => Some(Err(e)),
+                Some(Ok(Ahead::End)) => None,
+                // The thread ended without saying why (it panicked): not a log's fault.
+                _ => {
+                    return self.fail(LogError::Read {
+                        path: self.path.clone(),
+                        source: std::io::Error::other("the thread reading it stopped"),
+                    });
+                }
+            };
+            let Some(message) = message else {
                 self.done = true;
                 if self.counts != self.expected {
                     return self.fail(corrupt(&format!(
@@ -386,8 +444,10 @@ impl Messages {
         None
     }
 
-    /// Checks that a message [`next_raw`](Self::next_raw) yielded decodes with its channel's
-    /// schema, without building its JSON (a corrupt log's error if not).
+    /// Checks that the top level of a message [`next_raw`](Self::next_raw) yielded decodes
+    /// with its channel's schema (a corrupt log's error if not), without decoding the
+    /// messages nested in it: cheap enough for every message, where decoding a big message
+    /// whole costs more than reading it.
     pub fn check(&mut self, raw: &RawMessage) -> Result<(), LogError> {
         self.decoder.check(&raw.inner).map_err(|error| {
             self.done = true;
@@ -404,6 +464,16 @@ impl Messages {
             self.done = true;
             at(&self.path)(e)
         })
+    }
+}
+
+impl Drop for Messages {
+    fn drop(&mut self) {
+        // Dropping the receiver first wakes the thread if it waits to send, and it ends.
+        self.incoming = None;
+        if let Some(reading) = self.reading.take() {
+            let _ = reading.join();
+        }
     }
 }
 
