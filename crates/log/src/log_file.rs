@@ -75,6 +75,8 @@ pub struct LogFile {
     total: u64,
     /// The attachments: name, offset and length of the record (opcode and length included).
     attachments: Vec<(String, u64, u64)>,
+    /// Where its summary starts: what is before it is the header and the data section.
+    summary_start: u64,
 }
 
 impl LogFile {
@@ -220,6 +222,7 @@ impl LogFile {
             library,
             channels,
             total: stats.message_count,
+            summary_start: footer.summary_start,
         })
     }
 
@@ -268,6 +271,52 @@ impl LogFile {
                 "attachment {name}: no attachment record where the index points"
             )))),
         }
+    }
+
+    /// Whether `other` holds the same messages on the same channels as this log because it
+    /// holds the same bytes: the same channels in its summary (ids, topics, schemas, message
+    /// counts), and the same bytes from its start to its summary (magic, header, and the
+    /// whole data section: its chunks, with their CRCs, and the data section's CRC). Reading
+    /// this log's messages then checks both (two logs compared with themselves, or a golden
+    /// log with a fresh recording that matches it, are read once). Reads both files in blocks,
+    /// up to the first byte that differs.
+    pub(crate) fn same_data(&self, other: &LogFile) -> Result<bool, LogError> {
+        if self.channels != other.channels || self.summary_start != other.summary_start {
+            return Ok(false);
+        }
+        let (mut fa, mut fb) = (self.open_source()?, other.open_source()?);
+        let error_a = |source| LogError::Read {
+            path: self.path.clone(),
+            source,
+        };
+        let error_b = |source| LogError::Read {
+            path: other.path.clone(),
+            source,
+        };
+        let mut left = self.summary_start;
+        let (mut ba, mut bb) = (vec![0; 1 << 20], vec![0; 1 << 20]);
+        while left > 0 {
+            let n = left.min(ba.len() as u64) as usize;
+            fa.read_exact(&mut ba[..n]).map_err(error_a)?;
+            fb.read_exact(&mut bb[..n]).map_err(error_b)?;
+            if ba[..n] != bb[..n] {
+                return Ok(false);
+            }
+            left -= n as u64;
+        }
+        Ok(true)
+    }
+
+    /// The file its data is read from: itself, or the copy of what a pipe held.
+    fn open_source(&self) -> Result<File, LogError> {
+        let from: &Path = match &self.source {
+            Source::File(p) => p,
+            Source::Copy(t) => t,
+        };
+        File::open(from).map_err(|source| LogError::Read {
+            path: self.path.clone(),
+            source,
+        })
     }
 
     /// The `library` its header names as the writer (`ricochet 0.1.0`).
@@ -523,5 +572,51 @@ fn read_library(file: &mut File, len: u64) -> Result<String, LogError> {
     match mcap::parse_record(mcap::records::op::HEADER, &data) {
         Ok(mcap::records::Record::Header(header)) => Ok(header.library),
         _ => Err(no_header()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A log of `payloads` on one `/stats` channel (their content does not matter here).
+    fn write(path: &Path, payloads: &[&[u8]]) -> LogFile {
+        let mut w = mcap::WriteOptions::new()
+            .library("ricochet test")
+            .create(std::io::BufWriter::new(File::create(path).unwrap()))
+            .unwrap();
+        let schema = crate::Schema::ricochet("ricochet.Stats");
+        let sid = w
+            .add_schema(&schema.name, &schema.encoding, &schema.data)
+            .unwrap();
+        let ch = w
+            .add_channel(sid, "/stats", "protobuf", &Default::default())
+            .unwrap();
+        for (i, payload) in payloads.iter().enumerate() {
+            let header = mcap::records::MessageHeader {
+                channel_id: ch,
+                sequence: i as u32,
+                log_time: i as u64,
+                publish_time: i as u64,
+            };
+            w.write_to_known_channel(&header, payload).unwrap();
+        }
+        w.finish().unwrap();
+        LogFile::open(path).unwrap()
+    }
+
+    #[test]
+    fn same_data_is_the_same_channels_and_bytes_up_to_the_summary() {
+        let dir = tempfile::tempdir().unwrap();
+        let at = |name: &str| dir.path().join(name);
+        let a = write(&at("a"), &[b"\x08\x01", b"\x08\x02"]);
+        let same = write(&at("same"), &[b"\x08\x01", b"\x08\x02"]);
+        // One byte of one message differs: the same channels, other bytes.
+        let other = write(&at("other"), &[b"\x08\x01", b"\x08\x03"]);
+        // One message fewer: other counts in the summary.
+        let fewer = write(&at("fewer"), &[b"\x08\x01"]);
+        assert!(a.same_data(&same).unwrap() && same.same_data(&a).unwrap());
+        assert!(!a.same_data(&other).unwrap() && !other.same_data(&a).unwrap());
+        assert!(!a.same_data(&fewer).unwrap() && !fewer.same_data(&a).unwrap());
     }
 }
