@@ -1,8 +1,9 @@
-//! Two logs compared message by message, decoded, so chunking and compression never matter
-//! (`ricochet diff A.mcap B.mcap`, and golden checks): the first divergent frame, topic, body
-//! and field with both values, then how many messages differ per topic. Both logs are
-//! streamed, one topic at a time and one message at a time: memory does not grow with their
-//! length.
+//! Two logs compared message by message, so chunking and compression never matter (`ricochet
+//! diff A.mcap B.mcap`, and golden checks): the first divergent frame, topic, body and field
+//! with both values, then how many messages differ per topic. Equal bytes under the same
+//! valid schema are equal messages (their top level checked); only messages that differ are
+//! decoded and compared field by field. Both logs are streamed, each read on a thread of its
+//! own, one message at a time: memory does not grow with their length.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
