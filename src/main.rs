@@ -181,10 +181,14 @@ enum Command {
     },
     /// Compare two logs frame by frame and name the first difference.
     ///
-    /// Messages are decoded and compared field by field, so compression and chunking don't
-    /// matter. Prints the first divergent frame, topic, body and field with both values, then
-    /// how many messages differ per topic. Both logs are streamed, so memory does not grow
-    /// with their length. Exit code: 0 equal (within --tolerance), 1 they differ, 2 they
+    /// Messages are compared one by one, so compression and chunking don't matter: equal
+    /// bytes under the same schema are equal (schemas are compared and checked once per
+    /// channel, each message's top level is checked), messages that differ are decoded and
+    /// compared field by field. Prints the first divergent frame, topic, body and field with
+    /// both values as soon as it is found, then, when both logs have been read, how many
+    /// messages differ per topic (a log found damaged after the first difference is still an
+    /// error, exit code 2). Both logs are streamed, each read on a thread of its own, so
+    /// memory does not grow with their length. Exit code: 0 equal (within --tolerance), 1 they differ, 2 they
     /// can't be compared: a file is unreadable, truncated or damaged (chunk, data or summary
     /// CRC), not a Ricochet log, or --topic names a topic neither log has.
     ///
