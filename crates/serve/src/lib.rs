@@ -31,11 +31,18 @@ mod load_path;
 mod protocol;
 mod query;
 mod realtime;
+mod room;
+mod rooms;
+mod scenario_rooms;
 mod server;
 mod services;
 mod serving;
 
+pub use hub::{CLIENT_BUDGET, RECORDED_INPUT};
 pub use load_path::MAX_SCENARIO_BYTES;
 pub use realtime::{
     DEFAULT_BIND, Listener, Note, Options, SPEEDS, ServeError, Served, cpu_seconds, serve,
 };
+pub use rooms::{MAX_ROOM_INPUTS, MAX_THREADS, RoomMaker, RoomOptions, ServedRooms, serve_rooms};
+pub use scenario_rooms::ScenarioRooms;
+pub use server::{MAX_CLIENTS, MAX_ROOM_NAME};
