@@ -635,8 +635,13 @@ fn ricochet_serve_hosts_rooms_of_its_scenario_beside_the_plain_url() {
         .await;
         let (_, _, payload) = next_data(&mut ws).await;
         assert!(!payload.is_empty());
-        // The plain URL is today's server.
-        let (_plain, _) = connect(&server.url, "foxglove.websocket.v1").await.unwrap();
+        // The plain URL is today's server, and lists the rooms too.
+        let (mut plain, _, plain_services) = enter(&server.url).await;
+        let listed = call(&mut plain, &plain_services, "/rooms", 1, "{}")
+            .await
+            .unwrap();
+        assert_eq!(listed["rooms"][0]["name"], "lobby");
+        assert_eq!(listed["rooms"][0]["clients"], 1);
     });
     let status = terminate(&mut server, Duration::from_secs(10));
     assert!(status.success());

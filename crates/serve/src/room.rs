@@ -170,7 +170,7 @@ impl<G: Game> Room<G> {
         let frame = session.next_frame();
         catch_unwind(AssertUnwindSafe(|| f(session))).map_err(|payload| {
             Closing::Failed(format!(
-                "room {}: its game panicked in {what} before frame {frame}: {}",
+                "room {}: its game panicked in {what} at frame {frame}: {}",
                 self.name,
                 panic_text(payload.as_ref())
             ))

@@ -368,6 +368,10 @@ impl<M: RoomMaker> Door for Registry<M> {
     fn left(&self, _hub: &Hub, _client: u64) {
         self.clients.fetch_sub(1, Ordering::AcqRel);
     }
+
+    fn rooms_call(&self, payload: &[u8]) -> Result<String, String> {
+        Registry::rooms_call(self, payload)
+    }
 }
 
 /// The longest a worker sleeps before it looks at its rooms' clients again.

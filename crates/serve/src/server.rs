@@ -72,7 +72,13 @@ pub trait Door: Send + Sync {
     fn enter(&self, name: &str, queue: ClientQueue) -> Result<Entered, String>;
     /// The client left room `hub`.
     fn left(&self, hub: &Hub, client: u64);
+    /// `/rooms`: the rooms (making the one asked for), as JSON, or why not.
+    fn rooms_call(&self, payload: &[u8]) -> Result<String, String>;
 }
+
+/// `/rooms`' id on the plain URL, after the plain server's eight services (on a room's
+/// connection it is 3).
+pub const PLAIN_ROOMS: u32 = 9;
 
 /// A client admitted into a room.
 pub struct Entered {
@@ -260,7 +266,7 @@ async fn client(
             Ok(e) => (Ok((e.hub, e.id, e.kicked, e.hello)), Some(door)),
             Err(why) => (Err((why.clone(), why)), None),
         },
-        (_, Some((hub, session)), _) => (plain(hub, session, &queue), None),
+        (_, Some((hub, session)), rooms) => (plain(hub, session, &queue, rooms.is_some()), None),
         // The handshake refused any other route.
         _ => return Err("no route".to_owned()),
     };
@@ -313,6 +319,16 @@ async fn client(
                         }
                     }
                     Some(Ok(Message::Binary(data))) => {
+                        // `/rooms` on the plain URL: answered here, not by the session's loop.
+                        let plain_rooms = routes.plain.is_some() && door.is_none()
+                            && data.first() == Some(&protocol::OP_SERVICE_CALL);
+                        if let (true, Some(rooms)) = (plain_rooms, &routes.rooms)
+                            && let Ok(call) = protocol::service_call(&data)
+                            && call.service == PLAIN_ROOMS
+                        {
+                            hub.lock().answer(id, call.service, call.call, rooms.rooms_call(&call.payload));
+                            continue;
+                        }
                         if let Err(why) = publish(&hub, id, &data, &mut limit) {
                             let status = ServerMessage::Status { level: 2, message: &why };
                             let _ = queue.answer(Message::text(status.json()));
@@ -368,6 +384,7 @@ fn plain(
     hub: &Hub,
     session: &str,
     queue: &ClientQueue,
+    rooms: bool,
 ) -> Result<(Hub, u64, oneshot::Receiver<String>, [String; 3]), (String, String)> {
     let mut s = hub.lock();
     if s.client_count() >= MAX_CLIENTS {
@@ -388,9 +405,13 @@ fn plain(
     let advertise = ServerMessage::Advertise {
         channels: s.channels(),
     };
-    let services = ServerMessage::AdvertiseServices {
-        services: &crate::services::list(),
-    };
+    let mut list = crate::services::list();
+    if rooms {
+        let mut service = crate::room::services().swap_remove(2);
+        service.id = PLAIN_ROOMS;
+        list.push(service);
+    }
+    let services = ServerMessage::AdvertiseServices { services: &list };
     let hello = [info.json(), advertise.json(), services.json()];
     let (id, kicked) = s.connect(queue.clone());
     Ok((hub.clone(), id, kicked, hello))
