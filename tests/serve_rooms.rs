@@ -284,6 +284,27 @@ fn two_rooms_step_apart_each_recording_its_own_players_and_replaying_byte_for_by
         assert_eq!(names, ["alpha", "beta"]);
         assert!(rooms.iter().all(|r| r["players"] == 1 && r["clients"] == 1));
 
+        // Disconnecting is leaving: bob's ball goes, at beta's next frame.
+        drop(bob);
+        let deadline = Instant::now() + Duration::from_secs(10);
+        // Once beta shows no player, the leave is applied; two frames later it is recorded.
+        let mut gone_at = None;
+        for n in 10.. {
+            let listed = call(&mut ada, &services, "/rooms", n, "{}").await.unwrap();
+            let beta = &listed["rooms"][1];
+            let frame = beta["frame"].as_u64().unwrap();
+            if beta["players"] == 0 {
+                let at = *gone_at.get_or_insert(frame);
+                if frame >= at + 2 {
+                    break;
+                }
+            }
+            assert!(
+                Instant::now() < deadline,
+                "bob's leave not recorded: {listed}"
+            );
+            tokio::time::sleep(Duration::from_millis(20)).await;
+        }
         let left = call(&mut ada, &services, "/leave", 2, "{}").await.unwrap();
         assert_eq!(left["left"], 1);
         let game = loop {
@@ -323,7 +344,8 @@ fn two_rooms_step_apart_each_recording_its_own_players_and_replaying_byte_for_by
         [
             "join bob",
             r#"input {"push": [0, 2]}"#,
-            r#"input {"push": [0, 3]}"#
+            r#"input {"push": [0, 3]}"#,
+            "leave 1"
         ]
     );
     for (log, room) in [(&alpha, "alpha"), (&beta, "beta")] {
