@@ -192,14 +192,30 @@ async fn next_game(ws: &mut Ws, sub: u32) -> Value {
     }
 }
 
-/// Waits until `/game` shows `pushes` (on subscription 1).
+/// Waits (at most 10 s) until `/game` shows `pushes` (on subscription 1).
 async fn until_pushes(ws: &mut Ws, pushes: u64) -> Value {
-    loop {
-        let game = next_game(ws, 1).await;
-        if game["pushes"] == pushes {
-            return game;
+    within(async {
+        loop {
+            let game = next_game(ws, 1).await;
+            if game["pushes"] == pushes {
+                return game;
+            }
         }
-    }
+    })
+    .await
+}
+
+/// `f`'s answer, which must come within 10 s (data keeps coming, so a wait for one kind
+/// of message is bounded as a whole).
+async fn within<T>(f: impl std::future::Future<Output = T>) -> T {
+    tokio::time::timeout(Duration::from_secs(10), f)
+        .await
+        .expect("within 10 s")
+}
+
+/// The next status message (level, text), within 10 s.
+async fn status(ws: &mut Ws) -> (u64, String) {
+    within(next_status(ws)).await
 }
 
 /// A log's `/input` messages, as JSON.
@@ -307,12 +323,15 @@ fn two_rooms_step_apart_each_recording_its_own_players_and_replaying_byte_for_by
         }
         let left = call(&mut ada, &services, "/leave", 2, "{}").await.unwrap();
         assert_eq!(left["left"], 1);
-        let game = loop {
-            let g = next_game(&mut ada, 1).await;
-            if g["players"] == 0 {
-                break g;
+        let game = within(async {
+            loop {
+                let g = next_game(&mut ada, 1).await;
+                if g["players"] == 0 {
+                    return g;
+                }
             }
-        };
+        })
+        .await;
         assert_eq!(game["pushes"], 1);
     });
     let served = server.stop();
@@ -367,7 +386,7 @@ fn a_room_whose_game_panics_closes_with_its_recording_whole_and_another_goes_on(
         subscribe_to(&mut calm, &channels, "/game", 1).await;
         let (mut boom, _, _) = enter(&server.url("boom")).await;
         // The room's clients are told why, then closed.
-        let (level, why) = next_status(&mut boom).await;
+        let (level, why) = status(&mut boom).await;
         assert_eq!(level, 2);
         assert!(why.contains("panicked"), "{why}");
         assert!(
@@ -471,14 +490,14 @@ fn bad_room_names_bad_calls_and_a_bad_input_are_refused_by_name() {
         subscribe_to(&mut ws, &channels, "/game", 1).await;
         advertise_input(&mut ws).await;
         publish(&mut ws, r#"{"push": [1, 2], "jump": true}"#).await;
-        let (level, why) = next_status(&mut ws).await;
+        let (level, why) = status(&mut ws).await;
         assert_eq!(level, 2);
         assert!(
             why.starts_with("input refused: unknown field `jump`"),
             "{why}"
         );
         publish(&mut ws, r#"{"push": [1]}"#).await;
-        let (_, why) = next_status(&mut ws).await;
+        let (_, why) = status(&mut ws).await;
         assert!(why.contains("input refused: invalid length 1"), "{why}");
         publish(&mut ws, r#"{"push": [1, 2]}"#).await;
         // The refused inputs changed nothing: one push in all.
