@@ -214,7 +214,7 @@ async fn within<T>(f: impl std::future::Future<Output = T>) -> T {
 }
 
 /// The next status message (level, text), within 10 s.
-async fn status(ws: &mut Ws) -> (u64, String) {
+async fn status_within(ws: &mut Ws) -> (u64, String) {
     within(next_status(ws)).await
 }
 
@@ -386,7 +386,7 @@ fn a_room_whose_game_panics_closes_with_its_recording_whole_and_another_goes_on(
         subscribe_to(&mut calm, &channels, "/game", 1).await;
         let (mut boom, _, _) = enter(&server.url("boom")).await;
         // The room's clients are told why, then closed.
-        let (level, why) = status(&mut boom).await;
+        let (level, why) = status_within(&mut boom).await;
         assert_eq!(level, 2);
         assert!(why.contains("panicked"), "{why}");
         assert!(
@@ -490,14 +490,14 @@ fn bad_room_names_bad_calls_and_a_bad_input_are_refused_by_name() {
         subscribe_to(&mut ws, &channels, "/game", 1).await;
         advertise_input(&mut ws).await;
         publish(&mut ws, r#"{"push": [1, 2], "jump": true}"#).await;
-        let (level, why) = status(&mut ws).await;
+        let (level, why) = status_within(&mut ws).await;
         assert_eq!(level, 2);
         assert!(
             why.starts_with("input refused: unknown field `jump`"),
             "{why}"
         );
         publish(&mut ws, r#"{"push": [1]}"#).await;
-        let (_, why) = status(&mut ws).await;
+        let (_, why) = status_within(&mut ws).await;
         assert!(why.contains("input refused: invalid length 1"), "{why}");
         publish(&mut ws, r#"{"push": [1, 2]}"#).await;
         // The refused inputs changed nothing: one push in all.
