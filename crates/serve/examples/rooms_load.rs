@@ -239,12 +239,12 @@ fn main() {
     let served = server.join().expect("the server thread");
     let per_room = served.frames as f64 / rooms as f64;
     println!(
-        "{rooms} rooms, {threads} worker threads, {seconds} s: {pushes} inputs sent; {} frames \
-         ({:.1} a second a room, {} failed); frame start late: p50 {:.3} ms, p99 {:.3} ms, max \
-         {:.3} ms; RSS {:.1} MiB before, {:.1} MiB with the rooms: {:.2} MiB a room (the \
-         server's room and its 4 clients' both ends)",
+        "{rooms} rooms, {threads} worker threads, {seconds} s of inputs: {pushes} inputs sent; \
+         {} frames ({per_room:.0} a room, from its making to the stop; {} rooms failed); frame \
+         start late: p50 {:.3} ms, p99 {:.3} ms, max {:.3} ms (100 ms: 100 ms or more); RSS \
+         {:.1} MiB before, {:.1} MiB with the rooms: {:.2} MiB a room (the server's room and \
+         its 4 clients' both ends)",
         served.frames,
-        per_room / seconds as f64,
         served.failed,
         served.late_ms[0],
         served.late_ms[1],
