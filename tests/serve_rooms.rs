@@ -486,6 +486,20 @@ fn bad_room_names_bad_calls_and_a_bad_input_are_refused_by_name() {
         assert!(again.unwrap_err().contains("already joined, as player 3"));
         let bad = call(&mut ws, &services, "/rooms", 7, r#"{"create": "no way"}"#).await;
         assert!(bad.unwrap_err().contains("1 to 64 of A-Z"));
+        // A timeline request (the SDK's PlaybackControlRequest: play, seek to 0) is told
+        // it has no place in a room, and not kept.
+        let mut timeline = vec![3u8, 0];
+        timeline.extend_from_slice(&1.0f32.to_le_bytes());
+        timeline.push(1);
+        timeline.extend_from_slice(&0u64.to_le_bytes());
+        timeline.extend_from_slice(&2u32.to_le_bytes());
+        timeline.extend_from_slice(b"tl");
+        futures_util::SinkExt::send(&mut ws, Message::binary(timeline))
+            .await
+            .unwrap();
+        let (level, why) = status_within(&mut ws).await;
+        assert_eq!(level, 1);
+        assert_eq!(why, "a room has no timeline and answers no clicked points");
 
         subscribe_to(&mut ws, &channels, "/game", 1).await;
         advertise_input(&mut ws).await;

@@ -185,6 +185,16 @@ impl<G: Game> Room<G> {
     ) -> Result<(), Closing> {
         let (calls, inputs, left) = {
             let mut s = self.hub.lock();
+            // A room has no timeline and answers no clicks: what came is told so, not kept.
+            let mut refused: Vec<u64> = s.playback.drain(..).map(|(c, _)| c).collect();
+            refused.extend(s.clicks.drain(..).map(|(c, _)| c));
+            for client in refused {
+                s.tell(
+                    client,
+                    1,
+                    "a room has no timeline and answers no clicked points",
+                );
+            }
             (
                 std::mem::take(&mut s.calls),
                 std::mem::take(&mut s.inputs),
