@@ -9,6 +9,10 @@
 //!   scene queries (`query.rs`) and Lichtblick's clicked point (`click.rs`);
 //! - the real-time loop ([`serve`]: a fixed-timestep schedule, seeks, `/step`, pauses),
 //!   recording the session as it goes ([`Options::record`]).
+//! - rooms ([`serve_rooms`], `rooms.rs`, `room.rs`): many sessions of a game at once, each
+//!   its own simulation, game, recording and clients at `ws://HOST:PORT/rooms/NAME`, made
+//!   by a [`RoomMaker`], stepped on a bounded pool of threads (the client protocol:
+//!   `docs/protocol.md`).
 //!
 //! The messages are `ricochet-record`'s, the same a log holds; the inputs are its sessions'.
 //! This crate never lets the wall clock reach a message (it only paces the frames), never
