@@ -109,6 +109,11 @@ enum Command {
     /// server's directory of at most 16 MiB. A frame that still overflows pauses the session
     /// at its last good frame, the recording complete up to there.
     ///
+    /// Rooms: ws://IP:PORT/rooms/NAME (NAME: 1 to 64 of A-Z a-z 0-9 _ -) is a room of its
+    /// own, a fresh session of the scenario made on first connection, stepped in real time,
+    /// closed 10 s after its last client left (see docs/protocol.md). At most 1,000 rooms,
+    /// 64 clients a room and 1,000 in all; rooms step on a thread per core.
+    ///
     /// Example: ricochet serve scenarios/platformer.toml --record session.mcap
     Serve {
         /// The scenario file (TOML). Default: the built-in Asteroids demo.
@@ -129,7 +134,12 @@ enum Command {
         /// adds no file); /reset and /load start a new one, OUT-1.mcap, ... (at most 1,000).
         #[arg(long, value_name = "OUT.mcap")]
         record: Option<PathBuf>,
-        /// Start paused: frame 0 is shown; the /play or /step service goes on.
+        /// Record each room (ws://IP:PORT/rooms/NAME) to DIR/NAME.mcap (NAME-1.mcap, ... for
+        /// a name recorded before: no file is replaced), finished when the room closes.
+        #[arg(long, value_name = "DIR")]
+        record_rooms: Option<PathBuf>,
+        /// Start paused: frame 0 is shown; the /play or /step service goes on (the plain URL;
+        /// rooms always run).
         #[arg(long)]
         paused: bool,
     },
@@ -486,6 +496,7 @@ fn main() -> ExitCode {
             speed,
             frames,
             record,
+            record_rooms,
             paused,
         } => serve::run(&serve::Options {
             scenario: scenario.as_deref(),
@@ -493,6 +504,7 @@ fn main() -> ExitCode {
             speed,
             frames,
             record: record.as_deref(),
+            record_rooms: record_rooms.as_deref(),
             paused,
         }),
         Command::Replay { session, output } => replay::run(&session, output),

@@ -22,6 +22,7 @@ mod serve_client;
 mod serve_hostile;
 mod serve_load;
 mod serve_query;
+mod serve_rooms;
 mod serve_session;
 mod serve_siege;
 mod serve_ws;
