@@ -712,3 +712,101 @@ fn ricochet_serve_hosts_rooms_of_its_scenario_beside_the_plain_url() {
         String::from_utf8_lossy(&replay.stderr)
     );
 }
+
+/// One game value through every loop: served in a room (a client joins, pushes twice and
+/// leaves), then the room's recorded commands given to the game's own plain loop, to a
+/// golden check and to a replay. The replay is the recording byte for byte; the golden,
+/// written by a session of its own from the same commands, holds the same messages; the
+/// plain loop ends in the same world (equal checksums).
+#[test]
+fn one_game_served_then_plain_golden_and_replayed_agree() {
+    use ricochet_record::golden::{self, Command};
+    let dir = tempfile::tempdir().unwrap();
+    let server = Rooms::start(RoomOptions {
+        record: Some(dir.path().to_path_buf()),
+        ..quiet()
+    });
+    runtime().block_on(async {
+        let (mut ada, channels, services) = enter(&server.url("every")).await;
+        call(&mut ada, &services, "/join", 1, r#"{"name": "ada"}"#)
+            .await
+            .unwrap();
+        subscribe_to(&mut ada, &channels, "/game", 1).await;
+        advertise_input(&mut ada).await;
+        // As serde writes them, so that the golden's typed inputs are the same text.
+        publish(&mut ada, r#"{"push":[1.0,0.0]}"#).await;
+        until_pushes(&mut ada, 1).await;
+        publish(&mut ada, r#"{"push":[0.0,-2.5]}"#).await;
+        until_pushes(&mut ada, 2).await;
+        call(&mut ada, &services, "/leave", 2, "{}").await.unwrap();
+        within(async { while next_game(&mut ada, 1).await["players"] != 0 {} }).await;
+    });
+    server.stop();
+    let served = dir.path().join("every.mcap");
+    let log = ricochet_log::LogFile::open(&served).unwrap();
+
+    // Replayed: byte for byte.
+    let again = dir.path().join("again.mcap");
+    let (sim, game) = new_game("every");
+    let replayed = ricochet_record::replay::replay(
+        &log,
+        sim,
+        game,
+        ricochet_record::log_writer(&again).unwrap(),
+    )
+    .unwrap();
+    replayed.sink.finish().unwrap();
+    assert_eq!(
+        std::fs::read(&again).unwrap(),
+        std::fs::read(&served).unwrap()
+    );
+
+    // The recorded commands, as a script.
+    let script: Vec<(u64, Command<Push>)> = ricochet_record::replay::commands(&log)
+        .unwrap()
+        .into_iter()
+        .map(|c| {
+            let command = match (&c.join, c.leave, &c.input) {
+                (Some(name), _, _) => Command::Join(name.clone()),
+                (None, true, _) => Command::Leave(Player(c.player)),
+                (None, false, Some(text)) => {
+                    Command::Input(Player(c.player), serde_json::from_str(text).unwrap())
+                }
+                other => panic!("{other:?}"),
+            };
+            (c.frame, command)
+        })
+        .collect();
+    assert_eq!(script.len(), 4, "join, two pushes, leave");
+    let last = replayed.frames - 1;
+
+    // Plain: the game's own loop, the same commands at the same frames.
+    let (sim, game) = new_game("every");
+    let mut plain = GameLoop::new(sim, game);
+    for frame in 0..=last {
+        for (_, c) in script.iter().filter(|(f, _)| *f == frame) {
+            match c {
+                Command::Join(n) => drop(plain.join(n)),
+                Command::Leave(p) => drop(plain.leave(*p)),
+                Command::Input(p, i) => {
+                    let i: Push = serde_json::from_value(serde_json::to_value(i).unwrap()).unwrap();
+                    drop(plain.input(*p, i));
+                }
+            }
+        }
+        plain.step().unwrap();
+    }
+    assert_eq!(plain.sim().checksum(), replayed.sim.checksum());
+    assert_eq!(plain.game().state.pushes, 2);
+
+    // Golden: a session of its own, from the script, holds the served room's messages.
+    let golden_path = dir.path().join("golden.mcap");
+    let (sim, game) = new_game("every");
+    golden::check_game_or_bless(&golden_path, sim, game, last, &script, true).unwrap();
+    let (a, b) = (
+        ricochet_log::diff::open(&golden_path).unwrap(),
+        ricochet_log::diff::open(&served).unwrap(),
+    );
+    let report = ricochet_log::diff::diff_files(&a, &b, 0.0, None).unwrap();
+    assert!(report.first.is_none(), "{:?}", report.first);
+}

@@ -70,6 +70,8 @@ pub struct Replayed<S> {
     pub frames: u64,
     /// Commands applied (refused ones included).
     pub commands: usize,
+    /// The simulation at the end (what the recorded run's ended as).
+    pub sim: Simulation,
 }
 
 /// The name of the game that recorded `log`: its [`GAME_ATTACHMENT`], or the scenario's.
@@ -140,10 +142,12 @@ pub fn replay<G: Game, S: MessageSink>(
         }
         session.step()?;
     }
+    let (sink, sim, _) = session.into_parts();
     Ok(Replayed {
-        sink: session.into_sink(),
+        sink,
         frames,
         commands: commands.len(),
+        sim,
     })
 }
 
