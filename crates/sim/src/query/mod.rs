@@ -38,6 +38,7 @@
 mod filter;
 mod hits;
 pub(crate) mod index;
+mod tree;
 mod wrap;
 
 use std::sync::Arc;
@@ -48,7 +49,6 @@ pub use filter::QueryFilter;
 pub use hits::{RayHit, ShapeHit};
 pub(crate) use wrap::wrapping;
 
-use crate::broad_phase::Member;
 use crate::def::{LayerId, WorldBounds};
 use crate::entity::Entity;
 use crate::pipeline::Simulation;
@@ -265,8 +265,6 @@ impl<B: Bodies> Scene<'_, B> {
         };
         let trees = bodies.trees();
         let (offsets, images) = wrap::offsets(wrap);
-        // A walk holds at most one pending node per level (< 33): never regrown.
-        let mut stack = Vec::with_capacity(64);
         let mut best: Option<ShapeHit> = None;
         let mut segment = |from: Vec2, travelled: f64, len: f64| {
             let to = from + dir * len;
@@ -284,8 +282,7 @@ impl<B: Bodies> Scene<'_, B> {
                     &trees,
                     |l| filter.accepts_layer(l),
                     &q,
-                    &mut stack,
-                    &mut |i| {
+                    &mut |_, _, i| {
                         if !filter.accepts(layer[i], entity[i]) {
                             return;
                         }
@@ -338,9 +335,8 @@ impl<B: Bodies> Scene<'_, B> {
             min: point,
             max: point,
         };
-        self.overlapping(q, filter, &mut |i, o| {
-            let b = &self.bodies;
-            ricochet_geom::contains_point(b.shape(i), &b.pose(i), point - o)
+        self.overlapping(q, filter, &mut |set, k, i, o| {
+            set.contains_point(k, self.bodies.shape(i), point - o)
         })
     }
 
@@ -381,10 +377,9 @@ impl<B: Bodies> Scene<'_, B> {
             return Vec::new();
         }
         let q = shape.bounds(&pose);
-        self.overlapping(q, filter, &mut |i, o| {
-            let b = &self.bodies;
-            let at = Pose::new(pose.position - o, pose.angle);
-            ricochet_geom::overlaps(shape, &at, b.shape(i), &b.pose(i))
+        let probe = index::Probe::new(shape, pose.angle);
+        self.overlapping(q, filter, &mut |set, k, i, o| {
+            set.overlaps(k, self.bodies.shape(i), &probe, pose.position - o)
         })
     }
 
@@ -394,14 +389,12 @@ impl<B: Bodies> Scene<'_, B> {
         &self,
         q: Bounds,
         filter: &QueryFilter,
-        test: &mut impl FnMut(usize, Vec2) -> bool,
+        test: &mut impl FnMut(&index::Trees, usize, usize, Vec2) -> bool,
     ) -> Vec<Entity> {
         let (entity, layer) = (self.bodies.entity(), self.bodies.layer());
         let wrap = self.wrap;
         let shift = wrap.map_or(Vec2::ZERO, |b| wrap::wrap_point(b, q.center()) - q.center());
         let trees = self.bodies.trees();
-        // A walk holds at most one pending node per level (< 33): never regrown.
-        let mut stack = Vec::with_capacity(64);
         let mut found = Vec::new();
         let (offsets, images) = wrap::offsets(wrap);
         for &o in &offsets[..images] {
@@ -413,9 +406,8 @@ impl<B: Bodies> Scene<'_, B> {
                 &trees,
                 |l| filter.accepts_layer(l),
                 &qo,
-                &mut stack,
-                &mut |i| {
-                    if filter.accepts(layer[i], entity[i]) && test(i, o - shift) {
+                &mut |set, k, i| {
+                    if filter.accepts(layer[i], entity[i]) && test(set, k, i, o - shift) {
                         found.push(entity[i]);
                     }
                 },
@@ -477,35 +469,29 @@ impl<B: Bodies> Scene<'_, B> {
                     if room < 0.0 {
                         continue;
                     }
-                    set.tree
-                        .ray(seg.origin(), dir, room, &mut |m: &Member, max| {
-                            if !filter.accepts_layer(set.layers[m.handle as usize]) {
-                                return max;
-                            }
-                            let Some(i) = set.index(entity, m.handle) else {
-                                return max;
-                            };
-                            let e = entity[i];
-                            if !filter.accepts(layer[i], e) {
-                                return max;
-                            }
-                            let Some(h) = ricochet_geom::cast_ray(
-                                bodies.shape(i),
-                                &bodies.pose(i),
-                                &seg,
-                                max,
-                            ) else {
-                                return max;
-                            };
-                            hit_here = true;
-                            limit = f(RayHit {
-                                entity: e,
-                                point: if h.distance == 0.0 { from } else { h.point + o },
-                                normal: h.normal,
-                                distance: travelled + h.distance,
-                            });
-                            max.min(limit - travelled)
+                    set.tree.ray(seg.origin(), dir, room, &mut |k, max| {
+                        if !filter.accepts_layer(set.layers[k]) {
+                            return max;
+                        }
+                        let Some(i) = set.index(entity, k) else {
+                            return max;
+                        };
+                        let e = entity[i];
+                        if !filter.accepts(layer[i], e) {
+                            return max;
+                        }
+                        let Some(h) = set.cast_ray(k, bodies.shape(i), &seg, max) else {
+                            return max;
+                        };
+                        hit_here = true;
+                        limit = f(RayHit {
+                            entity: e,
+                            point: if h.distance == 0.0 { from } else { h.point + o },
+                            normal: h.normal,
+                            distance: travelled + h.distance,
                         });
+                        max.min(limit - travelled)
+                    });
                 }
             }
             !(first && hit_here)
