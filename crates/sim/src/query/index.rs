@@ -236,12 +236,13 @@ impl Trees {
     ) -> bool {
         let r = &self.ready[handle];
         let parts = shape.primitives();
-        if probe.placed.len() * parts.len() > ALL_PAIRS {
+        let placed = probe.placed();
+        if placed.len() * parts.len() > ALL_PAIRS {
             let pose = Pose::new(r.position, r.angle);
             return ricochet_geom::overlaps(probe.shape, &Pose::new(at, probe.angle), shape, &pose);
         }
         let (position, rot) = (r.position - at, r.shape_rot());
-        probe.placed.iter().any(|a| {
+        placed.iter().any(|a| {
             parts.iter().any(|b| {
                 ricochet_geom::overlaps_placed(a, &place_rotated(b, position, rot, r.angle))
             })
@@ -254,22 +255,35 @@ impl Trees {
 pub(crate) struct Probe<'a> {
     shape: &'a Shape,
     angle: f64,
-    /// Its parts placed, with its rotation.
-    placed: Vec<PlacedPrimitive>,
+    /// A one-part shape placed (the usual query: a box, a circle), with no allocation.
+    one: Option<[PlacedPrimitive; 1]>,
+    /// Every part placed, for any other shape.
+    many: Vec<PlacedPrimitive>,
 }
 
 impl<'a> Probe<'a> {
     pub(crate) fn new(shape: &'a Shape, angle: f64) -> Probe<'a> {
         let rot = shape.rotation(angle);
-        Probe {
-            shape,
-            angle,
-            placed: shape
-                .primitives()
-                .iter()
-                .map(|p| place_rotated(p, Vec2::ZERO, rot, angle))
-                .collect(),
+        let place = |p| place_rotated(p, Vec2::ZERO, rot, angle);
+        match shape.primitives() {
+            [p] => Probe {
+                shape,
+                angle,
+                one: Some([place(p)]),
+                many: Vec::new(),
+            },
+            parts => Probe {
+                shape,
+                angle,
+                one: None,
+                many: parts.iter().map(place).collect(),
+            },
         }
+    }
+
+    /// Its parts placed, with its rotation.
+    fn placed(&self) -> &[PlacedPrimitive] {
+        self.one.as_ref().map_or(&self.many, |one| one)
     }
 }
 

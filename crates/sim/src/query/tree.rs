@@ -71,32 +71,49 @@ impl QueryTree {
         let Some(top) = self.levels.len().checked_sub(1) else {
             return;
         };
-        if !self.levels[top][0].overlaps(q) {
+        if !meets(&self.levels[top][0], q) {
             return;
         }
         let mut stack = [(0u32, 0u32); STACK];
-        stack[0] = (top as u32, 0);
-        let mut len = 1;
-        while len > 0 {
-            len -= 1;
-            let (level, i) = stack[len];
-            let (level, i) = (level as usize, i as usize);
+        let mut len = 0;
+        // The node walked now: descended into directly, the other child pushed.
+        let (mut level, mut i) = (top, 0);
+        loop {
             if level == 0 {
                 let end = (i * LEAF + LEAF).min(self.boxes.len());
-                for (k, b) in self.boxes[i * LEAF..end].iter().enumerate() {
-                    if b.overlaps(q) {
-                        f(i * LEAF + k);
+                for k in i * LEAF..end {
+                    if meets(&self.boxes[k], q) {
+                        f(k);
                     }
                 }
-                continue;
-            }
-            let below = &self.levels[level - 1];
-            for c in [2 * i + 1, 2 * i] {
-                if below.get(c).is_some_and(|b| b.overlaps(q)) {
-                    stack[len] = ((level - 1) as u32, c as u32);
-                    len += 1;
+            } else {
+                let below = &self.levels[level - 1];
+                let a = meets(&below[2 * i], q);
+                let b = below.get(2 * i + 1).is_some_and(|c| meets(c, q));
+                level -= 1;
+                match (a, b) {
+                    (true, true) => {
+                        stack[len] = (level as u32, (2 * i + 1) as u32);
+                        len += 1;
+                        i *= 2;
+                        continue;
+                    }
+                    (true, false) => {
+                        i *= 2;
+                        continue;
+                    }
+                    (false, true) => {
+                        i = 2 * i + 1;
+                        continue;
+                    }
+                    (false, false) => {}
                 }
             }
+            if len == 0 {
+                return;
+            }
+            len -= 1;
+            (level, i) = (stack[len].0 as usize, stack[len].1 as usize);
         }
     }
 
@@ -116,20 +133,16 @@ impl QueryTree {
             return;
         };
         let slab = Slab::new(origin, dir, &self.levels[top][0]);
-        let Some(t) = slab.enter(&self.levels[top][0], max) else {
+        if slab.enter(&self.levels[top][0], max).is_none() {
             return;
-        };
-        // (level, index, entry distance).
+        }
+        // (level, index, entry distance) of the nodes put off.
         let mut stack = [(0u32, 0u32, 0.0f64); STACK];
-        stack[0] = (top as u32, 0, t);
-        let mut len = 1;
-        while len > 0 {
-            len -= 1;
-            let (level, i, t) = stack[len];
-            if t > max {
-                continue;
-            }
-            let (level, i) = (level as usize, i as usize);
+        let mut len = 0;
+        // The node walked now: of two children met, the nearer is descended into directly
+        // and the farther pushed, so the first hit is found early and prunes the rest.
+        let (mut level, mut i) = (top, 0);
+        loop {
             if level == 0 {
                 let end = (i * LEAF + LEAF).min(self.boxes.len());
                 for k in i * LEAF..end {
@@ -137,25 +150,46 @@ impl QueryTree {
                         max = f(k, max);
                     }
                 }
-                continue;
+            } else {
+                let below = &self.levels[level - 1];
+                let a = slab.enter(&below[2 * i], max);
+                let b = below.get(2 * i + 1).and_then(|c| slab.enter(c, max));
+                level -= 1;
+                match (a, b) {
+                    (Some(ta), Some(tb)) => {
+                        let (near, far, t) = if tb < ta {
+                            (2 * i + 1, 2 * i, ta)
+                        } else {
+                            (2 * i, 2 * i + 1, tb)
+                        };
+                        stack[len] = (level as u32, far as u32, t);
+                        len += 1;
+                        i = near;
+                        continue;
+                    }
+                    (Some(_), None) => {
+                        i *= 2;
+                        continue;
+                    }
+                    (None, Some(_)) => {
+                        i = 2 * i + 1;
+                        continue;
+                    }
+                    (None, None) => {}
+                }
             }
-            let below = &self.levels[level - 1];
-            let a = slab.enter(&below[2 * i], max);
-            let b = below.get(2 * i + 1).and_then(|c| slab.enter(c, max));
-            // The farther child first onto the stack, so the nearer is walked first.
-            let (near, far) = match (a, b) {
-                (Some(ta), Some(tb)) if tb < ta => ((2 * i + 1, tb), Some((2 * i, ta))),
-                (Some(ta), b) => ((2 * i, ta), b.map(|tb| (2 * i + 1, tb))),
-                (None, Some(tb)) => ((2 * i + 1, tb), None),
-                (None, None) => continue,
-            };
-            let level = (level - 1) as u32;
-            if let Some((c, t)) = far {
-                stack[len] = (level, c as u32, t);
-                len += 1;
+            // The next node put off that the segment, as shortened, still reaches.
+            loop {
+                if len == 0 {
+                    return;
+                }
+                len -= 1;
+                let (l, c, t) = stack[len];
+                if t <= max {
+                    (level, i) = (l as usize, c as usize);
+                    break;
+                }
             }
-            stack[len] = (level, near.0 as u32, near.1);
-            len += 1;
         }
     }
 }
@@ -266,6 +300,13 @@ impl Slab {
         }
         (enter <= exit).then_some(enter)
     }
+}
+
+/// Whether `a` and `b` overlap, touching counted ([`Bounds::overlaps`]), with one branch
+/// for the caller instead of four.
+#[inline]
+fn meets(a: &Bounds, b: &Bounds) -> bool {
+    (a.min.x <= b.max.x) & (b.min.x <= a.max.x) & (a.min.y <= b.max.y) & (b.min.y <= a.max.y)
 }
 
 /// The smallest box holding both, ignoring NaN coordinates (`f64::min` and `max` do; a NaN
