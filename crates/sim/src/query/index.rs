@@ -1,20 +1,23 @@
-//! The scene queries' broad phase: packed trees (the STR trees of `broad_phase/static_tree.rs`)
-//! per layer, one set over the static bodies and one over the moving bodies, each built on
-//! the first query that needs it and kept until the world changes.
+//! The scene queries' broad phase: one tree (`tree.rs`) over the static bodies and one over
+//! the moving bodies, every layer in each, each built on the first query that needs it and
+//! kept until the world changes.
 //!
-//! - **Static trees** hold every static body's bounds, by layer. They are kept while
-//!   [`World::static_generation`] stays the same (statics never move without bumping it),
-//!   so a scene of 10,000 tiles is indexed once, not once a frame.
-//! - **Moving trees** hold every moving body's [`World::bounds`], by layer, as they are
-//!   now. Every `&mut self` method of `Simulation` that can move, add, remove or reshape a
-//!   body drops them ([`QueryCache::invalidate`]); the next query rebuilds them, in
-//!   `O(m log m)` for `m` moving bodies. A step costs nothing more when no query is made:
-//!   dropping an empty cell is a branch.
+//! - **Static tree**: every static body. Kept while [`World::static_generation`] stays
+//!   the same (statics never move without bumping it), so a scene of 10,000 tiles is
+//!   indexed once, not once a frame.
+//! - **Moving tree**: every moving body as it is now. Every `&mut self` method of
+//!   `Simulation` that can move, add, remove or reshape a body drops it
+//!   ([`QueryCache::invalidate`]); the next query rebuilds it, in `O(m log m)` for `m`
+//!   moving bodies (and one sine and cosine a body). A step costs nothing more when no
+//!   query is made: dropping an empty cell is a branch.
 //!
-//! Members are named by their index into the tree set's entity list, and a candidate is
-//! found in the world by entity (a binary search): dense indices shift when any body is
-//! removed, entities never do. Both sets sit behind an `Arc`, so cloning a `Simulation`
-//! shares them instead of copying trees.
+//! Each member keeps its pose and rotation as the tree was built, and its box is its
+//! shape's exact box there: a candidate is tested with no sine or cosine, with the same
+//! arithmetic (so the same bits) as [`ricochet_geom::cast_ray`], [`ricochet_geom::overlaps`]
+//! and [`ricochet_geom::contains_point`]. A candidate is found in the world by its dense
+//! index when built, checked against its entity (a binary search by entity if a body was
+//! removed since: dense indices shift, entities never do). Both sets sit behind an `Arc`,
+//! so cloning a `Simulation` shares them instead of copying trees.
 
 use std::sync::{Arc, OnceLock};
 

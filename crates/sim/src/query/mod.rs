@@ -25,10 +25,11 @@
 //!   or pose outside a wrap world is first wrapped into it.
 //!
 //! # Candidates
-//! Never a loop over every body: per layer, packed trees over the static bodies (kept
-//! while the static generation stays) and over the moving bodies (built on the first query
-//! after the world changed), walked along the ray or by the query's bounds (`index.rs`).
-//! Only the layers a filter accepts are visited.
+//! Never a loop over every body: a tree over the static bodies (kept while the static
+//! generation stays) and one over the moving bodies (built on the first query after the
+//! world changed), walked along the ray or by the query's bounds (`index.rs`, `tree.rs`),
+//! each member's pose and rotation kept with it. A candidate of a layer the filter
+//! refuses is dropped before its exact test.
 //!
 //! # Now and then
 //! Every query is written once, over a [`Bodies`] view: the world now, or a frame kept for
