@@ -343,6 +343,11 @@ mod tests {
             Bounds::around(Vec2::new(-50.0, 0.0), Vec2::ONE),
             Bounds::around(Vec2::splat(500.0), Vec2::splat(0.5)),
             Bounds::around(Vec2::new(15.0, 12.0), Vec2::splat(40.0)),
+            // Touching member 0 (x in [-1, 1]) along its right face only: it counts.
+            Bounds {
+                min: Vec2::new(1.0, -0.5),
+                max: Vec2::new(1.5, 0.5),
+            },
         ] {
             let mut got = Vec::new();
             tree.query(&q, &mut |k| got.push(order[k]));
@@ -352,6 +357,21 @@ mod tests {
                 .collect();
             assert_eq!(got, want, "{q:?}");
         }
+    }
+
+    #[test]
+    fn a_ray_that_only_touches_a_corner_meets_that_box() {
+        let boxes = boxes();
+        let (tree, order) = QueryTree::new(&boxes);
+        // The line x + y = 1.8 touches member 0 (x in [-1, 1], y in [-0.8, 0.8]) at its
+        // corner (1, 0.8) only.
+        let (o, d) = (Vec2::new(0.0, 1.8), Vec2::new(1.0, -1.0).normalize());
+        let mut got = Vec::new();
+        tree.ray(o, d, 10.0, &mut |k, max| {
+            got.push(order[k]);
+            max
+        });
+        assert!(got.contains(&0), "{got:?}");
     }
 
     #[test]
