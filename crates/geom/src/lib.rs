@@ -70,8 +70,9 @@ pub use math::{Pose, Rot, Vec2};
 pub use number::{Number, Numbers};
 pub use placed::{
     PlacedAabb, PlacedCapsule, PlacedCircle, PlacedObb, PlacedPolygon, PlacedPrimitive, place,
+    place_rotated,
 };
-pub use ray::{Ray, RayIntersection, cast_ray, contains_placed, contains_point};
+pub use ray::{Ray, RayIntersection, cast_placed, cast_ray, contains_placed, contains_point};
 pub use shape::{
     Aabb, Capsule, Circle, Compound, MAX_COMPOUND_PARTS, MAX_COORDINATE, MAX_POLYGON_VERTICES,
     MIN_SIZE, Obb, Polygon, Primitive, Shape, ShapeError, ShapeKind,

@@ -89,6 +89,21 @@ pub fn place(primitive: &Primitive, pose: &Pose, origin: Vec2) -> PlacedPrimitiv
     )
 }
 
+/// [`place`] with the body rotation already computed (`rot`: `Rot::from_angle(angle)`, or
+/// [`Shape::rotation`] for a shape's parts), the body at `position` in the frame: for a
+/// caller that keeps each body's rotation ready (the scene queries) instead of computing its
+/// sine and cosine again for every test. The same bits as [`place`] given the same rotation.
+#[must_use]
+#[inline]
+pub fn place_rotated(
+    primitive: &Primitive,
+    position: Vec2,
+    rot: Rot,
+    angle: f64,
+) -> PlacedPrimitive {
+    place_with(primitive, position, rot, angle)
+}
+
 /// [`place`] with the body rotation already computed.
 #[must_use]
 pub(crate) fn place_with(

@@ -166,8 +166,10 @@ fn segment_distance_squared(p: Vec2, a: Vec2, b: Vec2) -> f64 {
 }
 
 /// The ray `o + t d` (`d` unit) against one primitive in the same frame: the entry
-/// distance in `[0, max]` and the normal there (zero when `o` is inside).
-fn cast_placed(prim: &PlacedPrimitive, o: Vec2, d: Vec2, max: f64) -> Option<(f64, Vec2)> {
+/// distance in `[0, max]` and the normal there (zero when `o` is inside). What [`cast_ray`]
+/// does for each part, for a caller that keeps its parts placed.
+#[must_use]
+pub fn cast_placed(prim: &PlacedPrimitive, o: Vec2, d: Vec2, max: f64) -> Option<(f64, Vec2)> {
     if contains_placed(prim, o) {
         return Some((0.0, Vec2::ZERO));
     }

@@ -29,7 +29,7 @@ use crate::limits::MAX_HISTORY;
 use crate::pipeline::Simulation;
 use crate::query::index::Trees;
 use crate::query::{Bodies, QueryFilter, RayHit, Scene, ShapeHit};
-use crate::world::{World, placed};
+use crate::world::World;
 
 /// Why [`Simulation::past`] or [`Simulation::keep_history`] refused.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
@@ -125,17 +125,12 @@ impl Bodies for &Kept {
     fn trees(&self) -> [Arc<Trees>; 2] {
         self.trees
             .get_or_init(|| {
-                // The bounds the world gives a body that has not turned: exact at its angle.
-                let bounds = |i: usize| -> Bounds {
-                    let local = self.shape(i).bounds(&Pose::new(Vec2::ZERO, self.angle[i]));
-                    placed(local, self.position[i])
-                };
                 let l = &self.layout;
                 let all = Trees::over(
                     0,
                     &l.entity,
                     &l.layer,
-                    (0..l.entity.len()).map(|i| (i, bounds(i))),
+                    (0..l.entity.len()).map(|i| (i, self.shape(i), self.pose(i))),
                 );
                 [Arc::new(all), Arc::new(Trees::default())]
             })

@@ -1,42 +1,56 @@
-//! The scene queries' broad phase: packed trees (the STR trees of `broad_phase/static_tree.rs`)
-//! per layer, one set over the static bodies and one over the moving bodies, each built on
-//! the first query that needs it and kept until the world changes.
+//! The scene queries' broad phase: one tree (`tree.rs`) over the static bodies and one over
+//! the moving bodies, every layer in each, each built on the first query that needs it and
+//! kept until the world changes.
 //!
-//! - **Static trees** hold every static body's bounds, by layer. They are kept while
-//!   [`World::static_generation`] stays the same (statics never move without bumping it),
-//!   so a scene of 10,000 tiles is indexed once, not once a frame.
-//! - **Moving trees** hold every moving body's [`World::bounds`], by layer, as they are
-//!   now. Every `&mut self` method of `Simulation` that can move, add, remove or reshape a
-//!   body drops them ([`QueryCache::invalidate`]); the next query rebuilds them, in
-//!   `O(m log m)` for `m` moving bodies. A step costs nothing more when no query is made:
-//!   dropping an empty cell is a branch.
+//! - **Static tree**: every static body. Kept while [`World::static_generation`] stays
+//!   the same (statics never move without bumping it), so a scene of 10,000 tiles is
+//!   indexed once, not once a frame.
+//! - **Moving tree**: every moving body as it is now. Every `&mut self` method of
+//!   `Simulation` that can move, add, remove or reshape a body drops it
+//!   ([`QueryCache::invalidate`]); the next query rebuilds it, in `O(m log m)` for `m`
+//!   moving bodies (and one sine and cosine a body). A step costs nothing more when no
+//!   query is made: dropping an empty cell is a branch.
 //!
-//! Members are named by their index into the tree set's entity list, and a candidate is
-//! found in the world by entity (a binary search): dense indices shift when any body is
-//! removed, entities never do. Both sets sit behind an `Arc`, so cloning a `Simulation`
-//! shares them instead of copying trees.
+//! Each member keeps its pose and rotation as the tree was built, and its box is its
+//! shape's exact box there: a candidate is tested with no sine or cosine, with the same
+//! arithmetic (so the same bits) as [`ricochet_geom::cast_ray`], [`ricochet_geom::overlaps`]
+//! and [`ricochet_geom::contains_point`]. A candidate is found in the world by its dense
+//! index when built, checked against its entity (a binary search by entity if a body was
+//! removed since: dense indices shift, entities never do). Both sets sit behind an `Arc`,
+//! so cloning a `Simulation` shares them instead of copying trees.
 
 use std::sync::{Arc, OnceLock};
 
-use ricochet_geom::Bounds;
+use ricochet_geom::{
+    Bounds, PlacedPrimitive, Pose, Ray, RayIntersection, Rot, Shape, Vec2, place_rotated,
+};
 
-use crate::broad_phase::Member;
-use crate::broad_phase::static_tree::StaticTree;
+use super::tree::QueryTree;
 use crate::def::{BodyKind, LayerId};
 use crate::entity::Entity;
-use crate::world::World;
+use crate::world::{World, placed};
+
+/// Part pairs of a query shape and a body up to which [`Trees::overlaps`] tests every pair
+/// with the kept rotation (the bodies of a game have one part or a few); beyond, the pair
+/// goes to [`ricochet_geom::overlaps`], which culls the parts (the same answer).
+const ALL_PAIRS: usize = 64;
 
 /// One tree over one set of bodies (the static ones or the moving ones), every layer in it.
 ///
 /// One tree per set, not per layer, as rapier's one BVH and Box2D's one tree per body type:
 /// a query that sees every layer walks one tree, not one per layer; a filter is applied to
 /// each candidate by its layer, read from [`Trees::layers`] before the body is looked up.
+///
+/// A member is named by its position in the tree (its handle), and every column below is
+/// in that order. Each member's pose and rotation are kept as the tree was built (rapier
+/// keeps each collider's world pose): a candidate is placed from them, with no sine or
+/// cosine a query, and its box in the tree is its shape's exact box at that angle.
 #[derive(Debug, Default)]
 pub(crate) struct Trees {
     /// The static generation they were built at (static trees only).
     generation: u64,
     /// The tree; a member's handle indexes the vectors below.
-    pub(crate) tree: StaticTree,
+    pub(crate) tree: QueryTree,
     /// Each member's entity, by handle.
     pub(crate) entities: Vec<Entity>,
     /// Each member's layer, by handle.
@@ -44,10 +58,57 @@ pub(crate) struct Trees {
     /// Each member's dense index when the tree was built: still right unless a body was
     /// removed since (then the entity is looked up, [`Trees::index`]).
     dense: Vec<u32>,
+    /// Each member's pose and rotation when the tree was built, by handle.
+    ready: Vec<Ready>,
     /// The box around every member (`None` when empty): an image of a query that misses it
     /// skips this set without walking its tree. In a wrap world most of the nine images of
     /// a query lie outside the world, so this is what keeps a query near one tree walk.
     pub(crate) bounds: Option<Bounds>,
+}
+
+/// A member's pose as the tree was built, with what placing it needs.
+#[derive(Clone, Copy, Debug)]
+struct Ready {
+    position: Vec2,
+    angle: f64,
+    /// `Rot::from_angle(angle)`: what a ray places the body's parts with
+    /// ([`ricochet_geom::cast_ray`]).
+    rot: Rot,
+    /// Whether any part turns with the body ([`Shape::rotation`]: an overlap places the
+    /// parts with `rot`, else with no rotation).
+    turns: bool,
+}
+
+impl Ready {
+    fn new(shape: &Shape, pose: Pose) -> Ready {
+        Ready {
+            position: pose.position,
+            angle: pose.angle,
+            rot: Rot::from_angle(pose.angle),
+            turns: shape.primitives().iter().any(|p| p.turns_with_body()),
+        }
+    }
+
+    /// [`Shape::rotation`] at this angle.
+    fn shape_rot(&self) -> Rot {
+        if self.turns { self.rot } else { Rot::IDENTITY }
+    }
+
+    /// The shape's box at this pose: its parts placed about the body, padded for the
+    /// translation (`world::placed`, as the world's own bounds).
+    fn bounds(&self, shape: &Shape) -> Bounds {
+        let rot = self.shape_rot();
+        let mut parts = shape
+            .primitives()
+            .iter()
+            .map(|p| place_rotated(p, Vec2::ZERO, rot, self.angle).bounds());
+        let local = parts
+            .next()
+            .map_or(Bounds::around(Vec2::ZERO, Vec2::ZERO), |b| {
+                parts.fold(b, Bounds::union)
+            });
+        placed(local, self.position)
+    }
 }
 
 impl Trees {
@@ -57,44 +118,41 @@ impl Trees {
             generation,
             &world.entity,
             &world.layer,
-            which.map(|i| (i, world.bounds_now(i))),
+            which.map(|i| (i, world.shape(i), world.pose(i))),
         )
     }
 
     /// The trees over the bodies `members` names, each by its dense index into `entity`
-    /// and `layer` and with its bounds (a past frame's bodies, `history.rs`, as the
+    /// and `layer`, with its shape and pose (a past frame's bodies, `history.rs`, as the
     /// world's).
-    pub(crate) fn over(
+    pub(crate) fn over<'s>(
         generation: u64,
         entity: &[Entity],
         layer: &[LayerId],
-        members: impl Iterator<Item = (usize, Bounds)>,
+        members: impl Iterator<Item = (usize, &'s Shape, Pose)>,
     ) -> Trees {
         let n = members.size_hint().0;
-        let mut list = Vec::with_capacity(n);
-        let (mut entities, mut layers, mut dense) = (
+        let (mut boxes, mut dense, mut ready) = (
             Vec::with_capacity(n),
             Vec::with_capacity(n),
             Vec::with_capacity(n),
         );
-        let mut all: Option<Bounds> = None;
-        for (i, bounds) in members {
-            all = Some(all.map_or(bounds, |a| a.union(bounds)));
-            list.push(Member {
-                bounds,
-                handle: entities.len() as u32,
-                dynamic: false,
-            });
-            entities.push(entity[i]);
-            layers.push(layer[i]);
+        for (i, shape, pose) in members {
+            let r = Ready::new(shape, pose);
+            boxes.push(r.bounds(shape));
             dense.push(i as u32);
+            ready.push(r);
         }
+        let all = boxes.iter().copied().reduce(Bounds::union);
+        let (tree, order) = QueryTree::new(&boxes);
+        let by = |k: &u32| dense[*k as usize] as usize;
         Trees {
             generation,
-            tree: StaticTree::new(list),
-            entities,
-            layers,
-            dense,
+            tree,
+            entities: order.iter().map(|k| entity[by(k)]).collect(),
+            layers: order.iter().map(|k| layer[by(k)]).collect(),
+            ready: order.iter().map(|&k| ready[k as usize]).collect(),
+            dense: order.iter().map(|&k| dense[k as usize]).collect(),
             bounds: all,
         }
     }
@@ -107,15 +165,128 @@ impl Trees {
     /// The dense index among the bodies `entity` (ascending) of the member `handle`, if
     /// its body is still there: the index it was built with when that still names the body
     /// (a lookup by entity else).
-    pub(crate) fn index(&self, entity: &[Entity], handle: u32) -> Option<usize> {
-        let h = handle as usize;
-        let e = self.entities[h];
-        let i = self.dense[h] as usize;
+    #[inline]
+    pub(crate) fn index(&self, entity: &[Entity], handle: usize) -> Option<usize> {
+        let e = self.entities[handle];
+        let i = self.dense[handle] as usize;
         if entity.get(i) == Some(&e) {
             Some(i)
         } else {
             entity.binary_search(&e).ok()
         }
+    }
+
+    /// [`ricochet_geom::cast_ray`] of `ray` against member `handle`, whose shape is
+    /// `shape`, from its kept rotation: the same arithmetic, so the same bits.
+    #[inline]
+    pub(crate) fn cast_ray(
+        &self,
+        handle: usize,
+        shape: &Shape,
+        ray: &Ray,
+        max_distance: f64,
+    ) -> Option<RayIntersection> {
+        let r = &self.ready[handle];
+        if max_distance.is_nan() || max_distance < 0.0 || !r.position.is_finite() {
+            return None;
+        }
+        let origin = ray.origin() - r.position;
+        let d = ray.direction();
+        let mut best: Option<(f64, Vec2)> = None;
+        for p in shape.primitives() {
+            let placed = place_rotated(p, Vec2::ZERO, r.rot, r.angle);
+            if let Some((t, n)) = ricochet_geom::cast_placed(&placed, origin, d, max_distance)
+                && best.is_none_or(|(b, _)| t < b)
+            {
+                best = Some((t, n));
+                if t == 0.0 {
+                    break;
+                }
+            }
+        }
+        best.map(|(t, normal)| RayIntersection {
+            distance: t,
+            point: if t == 0.0 {
+                ray.origin()
+            } else {
+                ray.point_at(t)
+            },
+            normal,
+        })
+    }
+
+    /// [`ricochet_geom::contains_point`] of `point` in member `handle` (shape `shape`),
+    /// from its kept rotation.
+    #[inline]
+    pub(crate) fn contains_point(&self, handle: usize, shape: &Shape, point: Vec2) -> bool {
+        let r = &self.ready[handle];
+        let p = point - r.position;
+        shape.primitives().iter().any(|prim| {
+            ricochet_geom::contains_placed(&place_rotated(prim, Vec2::ZERO, r.rot, r.angle), p)
+        })
+    }
+
+    /// [`ricochet_geom::overlaps`] of the query `probe` (its parts placed about its own
+    /// position, `at`) with member `handle` (shape `shape`), from the member's kept
+    /// rotation: the pair in the frame centred on the query, as that function places it.
+    #[inline]
+    pub(crate) fn overlaps(
+        &self,
+        handle: usize,
+        shape: &Shape,
+        probe: &Probe<'_>,
+        at: Vec2,
+    ) -> bool {
+        let r = &self.ready[handle];
+        let parts = shape.primitives();
+        let placed = probe.placed();
+        if placed.len() * parts.len() > ALL_PAIRS {
+            let pose = Pose::new(r.position, r.angle);
+            return ricochet_geom::overlaps(probe.shape, &Pose::new(at, probe.angle), shape, &pose);
+        }
+        let (position, rot) = (r.position - at, r.shape_rot());
+        placed.iter().any(|a| {
+            parts.iter().any(|b| {
+                ricochet_geom::overlaps_placed(a, &place_rotated(b, position, rot, r.angle))
+            })
+        })
+    }
+}
+
+/// A query shape placed once about its own position (the frame of
+/// [`ricochet_geom::overlaps`]), for every candidate of the query.
+pub(crate) struct Probe<'a> {
+    shape: &'a Shape,
+    angle: f64,
+    /// A one-part shape placed (the usual query: a box, a circle), with no allocation.
+    one: Option<[PlacedPrimitive; 1]>,
+    /// Every part placed, for any other shape.
+    many: Vec<PlacedPrimitive>,
+}
+
+impl<'a> Probe<'a> {
+    pub(crate) fn new(shape: &'a Shape, angle: f64) -> Probe<'a> {
+        let rot = shape.rotation(angle);
+        let place = |p| place_rotated(p, Vec2::ZERO, rot, angle);
+        match shape.primitives() {
+            [p] => Probe {
+                shape,
+                angle,
+                one: Some([place(p)]),
+                many: Vec::new(),
+            },
+            parts => Probe {
+                shape,
+                angle,
+                one: None,
+                many: parts.iter().map(place).collect(),
+            },
+        }
+    }
+
+    /// Its parts placed, with its rotation.
+    fn placed(&self) -> &[PlacedPrimitive] {
+        self.one.as_ref().map_or(&self.many, |one| one)
     }
 }
 
@@ -166,25 +337,25 @@ impl QueryCache {
     }
 }
 
-/// Calls `f` with the dense index of every body of an accepted layer whose bounds overlap
-/// `q` (touching counts), in no set order.
+/// Calls `f` with the set, handle and dense index of every body of an accepted layer whose
+/// box overlaps `q` (touching counts), in no set order.
+#[inline]
 pub(crate) fn each_in_box(
     entity: &[Entity],
     trees: &[Arc<Trees>; 2],
     accepts_layer: impl Fn(LayerId) -> bool,
     q: &Bounds,
-    stack: &mut Vec<(u32, u32)>,
-    f: &mut impl FnMut(usize),
+    f: &mut impl FnMut(&Trees, usize, usize),
 ) {
     for set in trees {
         if !set.may_meet(q) {
             continue;
         }
-        set.tree.query(q, stack, &mut |m: &Member| {
-            if accepts_layer(set.layers[m.handle as usize])
-                && let Some(i) = set.index(entity, m.handle)
+        set.tree.query(q, &mut |k| {
+            if accepts_layer(set.layers[k])
+                && let Some(i) = set.index(entity, k)
             {
-                f(i);
+                f(set, k, i);
             }
         });
     }

@@ -25,10 +25,11 @@
 //!   or pose outside a wrap world is first wrapped into it.
 //!
 //! # Candidates
-//! Never a loop over every body: per layer, packed trees over the static bodies (kept
-//! while the static generation stays) and over the moving bodies (built on the first query
-//! after the world changed), walked along the ray or by the query's bounds (`index.rs`).
-//! Only the layers a filter accepts are visited.
+//! Never a loop over every body: a tree over the static bodies (kept while the static
+//! generation stays) and one over the moving bodies (built on the first query after the
+//! world changed), walked along the ray or by the query's bounds (`index.rs`, `tree.rs`),
+//! each member's pose and rotation kept with it. A candidate of a layer the filter
+//! refuses is dropped before its exact test.
 //!
 //! # Now and then
 //! Every query is written once, over a [`Bodies`] view: the world now, or a frame kept for
@@ -38,6 +39,7 @@
 mod filter;
 mod hits;
 pub(crate) mod index;
+mod tree;
 mod wrap;
 
 use std::sync::Arc;
@@ -48,7 +50,6 @@ pub use filter::QueryFilter;
 pub use hits::{RayHit, ShapeHit};
 pub(crate) use wrap::wrapping;
 
-use crate::broad_phase::Member;
 use crate::def::{LayerId, WorldBounds};
 use crate::entity::Entity;
 use crate::pipeline::Simulation;
@@ -265,8 +266,6 @@ impl<B: Bodies> Scene<'_, B> {
         };
         let trees = bodies.trees();
         let (offsets, images) = wrap::offsets(wrap);
-        // A walk holds at most one pending node per level (< 33): never regrown.
-        let mut stack = Vec::with_capacity(64);
         let mut best: Option<ShapeHit> = None;
         let mut segment = |from: Vec2, travelled: f64, len: f64| {
             let to = from + dir * len;
@@ -284,8 +283,7 @@ impl<B: Bodies> Scene<'_, B> {
                     &trees,
                     |l| filter.accepts_layer(l),
                     &q,
-                    &mut stack,
-                    &mut |i| {
+                    &mut |_, _, i| {
                         if !filter.accepts(layer[i], entity[i]) {
                             return;
                         }
@@ -338,9 +336,8 @@ impl<B: Bodies> Scene<'_, B> {
             min: point,
             max: point,
         };
-        self.overlapping(q, filter, &mut |i, o| {
-            let b = &self.bodies;
-            ricochet_geom::contains_point(b.shape(i), &b.pose(i), point - o)
+        self.overlapping(q, filter, &mut |set, k, i, o| {
+            set.contains_point(k, self.bodies.shape(i), point - o)
         })
     }
 
@@ -381,10 +378,9 @@ impl<B: Bodies> Scene<'_, B> {
             return Vec::new();
         }
         let q = shape.bounds(&pose);
-        self.overlapping(q, filter, &mut |i, o| {
-            let b = &self.bodies;
-            let at = Pose::new(pose.position - o, pose.angle);
-            ricochet_geom::overlaps(shape, &at, b.shape(i), &b.pose(i))
+        let probe = index::Probe::new(shape, pose.angle);
+        self.overlapping(q, filter, &mut |set, k, i, o| {
+            set.overlaps(k, self.bodies.shape(i), &probe, pose.position - o)
         })
     }
 
@@ -394,14 +390,12 @@ impl<B: Bodies> Scene<'_, B> {
         &self,
         q: Bounds,
         filter: &QueryFilter,
-        test: &mut impl FnMut(usize, Vec2) -> bool,
+        test: &mut impl FnMut(&index::Trees, usize, usize, Vec2) -> bool,
     ) -> Vec<Entity> {
         let (entity, layer) = (self.bodies.entity(), self.bodies.layer());
         let wrap = self.wrap;
         let shift = wrap.map_or(Vec2::ZERO, |b| wrap::wrap_point(b, q.center()) - q.center());
         let trees = self.bodies.trees();
-        // A walk holds at most one pending node per level (< 33): never regrown.
-        let mut stack = Vec::with_capacity(64);
         let mut found = Vec::new();
         let (offsets, images) = wrap::offsets(wrap);
         for &o in &offsets[..images] {
@@ -413,9 +407,8 @@ impl<B: Bodies> Scene<'_, B> {
                 &trees,
                 |l| filter.accepts_layer(l),
                 &qo,
-                &mut stack,
-                &mut |i| {
-                    if filter.accepts(layer[i], entity[i]) && test(i, o - shift) {
+                &mut |set, k, i| {
+                    if filter.accepts(layer[i], entity[i]) && test(set, k, i, o - shift) {
                         found.push(entity[i]);
                     }
                 },
@@ -477,35 +470,29 @@ impl<B: Bodies> Scene<'_, B> {
                     if room < 0.0 {
                         continue;
                     }
-                    set.tree
-                        .ray(seg.origin(), dir, room, &mut |m: &Member, max| {
-                            if !filter.accepts_layer(set.layers[m.handle as usize]) {
-                                return max;
-                            }
-                            let Some(i) = set.index(entity, m.handle) else {
-                                return max;
-                            };
-                            let e = entity[i];
-                            if !filter.accepts(layer[i], e) {
-                                return max;
-                            }
-                            let Some(h) = ricochet_geom::cast_ray(
-                                bodies.shape(i),
-                                &bodies.pose(i),
-                                &seg,
-                                max,
-                            ) else {
-                                return max;
-                            };
-                            hit_here = true;
-                            limit = f(RayHit {
-                                entity: e,
-                                point: if h.distance == 0.0 { from } else { h.point + o },
-                                normal: h.normal,
-                                distance: travelled + h.distance,
-                            });
-                            max.min(limit - travelled)
+                    set.tree.ray(seg.origin(), dir, room, &mut |k, max| {
+                        if !filter.accepts_layer(set.layers[k]) {
+                            return max;
+                        }
+                        let Some(i) = set.index(entity, k) else {
+                            return max;
+                        };
+                        let e = entity[i];
+                        if !filter.accepts(layer[i], e) {
+                            return max;
+                        }
+                        let Some(h) = set.cast_ray(k, bodies.shape(i), &seg, max) else {
+                            return max;
+                        };
+                        hit_here = true;
+                        limit = f(RayHit {
+                            entity: e,
+                            point: if h.distance == 0.0 { from } else { h.point + o },
+                            normal: h.normal,
+                            distance: travelled + h.distance,
                         });
+                        max.min(limit - travelled)
+                    });
                 }
             }
             !(first && hit_here)

@@ -39,13 +39,6 @@ impl LocalBounds {
         placed(self.bounds, p)
     }
 
-    /// [`LocalBounds::at`] without keeping what it computed (for a reader holding `&self`):
-    /// the same bounds.
-    fn peek(&self, shape: &Shape, angle: f64, p: Vec2) -> Bounds {
-        let mut copy = *self;
-        copy.at(shape, angle, p)
-    }
-
     /// The bounds of a body of `shape` that has turned: the square around the disc that
     /// holds the shape at every angle.
     pub(super) fn turned(shape: &Shape, angle: f64) -> LocalBounds {
@@ -126,19 +119,6 @@ impl World {
             shape.bounds(&Pose::new(Vec2::ZERO, angle))
         };
         placed(local, self.position[i])
-    }
-
-    /// [`World::bounds`] for a reader (the scene queries): the same box, computed without
-    /// keeping it.
-    pub(crate) fn bounds_now(&self, i: usize) -> Bounds {
-        let p = self.position[i];
-        match self.row[i] {
-            NO_ROW => self.scenery_bounds(i),
-            r => {
-                let shape = &self.shapes.get(self.shape_id[i]).0;
-                self.rows.local_bounds[r as usize].peek(shape, self.angle[i], p)
-            }
-        }
     }
 
     /// Moves moving body `i` to `position`, whole world sizes from where it is, and its

@@ -1,0 +1,411 @@
+//! The scene queries' tree: a packed tree (sort-tile-recursive, as `broad_phase/
+//! static_tree.rs`, whose walk the step's broad phase keeps) over one set of bodies, with
+//! its members stored in tree order so that a leaf's boxes are contiguous and a member's
+//! position in the tree is its handle into the set's columns (`index.rs`).
+//!
+//! Against the broad phase's tree: leaves of [`LEAF`] = 4 members (each member of a visited
+//! leaf costs a box test, and a query's answer is a handful of bodies), the walk stack on
+//! the thread's stack (no allocation a query), a node's children tested before they are
+//! pushed, and the ray's slab test with the direction inverted and the rounding margin
+//! taken once a walk.
+
+use ricochet_geom::{Bounds, Vec2};
+
+/// Members per leaf.
+const LEAF: usize = 4;
+
+/// Entries a walk's stack holds: one pending sibling per level (a tree over 2^32 members
+/// has < 32 levels), plus the node being expanded.
+const STACK: usize = 64;
+
+/// A packed tree over boxes, its members in tree order.
+#[derive(Debug, Default)]
+pub(crate) struct QueryTree {
+    /// Each member's box, in tree order: leaf `k` holds members `LEAF * k ..`.
+    boxes: Vec<Bounds>,
+    /// `levels[0][k]` bounds leaf `k`; `levels[j + 1][k]` bounds `levels[j][2k..2k + 2]`.
+    levels: Vec<Vec<Bounds>>,
+}
+
+impl QueryTree {
+    /// The tree over `boxes`, and the order it keeps them in: `order[k]` is the index in
+    /// `boxes` of the tree's member `k`. Ties broken by index, so the tree is a pure
+    /// function of the boxes.
+    ///
+    /// Built top down by median cuts (`split`), not sort-tile-recursive: the implicit
+    /// layout pairs leaves `2k`, `2k + 1` at every level, and over STR's slices that pairs
+    /// the end of one slice with the start of the next, boxes as tall as the world that a
+    /// query then walks into. A median cut along the longer side at every node keeps each
+    /// node's box compact.
+    pub(crate) fn new(boxes: &[Bounds]) -> (QueryTree, Vec<u32>) {
+        let mut order: Vec<u32> = (0..boxes.len() as u32).collect();
+        if boxes.is_empty() {
+            return (QueryTree::default(), order);
+        }
+        let centers: Vec<Vec2> = boxes.iter().map(Bounds::center).collect();
+        let leaves = boxes.len().div_ceil(LEAF);
+        split(
+            &mut order,
+            &centers,
+            LEAF << leaves.next_power_of_two().trailing_zeros(),
+        );
+        let boxes: Vec<Bounds> = order.iter().map(|&k| boxes[k as usize]).collect();
+        let leaves: Vec<Bounds> = boxes
+            .chunks(LEAF)
+            .map(|c| c[1..].iter().fold(c[0], |u, b| hull(u, *b)))
+            .collect();
+        let mut levels = vec![leaves];
+        while levels[levels.len() - 1].len() > 1 {
+            let next = levels[levels.len() - 1]
+                .chunks(2)
+                .map(|c| c[1..].iter().fold(c[0], |u, b| hull(u, *b)))
+                .collect();
+            levels.push(next);
+        }
+        (QueryTree { boxes, levels }, order)
+    }
+
+    /// Calls `f` with every member whose box overlaps `q` (touching counts).
+    #[inline]
+    pub(crate) fn query(&self, q: &Bounds, f: &mut impl FnMut(usize)) {
+        let Some(top) = self.levels.len().checked_sub(1) else {
+            return;
+        };
+        if !meets(&self.levels[top][0], q) {
+            return;
+        }
+        let mut stack = [(0u32, 0u32); STACK];
+        let mut len = 0;
+        // The node walked now: descended into directly, the other child pushed.
+        let (mut level, mut i) = (top, 0);
+        loop {
+            if level == 0 {
+                let end = (i * LEAF + LEAF).min(self.boxes.len());
+                for k in i * LEAF..end {
+                    if meets(&self.boxes[k], q) {
+                        f(k);
+                    }
+                }
+            } else {
+                let below = &self.levels[level - 1];
+                let a = meets(&below[2 * i], q);
+                let b = below.get(2 * i + 1).is_some_and(|c| meets(c, q));
+                level -= 1;
+                match (a, b) {
+                    (true, true) => {
+                        stack[len] = (level as u32, (2 * i + 1) as u32);
+                        len += 1;
+                        i *= 2;
+                        continue;
+                    }
+                    (true, false) => {
+                        i *= 2;
+                        continue;
+                    }
+                    (false, true) => {
+                        i = 2 * i + 1;
+                        continue;
+                    }
+                    (false, false) => {}
+                }
+            }
+            if len == 0 {
+                return;
+            }
+            len -= 1;
+            (level, i) = (stack[len].0 as usize, stack[len].1 as usize);
+        }
+    }
+
+    /// Calls `f` on every member whose box the segment `origin + t * dir`, `t` in
+    /// `[0, max]`, may cross (a slab test, touching counts). `f` returns the new `max`: a
+    /// first-hit search shrinks it, so boxes beyond the best hit so far are skipped. Of two
+    /// children, the one the segment enters first is walked first, so the first hit is
+    /// found early and prunes the rest.
+    pub(crate) fn ray(
+        &self,
+        origin: Vec2,
+        dir: Vec2,
+        mut max: f64,
+        f: &mut impl FnMut(usize, f64) -> f64,
+    ) {
+        let Some(top) = self.levels.len().checked_sub(1) else {
+            return;
+        };
+        let slab = Slab::new(origin, dir, &self.levels[top][0]);
+        if slab.enter(&self.levels[top][0], max).is_none() {
+            return;
+        }
+        // (level, index, entry distance) of the nodes put off.
+        let mut stack = [(0u32, 0u32, 0.0f64); STACK];
+        let mut len = 0;
+        // The node walked now: of two children met, the nearer is descended into directly
+        // and the farther pushed, so the first hit is found early and prunes the rest.
+        let (mut level, mut i) = (top, 0);
+        loop {
+            if level == 0 {
+                let end = (i * LEAF + LEAF).min(self.boxes.len());
+                for k in i * LEAF..end {
+                    if slab.enter(&self.boxes[k], max).is_some() {
+                        max = f(k, max);
+                    }
+                }
+            } else {
+                let below = &self.levels[level - 1];
+                let a = slab.enter(&below[2 * i], max);
+                let b = below.get(2 * i + 1).and_then(|c| slab.enter(c, max));
+                level -= 1;
+                match (a, b) {
+                    (Some(ta), Some(tb)) => {
+                        let (near, far, t) = if tb < ta {
+                            (2 * i + 1, 2 * i, ta)
+                        } else {
+                            (2 * i, 2 * i + 1, tb)
+                        };
+                        stack[len] = (level as u32, far as u32, t);
+                        len += 1;
+                        i = near;
+                        continue;
+                    }
+                    (Some(_), None) => {
+                        i *= 2;
+                        continue;
+                    }
+                    (None, Some(_)) => {
+                        i = 2 * i + 1;
+                        continue;
+                    }
+                    (None, None) => {}
+                }
+            }
+            // The next node put off that the segment, as shortened, still reaches.
+            loop {
+                if len == 0 {
+                    return;
+                }
+                len -= 1;
+                let (l, c, t) = stack[len];
+                if t <= max {
+                    (level, i) = (l as usize, c as usize);
+                    break;
+                }
+            }
+        }
+    }
+}
+
+/// Orders `ids` (the members of a node holding up to `cap`, a power of two times [`LEAF`])
+/// so that the node's left child, holding `cap / 2`, gets those with the smallest centres
+/// along the longer side of their spread (ties by index), and recurses into both children.
+fn split(ids: &mut [u32], centers: &[Vec2], cap: usize) {
+    if ids.len() <= LEAF {
+        return;
+    }
+    let half = cap / 2;
+    if ids.len() <= half {
+        // Only a left child at this level.
+        split(ids, centers, half);
+        return;
+    }
+    let c = |k: &u32| centers[*k as usize];
+    let (lo, hi) = ids.iter().fold(
+        (Vec2::splat(f64::INFINITY), Vec2::splat(f64::NEG_INFINITY)),
+        |(lo, hi), k| (lo.min(c(k)), hi.max(c(k))),
+    );
+    let axis = usize::from(hi.y - lo.y > hi.x - lo.x);
+    ids.select_nth_unstable_by(half, |a, b| {
+        c(a)[axis].total_cmp(&c(b)[axis]).then(a.cmp(b))
+    });
+    let (left, right) = ids.split_at_mut(half);
+    split(left, centers, half);
+    split(right, centers, half);
+}
+
+/// A segment's slab test, set up once a walk.
+struct Slab {
+    origin: Vec2,
+    /// `1 / dir` per axis (infinite along an axis the segment is parallel to).
+    inv: Vec2,
+    /// Whether the segment is parallel to the faces of either axis.
+    flat: bool,
+    /// Per axis, whether the segment runs towards smaller coordinates (it meets a box's
+    /// `max` face first).
+    back: [bool; 2],
+    /// One rounding margin for the whole walk: the root's, which is at least any box's.
+    pad: Vec2,
+    /// `origin + pad` and `origin - pad`: `min - pad - origin` is `min - from_min`.
+    from_min: Vec2,
+    from_max: Vec2,
+}
+
+impl Slab {
+    fn new(origin: Vec2, dir: Vec2, root: &Bounds) -> Slab {
+        let inv = Vec2::new(1.0 / dir.x, 1.0 / dir.y);
+        let pad = root.max.abs().max(root.min.abs()).max(origin.abs()) * 1e-12;
+        Slab {
+            origin,
+            inv,
+            flat: inv.x.is_infinite() || inv.y.is_infinite(),
+            back: [dir.x < 0.0, dir.y < 0.0],
+            pad,
+            from_min: origin + pad,
+            from_max: origin - pad,
+        }
+    }
+
+    /// Where the segment, `t` in `[0, max]`, enters `b` widened by the margin (touching
+    /// counts), or `None` if it misses. The margin covers rounding, so a segment that only
+    /// grazes a box is never lost (the exact test follows).
+    #[inline]
+    fn enter(&self, b: &Bounds, max: f64) -> Option<f64> {
+        if self.flat {
+            return self.enter_flat(b, max);
+        }
+        let to_min = (b.min - self.from_min) * self.inv;
+        let to_max = (b.max - self.from_max) * self.inv;
+        let (near_x, far_x) = if self.back[0] {
+            (to_max.x, to_min.x)
+        } else {
+            (to_min.x, to_max.x)
+        };
+        let (near_y, far_y) = if self.back[1] {
+            (to_max.y, to_min.y)
+        } else {
+            (to_min.y, to_max.y)
+        };
+        let enter = near_x.max(near_y).max(0.0);
+        let exit = far_x.min(far_y).min(max);
+        (enter <= exit).then_some(enter)
+    }
+
+    /// [`Slab::enter`] for a segment parallel to an axis' faces (`inv` infinite there).
+    #[cold]
+    fn enter_flat(&self, b: &Bounds, max: f64) -> Option<f64> {
+        let (lo, hi) = (b.min - self.pad, b.max + self.pad);
+        let (mut enter, mut exit) = (0.0_f64, max);
+        for axis in 0..2 {
+            let (o, inv) = (self.origin[axis], self.inv[axis]);
+            if inv.is_infinite() {
+                // Inside the slab or never.
+                if o < lo[axis] || o > hi[axis] {
+                    return None;
+                }
+                continue;
+            }
+            let t1 = (lo[axis] - o) * inv;
+            let t2 = (hi[axis] - o) * inv;
+            let (near, far) = if t1 < t2 { (t1, t2) } else { (t2, t1) };
+            enter = enter.max(near);
+            exit = exit.min(far);
+        }
+        (enter <= exit).then_some(enter)
+    }
+}
+
+/// Whether `a` and `b` overlap, touching counted ([`Bounds::overlaps`]), with one branch
+/// for the caller instead of four.
+#[inline]
+fn meets(a: &Bounds, b: &Bounds) -> bool {
+    (a.min.x <= b.max.x) & (b.min.x <= a.max.x) & (a.min.y <= b.max.y) & (b.min.y <= a.max.y)
+}
+
+/// The smallest box holding both, ignoring NaN coordinates (`f64::min` and `max` do; a NaN
+/// box overlaps nothing, so nothing is lost).
+fn hull(a: Bounds, b: Bounds) -> Bounds {
+    Bounds {
+        min: Vec2::new(a.min.x.min(b.min.x), a.min.y.min(b.min.y)),
+        max: Vec2::new(a.max.x.max(b.max.x), a.max.y.max(b.max.y)),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Boxes on a grid, with one far off: every query's members, against a scan of all.
+    fn boxes() -> Vec<Bounds> {
+        let mut out: Vec<Bounds> = (0..97)
+            .map(|k| {
+                let c = Vec2::new((k % 10) as f64 * 3.0, (k / 10) as f64 * 2.5);
+                Bounds::around(c, Vec2::new(1.0 + (k % 3) as f64 * 0.4, 0.8))
+            })
+            .collect();
+        out.push(Bounds::around(Vec2::splat(500.0), Vec2::ONE));
+        out
+    }
+
+    #[test]
+    fn a_box_query_finds_every_overlapping_member_once() {
+        let boxes = boxes();
+        let (tree, order) = QueryTree::new(&boxes);
+        for q in [
+            Bounds::around(Vec2::new(7.0, 6.0), Vec2::new(2.0, 1.0)),
+            Bounds::around(Vec2::new(-50.0, 0.0), Vec2::ONE),
+            Bounds::around(Vec2::splat(500.0), Vec2::splat(0.5)),
+            Bounds::around(Vec2::new(15.0, 12.0), Vec2::splat(40.0)),
+            // Touching member 0 (x in [-1, 1]) along its right face only: it counts.
+            Bounds {
+                min: Vec2::new(1.0, -0.5),
+                max: Vec2::new(1.5, 0.5),
+            },
+        ] {
+            let mut got = Vec::new();
+            tree.query(&q, &mut |k| got.push(order[k]));
+            got.sort_unstable();
+            let want: Vec<u32> = (0..boxes.len() as u32)
+                .filter(|&k| boxes[k as usize].overlaps(&q))
+                .collect();
+            assert_eq!(got, want, "{q:?}");
+        }
+    }
+
+    #[test]
+    fn a_ray_that_only_touches_a_corner_meets_that_box() {
+        let boxes = boxes();
+        let (tree, order) = QueryTree::new(&boxes);
+        // The line x + y = 1.8 touches member 0 (x in [-1, 1], y in [-0.8, 0.8]) at its
+        // corner (1, 0.8) only.
+        let (o, d) = (Vec2::new(0.0, 1.8), Vec2::new(1.0, -1.0).normalize());
+        let mut got = Vec::new();
+        tree.ray(o, d, 10.0, &mut |k, max| {
+            got.push(order[k]);
+            max
+        });
+        assert!(got.contains(&0), "{got:?}");
+    }
+
+    #[test]
+    fn a_ray_meets_every_box_it_crosses_including_a_grazed_one() {
+        let boxes = boxes();
+        let (tree, order) = QueryTree::new(&boxes);
+        // Along y = 0.8 exactly: the top faces of the first row, grazed; and diagonals.
+        for (o, d) in [
+            (Vec2::new(-5.0, 0.8), Vec2::X),
+            (Vec2::new(-5.0, -5.0), Vec2::new(1.0, 1.0).normalize()),
+            (Vec2::new(3.0, -10.0), Vec2::Y),
+        ] {
+            let mut got = Vec::new();
+            tree.ray(o, d, 60.0, &mut |k, max| {
+                got.push(order[k]);
+                max
+            });
+            got.sort_unstable();
+            let crosses = |b: &Bounds| {
+                // Sampled densely: a box the segment crosses contains some sample, within
+                // the samples' spacing.
+                (0..=60_000).any(|s| {
+                    let p = o + d * (s as f64 * 1e-3);
+                    p.x >= b.min.x - 1e-9
+                        && p.x <= b.max.x + 1e-9
+                        && p.y >= b.min.y - 1e-9
+                        && p.y <= b.max.y + 1e-9
+                })
+            };
+            for k in 0..boxes.len() as u32 {
+                if crosses(&boxes[k as usize]) {
+                    assert!(got.contains(&k), "ray {o:?} {d:?} lost box {k}");
+                }
+            }
+        }
+    }
+}
