@@ -113,6 +113,14 @@ client.on("serviceCallResponse", (response) => {
   status(`playing in ${url} as ${name} (player ${page.player})`);
 });
 
+client.on("serviceCallFailure", (failure) => {
+  // A refused join (the room is full, a bad name): the server says why.
+  if (joinService !== null && failure.serviceId === joinService.id) {
+    page.error = `cannot join: ${failure.message}`;
+    status(page.error);
+  }
+});
+
 client.on("status", (s) => {
   // A refused join or input: the server says why.
   if (s.level >= 1) {
