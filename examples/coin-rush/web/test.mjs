@@ -101,7 +101,7 @@ async function open(name) {
   page.on("pageerror", (e) => fail(`page ${name}: ${e.message}`));
   await page.goto(pageUrl(name));
   const player = await until(`${name} joined`, () =>
-    page.evaluate(() => window.coinRush.error ?? window.coinRush.player),
+    page.evaluate(() => window.coinRush.player ?? window.coinRush.error),
   );
   if (typeof player !== "number") await fail(`${name} could not join: ${player}`);
   return { page, player };
