@@ -11,6 +11,7 @@ use serde_json::Value;
 use tokio_tungstenite::tungstenite::Message;
 
 use crate::serve_client::*;
+use crate::util::ricochet;
 
 #[test]
 fn inputs_from_a_client_are_applied_recorded_and_replayed_byte_for_byte() {
@@ -406,4 +407,58 @@ fn seeking_back_from_a_snapshot_gives_the_state_a_straight_run_has() {
             );
         }
     });
+}
+
+/// A game with players, for `ricochet replay`'s refusal: it names itself in its log.
+struct Tag;
+
+impl ricochet_sim::Game for Tag {
+    type Input = ();
+    type State = ();
+    fn name(&self) -> &str {
+        "tag"
+    }
+    fn join(
+        &mut self,
+        _: &mut ricochet_sim::Simulation,
+        _: ricochet_sim::Player,
+        _: &str,
+    ) -> Result<(), String> {
+        Ok(())
+    }
+    fn input(
+        &mut self,
+        _: &mut ricochet_sim::Simulation,
+        _: ricochet_sim::Player,
+        (): (),
+    ) -> Result<(), String> {
+        Ok(())
+    }
+}
+
+#[test]
+fn replay_of_a_game_it_does_not_have_is_refused_naming_the_game() {
+    let dir = tempfile::tempdir().unwrap();
+    let log_path = dir.path().join("room.mcap");
+    let mut log = ricochet_record::log_writer(&log_path).unwrap();
+    // A room of a game records the scenario it was built from too, as a served room does.
+    log.attach(
+        "scenario.toml",
+        "application/toml",
+        b"name = \"x\"\n[world]\ndt = 0.0166\n",
+    )
+    .unwrap();
+    let sim = ricochet_sim::Simulation::from_def(ricochet_sim::WorldDef::default()).unwrap();
+    let mut session = ricochet_record::session::GameSession::start(sim, Tag, log, true).unwrap();
+    session.join("ada").unwrap().unwrap();
+    for _ in 0..3 {
+        session.step().unwrap();
+    }
+    session.into_sink().finish().unwrap();
+    let out = ricochet(&["replay", log_path.to_str().unwrap()], b"");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("recorded by the game \"tag\""), "{stderr}");
+    // Nothing was written beside it.
+    assert!(!dir.path().join("room.replay.mcap").exists());
 }

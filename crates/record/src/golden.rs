@@ -110,13 +110,9 @@ pub fn check_or_bless(
     let owned = std::mem::replace(sim, placeholder);
     let mut back = None;
     let verdict = compare(golden, bless, |path| {
-        let ran = run(path, owned, ScenarioGame, frames, &[], false);
-        let (sim, verdict) = match ran {
-            Ok((sim, _)) => (sim, Ok(())),
-            Err((sim, e)) => (sim, Err(e)),
-        };
+        let (sim, ran) = run(path, owned, ScenarioGame, frames, &[], false);
         back = Some(sim);
-        verdict
+        ran.map(|_| ())
     });
     if let Some(s) = back {
         *sim = s;
@@ -149,9 +145,20 @@ pub fn check_game<G: Game>(
     frames: u64,
     script: &[(u64, Command<G::Input>)],
 ) -> Result<G, GoldenError> {
-    compare(golden.as_ref(), blessing(), |path| {
-        let (_, game) = run(path, sim, game, frames, script, true).map_err(|(_, e)| e)?;
-        Ok(game)
+    check_game_or_bless(golden.as_ref(), sim, game, frames, script, blessing())
+}
+
+/// [`check_game`], with the choice to bless given rather than read from the environment.
+pub fn check_game_or_bless<G: Game>(
+    golden: &Path,
+    sim: Simulation,
+    game: G,
+    frames: u64,
+    script: &[(u64, Command<G::Input>)],
+    bless: bool,
+) -> Result<G, GoldenError> {
+    compare(golden, bless, |path| {
+        run(path, sim, game, frames, script, true).1
     })
 }
 
@@ -244,8 +251,7 @@ fn new_name(golden: &Path) -> String {
 
 /// Runs `game` on `sim` for frame 0 to `frames`, the script's commands before their
 /// frames, recorded into `path` (a temporary file, renamed when complete). The simulation
-/// and the game back, with the error if one stopped it.
-#[allow(clippy::type_complexity)]
+/// back, and the game or the error that stopped it.
 fn run<G: Game>(
     path: &Path,
     sim: Simulation,
@@ -253,19 +259,19 @@ fn run<G: Game>(
     frames: u64,
     script: &[(u64, Command<G::Input>)],
     record_inputs: bool,
-) -> Result<(Simulation, G), (Simulation, GoldenError)> {
+) -> (Simulation, Result<G, GoldenError>) {
     let log = match crate::log_writer(path) {
         Ok(log) => log,
-        Err(e) => return Err((sim, e.into())),
+        Err(e) => return (sim, Err(e.into())),
     };
     let mut session = match GameSession::start(sim, game, log, record_inputs) {
         Ok(s) => s,
         // The simulation went with the session: the caller gets a stand-in back.
         Err(e) => {
-            return Err((
+            return (
                 Simulation::new(&ricochet_sim::Scenario::default()),
-                e.into(),
-            ));
+                Err(e.into()),
+            );
         }
     };
     let mut order: Vec<&(u64, Command<G::Input>)> = script.iter().collect();
@@ -303,10 +309,10 @@ fn run<G: Game>(
     }
     let (log, sim, game) = session.into_parts();
     if let Err(e) = log.finish() {
-        return Err((sim, failed.unwrap_or(e.into())));
+        return (sim, Err(failed.unwrap_or(e.into())));
     }
     match failed {
-        Some(e) => Err((sim, e)),
-        None => Ok((sim, game)),
+        Some(e) => (sim, Err(e)),
+        None => (sim, Ok(game)),
     }
 }

@@ -6,6 +6,7 @@
 //! not matter for determinism (it is a function of the spawn and removal history anyway).
 
 use std::collections::{BTreeMap, BTreeSet};
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use ricochet_geom::{Bounds, Primitive, Shape};
 
@@ -122,6 +123,24 @@ pub(crate) struct ShapeTable {
     ids: BTreeSet<(u64, u32)>,
     /// A candidate's bits, while comparing.
     scratch: Vec<u64>,
+    /// Each id's serial: a number given to each value the table makes, never given twice in
+    /// the process (a clone of the table keeps its serials: it holds the same values). A past
+    /// frame's shapes (`history.rs`) are kept by it: an id's serial changes exactly when the
+    /// id is given another shape.
+    serials: Vec<u64>,
+    /// The serial of the last value this table made (0: none yet).
+    last_serial: u64,
+}
+
+/// The next serial of [`ShapeTable::serial`], process-wide: a table built anew (a restore
+/// rebuilds the world) never repeats an earlier table's serial. Serials never reach an
+/// output, so which one a value gets does not matter for determinism.
+static NEXT_SERIAL: AtomicU64 = AtomicU64::new(1);
+
+/// A number never handed out before in this process (never 0): the serials of the shape
+/// table and of the world's layout ([`crate::World`]'s, `history.rs`).
+pub(crate) fn next_serial() -> u64 {
+    NEXT_SERIAL.fetch_add(1, Ordering::Relaxed)
 }
 
 impl ShapeTable {
@@ -146,17 +165,21 @@ impl ShapeTable {
             }
         }
         let entry = Some(value());
+        let serial = next_serial();
+        self.last_serial = serial;
         let id = match self.free.pop() {
             Some(id) => {
                 self.entries[id as usize] = entry;
                 self.names[id as usize] = name;
                 self.users[id as usize] = 1;
+                self.serials[id as usize] = serial;
                 id
             }
             None => {
                 self.entries.push(entry);
                 self.names.push(name);
                 self.users.push(1);
+                self.serials.push(serial);
                 u32::try_from(self.entries.len() - 1).expect("fewer than 2^32 distinct shapes")
             }
         };
@@ -195,6 +218,18 @@ impl ShapeTable {
         self.entries.get(id as usize)?.as_ref()
     }
 
+    /// The serial of `id`'s shape (see the field): the same while the id holds that shape.
+    #[inline]
+    pub(crate) fn serial(&self, id: u32) -> u64 {
+        self.serials[id as usize]
+    }
+
+    /// The serial of the last shape this table made: unchanged while no id was given a new
+    /// shape.
+    pub(crate) fn last_serial(&self) -> u64 {
+        self.last_serial
+    }
+
     /// How many ids have been handed out (some may be free now).
     pub(crate) fn len(&self) -> u32 {
         self.entries.len() as u32
@@ -206,6 +241,7 @@ impl ShapeTable {
             + self.names.capacity() * 4
             + self.users.capacity() * 4
             + self.free.capacity() * 4
+            + self.serials.capacity() * 8
             // A B-tree node holds up to 11 keys; count each entry at a full node's share.
             + self.ids.len() * (size_of::<(u64, u32)>() + 8)
             + self.scratch.capacity() * 8

@@ -104,6 +104,52 @@
 //! image is seen and a ray leaving one edge goes on from the other. Bad input (a zero or
 //! non-finite direction, a negative distance) answers nothing, never a panic.
 //!
+//! # A game's rules
+//!
+//! A game with players implements [`Game`] (joins, leaves, its own typed inputs, rules
+//! before and after each step, the state its players see) and runs in a [`GameLoop`], the
+//! one frame loop that `ricochet-record` (recording, golden checks, replays) and
+//! `ricochet-serve` (rooms) drive too. [`ScenarioGame`] is the game of a scenario file.
+//! README's "Run a game" has a whole one.
+//!
+//! # Lag compensation
+//!
+//! A server checks a player's shot against the world as that player saw it, some frames
+//! ago. [`Simulation::keep_history`] keeps the last `n` frames (at most [`MAX_HISTORY`]),
+//! and [`Simulation::past`] returns one as a [`Past`], with the same queries: exactly what
+//! they return on the scene restored from a snapshot taken right after that frame's step.
+//! A frame not kept is a [`HistoryError`], never an answer from another frame.
+//!
+//! ```
+//! use ricochet_sim::prelude::*;
+//!
+//! let mut sim = Simulation::from_def(WorldDef::default())?;
+//! let ball = sim.spawn(&BodyDef {
+//!     shape: Shape::circle(0.5)?,
+//!     velocity: Vec2::new(60.0, 0.0), // 1 unit a frame; frame 0 does not move it
+//!     ..BodyDef::default()
+//! });
+//! sim.keep_history(32)?; // from the next step on
+//! for _ in 0..10 {
+//!     sim.step(); // at the end of frame f the ball is at x = f
+//! }
+//! let shot = |q: &dyn Fn(Vec2, Vec2, f64, &QueryFilter) -> Option<RayHit>| {
+//!     q(Vec2::new(-10.0, 0.0), Vec2::new(1.0, 0.0), 100.0, &QueryFilter::all()).unwrap()
+//! };
+//! // A player who saw frame 4 shot at the ball's left side, at x = 4 - 0.5 ...
+//! let then = sim.past(4)?;
+//! let hit = shot(&|o, d, m, f| then.cast_ray(o, d, m, f));
+//! assert_eq!((hit.entity, hit.point), (ball, Vec2::new(3.5, 0.0)));
+//! // ... where the world now (the end of frame 9) has it at x = 8.5.
+//! let now = shot(&|o, d, m, f| sim.cast_ray(o, d, m, f));
+//! assert_eq!(now.point, Vec2::new(8.5, 0.0));
+//! assert!(matches!(
+//!     sim.past(10),
+//!     Err(HistoryError::NotKept { frame: 10, oldest: 0, newest: 9 })
+//! ));
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
 //! # Snapshots and rollback
 //!
 //! [`Simulation::snapshot`] holds everything the next step reads (every body, the pending
@@ -130,6 +176,7 @@ mod def;
 mod entity;
 mod event;
 mod game;
+mod history;
 mod interned;
 mod limits;
 #[cfg(feature = "toml")]
@@ -159,6 +206,8 @@ pub use event::{FireOutcome, GameEvent, JumpOutcome, Removal, ScriptInput};
 pub use game::{Game, GameLoop, Overflowed, Player};
 #[cfg(feature = "toml")]
 pub use game::{MAX_INPUT_VALUE, ScenarioGame};
+pub use history::{HistoryError, Past};
+pub use limits::MAX_HISTORY;
 #[cfg(feature = "toml")]
 pub use load::file::ActionFile;
 #[cfg(feature = "toml")]

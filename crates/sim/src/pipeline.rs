@@ -108,6 +108,8 @@ pub struct Simulation {
     pub(crate) queries: crate::query::index::QueryCache,
     /// The world before the first step, that snapshots are written against (`snapshot/`).
     pub(crate) baseline: std::sync::Arc<crate::snapshot::Baseline>,
+    /// The last frames kept for [`Simulation::past`] (`history.rs`); off by default.
+    pub(crate) history: crate::history::History,
 }
 
 /// A summary, not every body (`{:?}` of a 10,000-body world would be megabytes): the
@@ -133,6 +135,7 @@ impl std::fmt::Debug for Simulation {
             .field("touching", &self.touch.touching().len())
             .field("focus", &self.focus)
             .field("threads", &self.threads())
+            .field("kept_frames", &self.kept_frames())
             .finish_non_exhaustive()
     }
 }
@@ -215,6 +218,7 @@ impl Simulation {
             workers: Workers::default(),
             queries: crate::query::index::QueryCache::default(),
             baseline,
+            history: crate::history::History::default(),
         }
     }
 
@@ -405,6 +409,10 @@ impl Simulation {
         out.stats.bodies = self.world.len();
         out.stats.contacts = out.contacts.len() as u64;
         out.stats.kinetic_energy = self.world.kinetic_energy();
+        if self.history.on() {
+            // After every stage: the end of the frame, as a snapshot taken now holds it.
+            self.history.record(&self.world, self.frame);
+        }
         self.frame += 1;
         // The step moved bodies: the moving trees (and, if a static body changed, the
         // static ones) are stale. Dropping an empty cell costs a branch.

@@ -15,6 +15,7 @@ pub use crate::def::{
 pub use crate::entity::Entity;
 pub use crate::event::{FireOutcome, GameEvent, JumpOutcome, Removal, ScriptInput};
 pub use crate::game::{Game, GameLoop, Player};
+pub use crate::history::{HistoryError, Past};
 pub use crate::output::{ContactRecord, FrameOutput, RemovedBody};
 pub use crate::pipeline::Simulation;
 pub use crate::query::{QueryFilter, RayHit, ShapeHit};

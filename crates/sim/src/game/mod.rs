@@ -121,7 +121,8 @@ pub trait Game {
 }
 
 /// A step that made a value non-finite: nothing after it can be trusted.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("frame {frame}: {bad}; the simulation overflowed")]
 pub struct Overflowed {
     /// The frame that overflowed.
     pub frame: u64,

@@ -53,24 +53,45 @@ pub(crate) struct Trees {
 impl Trees {
     /// The trees over the bodies `which` picks.
     fn build(world: &World, generation: u64, which: impl Iterator<Item = usize>) -> Trees {
-        let mut members = Vec::new();
-        let (mut entities, mut layers, mut dense) = (Vec::new(), Vec::new(), Vec::new());
+        Trees::over(
+            generation,
+            &world.entity,
+            &world.layer,
+            which.map(|i| (i, world.bounds_now(i))),
+        )
+    }
+
+    /// The trees over the bodies `members` names, each by its dense index into `entity`
+    /// and `layer` and with its bounds (a past frame's bodies, `history.rs`, as the
+    /// world's).
+    pub(crate) fn over(
+        generation: u64,
+        entity: &[Entity],
+        layer: &[LayerId],
+        members: impl Iterator<Item = (usize, Bounds)>,
+    ) -> Trees {
+        let n = members.size_hint().0;
+        let mut list = Vec::with_capacity(n);
+        let (mut entities, mut layers, mut dense) = (
+            Vec::with_capacity(n),
+            Vec::with_capacity(n),
+            Vec::with_capacity(n),
+        );
         let mut all: Option<Bounds> = None;
-        for i in which {
-            let bounds = world.bounds_now(i);
+        for (i, bounds) in members {
             all = Some(all.map_or(bounds, |a| a.union(bounds)));
-            members.push(Member {
+            list.push(Member {
                 bounds,
                 handle: entities.len() as u32,
                 dynamic: false,
             });
-            entities.push(world.entity[i]);
-            layers.push(world.layer[i]);
+            entities.push(entity[i]);
+            layers.push(layer[i]);
             dense.push(i as u32);
         }
         Trees {
             generation,
-            tree: StaticTree::new(members),
+            tree: StaticTree::new(list),
             entities,
             layers,
             dense,
@@ -83,16 +104,17 @@ impl Trees {
         self.bounds.is_some_and(|b| b.overlaps(q))
     }
 
-    /// The dense index in `world` of the member `handle`, if its body is still there: the
-    /// index it was built with when that still names the body (a lookup by entity else).
-    pub(crate) fn index(&self, world: &World, handle: u32) -> Option<usize> {
+    /// The dense index among the bodies `entity` (ascending) of the member `handle`, if
+    /// its body is still there: the index it was built with when that still names the body
+    /// (a lookup by entity else).
+    pub(crate) fn index(&self, entity: &[Entity], handle: u32) -> Option<usize> {
         let h = handle as usize;
         let e = self.entities[h];
         let i = self.dense[h] as usize;
-        if world.entity.get(i) == Some(&e) {
+        if entity.get(i) == Some(&e) {
             Some(i)
         } else {
-            world.index_of(e)
+            entity.binary_search(&e).ok()
         }
     }
 }
@@ -147,7 +169,7 @@ impl QueryCache {
 /// Calls `f` with the dense index of every body of an accepted layer whose bounds overlap
 /// `q` (touching counts), in no set order.
 pub(crate) fn each_in_box(
-    world: &World,
+    entity: &[Entity],
     trees: &[Arc<Trees>; 2],
     accepts_layer: impl Fn(LayerId) -> bool,
     q: &Bounds,
@@ -160,7 +182,7 @@ pub(crate) fn each_in_box(
         }
         set.tree.query(q, stack, &mut |m: &Member| {
             if accepts_layer(set.layers[m.handle as usize])
-                && let Some(i) = set.index(world, m.handle)
+                && let Some(i) = set.index(entity, m.handle)
             {
                 f(i);
             }

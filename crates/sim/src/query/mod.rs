@@ -29,27 +29,168 @@
 //! while the static generation stays) and over the moving bodies (built on the first query
 //! after the world changed), walked along the ray or by the query's bounds (`index.rs`).
 //! Only the layers a filter accepts are visited.
+//!
+//! # Now and then
+//! Every query is written once, over a [`Bodies`] view: the world now, or a frame kept for
+//! lag compensation (`history.rs`, [`crate::Past`]), whose one tree over all its bodies is
+//! built by its first query. So a past frame answers exactly as the world restored there.
 
 mod filter;
 mod hits;
 pub(crate) mod index;
 mod wrap;
 
+use std::sync::Arc;
+
 use ricochet_geom::{Aabb, Bounds, Pose, Primitive, Ray, Shape, Sweep, Vec2};
 
 pub use filter::QueryFilter;
 pub use hits::{RayHit, ShapeHit};
+pub(crate) use wrap::wrapping;
 
 use crate::broad_phase::Member;
+use crate::def::{LayerId, WorldBounds};
 use crate::entity::Entity;
 use crate::pipeline::Simulation;
+use crate::world::World;
+
+/// What a query reads of a set of bodies, by dense index (ascending entities): the world
+/// now, or a past frame kept by `history.rs`. The query code runs over either alike, so a
+/// past frame answers as the world restored there would.
+pub(crate) trait Bodies {
+    /// Each body's entity, ascending.
+    fn entity(&self) -> &[Entity];
+    /// Each body's layer.
+    fn layer(&self) -> &[LayerId];
+    /// Body `i`'s shape, local coordinates.
+    fn shape(&self, i: usize) -> &Shape;
+    /// Body `i`'s pose.
+    fn pose(&self, i: usize) -> Pose;
+    /// The static trees and the moving trees over the bodies (`index.rs`), built if needed.
+    fn trees(&self) -> [Arc<index::Trees>; 2];
+}
+
+/// The world now, with the simulation's cached trees.
+pub(crate) struct Now<'a> {
+    world: &'a World,
+    cache: &'a index::QueryCache,
+}
+
+impl Bodies for Now<'_> {
+    fn entity(&self) -> &[Entity] {
+        &self.world.entity
+    }
+
+    fn layer(&self) -> &[LayerId] {
+        &self.world.layer
+    }
+
+    #[inline]
+    fn shape(&self, i: usize) -> &Shape {
+        self.world.shape(i)
+    }
+
+    #[inline]
+    fn pose(&self, i: usize) -> Pose {
+        self.world.pose(i)
+    }
+
+    fn trees(&self) -> [Arc<index::Trees>; 2] {
+        self.cache.trees(self.world)
+    }
+}
+
+/// A set of bodies and the world's wrap: what every query runs over.
+pub(crate) struct Scene<'a, B: Bodies> {
+    pub(crate) bodies: B,
+    /// The world's bounds if it wraps.
+    pub(crate) wrap: Option<&'a WorldBounds>,
+}
 
 impl Simulation {
+    /// The world now, to query.
+    fn scene(&self) -> Scene<'_, Now<'_>> {
+        Scene {
+            bodies: Now {
+                world: &self.world,
+                cache: &self.queries,
+            },
+            wrap: wrap::wrapping(self.scenario.world.bounds.as_ref()),
+        }
+    }
+
     /// The first body the ray from `origin` along `direction` hits within `max_distance`
     /// (the module's conventions: solid bodies, the normal out of the body, the lowest id
     /// on a tie). `None` for a miss or bad input.
     #[must_use]
     pub fn cast_ray(
+        &self,
+        origin: Vec2,
+        direction: Vec2,
+        max_distance: f64,
+        filter: &QueryFilter,
+    ) -> Option<RayHit> {
+        self.scene()
+            .cast_ray(origin, direction, max_distance, filter)
+    }
+
+    /// Every body the ray hits within `max_distance`, once each (its first hit), by
+    /// distance, then id. Empty for bad input.
+    #[must_use]
+    pub fn cast_ray_all(
+        &self,
+        origin: Vec2,
+        direction: Vec2,
+        max_distance: f64,
+        filter: &QueryFilter,
+    ) -> Vec<RayHit> {
+        self.scene()
+            .cast_ray_all(origin, direction, max_distance, filter)
+    }
+
+    /// Where `shape` at `pose`, moved by `translation` (its angle fixed), first touches a
+    /// body ([`ricochet_geom::time_of_impact`]: within `1e-9` of the smaller size of
+    /// touching): the smallest fraction of the translation, the lowest id on a tie. A shape
+    /// already overlapping a body touches it at fraction 0. In a wrap world the path goes
+    /// on from the opposite edge, as a ray's does. `None` for no touch or bad input.
+    #[must_use]
+    pub fn cast_shape(
+        &self,
+        shape: &Shape,
+        pose: Pose,
+        translation: Vec2,
+        filter: &QueryFilter,
+    ) -> Option<ShapeHit> {
+        self.scene().cast_shape(shape, pose, translation, filter)
+    }
+
+    /// The bodies `point` is strictly inside, in id order.
+    #[must_use]
+    pub fn overlap_point(&self, point: Vec2, filter: &QueryFilter) -> Vec<Entity> {
+        self.scene().overlap_point(point, filter)
+    }
+
+    /// The bodies whose shape overlaps the box `bounds` (exact shape against box, touching
+    /// not counted), in id order. Empty for a non-finite or inverted box, or one thinner
+    /// than [`ricochet_geom::MIN_SIZE`] (it has no inside to overlap).
+    #[must_use]
+    pub fn overlap_aabb(&self, bounds: Bounds, filter: &QueryFilter) -> Vec<Entity> {
+        self.scene().overlap_aabb(bounds, filter)
+    }
+
+    /// The bodies `shape` at `pose` overlaps (touching not counted), in id order.
+    #[must_use]
+    pub fn overlap_shape(&self, shape: &Shape, pose: Pose, filter: &QueryFilter) -> Vec<Entity> {
+        self.scene().overlap_shape(shape, pose, filter)
+    }
+}
+
+impl<B: Bodies> Scene<'_, B> {
+    /// The first body the ray from `origin` along `direction` hits within `max_distance`
+    /// (the module's conventions: solid bodies, the normal out of the body, the lowest id
+    /// on a tie). `None` for a miss or bad input.
+    #[must_use]
+    pub(crate) fn cast_ray(
         &self,
         origin: Vec2,
         direction: Vec2,
@@ -69,7 +210,7 @@ impl Simulation {
     /// Every body the ray hits within `max_distance`, once each (its first hit), by
     /// distance, then id. Empty for bad input.
     #[must_use]
-    pub fn cast_ray_all(
+    pub(crate) fn cast_ray_all(
         &self,
         origin: Vec2,
         direction: Vec2,
@@ -102,7 +243,7 @@ impl Simulation {
     /// already overlapping a body touches it at fraction 0. In a wrap world the path goes
     /// on from the opposite edge, as a ray's does. `None` for no touch or bad input.
     #[must_use]
-    pub fn cast_shape(
+    pub(crate) fn cast_shape(
         &self,
         shape: &Shape,
         pose: Pose,
@@ -112,8 +253,9 @@ impl Simulation {
         if !(pose.position.is_finite() && pose.angle.is_finite() && translation.is_finite()) {
             return None;
         }
-        let w = &self.world;
-        let wrap = wrap::wrapping(self.scenario.world.bounds.as_ref());
+        let bodies = &self.bodies;
+        let (entity, layer) = (bodies.entity(), bodies.layer());
+        let wrap = self.wrap;
         let start = wrap.map_or(pose.position, |b| wrap::wrap_point(b, pose.position));
         let total = translation.length();
         let dir = if total > 0.0 {
@@ -121,7 +263,7 @@ impl Simulation {
         } else {
             Vec2::ZERO
         };
-        let trees = self.queries.trees(w);
+        let trees = bodies.trees();
         let (offsets, images) = wrap::offsets(wrap);
         // A walk holds at most one pending node per level (< 33): never regrown.
         let mut stack = Vec::with_capacity(64);
@@ -138,22 +280,23 @@ impl Simulation {
                     .bounds(&Pose::new(sweep.start, pose.angle))
                     .union(shape.bounds(&Pose::new(sweep.end, pose.angle)));
                 index::each_in_box(
-                    w,
+                    entity,
                     &trees,
                     |l| filter.accepts_layer(l),
                     &q,
                     &mut stack,
                     &mut |i| {
-                        if !filter.accepts(w.layer[i], w.entity[i]) {
+                        if !filter.accepts(layer[i], entity[i]) {
                             return;
                         }
+                        let at = bodies.pose(i);
                         let body = Sweep {
-                            start: w.position[i],
-                            end: w.position[i],
-                            angle: w.angle[i],
+                            start: at.position,
+                            end: at.position,
+                            angle: at.angle,
                         };
                         let Some(hit) =
-                            ricochet_geom::time_of_impact(shape, &sweep, w.shape(i), &body)
+                            ricochet_geom::time_of_impact(shape, &sweep, bodies.shape(i), &body)
                         else {
                             return;
                         };
@@ -163,7 +306,7 @@ impl Simulation {
                             0.0
                         };
                         let h = ShapeHit {
-                            entity: w.entity[i],
+                            entity: entity[i],
                             fraction,
                             point: hit.contact.point + o,
                             normal: hit.contact.normal,
@@ -187,7 +330,7 @@ impl Simulation {
 
     /// The bodies `point` is strictly inside, in id order.
     #[must_use]
-    pub fn overlap_point(&self, point: Vec2, filter: &QueryFilter) -> Vec<Entity> {
+    pub(crate) fn overlap_point(&self, point: Vec2, filter: &QueryFilter) -> Vec<Entity> {
         if !point.is_finite() {
             return Vec::new();
         }
@@ -196,8 +339,8 @@ impl Simulation {
             max: point,
         };
         self.overlapping(q, filter, &mut |i, o| {
-            let w = &self.world;
-            ricochet_geom::contains_point(w.shape(i), &w.pose(i), point - o)
+            let b = &self.bodies;
+            ricochet_geom::contains_point(b.shape(i), &b.pose(i), point - o)
         })
     }
 
@@ -205,7 +348,7 @@ impl Simulation {
     /// not counted), in id order. Empty for a non-finite or inverted box, or one thinner
     /// than [`ricochet_geom::MIN_SIZE`] (it has no inside to overlap).
     #[must_use]
-    pub fn overlap_aabb(&self, bounds: Bounds, filter: &QueryFilter) -> Vec<Entity> {
+    pub(crate) fn overlap_aabb(&self, bounds: Bounds, filter: &QueryFilter) -> Vec<Entity> {
         let ok = bounds.min.is_finite()
             && bounds.max.is_finite()
             && bounds.min.x <= bounds.max.x
@@ -228,15 +371,20 @@ impl Simulation {
 
     /// The bodies `shape` at `pose` overlaps (touching not counted), in id order.
     #[must_use]
-    pub fn overlap_shape(&self, shape: &Shape, pose: Pose, filter: &QueryFilter) -> Vec<Entity> {
+    pub(crate) fn overlap_shape(
+        &self,
+        shape: &Shape,
+        pose: Pose,
+        filter: &QueryFilter,
+    ) -> Vec<Entity> {
         if !(pose.position.is_finite() && pose.angle.is_finite()) {
             return Vec::new();
         }
         let q = shape.bounds(&pose);
         self.overlapping(q, filter, &mut |i, o| {
-            let w = &self.world;
+            let b = &self.bodies;
             let at = Pose::new(pose.position - o, pose.angle);
-            ricochet_geom::overlaps(shape, &at, w.shape(i), &w.pose(i))
+            ricochet_geom::overlaps(shape, &at, b.shape(i), &b.pose(i))
         })
     }
 
@@ -248,10 +396,10 @@ impl Simulation {
         filter: &QueryFilter,
         test: &mut impl FnMut(usize, Vec2) -> bool,
     ) -> Vec<Entity> {
-        let w = &self.world;
-        let wrap = wrap::wrapping(self.scenario.world.bounds.as_ref());
+        let (entity, layer) = (self.bodies.entity(), self.bodies.layer());
+        let wrap = self.wrap;
         let shift = wrap.map_or(Vec2::ZERO, |b| wrap::wrap_point(b, q.center()) - q.center());
-        let trees = self.queries.trees(w);
+        let trees = self.bodies.trees();
         // A walk holds at most one pending node per level (< 33): never regrown.
         let mut stack = Vec::with_capacity(64);
         let mut found = Vec::new();
@@ -261,14 +409,14 @@ impl Simulation {
             let d = shift - o;
             let qo = q.translated(d);
             index::each_in_box(
-                w,
+                entity,
                 &trees,
                 |l| filter.accepts_layer(l),
                 &qo,
                 &mut stack,
                 &mut |i| {
-                    if filter.accepts(w.layer[i], w.entity[i]) && test(i, o - shift) {
-                        found.push(w.entity[i]);
+                    if filter.accepts(layer[i], entity[i]) && test(i, o - shift) {
+                        found.push(entity[i]);
                     }
                 },
             );
@@ -296,11 +444,12 @@ impl Simulation {
         let Some(ray) = Ray::new(origin, direction) else {
             return;
         };
-        let w = &self.world;
-        let wrap = wrap::wrapping(self.scenario.world.bounds.as_ref());
+        let bodies = &self.bodies;
+        let (entity, layer) = (bodies.entity(), bodies.layer());
+        let wrap = self.wrap;
         let start = wrap.map_or(origin, |b| wrap::wrap_point(b, origin));
         let dir = ray.direction();
-        let trees = self.queries.trees(w);
+        let trees = bodies.trees();
         let (offsets, images) = wrap::offsets(wrap);
         let mut limit = f64::INFINITY;
         let mut segment = |from: Vec2, travelled: f64, len: f64| {
@@ -333,16 +482,19 @@ impl Simulation {
                             if !filter.accepts_layer(set.layers[m.handle as usize]) {
                                 return max;
                             }
-                            let Some(i) = set.index(w, m.handle) else {
+                            let Some(i) = set.index(entity, m.handle) else {
                                 return max;
                             };
-                            let e = w.entity[i];
-                            if !filter.accepts(w.layer[i], e) {
+                            let e = entity[i];
+                            if !filter.accepts(layer[i], e) {
                                 return max;
                             }
-                            let Some(h) =
-                                ricochet_geom::cast_ray(w.shape(i), &w.pose(i), &seg, max)
-                            else {
+                            let Some(h) = ricochet_geom::cast_ray(
+                                bodies.shape(i),
+                                &bodies.pose(i),
+                                &seg,
+                                max,
+                            ) else {
                                 return max;
                             };
                             hit_here = true;

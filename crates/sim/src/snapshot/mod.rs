@@ -27,7 +27,7 @@
 //! | World: `entity`, `layer`, `kind`, `position`, `angle`, `shape`, `name` | state (a script finds bodies by name) | as they differ from the baseline | yes |
 //! | World: the allocator's `generations` (its free list: every slot not alive) | state | as they differ from the baseline | yes |
 //! | World: `shapes`, `names` tables, `row`, `movers`, `active`, counters, `non_boxes`, `key` | caches of the above | no: rebuilt or patched | no |
-//! | World: `static_generation` | a counter the caches compare | no: the caches are built new | no |
+//! | World: `static_generation`, `layout` | counters the caches (and kept frames) compare | no: the caches are built new | no |
 //! | World: `reshaped` | whether a body may no longer have the baseline's shape and name: only what is compared | no | no |
 //! | Rows: `mass`, `velocity`, `angular_velocity`, `force`, `gravity_scale`, `lifetime`, `controller`, `inputs`, `grounded`, `on_static`, `carrier`, `still`, `split`, `frozen`, `asleep`, `rest_frames` | state | as they differ from the baseline | yes |
 //! | Rows: whether a static body has a row (`has_row`: scenery given one) | state of the layout | yes | yes |
@@ -36,6 +36,7 @@
 //! | Rows: `entity` (row to body) | the layout | no | no |
 //! | Rows: `user_data` | game data: no stage reads it | yes | **no** |
 //! | `baseline` (the world before the first step) | definition | its hash, in the scene's | no |
+//! | `history` (the frames kept for `Simulation::past`) | past states for queries; no step reads them | no: `restore` clears them | no |
 //!
 //! `world/checksum_fields.rs` changes every field marked "in `checksum`" in turn and checks
 //! that the checksum changes (its list is checked against this table, and it destructures
@@ -338,7 +339,9 @@ impl Simulation {
 
     /// Puts the simulation back in the state of `s`: it then steps exactly as the one `s`
     /// was taken of did from there. The broad phase and the grids are built anew. The
-    /// thread count and `capture_detect_poses` stay this simulation's.
+    /// thread count and `capture_detect_poses` stay this simulation's, and so does the
+    /// length of its history, whose frames are cleared ([`Simulation::past`]: they belong
+    /// to the timeline left).
     ///
     /// # Errors
     /// [`SnapshotError::OtherScene`] for a snapshot of another scene,
@@ -370,6 +373,8 @@ impl Simulation {
         // Another world: neither tree set of the scene queries may be kept (a static
         // generation can repeat with other static bodies).
         self.queries = crate::query::index::QueryCache::default();
+        // The frames kept belong to the timeline left (`history.rs`); the length stays.
+        self.history.clear();
         self.frame = s.frame;
         self.cursor = st.cursor;
         self.pending = st.pending;

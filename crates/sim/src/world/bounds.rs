@@ -231,7 +231,7 @@ impl World {
 
 /// Bounds `b`, relative to a body, placed at `p`.
 #[inline]
-fn placed(b: Bounds, p: Vec2) -> Bounds {
+pub(crate) fn placed(b: Bounds, p: Vec2) -> Bounds {
     // Translating rounds differently from placing the shape at `p` (a rounding or two,
     // each at most half an ulp of these magnitudes): pad by more than that.
     let pad = (p.abs() + b.min.abs().max(b.max.abs())) * 1e-15;

@@ -42,6 +42,7 @@ mod rows;
 mod sleep;
 mod state;
 
+pub(crate) use bounds::placed;
 pub(crate) use state::{Bodies, PackedWorld};
 
 use bounds::LocalBounds;
@@ -107,6 +108,11 @@ pub struct World {
     /// Whether [`World::set_shape`] ever ran: until then every body has the shape it was
     /// spawned with (a snapshot compares shapes only after it).
     reshaped: bool,
+    /// Counts every body added or removed or given another look: while it stays,
+    /// `entity`, `layer` and the look ids are the same, and kept frames share one copy of
+    /// them (`history.rs`). A world a restore builds or patches takes a number never used
+    /// before ([`crate::interned::next_serial`]): it is another world.
+    layout: u64,
 }
 
 impl World {
@@ -160,6 +166,23 @@ impl World {
     #[inline]
     pub fn shape(&self, i: usize) -> &Shape {
         &self.shapes.get(self.shape_id[i]).0
+    }
+
+    /// Each body's look id (its shape and name) in [`World::shape_table`], by dense index:
+    /// what a kept frame copies (`history.rs`).
+    pub(crate) fn looks(&self) -> &[u32] {
+        &self.shape_id
+    }
+
+    /// The world's layout serial (see the field): the same while `entity`, `layer` and
+    /// [`World::looks`] are.
+    pub(crate) fn layout(&self) -> u64 {
+        self.layout
+    }
+
+    /// The table the look ids index.
+    pub(crate) fn shape_table(&self) -> &ShapeTable {
+        &self.shapes
     }
 
     /// Body `i`'s name.
@@ -283,6 +306,7 @@ impl World {
     /// Creates body `e` (an id the caller took from the allocator, or a restored one) at its
     /// place in id order.
     fn insert(&mut self, e: Entity, def: &BodyDef) {
+        self.layout += 1;
         let i = self.entity.partition_point(|x| *x < e);
         self.entity.insert(i, e);
         let name = self.names.acquire(def.name.as_str(), || ());
@@ -352,6 +376,7 @@ impl World {
 
     /// Removes the body at dense index `i`, keeping the order of the rest.
     pub fn despawn(&mut self, i: usize) {
+        self.layout += 1;
         let e = self.entity.remove(i);
         self.ids.free(e);
         let layer = self.layer.remove(i);
@@ -431,6 +456,7 @@ impl World {
     /// [`World::static_generation`] (re-indexed by the broad phase and the per-axis stages)
     /// and wakes every sleeper, a moving body wakes.
     pub fn set_shape(&mut self, i: usize, shape: &Shape) {
+        self.layout += 1;
         self.reshaped = true;
         let old = self.shape_id[i];
         let layer = usize::from(self.layer[i]);
@@ -469,6 +495,7 @@ impl World {
     /// Renames body `i` (tests: no stage renames a body).
     #[cfg(test)]
     pub(crate) fn set_name(&mut self, i: usize, name: &str) {
+        self.layout += 1;
         let old = self.shape_id[i];
         let id = self.names.acquire(name, || ());
         shape_key(&self.shapes.get(old).0, &mut self.key);

@@ -189,6 +189,7 @@ impl World {
             non_boxes,
             key,
             reshaped,
+            layout: _,
         } = self;
         World {
             ids: EntityAllocator::default(),
@@ -211,6 +212,8 @@ impl World {
             non_boxes: non_boxes.clone(),
             key: key.clone(),
             reshaped: *reshaped,
+            // Another world: its own serial.
+            layout: crate::interned::next_serial(),
         }
     }
 

@@ -12,6 +12,7 @@ impl World {
         if !self.patch(base, b) {
             *self = World::rebuilt(base, b);
         }
+        self.layout = crate::interned::next_serial();
     }
 
     /// Patches the columns in place; false (nothing changed) when this world's bodies are
