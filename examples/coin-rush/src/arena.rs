@@ -17,6 +17,8 @@
 
 use ricochet_sim::prelude::*;
 
+use crate::ZAP_WINDOW;
+
 /// The runners' layer.
 pub const RUNNER: LayerId = 0;
 /// The tiles (floor, walls, ledges).
@@ -87,6 +89,9 @@ pub enum ArenaError {
     /// The world or a body was refused.
     #[error(transparent)]
     Control(#[from] ControlError),
+    /// The history a zap needs was refused.
+    #[error(transparent)]
+    History(#[from] HistoryError),
 }
 
 /// The arena's bodies that the game keeps track of.
@@ -117,7 +122,8 @@ pub fn build() -> Result<Arena, ArenaError> {
         layers,
         ..WorldDef::default()
     })?;
-    // past: the lead adds `sim.keep_history(ZAP_WINDOW)` here with `Simulation::past`.
+    // A zap is checked against the frame its player saw: one of the last ZAP_WINDOW.
+    sim.keep_history(ZAP_WINDOW as usize)?;
     let tile = Shape::aabb(Vec2::splat(TILE_HALF))?;
     sim.spawn_tiles(&TileRows {
         name: "floor".into(),

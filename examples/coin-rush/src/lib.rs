@@ -269,11 +269,9 @@ fn zap_ray(
     dir: Vec2,
     filter: &QueryFilter,
 ) -> Result<Option<RayHit>, String> {
-    // past: `sim.past(seen)` (lag compensation, with `keep_history(ZAP_WINDOW)` in
-    // `arena::build`) replaces this present-time query once it is merged:
-    // `Ok(sim.past(seen).map_err(|e| format!("zap.seen: {e}"))?.cast_ray(origin, dir, ZAP_RANGE, filter))`
-    let _ = seen;
-    Ok(sim.cast_ray(origin, dir, ZAP_RANGE, filter))
+    // Lag compensation: the world `seen` as kept by `keep_history(ZAP_WINDOW)`.
+    let then = sim.past(seen).map_err(|e| format!("zap.seen: {e}"))?;
+    Ok(then.cast_ray(origin, dir, ZAP_RANGE, filter))
 }
 
 impl Game for CoinRush {

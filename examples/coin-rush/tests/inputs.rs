@@ -144,3 +144,46 @@ fn a_full_room_refuses_a_join() {
     assert!(!run.sim().contains(body));
     run.join("later").unwrap();
 }
+
+/// Bob jumps; ten frames later his feet are over 2 units up (15 units/s against 30: about
+/// 15/6 - 15/36 ≈ 2.1), above a ray along y = 1 from ada. A zap naming the frame before his
+/// jump, when he stood in its path, stuns him (lag compensation: the world as ada saw it);
+/// one naming the last frame misses him.
+#[test]
+fn a_zap_is_checked_against_the_frame_its_player_saw() {
+    let stunned_by = |seen_before_jump: bool| {
+        let mut run = started();
+        let (ada, bob) = (Player(1), Player(2));
+        while run.frame() < 5 {
+            run.step().unwrap();
+        }
+        let before_jump = run.frame() - 1;
+        run.input(
+            bob,
+            Input {
+                jump: true,
+                ..Input::default()
+            },
+        )
+        .unwrap();
+        for _ in 0..10 {
+            run.step().unwrap();
+        }
+        let bob_body = run.game().runner(bob).unwrap();
+        let feet = run.sim().position(bob_body).unwrap().y - 0.5;
+        assert!(feet > 1.5, "bob's feet at {feet}: still in the ray's way");
+        let seen = if seen_before_jump {
+            before_jump
+        } else {
+            run.frame() - 1
+        };
+        run.input(ada, zap([1.0, 0.0], seen)).unwrap();
+        run.step().unwrap();
+        run.game().state().unwrap().players[1].stunned
+    };
+    assert!(stunned_by(true), "a zap at the frame ada saw missed bob");
+    assert!(
+        !stunned_by(false),
+        "a zap at the last frame hit bob in the air"
+    );
+}
