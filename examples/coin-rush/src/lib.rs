@@ -71,6 +71,9 @@ pub struct Input {
     pub zap: Option<Zap>,
 }
 
+/// The JSON Schema of [`Input`] (what a client publishes on `/input`).
+pub const INPUT_SCHEMA: &str = r#"{"type":"object","additionalProperties":false,"properties":{"run":{"type":"number","minimum":-1,"maximum":1},"jump":{"type":"boolean"},"zap":{"type":"object","additionalProperties":false,"required":["dir","seen"],"properties":{"dir":{"type":"array","items":{"type":"number"},"minItems":2,"maxItems":2},"seen":{"type":"integer","minimum":0}}}}}"#;
+
 /// A zap: a ray from the player's runner along `dir`, against the world of frame `seen`.
 #[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
