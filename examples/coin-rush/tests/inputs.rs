@@ -187,3 +187,20 @@ fn a_zap_is_checked_against_the_frame_its_player_saw() {
         "a zap at the last frame hit bob in the air"
     );
 }
+
+/// The schemas sent to clients are JSON, and name what the game parses.
+#[test]
+fn the_schemas_are_json_and_name_the_fields() {
+    let input: serde_json::Value = serde_json::from_str(ricochet_coin_rush::INPUT_SCHEMA).unwrap();
+    let fields: Vec<&String> = input["properties"].as_object().unwrap().keys().collect();
+    assert_eq!(fields, ["jump", "run", "zap"]);
+    // Every field it names parses; one it does not is refused by name.
+    let ok: Input =
+        serde_json::from_str(r#"{"run": 1, "jump": true, "zap": {"dir": [1, 0], "seen": 3}}"#)
+            .unwrap();
+    assert_eq!(ok.run, Some(1.0));
+    let bad = serde_json::from_str::<Input>(r#"{"runn": 1}"#).unwrap_err();
+    assert!(bad.to_string().contains("unknown field `runn`"), "{bad}");
+    let state: serde_json::Value = serde_json::from_str(ricochet_coin_rush::STATE_SCHEMA).unwrap();
+    assert_eq!(state["type"], "object");
+}
