@@ -3,12 +3,12 @@
 use std::path::Path;
 use std::process::ExitCode;
 
-use crate::load::load;
+use crate::load::load_all;
 
 /// `ricochet check`: load and validate, print a one-line description.
 pub fn check(path: &Path) -> anyhow::Result<ExitCode> {
-    let s = match load(Some(path)) {
-        Ok(s) => s,
+    let (s, map) = match load_all(Some(path)) {
+        Ok((s, _, map)) => (s, map),
         Err(code) => return Ok(code),
     };
     // A closed pipe or a failed write is the caller's (`main`) to report.
@@ -23,5 +23,20 @@ pub fn check(path: &Path) -> anyhow::Result<ExitCode> {
         s.world.dt,
         s.frames
     ))?;
+    if let Some(m) = map {
+        let spawns: Vec<String> = m.spawns.iter().map(|(t, n)| format!("{n} {t}")).collect();
+        crate::out::print(&format!(
+            "  tiled map: {} static tiles, {} solid bodies, {} one-way pieces, {} chains, spawns: {}\n",
+            m.tiles,
+            m.solids,
+            m.one_way,
+            m.chains,
+            if spawns.is_empty() {
+                "none".to_owned()
+            } else {
+                spawns.join(", ")
+            }
+        ))?;
+    }
     Ok(ExitCode::SUCCESS)
 }

@@ -24,9 +24,17 @@ pub fn run(
         ));
         return Ok(ExitCode::from(2));
     }
+    // The report's head is printed as soon as the first difference is known (the counts
+    // need both logs read to the end); the JSON report is printed whole at the end.
+    let mut told: Option<Result<(), out::WriteError>> = None;
+    let mut tell = |d: &Divergence| {
+        if !json {
+            told = Some(out::print(&render_head(Some(d), tolerance, a, b)));
+        }
+    };
     let report = open(a)
         .and_then(|la| open(b).map(|lb| (la, lb)))
-        .and_then(|(la, lb)| diff_files(&la, &lb, tolerance, topic));
+        .and_then(|(la, lb)| diff_files_with(&la, &lb, tolerance, topic, &mut tell));
     let report = match report {
         Ok(r) => r,
         Err(e) => {
@@ -39,12 +47,13 @@ pub fn run(
     } else {
         ExitCode::from(1)
     };
-    let text = if json {
-        serde_json::to_string_pretty(&report)? + "\n"
-    } else {
-        render(&report, a, b)
+    let printed = match told {
+        None if json => out::print(&(serde_json::to_string_pretty(&report)? + "\n")),
+        None => out::print(&render(&report, a, b)),
+        Some(Ok(())) => out::print(&render_counts(&report)),
+        Some(Err(e)) => Err(e),
     };
-    match out::print(&text) {
+    match printed {
         // The reader went away (`| head`): the verdict is still the exit code.
         Err(e) if e.is_closed() => Ok(code),
         Err(e) => Err(e.into()),

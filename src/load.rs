@@ -4,7 +4,8 @@
 use std::path::Path;
 use std::process::ExitCode;
 
-use ricochet_sim::{Scenario, load_scenario};
+use ricochet_sim::{Scenario, load_scenario_and_map};
+use ricochet_tiled::MapSummary;
 
 /// The built-in demo: `scenarios/asteroids.toml`, embedded.
 pub const DEFAULT_SCENARIO: &str = include_str!("../scenarios/asteroids.toml");
@@ -18,6 +19,12 @@ pub fn load(path: Option<&Path>) -> Result<Scenario, ExitCode> {
 
 /// [`load`], with the file's text.
 pub fn load_text(path: Option<&Path>) -> Result<(Scenario, String), ExitCode> {
+    load_all(path).map(|(scenario, text, _)| (scenario, text))
+}
+
+/// [`load`], with the file's text and, when the scenario takes its level from a Tiled map
+/// (`[tiled]`), what the map became: its bodies are added to the scenario here.
+pub fn load_all(path: Option<&Path>) -> Result<(Scenario, String, Option<MapSummary>), ExitCode> {
     let (text, name) = match path {
         None => (DEFAULT_SCENARIO.to_owned(), DEFAULT_NAME.to_owned()),
         Some(p) => match std::fs::read_to_string(p) {
@@ -28,11 +35,23 @@ pub fn load_text(path: Option<&Path>) -> Result<(Scenario, String), ExitCode> {
             }
         },
     };
-    match load_scenario(&text, &name) {
-        Ok(s) => Ok((s, text)),
+    let (mut scenario, tiled) = match load_scenario_and_map(&text, &name) {
+        Ok(s) => s,
         Err(e) => {
             crate::out::error(&format!("error: {e}"));
-            Err(ExitCode::from(2))
+            return Err(ExitCode::from(2));
         }
-    }
+    };
+    let summary = match (tiled, path) {
+        (Some(def), Some(p)) => match ricochet_tiled::add_map(&mut scenario, &def, p) {
+            Ok(summary) => Some(summary),
+            Err(e) => {
+                crate::out::error(&format!("error: {e}"));
+                return Err(ExitCode::from(2));
+            }
+        },
+        // The built-in demo has no map.
+        _ => None,
+    };
+    Ok((scenario, text, summary))
 }

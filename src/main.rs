@@ -109,6 +109,11 @@ enum Command {
     /// server's directory of at most 16 MiB. A frame that still overflows pauses the session
     /// at its last good frame, the recording complete up to there.
     ///
+    /// Rooms: ws://IP:PORT/rooms/NAME (NAME: 1 to 64 of A-Z a-z 0-9 _ -) is a room of its
+    /// own, a fresh session of the scenario made on first connection, stepped in real time,
+    /// closed 10 s after its last client left (see docs/protocol.md). At most 1,000 rooms,
+    /// 64 clients a room and 1,000 in all; rooms step on a thread per core.
+    ///
     /// Example: ricochet serve scenarios/platformer.toml --record session.mcap
     Serve {
         /// The scenario file (TOML). Default: the built-in Asteroids demo.
@@ -129,7 +134,12 @@ enum Command {
         /// adds no file); /reset and /load start a new one, OUT-1.mcap, ... (at most 1,000).
         #[arg(long, value_name = "OUT.mcap")]
         record: Option<PathBuf>,
-        /// Start paused: frame 0 is shown; the /play or /step service goes on.
+        /// Record each room (ws://IP:PORT/rooms/NAME) to DIR/NAME.mcap (NAME-1.mcap, ... for
+        /// a name recorded before: no file is replaced), finished when the room closes.
+        #[arg(long, value_name = "DIR")]
+        record_rooms: Option<PathBuf>,
+        /// Start paused: frame 0 is shown; the /play or /step service goes on (the plain URL;
+        /// rooms always run).
         #[arg(long)]
         paused: bool,
     },
@@ -181,10 +191,14 @@ enum Command {
     },
     /// Compare two logs frame by frame and name the first difference.
     ///
-    /// Messages are decoded and compared field by field, so compression and chunking don't
-    /// matter. Prints the first divergent frame, topic, body and field with both values, then
-    /// how many messages differ per topic. Both logs are streamed, so memory does not grow
-    /// with their length. Exit code: 0 equal (within --tolerance), 1 they differ, 2 they
+    /// Messages are compared one by one, so compression and chunking don't matter: equal
+    /// bytes under the same schema are equal (schemas are compared and checked once per
+    /// channel, each message's top level is checked), messages that differ are decoded and
+    /// compared field by field. Prints the first divergent frame, topic, body and field with
+    /// both values as soon as it is found, then, when both logs have been read, how many
+    /// messages differ per topic (a log found damaged after the first difference is still an
+    /// error, exit code 2). Both logs are streamed, each read on a thread of its own, so
+    /// memory does not grow with their length. Exit code: 0 equal (within --tolerance), 1 they differ, 2 they
     /// can't be compared: a file is unreadable, truncated or damaged (chunk, data or summary
     /// CRC), not a Ricochet log, or --topic names a topic neither log has.
     ///
@@ -482,6 +496,7 @@ fn main() -> ExitCode {
             speed,
             frames,
             record,
+            record_rooms,
             paused,
         } => serve::run(&serve::Options {
             scenario: scenario.as_deref(),
@@ -489,6 +504,7 @@ fn main() -> ExitCode {
             speed,
             frames,
             record: record.as_deref(),
+            record_rooms: record_rooms.as_deref(),
             paused,
         }),
         Command::Replay { session, output } => replay::run(&session, output),

@@ -25,6 +25,8 @@ pub struct Options<'a> {
     pub frames: Option<u64>,
     /// Also write the log here.
     pub record: Option<&'a Path>,
+    /// Record each room to DIR/NAME.mcap.
+    pub record_rooms: Option<&'a Path>,
     /// Start paused (the clients see frame 0; `/play` or `/step` goes on).
     pub paused: bool,
 }
@@ -61,6 +63,15 @@ pub fn run(o: &Options) -> anyhow::Result<ExitCode> {
             return Ok(ExitCode::from(2));
         }
     };
+    if let Some(dir) = o.record_rooms
+        && !dir.is_dir()
+    {
+        out::error(&format!(
+            "error: --record-rooms {}: not a folder (make it first)",
+            dir.display()
+        ));
+        return Ok(ExitCode::from(2));
+    }
     let interrupted = Arc::new(AtomicBool::new(false));
     {
         let flag = Arc::clone(&interrupted);
@@ -82,17 +93,24 @@ pub fn run(o: &Options) -> anyhow::Result<ExitCode> {
         ))?;
     }
     out::note(&format!(
-        "serving {} on ws://{local} (Foxglove: Open connection; layout foxglove/ricochet-layout.json); Ctrl-C stops",
+        "serving {} on ws://{local} (Foxglove: Open connection; layout foxglove/ricochet-layout.json), \
+         and rooms of it on ws://{local}/rooms/NAME; Ctrl-C stops",
         scenario.name
     ))?;
+    let note: ricochet_serve::Note = Arc::new(|text: &str| {
+        // A lost line on stderr is no failure.
+        let _ = out::note(text);
+    });
     let options = ricochet_serve::Options {
         speed: o.speed,
         frames: o.frames,
         record: o.record.map(Path::to_path_buf),
         paused: o.paused,
-        // A lost line on stderr is no failure.
-        note: Arc::new(|text: &str| {
-            let _ = out::note(text);
+        note: note.clone(),
+        rooms: Some(ricochet_serve::RoomOptions {
+            record: o.record_rooms.map(Path::to_path_buf),
+            note,
+            ..Default::default()
         }),
     };
     let served = ricochet_serve::serve(listener, scenario, text, &options, &interrupted)?;
@@ -108,5 +126,11 @@ pub fn run(o: &Options) -> anyhow::Result<ExitCode> {
         served.dropped,
         ricochet_serve::cpu_seconds().map_or("?".to_owned(), |s| format!("{s:.2}"))
     ))?;
+    if let Some(r) = &served.rooms {
+        out::note(&format!(
+            "rooms: {} opened, {} failed, {} frames; frame starts late: p50 {:.3} ms, p99 {:.3} ms, max {:.3} ms",
+            r.opened, r.failed, r.frames, r.late_ms[0], r.late_ms[1], r.late_ms[2]
+        ))?;
+    }
     Ok(ExitCode::SUCCESS)
 }

@@ -8,7 +8,7 @@ use std::process::Output;
 
 use ricochet_log::LogWriter;
 
-use crate::util::{record, ricochet, root};
+use crate::util::{one_ulp_up, record, ricochet, root};
 
 /// What a rewrite does to one channel's schema: its name and data, by topic.
 type Damage = fn(&str, &mut String, &mut Vec<u8>);
@@ -149,39 +149,122 @@ fn diff_reports_a_schema_that_differs_between_the_logs() {
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
 }
 
+/// A log of one message, `payload`, on `topic` with Ricochet's schema `schema` (a valid
+/// schema: whether the payload is one of its messages is what the tests ask).
+fn one_message_log(path: &Path, schema: &str, topic: &str, payload: &[u8]) {
+    let mut w = mcap::WriteOptions::new()
+        .library("ricochet 0.1.0")
+        .create(BufWriter::new(File::create(path).unwrap()))
+        .unwrap();
+    let schema = ricochet_log::Schema::ricochet(schema);
+    let sid = w
+        .add_schema(&schema.name, &schema.encoding, &schema.data)
+        .unwrap();
+    let ch = w
+        .add_channel(sid, topic, "protobuf", &Default::default())
+        .unwrap();
+    let header = mcap::records::MessageHeader {
+        channel_id: ch,
+        sequence: 0,
+        log_time: 0,
+        publish_time: 0,
+    };
+    w.write_to_known_channel(&header, payload).unwrap();
+    w.finish().unwrap();
+}
+
 #[test]
 fn diff_refuses_equal_messages_that_their_schema_cannot_decode() {
     // Two logs with the same valid schema and the same payload, which is not a
     // `ricochet.Stats` (field 1 as a length running past the end): byte for byte equal,
-    // but neither log is readable.
+    // but neither log is readable. Equal bytes are not decoded whole, but their top level
+    // (keys, lengths, the fields that are not nested messages) is checked.
     let dir = tempfile::tempdir().unwrap();
     let (a, b) = (dir.path().join("a.mcap"), dir.path().join("b.mcap"));
     for path in [&a, &b] {
-        let mut w = mcap::WriteOptions::new()
-            .library("ricochet 0.1.0")
-            .create(BufWriter::new(File::create(path).unwrap()))
-            .unwrap();
-        let schema = ricochet_log::Schema::ricochet("ricochet.Stats");
-        let sid = w
-            .add_schema(&schema.name, &schema.encoding, &schema.data)
-            .unwrap();
-        let ch = w
-            .add_channel(sid, "/stats", "protobuf", &Default::default())
-            .unwrap();
-        let header = mcap::records::MessageHeader {
-            channel_id: ch,
-            sequence: 0,
-            log_time: 0,
-            publish_time: 0,
-        };
-        w.write_to_known_channel(&header, b"\x0a\x7f\x01").unwrap();
-        w.finish().unwrap();
+        one_message_log(path, "ricochet.Stats", "/stats", b"\x0a\x7f\x01");
     }
     let o = ricochet(&["diff", s(&a), s(&b)], b"");
     let err = stderr(&o);
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(
         err.contains("corrupt log") && err.contains("not a ricochet.Stats message"),
+        "{err}"
+    );
+}
+
+#[test]
+fn diff_takes_equal_bytes_as_equal_and_decodes_those_that_differ() {
+    // A `ricochet.Bodies` whose top level is sound (field 4, `bodies`, 3 bytes long) but
+    // whose body is not a `ricochet.Body` (its field 1 a length running past the end).
+    let nested_damage: &[u8] = b"\x22\x03\x0a\x7f\x01";
+    // The same message with a sound body: `id` 1.
+    let sound: &[u8] = b"\x22\x02\x08\x01";
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b, c) = (
+        dir.path().join("a.mcap"),
+        dir.path().join("b.mcap"),
+        dir.path().join("c.mcap"),
+    );
+    one_message_log(&a, "ricochet.Bodies", "/bodies", nested_damage);
+    one_message_log(&b, "ricochet.Bodies", "/bodies", nested_damage);
+    one_message_log(&c, "ricochet.Bodies", "/bodies", sound);
+    // Where the bytes differ, the message is decoded, and the damage found, in either order.
+    for (x, y) in [(&a, &c), (&c, &a)] {
+        let o = ricochet(&["diff", s(x), s(y)], b"");
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        assert!(
+            err.contains("corrupt log")
+                && err.contains("a.mcap")
+                && err.contains("not a ricochet.Bodies message"),
+            "{err}"
+        );
+    }
+    // Equal bytes under the same valid schema are equal messages: what is nested in them is
+    // not decoded by `diff` (that is what keeps big logs fast); `dump` decodes it.
+    let o = ricochet(&["diff", s(&a), s(&b)], b"");
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let dump = ricochet(&["dump", s(&a)], b"");
+    assert_eq!(dump.status.code(), Some(2), "{}", stderr(&dump));
+    assert!(stderr(&dump).contains("not a ricochet.Bodies message"));
+}
+
+#[test]
+fn diff_prints_the_first_difference_before_damage_found_later() {
+    // A velocity one ulp off in frame 0, and a data section CRC that does not match, which
+    // only the end of the data section shows: the first difference is printed as soon as it
+    // is found, then the damage is an error (exit code 2, no counts).
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = root().join("scenarios/asteroids.toml");
+    let (text, _) = one_ulp_up(&std::fs::read_to_string(&scenario).unwrap());
+    let nudged = dir.path().join("nudged.toml");
+    std::fs::write(&nudged, text).unwrap();
+    let (good, bad) = (dir.path().join("good.mcap"), dir.path().join("bad.mcap"));
+    record(&scenario, &good);
+    record(&nudged, &bad);
+    let mut bytes = std::fs::read(&bad).unwrap();
+    // The footer (before the closing magic) starts with the summary's offset; the data
+    // end record (opcode 0x0f, length 4, the CRC) ends right before it.
+    let n = bytes.len();
+    let summary = u64::from_le_bytes(bytes[n - 8 - 20..n - 8 - 12].try_into().unwrap()) as usize;
+    assert_eq!(bytes[summary - 13], 0x0f, "a data end record");
+    assert_ne!(
+        bytes[summary - 4..summary],
+        [0; 4],
+        "a data section CRC to damage"
+    );
+    bytes[summary - 4] ^= 1;
+    std::fs::write(&bad, bytes).unwrap();
+    let o = ricochet(&["diff", s(&good), s(&bad)], b"");
+    let (out, err) = (String::from_utf8_lossy(&o.stdout), stderr(&o));
+    assert_eq!(o.status.code(), Some(2), "{out}{err}");
+    assert!(
+        out.contains("differ\nfirst difference: frame 0") && !out.contains("per topic"),
+        "{out}"
+    );
+    assert!(
+        err.contains("corrupt log") && err.contains("bad.mcap") && err.contains("data section"),
         "{err}"
     );
 }

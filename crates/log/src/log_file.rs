@@ -6,6 +6,8 @@ use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::{BufReader, Read, Seek, SeekFrom};
 use std::path::Path;
+use std::sync::mpsc::{self, Receiver, SyncSender};
+use std::thread::JoinHandle;
 
 use mcap::McapError;
 use mcap::read::Summary;
@@ -73,6 +75,8 @@ pub struct LogFile {
     total: u64,
     /// The attachments: name, offset and length of the record (opcode and length included).
     attachments: Vec<(String, u64, u64)>,
+    /// Where its summary starts: what is before it is the header and the data section.
+    summary_start: u64,
 }
 
 impl LogFile {
@@ -218,6 +222,7 @@ impl LogFile {
             library,
             channels,
             total: stats.message_count,
+            summary_start: footer.summary_start,
         })
     }
 
@@ -268,6 +273,52 @@ impl LogFile {
         }
     }
 
+    /// Whether `other` holds the same messages on the same channels as this log because it
+    /// holds the same bytes: the same channels in its summary (ids, topics, schemas, message
+    /// counts), and the same bytes from its start to its summary (magic, header, and the
+    /// whole data section: its chunks, with their CRCs, and the data section's CRC). Reading
+    /// this log's messages then checks both (two logs compared with themselves, or a golden
+    /// log with a fresh recording that matches it, are read once). Reads both files in blocks,
+    /// up to the first byte that differs.
+    pub(crate) fn same_data(&self, other: &LogFile) -> Result<bool, LogError> {
+        if self.channels != other.channels || self.summary_start != other.summary_start {
+            return Ok(false);
+        }
+        let (mut fa, mut fb) = (self.open_source()?, other.open_source()?);
+        let error_a = |source| LogError::Read {
+            path: self.path.clone(),
+            source,
+        };
+        let error_b = |source| LogError::Read {
+            path: other.path.clone(),
+            source,
+        };
+        let mut left = self.summary_start;
+        let (mut ba, mut bb) = (vec![0; 1 << 20], vec![0; 1 << 20]);
+        while left > 0 {
+            let n = left.min(ba.len() as u64) as usize;
+            fa.read_exact(&mut ba[..n]).map_err(error_a)?;
+            fb.read_exact(&mut bb[..n]).map_err(error_b)?;
+            if ba[..n] != bb[..n] {
+                return Ok(false);
+            }
+            left -= n as u64;
+        }
+        Ok(true)
+    }
+
+    /// The file its data is read from: itself, or the copy of what a pipe held.
+    fn open_source(&self) -> Result<File, LogError> {
+        let from: &Path = match &self.source {
+            Source::File(p) => p,
+            Source::Copy(t) => t,
+        };
+        File::open(from).map_err(|source| LogError::Read {
+            path: self.path.clone(),
+            source,
+        })
+    }
+
     /// The `library` its header names as the writer (`ricochet 0.1.0`).
     pub fn library(&self) -> &str {
         &self.library
@@ -299,18 +350,29 @@ impl LogFile {
             Source::File(p) => p,
             Source::Copy(t) => t,
         };
-        let file = File::open(from).map_err(|source| LogError::Read {
+        let read_error = |source| LogError::Read {
             path: self.path.clone(),
             source,
-        })?;
+        };
+        let file = File::open(from).map_err(read_error)?;
         let options = LinearReaderOptions::default()
             .with_prevalidate_chunk_crcs(true)
             .with_validate_data_section_crc(true)
             .with_validate_summary_section_crc(true)
             .with_check_finishes_after_end_magic(true)
             .with_record_length_limit(RECORD_LIMIT);
+        let reader = mcap::io::MessageReader::new_with_options(BufReader::new(file), options);
+        // Reading (decompressing and checking the CRCs) is most of the work of comparing
+        // two logs byte for byte: each log is read on a thread of its own, a few messages
+        // ahead of its reader, so two logs are read at the same time on two cores.
+        let (sender, incoming) = mpsc::sync_channel(AHEAD);
+        let reading = std::thread::Builder::new()
+            .name("log reader".to_owned())
+            .spawn(move || read_ahead(reader, &sender))
+            .map_err(read_error)?;
         Ok(Messages {
-            reader: mcap::io::MessageReader::new_with_options(BufReader::new(file), options),
+            incoming: Some(incoming),
+            reading: Some(reading),
             topic,
             path: self.path.clone(),
             expected: self
@@ -324,6 +386,35 @@ impl LogFile {
             decoder: Decoder::default(),
         })
     }
+}
+
+/// How many messages a log's reading thread may have read that [`Messages`] has not yet
+/// taken: memory stays flat (at most this many messages, and the chunk being read).
+const AHEAD: usize = 4;
+
+/// What a log's reading thread hands over, in file order.
+enum Ahead {
+    Message(mcap::Message<'static>),
+    /// The reader's error: nothing follows it.
+    Failed(McapError),
+    /// The last record was read.
+    End,
+}
+
+/// The body of a log's reading thread: every message in turn, until the end, an error, or
+/// [`Messages`] is dropped (the send then fails).
+fn read_ahead(reader: mcap::io::MessageReader<BufReader<File>>, sender: &SyncSender<Ahead>) {
+    for message in reader {
+        let (item, last) = match message {
+            Ok(m) => (Ahead::Message(m), false),
+            Err(e) => (Ahead::Failed(e), true),
+        };
+        if sender.send(item).is_err() || last {
+            return;
+        }
+    }
+    // Nobody may be left to receive it: that is fine.
+    let _ = sender.send(Ahead::End);
 }
 
 /// Where a [`LogFile`]'s messages are read from.
@@ -340,7 +431,10 @@ enum Source {
 /// the summary's and the message counts against the statistics at the end.
 /// After an error it yields nothing more.
 pub struct Messages {
-    reader: mcap::io::MessageReader<BufReader<File>>,
+    /// The messages the reading thread has read, `None` once dropped.
+    incoming: Option<Receiver<Ahead>>,
+    /// The reading thread, joined when this is dropped.
+    reading: Option<JoinHandle<()>>,
     topic: Option<String>,
     path: std::path::PathBuf,
     expected: BTreeMap<u16, u64>,
@@ -359,7 +453,20 @@ impl Messages {
     /// decoded: to compare payloads byte for byte before decoding them.
     pub fn next_raw(&mut self) -> Option<Result<RawMessage, LogError>> {
         while !self.done {
-            let Some(message) = self.reader.next() else {
+            let received = self.incoming.as_ref().map(Receiver::recv);
+            let message = match received {
+                Some(Ok(Ahead::Message(m))) => Some(Ok(m)),
+                Some(Ok(Ahead::Failed(e))) => Some(Err(e)),
+                Some(Ok(Ahead::End)) => None,
+                // The thread ended without saying why (it panicked): not a log's fault.
+                _ => {
+                    return self.fail(LogError::Read {
+                        path: self.path.clone(),
+                        source: std::io::Error::other("the thread reading it stopped"),
+                    });
+                }
+            };
+            let Some(message) = message else {
                 self.done = true;
                 if self.counts != self.expected {
                     return self.fail(corrupt(&format!(
@@ -386,8 +493,10 @@ impl Messages {
         None
     }
 
-    /// Checks that a message [`next_raw`](Self::next_raw) yielded decodes with its channel's
-    /// schema, without building its JSON (a corrupt log's error if not).
+    /// Checks that the top level of a message [`next_raw`](Self::next_raw) yielded decodes
+    /// with its channel's schema (a corrupt log's error if not), without decoding the
+    /// messages nested in it: cheap enough for every message, where decoding a big message
+    /// whole costs more than reading it.
     pub fn check(&mut self, raw: &RawMessage) -> Result<(), LogError> {
         self.decoder.check(&raw.inner).map_err(|error| {
             self.done = true;
@@ -404,6 +513,16 @@ impl Messages {
             self.done = true;
             at(&self.path)(e)
         })
+    }
+}
+
+impl Drop for Messages {
+    fn drop(&mut self) {
+        // Dropping the receiver first wakes the thread if it waits to send, and it ends.
+        self.incoming = None;
+        if let Some(reading) = self.reading.take() {
+            let _ = reading.join();
+        }
     }
 }
 
@@ -453,5 +572,51 @@ fn read_library(file: &mut File, len: u64) -> Result<String, LogError> {
     match mcap::parse_record(mcap::records::op::HEADER, &data) {
         Ok(mcap::records::Record::Header(header)) => Ok(header.library),
         _ => Err(no_header()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A log of `payloads` on one `/stats` channel (their content does not matter here).
+    fn write(path: &Path, payloads: &[&[u8]]) -> LogFile {
+        let mut w = mcap::WriteOptions::new()
+            .library("ricochet test")
+            .create(std::io::BufWriter::new(File::create(path).unwrap()))
+            .unwrap();
+        let schema = crate::Schema::ricochet("ricochet.Stats");
+        let sid = w
+            .add_schema(&schema.name, &schema.encoding, &schema.data)
+            .unwrap();
+        let ch = w
+            .add_channel(sid, "/stats", "protobuf", &Default::default())
+            .unwrap();
+        for (i, payload) in payloads.iter().enumerate() {
+            let header = mcap::records::MessageHeader {
+                channel_id: ch,
+                sequence: i as u32,
+                log_time: i as u64,
+                publish_time: i as u64,
+            };
+            w.write_to_known_channel(&header, payload).unwrap();
+        }
+        w.finish().unwrap();
+        LogFile::open(path).unwrap()
+    }
+
+    #[test]
+    fn same_data_is_the_same_channels_and_bytes_up_to_the_summary() {
+        let dir = tempfile::tempdir().unwrap();
+        let at = |name: &str| dir.path().join(name);
+        let a = write(&at("a"), &[b"\x08\x01", b"\x08\x02"]);
+        let same = write(&at("same"), &[b"\x08\x01", b"\x08\x02"]);
+        // One byte of one message differs: the same channels, other bytes.
+        let other = write(&at("other"), &[b"\x08\x01", b"\x08\x03"]);
+        // One message fewer: other counts in the summary.
+        let fewer = write(&at("fewer"), &[b"\x08\x01"]);
+        assert!(a.same_data(&same).unwrap() && same.same_data(&a).unwrap());
+        assert!(!a.same_data(&other).unwrap() && !other.same_data(&a).unwrap());
+        assert!(!a.same_data(&fewer).unwrap() && !fewer.same_data(&a).unwrap());
     }
 }

@@ -226,6 +226,9 @@ pub fn compare_motion(scenario: &Scenario, frames: u64) -> MotionReport {
         }
     });
     let mut tracked: Vec<Tracked> = tracked_bodies.collect();
+    // A scenario's tile rows are spawned first (ids 0 on), its bodies after them: body `i`
+    // is the world's slot `tiles + i` (nothing is removed in free flight).
+    let tiles: usize = s.tiles.iter().map(ricochet_sim::TileRows::len).sum();
 
     for n in 1..=frames {
         sim.step();
@@ -235,8 +238,8 @@ pub fn compare_motion(scenario: &Scenario, frames: u64) -> MotionReport {
             let rb = &world.bodies[t.handle];
             let p_rapier = from_vector(rb.translation());
             let a_rapier = rb.rotation().angle();
-            let p = sim.world().position[t.index];
-            let a = sim.world().angle[t.index];
+            let p = sim.world().position[tiles + t.index];
+            let a = sim.world().angle[tiles + t.index];
 
             let scale = 1.0_f64
                 .max(t.x0.length())

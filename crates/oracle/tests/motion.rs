@@ -100,3 +100,36 @@ fn an_infinite_state_never_passes() {
     assert!(!r.passed(), "{r:?}");
     assert!(!r.bodies[0].passed());
 }
+
+/// A scene with tile rows (a Tiled level's, spawned before the bodies): each body is compared
+/// with its own rapier twin, not with a tile of the same index.
+#[test]
+fn bodies_after_tile_rows_fly_the_same_in_both_engines() {
+    use ricochet_sim::{Scenario, TileRows, Vec2};
+    let mut s = load_scenario(
+        r#"
+        frames = 120
+        layers = ["tile", "a"]
+        world.gravity = [0, -9.81]
+        [[bodies]]
+        name = "ball"
+        layer = "a"
+        shape = { kind = "circle", radius = 0.5 }
+        position = [0, 10]
+        velocity = [2, 3]
+        "#,
+        "tiles.toml",
+    )
+    .unwrap();
+    s.tiles.push(TileRows {
+        name: "tile".to_owned(),
+        layer: 0,
+        shape: ricochet_sim::Shape::aabb(Vec2::splat(0.5)).unwrap(),
+        step: Vec2::new(1.0, 0.0),
+        rows: vec![(Vec2::new(0.5, -20.0), 5)],
+    });
+    let s: Scenario = s;
+    let report = compare_motion(&s, s.frames);
+    assert_eq!(report.bodies.len(), 1);
+    assert!(report.passed(), "{report:?}");
+}

@@ -111,6 +111,13 @@ impl ClientQueueReceiver {
         self.queued.fetch_sub(weight(&message), Ordering::AcqRel);
         Some(message)
     }
+
+    /// The next message if one is queued now.
+    pub fn try_recv(&mut self) -> Result<Message, mpsc::error::TryRecvError> {
+        let message = self.receiver.try_recv()?;
+        self.queued.fetch_sub(weight(&message), Ordering::AcqRel);
+        Ok(message)
+    }
 }
 
 /// Channels one client may advertise (`clientPublish`): Foxglove's panels advertise a few
@@ -155,6 +162,8 @@ struct Client {
     dropped: u64,
     /// Latched channels whose message was dropped for it: sent again when it catches up.
     stale: BTreeSet<u32>,
+    /// Ends its connection, saying why (a room that closes).
+    kick: Option<tokio::sync::oneshot::Sender<String>>,
 }
 
 /// Everything the simulation thread and the connections share.
@@ -179,6 +188,16 @@ pub struct Shared {
     pub data_end_ns: u64,
     /// Messages dropped for slow clients, in all.
     pub dropped: u64,
+    /// A room's: the clients that disconnected since the room last looked (its players
+    /// leave), kept only when set.
+    pub track_leaves: bool,
+    /// The clients that disconnected (with [`Shared::track_leaves`]), in order.
+    pub left: Vec<u64>,
+    /// Inputs waiting beyond which new ones are refused, if not [`MAX_PENDING_INPUTS`] (a
+    /// room's cap is smaller: there are many rooms).
+    pub input_cap: Option<usize>,
+    /// The room closed: no client connects any more.
+    pub closed: bool,
 }
 
 /// A handle on the shared state.
@@ -200,8 +219,10 @@ impl Shared {
         &self.channels
     }
 
-    /// A new client with its outgoing queue; returns its id.
-    pub fn connect(&mut self, queue: ClientQueue) -> u64 {
+    /// A new client with its outgoing queue; returns its id, and what tells its connection
+    /// to end (see [`Shared::close_all`]).
+    pub fn connect(&mut self, queue: ClientQueue) -> (u64, tokio::sync::oneshot::Receiver<String>) {
+        let (kick, kicked) = tokio::sync::oneshot::channel();
         let id = self.next_client;
         self.next_client += 1;
         self.clients.insert(
@@ -212,9 +233,26 @@ impl Shared {
                 subscriptions: BTreeMap::new(),
                 dropped: 0,
                 stale: BTreeSet::new(),
+                kick: Some(kick),
             },
         );
-        id
+        (id, kicked)
+    }
+
+    /// Ends every client's connection: a status saying `why` (level 2), then a close frame
+    /// with it; no client connects after.
+    pub fn close_all(&mut self, why: &str) {
+        self.closed = true;
+        for c in self.clients.values_mut() {
+            let status = protocol::ServerMessage::Status {
+                level: 2,
+                message: why,
+            };
+            let _ = c.queue.answer(Message::text(status.json()));
+            if let Some(kick) = c.kick.take() {
+                let _ = kick.send(why.to_owned());
+            }
+        }
     }
 
     /// How many clients are connected.
@@ -224,7 +262,9 @@ impl Shared {
 
     /// Forgets a client.
     pub fn disconnect(&mut self, client: u64) {
-        self.clients.remove(&client);
+        if self.clients.remove(&client).is_some() && self.track_leaves {
+            self.left.push(client);
+        }
     }
 
     /// Subscribes `client` to `channel` as `subscription`; an unknown channel is an error
@@ -320,7 +360,7 @@ impl Shared {
                 ricochet_record::session::MAX_INPUT
             ));
         }
-        if self.inputs.len() >= MAX_PENDING_INPUTS {
+        if self.inputs.len() >= self.input_cap.unwrap_or(MAX_PENDING_INPUTS) {
             return Err("too many inputs waiting for the next frame".to_owned());
         }
         let text = std::str::from_utf8(payload).map_err(|_| "an input that is not UTF-8")?;
@@ -454,17 +494,44 @@ impl Shared {
 /// published to the clients subscribed to its channel.
 pub struct LiveSink {
     hub: Hub,
+    /// The topic the session's own `/input` (what it records) is advertised as live.
+    input_topic: &'static str,
 }
+
+/// The topic a room advertises its recorded commands on: `/input` is what its clients
+/// publish (the game's input, JSON), so the server's record of them is told apart (the
+/// recording keeps `/input`, which replays read).
+pub const RECORDED_INPUT: &str = "/input/recorded";
 
 impl LiveSink {
     /// A sink publishing through `hub`.
     pub fn new(hub: Hub) -> LiveSink {
-        LiveSink { hub }
+        LiveSink {
+            hub,
+            input_topic: "/input",
+        }
+    }
+
+    /// A room's sink: its recorded `/input` is advertised as [`RECORDED_INPUT`].
+    pub fn for_room(hub: Hub) -> LiveSink {
+        LiveSink {
+            hub,
+            input_topic: RECORDED_INPUT,
+        }
+    }
+
+    fn topic<'a>(&self, topic: &'a str) -> &'a str {
+        if topic == "/input" {
+            self.input_topic
+        } else {
+            topic
+        }
     }
 }
 
 impl MessageSink for LiveSink {
     fn add_protobuf_channel(&mut self, topic: &str, schema: Schema) -> Result<ChannelId, LogError> {
+        let topic = self.topic(topic);
         let mut s = self.hub.lock();
         // A new session (after a reset) adds the same topics: they keep their ids, and the
         // clients their subscriptions.
@@ -496,6 +563,7 @@ impl MessageSink for LiveSink {
         schema_name: &str,
         schema_json: &str,
     ) -> Result<ChannelId, LogError> {
+        let topic = self.topic(topic);
         let mut s = self.hub.lock();
         if let Some(c) = s.channels.iter().find(|c| c.topic == topic) {
             return Ok(ChannelId::from_index(c.id as u16));

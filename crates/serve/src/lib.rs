@@ -9,6 +9,10 @@
 //!   scene queries (`query.rs`) and Lichtblick's clicked point (`click.rs`);
 //! - the real-time loop ([`serve`]: a fixed-timestep schedule, seeks, `/step`, pauses),
 //!   recording the session as it goes ([`Options::record`]).
+//! - rooms ([`serve_rooms`], `rooms.rs`, `room.rs`): many sessions of a game at once, each
+//!   its own simulation, game, recording and clients at `ws://HOST:PORT/rooms/NAME`, made
+//!   by a [`RoomMaker`], stepped on a bounded pool of threads (the client protocol:
+//!   `docs/protocol.md`).
 //!
 //! The messages are `ricochet-record`'s, the same a log holds; the inputs are its sessions'.
 //! This crate never lets the wall clock reach a message (it only paces the frames), never
@@ -31,11 +35,18 @@ mod load_path;
 mod protocol;
 mod query;
 mod realtime;
+mod room;
+mod rooms;
+mod scenario_rooms;
 mod server;
 mod services;
 mod serving;
 
+pub use hub::{CLIENT_BUDGET, RECORDED_INPUT};
 pub use load_path::MAX_SCENARIO_BYTES;
 pub use realtime::{
     DEFAULT_BIND, Listener, Note, Options, SPEEDS, ServeError, Served, cpu_seconds, serve,
 };
+pub use rooms::{MAX_ROOM_INPUTS, MAX_THREADS, RoomMaker, RoomOptions, ServedRooms, serve_rooms};
+pub use scenario_rooms::ScenarioRooms;
+pub use server::{MAX_CLIENTS, MAX_ROOM_NAME};

@@ -188,6 +188,9 @@ pub struct Options {
     pub paused: bool,
     /// Where notes go.
     pub note: Note,
+    /// Also host rooms of the scenario's game on `/rooms/NAME` (each a fresh simulation of
+    /// the scenario), besides the single session on the plain URL.
+    pub rooms: Option<crate::RoomOptions>,
 }
 
 impl Default for Options {
@@ -199,6 +202,7 @@ impl Default for Options {
             record: None,
             paused: false,
             note: Arc::new(|text: &str| eprintln!("{text}")),
+            rooms: None,
         }
     }
 }
@@ -230,8 +234,8 @@ pub enum ServeError {
 
 /// A bound WebSocket listener, not serving yet (so the caller can say where it listens).
 pub struct Listener {
-    runtime: tokio::runtime::Runtime,
-    listener: tokio::net::TcpListener,
+    pub(crate) runtime: tokio::runtime::Runtime,
+    pub(crate) listener: tokio::net::TcpListener,
     local: SocketAddr,
 }
 
@@ -262,7 +266,7 @@ impl Listener {
 }
 
 /// What a served session did.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Served {
     /// The frame the session would step next: it holds frames 0 to `next_frame - 1`.
     pub next_frame: u64,
@@ -272,6 +276,8 @@ pub struct Served {
     pub real_time: u64,
     /// Messages slow clients lost.
     pub dropped: u64,
+    /// What the rooms did, if it hosted rooms.
+    pub rooms: Option<crate::ServedRooms>,
 }
 
 /// Serves `scenario` (a file's, or one a game builds in code; `text` is its file, attached
@@ -304,6 +310,14 @@ pub fn serve(
         .frames
         .saturating_mul((scenario.world.dt * 1e9).round() as u64);
     let session = start(&scenario, &text, &hub, o.record.as_deref(), 0)?;
+    let hosted = match &o.rooms {
+        Some(ro) => Some(crate::rooms::host(
+            crate::scenario_rooms::ScenarioRooms::new(scenario.clone(), text.clone()),
+            ro,
+        )?),
+        None => None,
+    };
+    let rooms = hosted.as_ref().map(|h| Arc::clone(&h.door));
     let session_id = format!("ricochet-{}", scenario.name);
     let server_hub = hub.clone();
     let Listener {
@@ -312,10 +326,18 @@ pub fn serve(
     let note = o.note.clone();
     std::thread::Builder::new()
         .name("serve".into())
-        .spawn(move || runtime.block_on(server::accept(listener, server_hub, session_id, note)))
+        .spawn(move || {
+            let routes = server::Routes {
+                plain: Some((server_hub, session_id)),
+                rooms,
+            };
+            runtime.block_on(server::accept(listener, routes, note))
+        })
         .map_err(ServeError::Runtime)?;
     let mut serving = Serving::new(session, scenario, text, o);
-    let real_time = run_loop(&mut serving, &hub, stop, &o.note)?;
+    let real_time = run_loop(&mut serving, &hub, stop, &o.note);
+    let rooms = hosted.map(crate::rooms::Hosted::stop);
+    let real_time = real_time?;
     let next_frame = serving.session.next_frame();
     let stepped = serving.stepped;
     finish(serving.session)?;
@@ -325,6 +347,7 @@ pub fn serve(
         stepped,
         real_time,
         dropped,
+        rooms,
     })
 }
 
@@ -454,7 +477,7 @@ fn run_loop(
 
 /// How late frames start, in a fixed histogram (bounded memory however long the server
 /// runs): 0.05 ms buckets up to 100 ms, then one for all later.
-struct Lateness {
+pub(crate) struct Lateness {
     buckets: [u64; 2001],
     count: u64,
     max_ms: f64,
@@ -471,7 +494,21 @@ impl Default for Lateness {
 }
 
 impl Lateness {
-    fn add(&mut self, late: Duration) {
+    /// Adds `other`'s counts.
+    pub(crate) fn merge(&mut self, other: &Lateness) {
+        for (a, b) in self.buckets.iter_mut().zip(other.buckets.iter()) {
+            *a += b;
+        }
+        self.count += other.count;
+        self.max_ms = self.max_ms.max(other.max_ms);
+    }
+
+    /// The latest, ms.
+    pub(crate) fn max_ms(&self) -> f64 {
+        self.max_ms
+    }
+
+    pub(crate) fn add(&mut self, late: Duration) {
         let ms = late.as_secs_f64() * 1e3;
         let bucket = ((ms / 0.05) as usize).min(self.buckets.len() - 1);
         self.buckets[bucket] += 1;
@@ -480,7 +517,7 @@ impl Lateness {
     }
 
     /// The `q` quantile, ms (the upper edge of its bucket).
-    fn quantile(&self, q: f64) -> f64 {
+    pub(crate) fn quantile(&self, q: f64) -> f64 {
         let want = (q * self.count as f64).ceil() as u64;
         let mut seen = 0;
         for (i, n) in self.buckets.iter().enumerate() {

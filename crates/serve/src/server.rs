@@ -21,7 +21,9 @@ use tokio_tungstenite::tungstenite::protocol::CloseFrame;
 use tokio_tungstenite::tungstenite::protocol::frame::coding::CloseCode;
 use tokio_tungstenite::tungstenite::{Error as WsError, Message};
 
-use crate::hub::{Hub, client_queue};
+use std::sync::Arc;
+
+use crate::hub::{ClientQueue, Hub, client_queue};
 use crate::protocol::{self, ClientMessage, ServerMessage};
 use crate::realtime::Note;
 
@@ -53,8 +55,88 @@ pub const HANDSHAKE_TIMEOUT: Duration = Duration::from_secs(5);
 /// readable then, so retrying at once would spin.
 const ACCEPT_BACKOFF: Duration = Duration::from_millis(100);
 
+/// Where connections go, by their URL's path: `/rooms/NAME` to the rooms (if the server
+/// hosts rooms), any other path to the plain server's single session (if there is one).
+#[derive(Clone)]
+pub struct Routes {
+    /// The single session's hub and its id for `serverInfo`.
+    pub plain: Option<(Hub, String)>,
+    /// The rooms.
+    pub rooms: Option<Arc<dyn Door>>,
+}
+
+/// The rooms, as connections see them (`rooms.rs`).
+pub trait Door: Send + Sync {
+    /// Admits a client with `queue` into room `name`, creating the room if it has none;
+    /// or says why not (too many clients, in the room or the server; too many rooms).
+    fn enter(&self, name: &str, queue: ClientQueue) -> Result<Entered, String>;
+    /// The client left room `hub`.
+    fn left(&self, hub: &Hub, client: u64);
+    /// `/rooms`: the rooms (making the one asked for), as JSON, or why not.
+    fn rooms_call(&self, payload: &[u8]) -> Result<String, String>;
+}
+
+/// `/rooms`' id on the plain URL, after the plain server's eight services (on a room's
+/// connection it is 3).
+pub const PLAIN_ROOMS: u32 = 9;
+
+/// A client admitted into a room.
+pub struct Entered {
+    /// The room's hub.
+    pub hub: Hub,
+    /// The client's id there.
+    pub id: u64,
+    /// Ends the connection when the room closes.
+    pub kicked: oneshot::Receiver<String>,
+    /// `serverInfo`, `advertise`, `advertiseServices`.
+    pub hello: [String; 3],
+}
+
+/// A room's name: 1 to [`MAX_ROOM_NAME`] of `A-Z a-z 0-9 _ -`.
+pub const MAX_ROOM_NAME: usize = 64;
+
+/// Whether `name` is a room's name, or why not.
+pub fn check_room_name(name: &str) -> Result<(), String> {
+    let ok = (1..=MAX_ROOM_NAME).contains(&name.len())
+        && name
+            .bytes()
+            .all(|b| b.is_ascii_alphanumeric() || b == b'_' || b == b'-');
+    if ok {
+        Ok(())
+    } else {
+        Err(format!(
+            "room name {:?}: 1 to {MAX_ROOM_NAME} of A-Z, a-z, 0-9, _ and -",
+            name.chars().take(80).collect::<String>()
+        ))
+    }
+}
+
+/// Where a connection goes.
+#[derive(Clone, Debug)]
+enum Route {
+    Plain,
+    Room(String),
+}
+
+/// The route of a request's path, or why it has none.
+fn route(routes: &Routes, path: &str) -> Result<Route, String> {
+    let rooms = path == "/rooms" || path.starts_with("/rooms/");
+    if !rooms {
+        return match routes.plain {
+            Some(_) => Ok(Route::Plain),
+            None => Err("this server hosts rooms: connect to /rooms/NAME".to_owned()),
+        };
+    }
+    if routes.rooms.is_none() {
+        return Err("this server hosts no rooms".to_owned());
+    }
+    let name = path.strip_prefix("/rooms/").unwrap_or("");
+    check_room_name(name)?;
+    Ok(Route::Room(name.to_owned()))
+}
+
 /// Accepts connections on `listener` until the runtime stops.
-pub async fn accept(listener: TcpListener, hub: Hub, session: String, note: Note) {
+pub async fn accept(listener: TcpListener, routes: Routes, note: Note) {
     // The handshakes under way, oldest first: dropping one's sender evicts it; a finished
     // one has dropped its receiver.
     let mut pending: VecDeque<oneshot::Sender<()>> = VecDeque::new();
@@ -86,9 +168,9 @@ pub async fn accept(listener: TcpListener, hub: Hub, session: String, note: Note
         }
         let (evict, evicted) = oneshot::channel();
         pending.push_back(evict);
-        let (hub, session, note) = (hub.clone(), session.clone(), note.clone());
+        let (routes, note) = (routes.clone(), note.clone());
         tokio::spawn(async move {
-            if let Err(e) = client(stream, peer, hub, &session, evicted, &note).await {
+            if let Err(e) = client(stream, peer, routes, evicted, &note).await {
                 note(&format!("serve: client {peer}: {e}"));
             }
         });
@@ -100,13 +182,31 @@ pub async fn accept(listener: TcpListener, hub: Hub, session: String, note: Note
 /// a ROS data source, which it recognises by that key. Any value but a ROS 1 distro makes
 /// it a ROS 2 source; `humble` picks the message definitions it ships for that. Ricochet
 /// speaks no ROS otherwise: every channel stays protobuf, every schema Foxglove's or its own.
-fn metadata() -> std::collections::BTreeMap<String, String> {
+pub(crate) fn metadata() -> std::collections::BTreeMap<String, String> {
     [("ROS_DISTRO".to_owned(), "humble".to_owned())].into()
 }
 
-/// The handshake's answer: the subprotocol chosen, or HTTP 400 naming the ones accepted.
+/// The handshake's answer: the subprotocol chosen, or HTTP 400 naming the ones accepted;
+/// or HTTP 400 naming why the path is no room's (`route`'s error).
 #[allow(clippy::result_large_err, reason = "tungstenite's callback signature")]
-fn negotiate(request: &Request, mut response: Response) -> Result<Response, ErrorResponse> {
+fn negotiate(
+    routes: &Routes,
+    chosen_route: &std::sync::Mutex<Option<Route>>,
+    request: &Request,
+    mut response: Response,
+) -> Result<Response, ErrorResponse> {
+    match route(routes, request.uri().path()) {
+        Ok(r) => {
+            *chosen_route
+                .lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner) = Some(r);
+        }
+        Err(why) => {
+            let mut refusal = ErrorResponse::new(Some(why));
+            *refusal.status_mut() = StatusCode::BAD_REQUEST;
+            return Err(refusal);
+        }
+    }
     let offered = request
         .headers()
         .get("Sec-WebSocket-Protocol")
@@ -133,16 +233,18 @@ fn negotiate(request: &Request, mut response: Response) -> Result<Response, Erro
 async fn client(
     stream: TcpStream,
     peer: SocketAddr,
-    hub: Hub,
-    session: &str,
+    routes: Routes,
     evicted: oneshot::Receiver<()>,
     note: &Note,
 ) -> Result<(), String> {
     let config = tokio_tungstenite::tungstenite::protocol::WebSocketConfig::default()
         .max_message_size(Some(MAX_CLIENT_MESSAGE))
         .max_frame_size(Some(MAX_CLIENT_MESSAGE));
-    let handshake =
-        tokio_tungstenite::accept_hdr_async_with_config(stream, negotiate, Some(config));
+    let chosen = std::sync::Mutex::new(None);
+    #[allow(clippy::result_large_err, reason = "tungstenite's callback signature")]
+    let callback =
+        |request: &Request, response: Response| negotiate(&routes, &chosen, request, response);
+    let handshake = tokio_tungstenite::accept_hdr_async_with_config(stream, callback, Some(config));
     let ws = tokio::select! {
         done = tokio::time::timeout(HANDSHAKE_TIMEOUT, handshake) => match done {
             Ok(ws) => ws.map_err(|e| format!("handshake: {e}"))?,
@@ -156,43 +258,34 @@ async fn client(
     };
     let (mut out, mut incoming) = ws.split();
     let (queue, mut pending) = client_queue();
-    let admitted = {
-        let mut s = hub.lock();
-        (s.client_count() < MAX_CLIENTS).then(|| {
-            let info = ServerMessage::ServerInfo {
-                name: "ricochet",
-                capabilities: &["time", "clientPublish", "services", "playbackControl"],
-                supported_encodings: &["json"],
-                metadata: metadata(),
-                session_id: session,
-                data_start_time: protocol::Time::from_ns(0),
-                data_end_time: protocol::Time::from_ns(s.data_end_ns),
-            };
-            let advertise = ServerMessage::Advertise {
-                channels: s.channels(),
-            };
-            let services = ServerMessage::AdvertiseServices {
-                services: &crate::services::list(),
-            };
-            let hello = [info.json(), advertise.json(), services.json()];
-            (s.connect(queue.clone()), hello)
-        })
+    let route = chosen
+        .into_inner()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    let (admitted, door) = match (route, &routes.plain, &routes.rooms) {
+        (Some(Route::Room(name)), _, Some(door)) => match door.enter(&name, queue.clone()) {
+            Ok(e) => (Ok((e.hub, e.id, e.kicked, e.hello)), Some(door)),
+            Err(why) => (Err((why.clone(), why)), None),
+        },
+        (_, Some((hub, session)), rooms) => (plain(hub, session, &queue, rooms.is_some()), None),
+        // The handshake refused any other route.
+        _ => return Err("no route".to_owned()),
     };
-    let Some((id, hello)) = admitted else {
-        let status = ServerMessage::Status {
-            level: 2,
-            message: "too many clients",
-        };
-        let frame = CloseFrame {
-            code: CloseCode::Again,
-            reason: format!("too many clients, at most {MAX_CLIENTS}").into(),
-        };
-        if let Ok(ws) = out.reunite(incoming) {
-            close_with(ws, Some(Message::text(status.json())), frame).await;
+    let (hub, id, mut kicked, hello) = match admitted {
+        Ok(a) => a,
+        Err((status, why)) => {
+            let status = ServerMessage::Status {
+                level: 2,
+                message: &status,
+            };
+            let frame = CloseFrame {
+                code: CloseCode::Again,
+                reason: why.clone().into(),
+            };
+            if let Ok(ws) = out.reunite(incoming) {
+                close_with(ws, Some(Message::text(status.json())), frame).await;
+            }
+            return Err(format!("refused: {why}; closed with 1013"));
         }
-        return Err(format!(
-            "refused: too many clients, at most {MAX_CLIENTS}; closed with 1013"
-        ));
     };
     note(&format!("serve: client {peer} connected"));
     let mut limit = RateLimit::new();
@@ -208,6 +301,13 @@ async fn client(
                     Some(m) => out.send(m).await.map_err(|e| Ended::Failed(e.to_string()))?,
                     None => return Ok(()),
                 },
+                Ok(why) = &mut kicked => {
+                    // What was queued before (the status saying why) goes first.
+                    while let Ok(m) = pending.try_recv() {
+                        out.send(m).await.map_err(|e| Ended::Failed(e.to_string()))?;
+                    }
+                    return Err(Ended::Closed(why));
+                }
                 got = incoming.next() => match got {
                     None | Some(Ok(Message::Close(_))) => return Ok(()),
                     Some(Err(WsError::Capacity(e))) => return Err(Ended::TooBig(e.to_string())),
@@ -219,6 +319,16 @@ async fn client(
                         }
                     }
                     Some(Ok(Message::Binary(data))) => {
+                        // `/rooms` on the plain URL: answered here, not by the session's loop.
+                        let plain_rooms = routes.plain.is_some() && door.is_none()
+                            && data.first() == Some(&protocol::OP_SERVICE_CALL);
+                        if let (true, Some(rooms)) = (plain_rooms, &routes.rooms)
+                            && let Ok(call) = protocol::service_call(&data)
+                            && call.service == PLAIN_ROOMS
+                        {
+                            hub.lock().answer(id, call.service, call.call, rooms.rooms_call(&call.payload));
+                            continue;
+                        }
                         if let Err(why) = publish(&hub, id, &data, &mut limit) {
                             let status = ServerMessage::Status { level: 2, message: &why };
                             let _ = queue.answer(Message::text(status.json()));
@@ -231,11 +341,24 @@ async fn client(
     }
     .await;
     hub.lock().disconnect(id);
+    if let Some(door) = door {
+        door.left(&hub, id);
+    }
     // Nothing more is sent to it: the queue's messages are dropped with it.
     drop(pending);
     let result = match result {
         Ok(()) => Ok(()),
         Err(Ended::Failed(e)) => Err(e),
+        Err(Ended::Closed(why)) => {
+            let frame = CloseFrame {
+                code: CloseCode::Away,
+                reason: why.chars().take(120).collect::<String>().into(),
+            };
+            if let Ok(ws) = out.reunite(incoming) {
+                close_with(ws, None, frame).await;
+            }
+            Ok(())
+        }
         Err(Ended::TooBig(e)) => {
             let frame = CloseFrame {
                 code: CloseCode::Size,
@@ -254,8 +377,50 @@ async fn client(
     result
 }
 
+/// Admits a client to the plain server's session, or says why not (the status, the close
+/// frame's reason).
+#[allow(clippy::type_complexity, reason = "one use")]
+fn plain(
+    hub: &Hub,
+    session: &str,
+    queue: &ClientQueue,
+    rooms: bool,
+) -> Result<(Hub, u64, oneshot::Receiver<String>, [String; 3]), (String, String)> {
+    let mut s = hub.lock();
+    if s.client_count() >= MAX_CLIENTS {
+        return Err((
+            "too many clients".to_owned(),
+            format!("too many clients, at most {MAX_CLIENTS}"),
+        ));
+    }
+    let info = ServerMessage::ServerInfo {
+        name: "ricochet",
+        capabilities: &["time", "clientPublish", "services", "playbackControl"],
+        supported_encodings: &["json"],
+        metadata: metadata(),
+        session_id: session,
+        data_start_time: protocol::Time::from_ns(0),
+        data_end_time: protocol::Time::from_ns(s.data_end_ns),
+    };
+    let advertise = ServerMessage::Advertise {
+        channels: s.channels(),
+    };
+    let mut list = crate::services::list();
+    if rooms {
+        let mut service = crate::room::services().swap_remove(2);
+        service.id = PLAIN_ROOMS;
+        list.push(service);
+    }
+    let services = ServerMessage::AdvertiseServices { services: &list };
+    let hello = [info.json(), advertise.json(), services.json()];
+    let (id, kicked) = s.connect(queue.clone());
+    Ok((hub.clone(), id, kicked, hello))
+}
+
 /// Why a client's connection ended, but for its closing it.
 enum Ended {
+    /// The room closed (why).
+    Closed(String),
     /// A message over [`MAX_CLIENT_MESSAGE`] (tungstenite's words).
     TooBig(String),
     /// Reading or writing failed.

@@ -211,11 +211,11 @@ pub use limits::MAX_HISTORY;
 #[cfg(feature = "toml")]
 pub use load::file::ActionFile;
 #[cfg(feature = "toml")]
-pub use load::load_scenario;
+pub use load::{load_scenario, load_scenario_and_map};
 pub use output::{ContactRecord, FrameOutput, Phase, RemovedBody, Stats};
 pub use pipeline::Simulation;
 pub use query::{QueryFilter, RayHit, ShapeHit};
-pub use scenario::{Scenario, TileRows};
+pub use scenario::{Scenario, TileRows, TiledDef};
 pub use snapshot::{SNAPSHOT_VERSION, Snapshot, SnapshotError};
 pub use stage_set::{Stage, StageSet};
 pub use stages::SLOP;

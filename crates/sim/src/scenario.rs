@@ -23,7 +23,8 @@ pub struct Scenario {
     /// Body prototypes by name.
     pub templates: BTreeMap<String, BodyDef>,
     /// Static tiles at frame 0, spawned first (ids from 0 on), in order: a level's tiles
-    /// as a few numbers per row instead of a [`BodyDef`] each. Scenario files have none.
+    /// as a few numbers per row instead of a [`BodyDef`] each. A scenario file's come from its
+    /// Tiled map (`[tiled]`), added by `ricochet-tiled`.
     pub tiles: Vec<TileRows>,
     /// Bodies at frame 0, in file order (which is their id order), after the tiles.
     pub bodies: Vec<BodyDef>,
@@ -47,6 +48,25 @@ impl Default for Scenario {
             script: Vec::new(),
         }
     }
+}
+
+/// A scenario's `[tiled]` table, checked against the scenario (its layer exists, its spawn
+/// templates exist, its scale is positive) but not against the map, which
+/// `ricochet-tiled` reads: this crate does no I/O.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TiledDef {
+    /// The map file as written, relative to the scenario file.
+    pub map: String,
+    /// World units per tile width (> 0).
+    pub units_per_tile: f64,
+    /// `solid` entries: `LAYER`, `LAYER?PROP` or `LAYER?PROP=VALUE`.
+    pub solid: Vec<String>,
+    /// `one_way` entries, same syntax.
+    pub one_way: Vec<String>,
+    /// The scenario layer the map's static bodies go to.
+    pub layer: LayerId,
+    /// Object class, type or name → template name (a template the scenario has).
+    pub spawn: BTreeMap<String, String>,
 }
 
 /// Rows of identical static bodies (a tile map's tiles): the `k`-th tile of a row starting

@@ -1,8 +1,9 @@
-//! Two logs compared message by message, decoded, so chunking and compression never matter
-//! (`ricochet diff A.mcap B.mcap`, and golden checks): the first divergent frame, topic, body
-//! and field with both values, then how many messages differ per topic. Both logs are
-//! streamed, one topic at a time and one message at a time: memory does not grow with their
-//! length.
+//! Two logs compared message by message, so chunking and compression never matter (`ricochet
+//! diff A.mcap B.mcap`, and golden checks): the first divergent frame, topic, body and field
+//! with both values, then how many messages differ per topic. Equal bytes under the same
+//! valid schema are equal messages (their top level checked); only messages that differ are
+//! decoded and compared field by field. Both logs are streamed, each read on a thread of its
+//! own, one message at a time: memory does not grow with their length.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
@@ -10,8 +11,10 @@ use std::path::Path;
 use crate::{LogError, LogFile, Messages, RawMessage, escape_controls};
 
 mod fields;
+mod render;
 
 use fields::{BodyId, first_in_message, id_of};
+pub use render::{render, render_counts, render_head};
 use serde::Serialize;
 use serde_json::Value;
 
@@ -149,7 +152,7 @@ fn diff_topic(
                 count.messages_a += 1;
                 count.messages_b += 1;
                 if x.bytes() == y.bytes() {
-                    // Equal, but only if each decodes with its own log's schema.
+                    // Equal bytes under the same valid schema: equal (see `lockstep`).
                     ma.check(&x)?;
                     mb.check(&y)?;
                     continue;
@@ -223,7 +226,8 @@ fn lockstep(
     b: &LogFile,
     tol: f64,
     topics: &BTreeSet<&str>,
-) -> Result<Option<Report>, LogError> {
+    announce: &mut Announce<'_>,
+) -> Result<Lockstep, LogError> {
     let (mut ma, mut mb) = (a.messages()?, b.messages()?);
     let mut counts: BTreeMap<String, TopicCount> = topics
         .iter()
@@ -264,10 +268,10 @@ fn lockstep(
         let (x, y) = match (ma.next_raw().transpose()?, mb.next_raw().transpose()?) {
             (None, None) => break,
             (Some(x), Some(y)) if x.topic() == y.topic() && x.log_time() == y.log_time() => (x, y),
-            _ => return Ok(None),
+            _ => return Ok(Lockstep::Broken(first)),
         };
         let Some(count) = counts.get_mut(x.topic()) else {
-            return Ok(None);
+            return Ok(Lockstep::Broken(first));
         };
         count.messages_a += 1;
         count.messages_b += 1;
@@ -275,24 +279,74 @@ fn lockstep(
             .first()
             .is_some_and(|(_, g, _)| g.log_time() != x.log_time())
         {
+            let found = first.is_some();
             resolve(&mut group, &mut counts, &mut first, &mut ma, &mut mb)?;
+            // The first difference of the earliest time that has one is the first: nothing
+            // read later can come before it, so it is told before the counts are done.
+            if !found && let Some(d) = first.as_mut() {
+                announce(d)?;
+            }
         }
         if x.bytes() != y.bytes() {
             group.push((rank(x.topic()), x, y));
         } else {
-            // Equal, but only if each decodes with its own log's schema.
+            // Equal bytes under the same valid schema (checked once per channel, when the
+            // logs were opened and by `schema_difference`) are equal messages: only their
+            // top level is checked, not decoded whole (see `Messages::check`).
             ma.check(&x)?;
             mb.check(&y)?;
         }
     }
     resolve(&mut group, &mut counts, &mut first, &mut ma, &mut mb)?;
-    Ok(Some(Report {
+    Ok(Lockstep::Done(Report {
         equal: first.is_none(),
         tolerance: tol,
         first,
         topics: counts,
     }))
 }
+
+/// The report on two logs with the same channels and the same bytes up to their summaries
+/// ([`LogFile::same_data`]): equal, their messages counted (and checked) by reading one.
+fn same_data(
+    a: &LogFile,
+    tol: f64,
+    topics: &BTreeSet<&str>,
+    only: Option<&str>,
+) -> Result<Report, LogError> {
+    let mut counts: BTreeMap<String, TopicCount> = topics
+        .iter()
+        .filter(|t| only.is_none_or(|o| o == **t))
+        .map(|t| ((*t).to_owned(), TopicCount::default()))
+        .collect();
+    let mut messages = a.messages()?;
+    while let Some(x) = messages.next_raw().transpose()? {
+        if let Some(count) = counts.get_mut(x.topic()) {
+            count.messages_a += 1;
+            count.messages_b += 1;
+        }
+        messages.check(&x)?;
+    }
+    Ok(Report {
+        equal: true,
+        tolerance: tol,
+        first: None,
+        topics: counts,
+    })
+}
+
+/// How a one-pass comparison ended.
+enum Lockstep {
+    /// Both logs were read to the end.
+    Done(Report),
+    /// Their messages stopped pairing up; the first difference before that, if any, is the
+    /// first of the whole comparison (and was announced).
+    Broken(Option<Divergence>),
+}
+
+/// What is told the first difference as soon as it is known: it names the body, then hands
+/// it on (see [`diff_files_with`]).
+type Announce<'f> = dyn FnMut(&mut Divergence) -> Result<(), LogError> + 'f;
 
 /// How a topic's channels are encoded in a log: message encoding, schema name, schema
 /// encoding and schema bytes of each, in channel id order.
@@ -362,22 +416,59 @@ fn schema_difference(a: &LogFile, b: &LogFile) -> Option<Divergence> {
 }
 
 /// Compares two logs, streaming them topic by topic: memory does not grow with their length.
-/// A schema that differs between them is the first difference; every message found equal
-/// decodes with its own log's schema (a corrupt log's error otherwise).
+/// A schema that differs between them is the first difference. Schemas are checked once per
+/// channel (when a log is opened, and against the other log's); a message whose bytes are
+/// equal in both logs is then an equal message, its top level checked but not decoded; a
+/// message that differs is decoded and compared field by field.
 pub fn diff_files(
     a: &LogFile,
     b: &LogFile,
     tol: f64,
     only: Option<&str>,
 ) -> Result<Report, DiffError> {
-    let mut report = diff_messages(a, b, tol, only)?;
-    if let Some(d) = schema_difference(a, b).filter(|d| only.is_none_or(|t| t == d.topic)) {
+    diff_files_with(a, b, tol, only, &mut |_| {})
+}
+
+/// [`diff_files`], telling `on_first` the first difference as soon as it is known (the same
+/// one the report gives), before the counts are done: at once for a schema, and when the
+/// logs are read in one pass, once the log time it is at is over. At most once; never when
+/// the logs are equal or the first is only known at the end.
+pub fn diff_files_with(
+    a: &LogFile,
+    b: &LogFile,
+    tol: f64,
+    only: Option<&str>,
+    on_first: &mut dyn FnMut(&Divergence),
+) -> Result<Report, DiffError> {
+    let schema = schema_difference(a, b).filter(|d| only.is_none_or(|t| t == d.topic));
+    let mut told = false;
+    if let Some(d) = &schema {
+        on_first(d);
+        told = true;
+    }
+    let mut announce = |d: &mut Divergence| -> Result<(), LogError> {
+        if !told {
+            name_body(a, b, d)?;
+            on_first(d);
+            told = true;
+        }
+        Ok(())
+    };
+    let mut report = diff_messages(a, b, tol, only, &mut announce)?;
+    if let Some(d) = schema {
         report.equal = false;
         report.first = Some(d);
     }
-    if let Some(d) = report.first.as_mut()
+    if let Some(d) = report.first.as_mut() {
+        name_body(a, b, d)?;
+    }
+    Ok(report)
+}
+
+/// Names the body of a `/bodies` divergence, from either log (once: its id is then taken).
+fn name_body(a: &LogFile, b: &LogFile, d: &mut Divergence) -> Result<(), LogError> {
+    if d.topic == "/bodies"
         && let Some(id) = d.unnamed.take()
-        && d.topic == "/bodies"
     {
         let name = match name_of(a, id, d.time_ns)? {
             Some(n) => Some(n),
@@ -387,7 +478,7 @@ pub fn diff_files(
             d.body = Some(format!("{id} ({})", escape_controls(&name)));
         }
     }
-    Ok(report)
+    Ok(())
 }
 
 /// The name of body `id` in `log`: a `/bodies` message lists a body's name when the body
@@ -420,6 +511,7 @@ fn diff_messages(
     b: &LogFile,
     tol: f64,
     only: Option<&str>,
+    announce: &mut Announce<'_>,
 ) -> Result<Report, DiffError> {
     let present: BTreeSet<&str> = a
         .channels()
@@ -449,13 +541,20 @@ fn diff_messages(
         .filter(|c| c.messages > 0 || only == Some(c.topic.as_str()))
         .map(|c| c.topic.as_str())
         .collect();
-    if only.is_none()
-        && let Some(report) = lockstep(a, b, tol, &with_messages)?
-    {
-        return Ok(report);
+    if a.same_data(b)? {
+        return Ok(same_data(a, tol, &with_messages, only)?);
     }
-    let mut topics = BTreeMap::new();
+    // The first difference found in one pass before the logs stopped pairing up: the first
+    // of all (both logs are the same messages up to there), already announced.
     let mut first: Option<Divergence> = None;
+    if only.is_none() {
+        match lockstep(a, b, tol, &with_messages, announce)? {
+            Lockstep::Done(report) => return Ok(report),
+            Lockstep::Broken(found) => first = found,
+        }
+    }
+    let told = first.is_some();
+    let mut topics = BTreeMap::new();
     // Best ranked first: a later topic's messages need no decoding once they can't be first.
     let mut ordered: Vec<&str> = with_messages.into_iter().collect();
     ordered.sort_by_key(|t| (rank(t), *t));
@@ -466,6 +565,7 @@ fn diff_messages(
         let best = first.as_ref().map(|f| (f.time_ns, rank(&f.topic)));
         let (count, topic_first) = diff_topic(a, b, topic, tol, best)?;
         if let Some(d) = topic_first
+            && !told
             && first.as_ref().is_none_or(|f| earlier(&d, f))
         {
             first = Some(d);
@@ -478,50 +578,4 @@ fn diff_messages(
         first,
         topics,
     })
-}
-
-/// The human-readable report.
-pub fn render(report: &Report, a: &Path, b: &Path) -> String {
-    let mut s = String::new();
-    match &report.first {
-        None => {
-            s += &format!(
-                "{} and {} are equal{}\n",
-                a.display(),
-                b.display(),
-                if report.tolerance > 0.0 {
-                    format!(" within {}", report.tolerance)
-                } else {
-                    String::new()
-                }
-            )
-        }
-        Some(d) => {
-            s += &format!("{} and {} differ\n", a.display(), b.display());
-            let frame = d.frame.map_or_else(
-                || format!("t = {} ns", d.time_ns),
-                |f| format!("frame {f} (t = {:.6} s)", d.time_ns as f64 * 1e-9),
-            );
-            if d.field == "schema" {
-                s += &format!("first difference: the schema of topic {}", d.topic);
-            } else {
-                s += &format!("first difference: {frame}, topic {}", d.topic);
-            }
-            match &d.body {
-                Some(pair) if pair.starts_with("pair ") => s += &format!(", {pair}"),
-                Some(body) => s += &format!(", body {body}"),
-                None => {}
-            }
-            s += &format!("\n  field {}\n  A: {}\n  B: {}\n", d.field, d.a, d.b);
-        }
-    }
-    s += "per topic (differing messages / messages in A, B):\n";
-    let width = report.topics.keys().map(String::len).max().unwrap_or(0);
-    for (t, c) in &report.topics {
-        s += &format!(
-            "  {t:<width$} {:>6} / {}, {}\n",
-            c.differing, c.messages_a, c.messages_b
-        );
-    }
-    s
 }

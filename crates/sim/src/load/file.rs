@@ -43,6 +43,29 @@ pub struct ScenarioFile {
     /// Timed inputs and events.
     #[serde(default)]
     pub script: Vec<Spanned<EventFile>>,
+    /// A level from a Tiled map (read by `ricochet-tiled`, not here: this crate does no I/O).
+    pub tiled: Option<Spanned<TiledFile>>,
+}
+
+/// `[tiled]`: which map, and which of its layers become what.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TiledFile {
+    /// The map file (`.tmx`, `.tmj` or Tiled `.json`), relative to the scenario file.
+    pub map: Spanned<String>,
+    /// World units per tile width, > 0 (default 1).
+    pub units_per_tile: Option<Spanned<f64>>,
+    /// Map layers (`LAYER`, `LAYER?PROP`, `LAYER?PROP=VALUE`) whose shapes are static solids.
+    #[serde(default)]
+    pub solid: Vec<Spanned<String>>,
+    /// Map layers whose shapes are one-way platforms (not supported yet: refused).
+    #[serde(default)]
+    pub one_way: Vec<Spanned<String>>,
+    /// The scenario layer the map's static bodies go to.
+    pub layer: Spanned<String>,
+    /// Object class, type or name → the template spawned at the object's centre.
+    #[serde(default)]
+    pub spawn: BTreeMap<String, Spanned<String>>,
 }
 
 /// One `[[bodies]]` table parsed on its own (see `chunks.rs`).

@@ -7,13 +7,14 @@ mod chunks;
 mod context;
 pub mod file;
 mod script;
+mod tiled;
 mod world;
 
 use std::collections::BTreeMap;
 
 use crate::check::problems::{names_sorted, shared_name};
 use crate::check::problems::{oversized, split_problem, static_outside};
-use crate::scenario::Scenario;
+use crate::scenario::{Scenario, TiledDef};
 use bodies::{body_def, ignored_field, merge, references};
 use chunks::split_bodies;
 pub use context::ScenarioError;
@@ -25,13 +26,43 @@ use toml::Spanned;
 use world::world_settings;
 
 /// Parses and checks a scenario. `file` is only used in error messages.
+///
+/// # Errors
+/// The first problem, located. A scenario with a `[tiled]` table is refused here (its
+/// level would be missing): load it with [`load_scenario_and_map`] and give the table to
+/// `ricochet-tiled`, as the `ricochet` binary does.
 pub fn load_scenario(text: &str, file: &str) -> Result<Scenario, ScenarioError> {
-    load(text, file, true)
+    match load(text, file, true)? {
+        (s, None) => Ok(s),
+        (_, Some((_, span))) => Err(Ctx { file, text }.err(
+            span,
+            "tiled",
+            "this scenario takes its level from a Tiled map, which this loader does not read \
+             (it does no I/O): load it with `load_scenario_and_map` and \
+             `ricochet_tiled::add_map` (the `ricochet` binary's run, check, validate and serve do)",
+        )),
+    }
 }
+
+/// [`load_scenario`], also returning the scenario's `[tiled]` table (when it has one) for
+/// `ricochet-tiled` to read the map: the scenario returned lacks the map's bodies until then.
+///
+/// # Errors
+/// The first problem, located, as for [`load_scenario`].
+pub fn load_scenario_and_map(
+    text: &str,
+    file: &str,
+) -> Result<(Scenario, Option<TiledDef>), ScenarioError> {
+    let (s, t) = load(text, file, true)?;
+    Ok((s, t.map(|(def, _)| def)))
+}
+
+/// A scenario, and its `[tiled]` table with where it is written.
+type Loaded = (Scenario, Option<(TiledDef, Range<usize>)>);
 
 /// [`load_scenario`], with `[[bodies]]` tables parsed one at a time (`chunked`) or with the
 /// whole file (the tests check that both give the same scenario or the same error).
-fn load(text: &str, file: &str, chunked: bool) -> Result<Scenario, ScenarioError> {
+fn load(text: &str, file: &str, chunked: bool) -> Result<Loaded, ScenarioError> {
     let ctx = Ctx { file, text };
     let syntax = |e: toml::de::Error, offset: usize| {
         let span = e
@@ -181,7 +212,11 @@ fn load(text: &str, file: &str, chunked: bool) -> Result<Scenario, ScenarioError
         }
     }
     let script = script(&ctx, &raw, &world, &templates, &bodies, frames)?;
-    Ok(Scenario {
+    let tiled = match &raw.tiled {
+        None => None,
+        Some(t) => Some((tiled::tiled_def(&ctx, t, &world, &templates)?, t.span())),
+    };
+    let scenario = Scenario {
         name: raw.name.clone().unwrap_or_else(|| {
             std::path::Path::new(file).file_stem().map_or_else(
                 || "scenario".to_owned(),
@@ -194,7 +229,8 @@ fn load(text: &str, file: &str, chunked: bool) -> Result<Scenario, ScenarioError
         tiles: Vec::new(),
         bodies,
         script,
-    })
+    };
+    Ok((scenario, tiled))
 }
 
 #[cfg(test)]

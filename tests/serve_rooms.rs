@@ -1,0 +1,714 @@
+//! Rooms (`ricochet_serve::serve_rooms`, and `ricochet serve`'s `/rooms/NAME`): rooms step
+//! independently, each recording only its own players' commands and replaying byte for
+//! byte; a room whose game panics closes with its recording complete while another goes
+//! on; bad room names and bad inputs are refused by name; the per-room and server-wide
+//! caps; an empty room closes after its grace. Loopback only; every wait bounded.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+use futures_util::StreamExt;
+use ricochet_serve::{Listener, RoomMaker, RoomOptions, ServedRooms};
+use ricochet_sim::prelude::*;
+use ricochet_sim::{Game, Player};
+use serde_json::Value;
+use tokio_tungstenite::tungstenite::Message;
+
+use crate::serve_client::*;
+
+/// A ball per player, pushed by `{"push": [vx, vy]}`.
+#[derive(Default)]
+struct Balls {
+    /// The game panics just after this frame's step.
+    panic_at: Option<u64>,
+    balls: BTreeMap<Player, Entity>,
+    state: BallsState,
+}
+
+#[derive(Default, serde::Serialize)]
+struct BallsState {
+    frame: u64,
+    players: u64,
+    pushes: u64,
+}
+
+#[derive(serde::Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+struct Push {
+    push: [f64; 2],
+}
+
+impl Game for Balls {
+    type Input = Push;
+    type State = BallsState;
+
+    fn name(&self) -> &str {
+        "balls"
+    }
+
+    fn join(&mut self, sim: &mut Simulation, player: Player, name: &str) -> Result<(), String> {
+        if name == "nobody" {
+            return Err("nobody may not play".to_owned());
+        }
+        let ball = sim.spawn(&BodyDef {
+            position: Vec2::new(2.0 * f64::from(player.0), 0.0),
+            ..BodyDef::default()
+        });
+        self.balls.insert(player, ball);
+        self.state.players += 1;
+        Ok(())
+    }
+
+    fn leave(&mut self, sim: &mut Simulation, player: Player) {
+        if let Some(ball) = self.balls.remove(&player) {
+            let _ = sim.despawn(ball);
+            self.state.players -= 1;
+        }
+    }
+
+    fn input(&mut self, sim: &mut Simulation, player: Player, input: Push) -> Result<(), String> {
+        let ball = *self.balls.get(&player).ok_or("no ball")?;
+        sim.set_velocity(ball, Vec2::new(input.push[0], input.push[1]))
+            .map_err(|e| e.to_string())?;
+        self.state.pushes += 1;
+        Ok(())
+    }
+
+    fn after_step(&mut self, _sim: &mut Simulation, out: &FrameOutput) {
+        if self.panic_at == Some(out.frame) {
+            panic!("the test game panics at frame {}", out.frame);
+        }
+        self.state.frame = out.frame;
+    }
+
+    fn state(&self) -> Option<&BallsState> {
+        Some(&self.state)
+    }
+}
+
+/// Rooms of [`Balls`]; the room named `boom` panics after frame 30.
+struct Maker;
+
+const PANIC_AT: u64 = 30;
+
+fn new_game(room: &str) -> (Simulation, Balls) {
+    let sim = Simulation::from_def(WorldDef {
+        gravity: Vec2::ZERO,
+        ..WorldDef::default()
+    })
+    .unwrap();
+    let game = Balls {
+        panic_at: (room == "boom").then_some(PANIC_AT),
+        ..Balls::default()
+    };
+    (sim, game)
+}
+
+impl RoomMaker for Maker {
+    type Game = Balls;
+
+    fn make(&self, room: &str) -> Result<(Simulation, Balls), String> {
+        Ok(new_game(room))
+    }
+
+    fn input_schema(&self) -> String {
+        r#"{"type": "object", "properties": {"push": {"type": "array"}}, "required": ["push"]}"#
+            .to_owned()
+    }
+}
+
+/// A rooms server on a free loopback port, stopped (and its result kept) when asked.
+struct Rooms {
+    base: String,
+    stop: Arc<AtomicBool>,
+    thread: Option<std::thread::JoinHandle<ServedRooms>>,
+}
+
+impl Rooms {
+    fn start(options: RoomOptions) -> Rooms {
+        let listener = Listener::bind("127.0.0.1:0".parse().unwrap()).unwrap();
+        let base = format!("ws://{}", listener.local_addr());
+        let stop = Arc::new(AtomicBool::new(false));
+        let flag = Arc::clone(&stop);
+        let thread = std::thread::spawn(move || {
+            ricochet_serve::serve_rooms(listener, Maker, &options, &flag).unwrap()
+        });
+        Rooms {
+            base,
+            stop,
+            thread: Some(thread),
+        }
+    }
+
+    fn url(&self, room: &str) -> String {
+        format!("{}/rooms/{room}", self.base)
+    }
+
+    fn stop(mut self) -> ServedRooms {
+        self.stop.store(true, Ordering::SeqCst);
+        self.thread.take().unwrap().join().unwrap()
+    }
+}
+
+impl Drop for Rooms {
+    fn drop(&mut self) {
+        self.stop.store(true, Ordering::SeqCst);
+    }
+}
+
+fn quiet() -> RoomOptions {
+    RoomOptions {
+        note: Arc::new(|_: &str| {}),
+        threads: 2,
+        ..RoomOptions::default()
+    }
+}
+
+/// Connects to a room: the socket, its channels and its services.
+async fn enter(url: &str) -> (Ws, Value, Value) {
+    let (mut ws, _) = connect(url, "foxglove.websocket.v1").await.unwrap();
+    let (mut channels, mut services) = (Value::Null, Value::Null);
+    while channels.is_null() || services.is_null() {
+        let v = any_json(&mut ws).await;
+        match v["op"].as_str() {
+            Some("advertise") => channels = v,
+            Some("advertiseServices") => services = v,
+            _ => {}
+        }
+    }
+    (ws, channels, services)
+}
+
+/// The next `/game` state on subscription `sub` (JSON).
+async fn next_game(ws: &mut Ws, sub: u32) -> Value {
+    loop {
+        let (s, _, payload) = next_data(ws).await;
+        if s == sub {
+            return serde_json::from_slice(&payload).unwrap();
+        }
+    }
+}
+
+/// Waits (at most 10 s) until `/game` shows `pushes` (on subscription 1).
+async fn until_pushes(ws: &mut Ws, pushes: u64) -> Value {
+    within(async {
+        loop {
+            let game = next_game(ws, 1).await;
+            if game["pushes"] == pushes {
+                return game;
+            }
+        }
+    })
+    .await
+}
+
+/// `f`'s answer, which must come within 10 s (data keeps coming, so a wait for one kind
+/// of message is bounded as a whole).
+async fn within<T>(f: impl std::future::Future<Output = T>) -> T {
+    tokio::time::timeout(Duration::from_secs(10), f)
+        .await
+        .expect("within 10 s")
+}
+
+/// The next status message (level, text), within 10 s.
+async fn status_within(ws: &mut Ws) -> (u64, String) {
+    within(next_status(ws)).await
+}
+
+/// A log's `/input` messages, as JSON.
+fn commands(log: &Path) -> Vec<Value> {
+    let bytes = std::fs::read(log).unwrap();
+    mcap::MessageStream::new(&bytes)
+        .unwrap()
+        .map(Result::unwrap)
+        .filter(|m| m.channel.topic == "/input")
+        .map(|m| serde_json::from_slice(&m.data).unwrap())
+        .collect()
+}
+
+/// Replays `log` with a new game for `room` and says whether the replay is the same
+/// bytes; also the frames it holds.
+fn replays_byte_for_byte(log: &Path, room: &str, dir: &Path) -> (bool, u64) {
+    let recorded = ricochet_log::LogFile::open(log).unwrap();
+    let again = dir.join(format!("{room}.again.mcap"));
+    let out = ricochet_record::log_writer(&again).unwrap();
+    let (sim, game) = new_game(room);
+    let replayed = ricochet_record::replay::replay(&recorded, sim, game, out).unwrap();
+    replayed.sink.finish().unwrap();
+    let same = std::fs::read(log).unwrap() == std::fs::read(&again).unwrap();
+    (same, replayed.frames)
+}
+
+#[test]
+fn two_rooms_step_apart_each_recording_its_own_players_and_replaying_byte_for_byte() {
+    let dir = tempfile::tempdir().unwrap();
+    let server = Rooms::start(RoomOptions {
+        record: Some(dir.path().to_path_buf()),
+        ..quiet()
+    });
+    runtime().block_on(async {
+        let (mut ada, channels, services) = enter(&server.url("alpha")).await;
+        let topics: Vec<&str> = channels["channels"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| c["topic"].as_str().unwrap())
+            .collect();
+        // What a client publishes on `/input` is the game's input: the server's record of
+        // the commands is advertised apart, and the game's state is there.
+        assert!(topics.contains(&"/input/recorded"), "{topics:?}");
+        assert!(!topics.contains(&"/input"), "{topics:?}");
+        assert!(topics.contains(&"/game") && topics.contains(&"/scene"));
+        let joined = call(&mut ada, &services, "/join", 1, r#"{"name": "ada"}"#)
+            .await
+            .unwrap();
+        assert_eq!(joined["player"], 1);
+        assert_eq!(joined["input_schema"]["required"][0], "push");
+        subscribe_to(&mut ada, &channels, "/game", 1).await;
+        advertise_input(&mut ada).await;
+        publish(&mut ada, r#"{"push": [1, 0]}"#).await;
+        let alpha_at = until_pushes(&mut ada, 1).await["frame"].as_u64().unwrap();
+
+        // Beta starts at frame 0 while alpha is well past it.
+        let (mut bob, channels_b, services_b) = enter(&server.url("beta")).await;
+        subscribe_to(&mut bob, &channels_b, "/game", 1).await;
+        let beta_first = next_game(&mut bob, 1).await["frame"].as_u64().unwrap();
+        let alpha_now = next_game(&mut ada, 1).await["frame"].as_u64().unwrap();
+        assert!(alpha_now >= alpha_at);
+        assert!(
+            beta_first < alpha_now,
+            "beta at {beta_first}, alpha at {alpha_now}"
+        );
+        let joined = call(&mut bob, &services_b, "/join", 1, r#"{"name": "bob"}"#)
+            .await
+            .unwrap();
+        // Players are numbered per room.
+        assert_eq!(joined["player"], 1);
+        advertise_input(&mut bob).await;
+        publish(&mut bob, r#"{"push": [0, 2]}"#).await;
+        publish(&mut bob, r#"{"push": [0, 3]}"#).await;
+        until_pushes(&mut bob, 2).await;
+
+        let listed = call(&mut bob, &services_b, "/rooms", 2, "{}")
+            .await
+            .unwrap();
+        let rooms = listed["rooms"].as_array().unwrap();
+        let names: Vec<&str> = rooms.iter().map(|r| r["name"].as_str().unwrap()).collect();
+        assert_eq!(names, ["alpha", "beta"]);
+        assert!(rooms.iter().all(|r| r["players"] == 1 && r["clients"] == 1));
+
+        // Disconnecting is leaving: bob's ball goes, at beta's next frame.
+        drop(bob);
+        let deadline = Instant::now() + Duration::from_secs(10);
+        // Once beta shows no player, the leave is applied; two frames later it is recorded.
+        let mut gone_at = None;
+        for n in 10.. {
+            let listed = call(&mut ada, &services, "/rooms", n, "{}").await.unwrap();
+            let beta = &listed["rooms"][1];
+            let frame = beta["frame"].as_u64().unwrap();
+            if beta["players"] == 0 {
+                let at = *gone_at.get_or_insert(frame);
+                if frame >= at + 2 {
+                    break;
+                }
+            }
+            assert!(
+                Instant::now() < deadline,
+                "bob's leave not recorded: {listed}"
+            );
+            tokio::time::sleep(Duration::from_millis(20)).await;
+        }
+        let left = call(&mut ada, &services, "/leave", 2, "{}").await.unwrap();
+        assert_eq!(left["left"], 1);
+        let game = within(async {
+            loop {
+                let g = next_game(&mut ada, 1).await;
+                if g["players"] == 0 {
+                    return g;
+                }
+            }
+        })
+        .await;
+        assert_eq!(game["pushes"], 1);
+    });
+    let served = server.stop();
+    assert_eq!((served.opened, served.failed), (2, 0));
+
+    let alpha = dir.path().join("alpha.mcap");
+    let beta = dir.path().join("beta.mcap");
+    let a = commands(&alpha);
+    let b = commands(&beta);
+    let kinds = |c: &[Value]| -> Vec<String> {
+        c.iter()
+            .map(|m| {
+                if let Some(name) = m["join"].as_str() {
+                    format!("join {name}")
+                } else if m["leave"] == true {
+                    format!("leave {}", m["player"])
+                } else {
+                    format!("input {}", m["input"].as_str().unwrap())
+                }
+            })
+            .collect()
+    };
+    assert_eq!(
+        kinds(&a),
+        ["join ada", r#"input {"push": [1, 0]}"#, "leave 1"]
+    );
+    assert_eq!(
+        kinds(&b),
+        [
+            "join bob",
+            r#"input {"push": [0, 2]}"#,
+            r#"input {"push": [0, 3]}"#,
+            "leave 1"
+        ]
+    );
+    for (log, room) in [(&alpha, "alpha"), (&beta, "beta")] {
+        let (same, frames) = replays_byte_for_byte(log, room, dir.path());
+        assert!(frames > 0);
+        assert!(same, "{room}'s recording replays byte for byte");
+    }
+}
+
+#[test]
+fn a_room_whose_game_panics_closes_with_its_recording_whole_and_another_goes_on() {
+    let dir = tempfile::tempdir().unwrap();
+    let server = Rooms::start(RoomOptions {
+        record: Some(dir.path().to_path_buf()),
+        ..quiet()
+    });
+    runtime().block_on(async {
+        let (mut calm, channels, _) = enter(&server.url("calm")).await;
+        subscribe_to(&mut calm, &channels, "/game", 1).await;
+        let (mut boom, _, _) = enter(&server.url("boom")).await;
+        // The room's clients are told why, then closed.
+        let (level, why) = status_within(&mut boom).await;
+        assert_eq!(level, 2);
+        assert!(why.contains("panicked"), "{why}");
+        assert!(
+            why.contains(&format!("the test game panics at frame {PANIC_AT}")),
+            "{why}"
+        );
+        assert!(
+            why.contains(&format!("frames 0 to {}", PANIC_AT - 1)),
+            "{why}"
+        );
+        let closed = loop {
+            match tokio::time::timeout(Duration::from_secs(10), boom.next())
+                .await
+                .expect("closed within 10 s")
+            {
+                Some(Ok(Message::Close(frame))) => break frame,
+                Some(Ok(_)) => {}
+                other => panic!("{other:?}"),
+            }
+        };
+        assert_eq!(u16::from(closed.unwrap().code), 1001);
+        // The other room goes on stepping.
+        let before = next_game(&mut calm, 1).await["frame"].as_u64().unwrap();
+        let mut after = before;
+        while after < before + 20 {
+            after = next_game(&mut calm, 1).await["frame"].as_u64().unwrap();
+        }
+    });
+    let served = server.stop();
+    assert_eq!((served.opened, served.failed), (2, 1));
+    let log = dir.path().join("boom.mcap");
+    let (same, frames) = replays_byte_for_byte(&log, "boom", dir.path());
+    assert_eq!(frames, PANIC_AT, "frames 0 to {}", PANIC_AT - 1);
+    assert!(same);
+}
+
+/// The HTTP status and body of a refused handshake.
+async fn refused_http(url: &str) -> (u16, String) {
+    use tokio_tungstenite::tungstenite::Error;
+    use tokio_tungstenite::tungstenite::client::IntoClientRequest;
+    let mut request = url.into_client_request().unwrap();
+    request.headers_mut().insert(
+        "Sec-WebSocket-Protocol",
+        "foxglove.websocket.v1".parse().unwrap(),
+    );
+    match tokio_tungstenite::connect_async(request).await {
+        Err(Error::Http(response)) => (
+            response.status().as_u16(),
+            String::from_utf8_lossy(response.body().as_deref().unwrap_or(b"")).into_owned(),
+        ),
+        Err(e) => panic!("{url}: {e}"),
+        Ok(_) => panic!("{url} was accepted"),
+    }
+}
+
+#[test]
+fn bad_room_names_bad_calls_and_a_bad_input_are_refused_by_name() {
+    let server = Rooms::start(quiet());
+    runtime().block_on(async {
+        let long = "x".repeat(65);
+        for path in [
+            "/rooms/",
+            "/rooms",
+            "/rooms/a.b",
+            "/rooms/a/b",
+            &format!("/rooms/{long}"),
+        ] {
+            let (status, body) = refused_http(&format!("{}{path}", server.base)).await;
+            assert_eq!(status, 400, "{path}");
+            assert!(
+                body.contains("1 to 64 of A-Z, a-z, 0-9, _ and -"),
+                "{path}: {body}"
+            );
+        }
+        let (status, body) = refused_http(&format!("{}/", server.base)).await;
+        assert_eq!(status, 400);
+        assert!(body.contains("connect to /rooms/NAME"), "{body}");
+        // 64 characters is a name.
+        let (_ws, _, _) = enter(&server.url(&"y".repeat(64))).await;
+
+        let (mut ws, channels, services) = enter(&server.url("lobby")).await;
+        let bad = call(&mut ws, &services, "/join", 1, r#"{"nam": "ada"}"#).await;
+        assert!(bad.unwrap_err().contains("unknown field `nam`"));
+        let bad = call(&mut ws, &services, "/join", 2, r#"{"name": ""}"#).await;
+        assert!(bad.unwrap_err().contains("a name of 1 to 64 bytes"));
+        let bad = call(&mut ws, &services, "/join", 3, r#"{"name": "nobody"}"#).await;
+        assert_eq!(bad.unwrap_err(), "nobody may not play");
+        let bad = call(&mut ws, &services, "/leave", 4, "{}").await;
+        assert_eq!(bad.unwrap_err(), "this client has not joined");
+        // Refused joins the session saw used numbers 1 and 2 (a bad request never reached
+        // it): the numbers follow the order of joins, refused or not.
+        let joined = call(&mut ws, &services, "/join", 5, r#"{"name": "ada"}"#)
+            .await
+            .unwrap();
+        assert_eq!(joined["player"], 3);
+        let again = call(&mut ws, &services, "/join", 6, r#"{"name": "ada"}"#).await;
+        assert!(again.unwrap_err().contains("already joined, as player 3"));
+        let bad = call(&mut ws, &services, "/rooms", 7, r#"{"create": "no way"}"#).await;
+        assert!(bad.unwrap_err().contains("1 to 64 of A-Z"));
+        // A timeline request (the SDK's PlaybackControlRequest: play, seek to 0) is told
+        // it has no place in a room, and not kept.
+        let mut timeline = vec![3u8, 0];
+        timeline.extend_from_slice(&1.0f32.to_le_bytes());
+        timeline.push(1);
+        timeline.extend_from_slice(&0u64.to_le_bytes());
+        timeline.extend_from_slice(&2u32.to_le_bytes());
+        timeline.extend_from_slice(b"tl");
+        futures_util::SinkExt::send(&mut ws, Message::binary(timeline))
+            .await
+            .unwrap();
+        let (level, why) = status_within(&mut ws).await;
+        assert_eq!(level, 1);
+        assert_eq!(why, "a room has no timeline and answers no clicked points");
+
+        subscribe_to(&mut ws, &channels, "/game", 1).await;
+        advertise_input(&mut ws).await;
+        publish(&mut ws, r#"{"push": [1, 2], "jump": true}"#).await;
+        let (level, why) = status_within(&mut ws).await;
+        assert_eq!(level, 2);
+        assert!(
+            why.starts_with("input refused: unknown field `jump`"),
+            "{why}"
+        );
+        publish(&mut ws, r#"{"push": [1]}"#).await;
+        let (_, why) = status_within(&mut ws).await;
+        assert!(why.contains("input refused: invalid length 1"), "{why}");
+        publish(&mut ws, r#"{"push": [1, 2]}"#).await;
+        // The refused inputs changed nothing: one push in all.
+        let game = until_pushes(&mut ws, 1).await;
+        assert_eq!(game["players"], 1);
+        let mut later = game;
+        for _ in 0..5 {
+            later = next_game(&mut ws, 1).await;
+        }
+        assert_eq!(later["pushes"], 1);
+    });
+    server.stop();
+}
+
+/// Connects and reads what comes until the server closes: the last status and the close
+/// code, or `None` if it stays open (it gets its channels).
+async fn turned_away(url: &str) -> Option<(String, u16)> {
+    let (mut ws, _) = connect(url, "foxglove.websocket.v1").await.unwrap();
+    let mut status = String::new();
+    loop {
+        let m = tokio::time::timeout(Duration::from_secs(10), ws.next())
+            .await
+            .expect("a message within 10 s");
+        match m {
+            Some(Ok(Message::Text(t))) => {
+                let v: Value = serde_json::from_str(t.as_str()).unwrap();
+                if v["op"] == "status" {
+                    status = v["message"].as_str().unwrap().to_owned();
+                }
+                if v["op"] == "advertise" {
+                    return None;
+                }
+            }
+            Some(Ok(Message::Close(frame))) => {
+                return Some((status, u16::from(frame.unwrap().code)));
+            }
+            Some(Ok(_)) => {}
+            other => panic!("{other:?}"),
+        }
+    }
+}
+
+#[test]
+fn the_room_and_server_caps_turn_clients_away_by_name_and_empty_rooms_close() {
+    let dir = tempfile::tempdir().unwrap();
+    let server = Rooms::start(RoomOptions {
+        record: Some(dir.path().to_path_buf()),
+        max_clients_per_room: 2,
+        max_clients: 3,
+        max_rooms: 2,
+        grace: Duration::from_millis(300),
+        ..quiet()
+    });
+    runtime().block_on(async {
+        let (_a1, _, _) = enter(&server.url("a")).await;
+        let (_a2, _, _) = enter(&server.url("a")).await;
+        assert_eq!(
+            turned_away(&server.url("a")).await,
+            Some(("room a is full, at most 2 clients".to_owned(), 1013))
+        );
+        let (mut b, _, services) = enter(&server.url("b")).await;
+        assert_eq!(
+            turned_away(&server.url("c")).await,
+            Some((
+                "too many clients on this server, at most 3".to_owned(),
+                1013
+            ))
+        );
+        let bad = call(&mut b, &services, "/rooms", 1, r#"{"create": "c"}"#).await;
+        assert_eq!(bad.unwrap_err(), "too many rooms, at most 2");
+        drop(_a1);
+        drop(_a2);
+        // Room a, empty, closes after its grace: its recording is in place, and a new
+        // client makes a new room a.
+        let deadline = Instant::now() + Duration::from_secs(10);
+        let mut n = 2;
+        loop {
+            let listed = call(&mut b, &services, "/rooms", n, "{}").await.unwrap();
+            n += 1;
+            let names: Vec<Value> = listed["rooms"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|r| r["name"].clone())
+                .collect();
+            if names == [Value::from("b")] {
+                break;
+            }
+            assert!(Instant::now() < deadline, "room a still open: {listed}");
+            tokio::time::sleep(Duration::from_millis(50)).await;
+        }
+        assert!(dir.path().join("a.mcap").is_file());
+        let made = call(&mut b, &services, "/rooms", n, r#"{"create": "a"}"#)
+            .await
+            .unwrap();
+        assert_eq!(made["rooms"].as_array().unwrap().len(), 2);
+    });
+    let served = server.stop();
+    assert_eq!((served.opened, served.failed), (3, 0));
+    // The second room a recorded beside the first, which is kept.
+    assert!(dir.path().join("a-1.mcap").is_file());
+}
+
+/// Eight rooms of four players each, pushing ten times a second for 2 s: every room
+/// steps, and every push lands in its own room's state.
+#[test]
+fn eight_rooms_of_four_players_keep_stepping_under_inputs() {
+    const ROOMS: usize = 8;
+    const PLAYERS: usize = 4;
+    const PUSHES: u64 = 20;
+    let server = Rooms::start(quiet());
+    let urls: Vec<String> = (0..ROOMS)
+        .map(|r| server.url(&format!("load-{r}")))
+        .collect();
+    runtime().block_on(async {
+        let mut clients = Vec::new();
+        for url in &urls {
+            for p in 0..PLAYERS {
+                let (mut ws, channels, services) = enter(url).await;
+                let name = format!("p{p}");
+                call(
+                    &mut ws,
+                    &services,
+                    "/join",
+                    1,
+                    &format!(r#"{{"name": "{name}"}}"#),
+                )
+                .await
+                .unwrap();
+                if p == 0 {
+                    subscribe_to(&mut ws, &channels, "/game", 1).await;
+                }
+                advertise_input(&mut ws).await;
+                clients.push(ws);
+            }
+        }
+        let mut tick = tokio::time::interval(Duration::from_millis(100));
+        for k in 0..PUSHES {
+            tick.tick().await;
+            for ws in &mut clients {
+                publish(ws, &format!(r#"{{"push": [{k}, 0]}}"#)).await;
+            }
+        }
+        for r in 0..ROOMS {
+            let game = until_pushes(&mut clients[r * PLAYERS], PUSHES * PLAYERS as u64).await;
+            assert_eq!(game["players"], PLAYERS as u64);
+        }
+    });
+    let served = server.stop();
+    assert_eq!((served.opened, served.failed), (ROOMS as u64, 0));
+    eprintln!(
+        "{ROOMS} rooms x {PLAYERS} players: {} frames; late p50 {:.3} ms, p99 {:.3} ms, max {:.3} ms",
+        served.frames, served.late_ms[0], served.late_ms[1], served.late_ms[2]
+    );
+}
+
+/// `ricochet serve SCENARIO` keeps its plain URL and hosts rooms of the scenario's game:
+/// no players, inputs as the plain server takes them, one recording per room that
+/// `ricochet replay` replays.
+#[test]
+fn ricochet_serve_hosts_rooms_of_its_scenario_beside_the_plain_url() {
+    let dir = tempfile::tempdir().unwrap();
+    let rooms_dir: PathBuf = dir.path().join("rooms");
+    std::fs::create_dir(&rooms_dir).unwrap();
+    let mut server = serve(&["--record-rooms", rooms_dir.to_str().unwrap()]);
+    runtime().block_on(async {
+        let (mut ws, channels, services) = enter(&format!("{}/rooms/lobby", server.url)).await;
+        let bad = call(&mut ws, &services, "/join", 1, r#"{"name": "ada"}"#).await;
+        assert!(bad.unwrap_err().contains("this game has no players"));
+        subscribe_to(&mut ws, &channels, "/input/recorded", 1).await;
+        advertise_input(&mut ws).await;
+        publish(
+            &mut ws,
+            r#"{"action": "turn", "body": "ship", "input": 0.5}"#,
+        )
+        .await;
+        let (_, _, payload) = next_data(&mut ws).await;
+        assert!(!payload.is_empty());
+        // The plain URL is today's server, and lists the rooms too.
+        let (mut plain, _, plain_services) = enter(&server.url).await;
+        let listed = call(&mut plain, &plain_services, "/rooms", 1, "{}")
+            .await
+            .unwrap();
+        assert_eq!(listed["rooms"][0]["name"], "lobby");
+        assert_eq!(listed["rooms"][0]["clients"], 1);
+    });
+    let status = terminate(&mut server, Duration::from_secs(10));
+    assert!(status.success());
+    let log = rooms_dir.join("lobby.mcap");
+    let out = dir.path().join("again.mcap");
+    let replay = std::process::Command::new(env!("CARGO_BIN_EXE_ricochet"))
+        .args(["replay", log.to_str().unwrap(), "-o", out.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(
+        replay.status.success(),
+        "{}",
+        String::from_utf8_lossy(&replay.stderr)
+    );
+}

@@ -1,0 +1,360 @@
+//! `[tiled]`: maps in every form Tiled saves become static solids covering exactly the points
+//! the map's shapes cover (sampled, the answers computed here from the map's own numbers in
+//! pixels), and bad maps are located errors.
+
+mod errors;
+mod write;
+
+use std::path::Path;
+
+use ricochet_sim::{QueryFilter, Simulation, Vec2};
+use write::{Encoding, FLIP_D, FLIP_H, FLIP_V, H, Obj, TILE};
+
+/// A scenario taking its level from `map`, 1 unit a tile (10 px).
+pub fn scenario_text(map: &str, solid: &str, extra: &str) -> String {
+    format!(
+        "layers = [\"tile\", \"box\"]\n[tiled]\nmap = \"{map}\"\nsolid = {solid}\nlayer = \"tile\"\n{extra}\n\
+         [templates.box]\nlayer = \"box\"\nshape = {{ kind = \"circle\", radius = 0.2 }}\n"
+    )
+}
+
+/// Loads `dir/level.toml` as the binary does.
+pub fn load(dir: &Path) -> Result<(ricochet_sim::Scenario, ricochet_tiled::MapSummary), String> {
+    let path = dir.join("level.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let (mut s, def) = ricochet_sim::load_scenario_and_map(&text, &path.display().to_string())
+        .map_err(|e| e.to_string())?;
+    let summary = ricochet_tiled::add_map(&mut s, &def.expect("a [tiled] table"), &path)
+        .map_err(|e| e.to_string())?;
+    Ok((s, summary))
+}
+
+/// Whether tile-local pixel `(u, v)` (0..10, y down, before the flips) is in gid `g`'s shape.
+fn in_tile_shape(g: u32, u: f64, v: f64) -> bool {
+    match g {
+        1 => (0.0..=TILE).contains(&u) && (0.0..=TILE).contains(&v),
+        // Below the diagonal from (0, 10) to (10, 0).
+        2 => (0.0..=TILE).contains(&u) && (0.0..=TILE).contains(&v) && u + v >= TILE,
+        3 => (2.0..=8.0).contains(&u) && (4.0..=10.0).contains(&v),
+        _ => false,
+    }
+}
+
+/// Whether map pixel `(px, py)` is in the tile `bits` at cell `(cx, cy)`: the flips undone in
+/// the reverse of the order Tiled applies them (diagonal, then horizontal, then vertical).
+fn in_tile(cx: i32, cy: i32, bits: u32, px: f64, py: f64) -> bool {
+    let (mut u, mut v) = (px - f64::from(cx) * TILE, py - f64::from(cy) * TILE);
+    if bits & FLIP_V != 0 {
+        v = TILE - v;
+    }
+    if bits & FLIP_H != 0 {
+        u = TILE - u;
+    }
+    if bits & FLIP_D != 0 {
+        std::mem::swap(&mut u, &mut v);
+    }
+    in_tile_shape(bits & 0x0fff_ffff, u, v)
+}
+
+/// Even-odd rule.
+fn in_polygon(p: &[(f64, f64)], x: f64, y: f64) -> bool {
+    let mut inside = false;
+    for i in 0..p.len() {
+        let (a, b) = (p[i], p[(i + 1) % p.len()]);
+        if (a.1 > y) != (b.1 > y) && x < a.0 + (y - a.1) / (b.1 - a.1) * (b.0 - a.0) {
+            inside = !inside;
+        }
+    }
+    inside
+}
+
+/// Whether the object covers `(px, py)`: `Some(true)`/`Some(false)`, or `None` in an
+/// ellipse's stated tolerance band (inside the ellipse, outside its inscribed 32-gon).
+fn in_object(o: &Obj, px: f64, py: f64) -> Option<bool> {
+    Some(match o {
+        Obj::Rect { x, y, w, h, rot } => {
+            let r = -rot.to_radians();
+            let (dx, dy) = (px - x, py - y);
+            let (u, v) = (
+                dx * libm::cos(r) - dy * libm::sin(r),
+                dx * libm::sin(r) + dy * libm::cos(r),
+            );
+            (0.0..=*w).contains(&u) && (0.0..=*h).contains(&v)
+        }
+        Obj::Ellipse { x, y, w, h } => {
+            let q = (((px - x - w / 2.0) / (w / 2.0)).powi(2)
+                + ((py - y - h / 2.0) / (h / 2.0)).powi(2))
+            .sqrt();
+            if w == h {
+                q <= 1.0
+            } else if q <= libm::cos(std::f64::consts::PI / 32.0) {
+                true
+            } else if q > 1.0 {
+                false
+            } else {
+                return None;
+            }
+        }
+        Obj::Polygon { x, y, points } => in_polygon(points, px - x, py - y),
+        Obj::Tile { x, y, w, h } => {
+            let (u, v) = ((px - x) * TILE / w, (py - (y - h)) * TILE / h);
+            in_tile_shape(2, u, v)
+        }
+    })
+}
+
+/// The map's answer at pixel `(px, py)` for its tiles moved by `(dx, dy)` cells, `None` near
+/// an edge (the answer changes within 0.02 px) or in an ellipse's tolerance band.
+fn expected(px: f64, py: f64, dx: i32, dy: i32) -> Option<bool> {
+    let at = |px: f64, py: f64| -> Option<bool> {
+        let tiles = write::tiles()
+            .iter()
+            .any(|&(x, y, g)| in_tile(x + dx, y + dy, g, px, py));
+        let mut any = tiles;
+        for o in write::objects() {
+            any |= in_object(&o, px, py)?;
+        }
+        Some(any)
+    };
+    let here = at(px, py)?;
+    for (ex, ey) in [(0.02, 0.0), (-0.02, 0.0), (0.0, 0.02), (0.0, -0.02)] {
+        if at(px + ex, py + ey)? != here {
+            return None;
+        }
+    }
+    Some(here)
+}
+
+/// Samples the map's area in pixels and compares each answer with the built scene; `dx, dy`
+/// as for [`expected`]. Returns how many points were compared.
+fn check_cover(dir: &Path, dx: i32, dy: i32) -> usize {
+    let (scenario, _) = load(dir).unwrap_or_else(|e| panic!("{e}"));
+    let sim = Simulation::new(&scenario);
+    // World = (px / 10, (H * 10 - py) / 10): 1 unit a tile, the map's bottom-left at 0.
+    let h_px = f64::from(H) * TILE;
+    let filter = QueryFilter::default();
+    let mut compared = 0;
+    let (x_lo, y_lo) = (
+        f64::from(dx.min(0)) * TILE - 5.0,
+        f64::from(dy.min(0)) * TILE - 5.0,
+    );
+    let mut py = y_lo + 0.013;
+    while py < h_px + 5.0 {
+        let mut px = x_lo + 0.017;
+        while px < 125.0 {
+            if let Some(want) = expected(px, py, dx, dy) {
+                let world = Vec2::new(px / TILE, (h_px - py) / TILE);
+                let got = !sim.overlap_point(world, &filter).is_empty();
+                assert_eq!(
+                    got,
+                    want,
+                    "{}: pixel ({px}, {py}), world {world}",
+                    dir.display()
+                );
+                compared += 1;
+            }
+            px += 0.7;
+        }
+        py += 0.7;
+    }
+    assert!(compared > 10_000, "{compared}");
+    compared
+}
+
+fn level(files: &[(&str, String)], map: &str) -> tempfile::TempDir {
+    level_with(files, map, "[\"Ground\", \"Shapes\"]")
+}
+
+fn level_with(files: &[(&str, String)], map: &str, solid: &str) -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, text) in files {
+        std::fs::write(dir.path().join(name), text).unwrap();
+    }
+    std::fs::write(dir.path().join("level.toml"), scenario_text(map, solid, "")).unwrap();
+    dir
+}
+
+#[test]
+fn tmx_in_every_tile_encoding_covers_exactly_the_maps_shapes() {
+    let embedded = write::tileset_xml(" firstgid=\"1\"");
+    for enc in [
+        Encoding::Csv,
+        Encoding::Base64,
+        Encoding::Zlib,
+        Encoding::Gzip,
+        Encoding::Zstd,
+        Encoding::Xml,
+    ] {
+        let dir = level(&[("m.tmx", write::tmx(enc, &embedded, None))], "m.tmx");
+        check_cover(dir.path(), 0, 0);
+    }
+}
+
+#[test]
+fn tmx_with_an_external_tileset_and_a_template_covers_the_same() {
+    let tx = "<?xml version=\"1.0\"?><template><tileset firstgid=\"1\" source=\"t.tsx\"/>\
+              <object gid=\"2\" width=\"20\" height=\"20\"/></template>";
+    let dir = level(
+        &[
+            (
+                "m.tmx",
+                write::tmx(
+                    Encoding::Csv,
+                    "<tileset firstgid=\"1\" source=\"t.tsx\"/>",
+                    Some("o.tx"),
+                ),
+            ),
+            (
+                "t.tsx",
+                format!("<?xml version=\"1.0\"?>{}", write::tileset_xml("")),
+            ),
+            ("o.tx", tx.to_owned()),
+        ],
+        "m.tmx",
+    );
+    check_cover(dir.path(), 0, 0);
+}
+
+#[test]
+fn infinite_maps_with_negative_chunks_cover_the_moved_tiles() {
+    for enc in [Encoding::Csv, Encoding::Zlib] {
+        let dir = level(&[("m.tmx", write::infinite_tmx(enc, -5, -3))], "m.tmx");
+        check_cover(dir.path(), -5, -3);
+    }
+}
+
+#[test]
+fn tiled_json_maps_with_tsj_and_tj_cover_the_same() {
+    for zlib in [false, true] {
+        let dir = level(
+            &[
+                ("m.tmj", write::tmj(zlib)),
+                ("t.tsj", write::tsj()),
+                ("o.tj", write::tj()),
+            ],
+            "m.tmj",
+        );
+        check_cover(dir.path(), 0, 0);
+    }
+}
+
+#[test]
+fn whole_cell_tiles_become_tile_rows_and_spawns_become_bodies() {
+    let embedded = write::tileset_xml(" firstgid=\"1\"");
+    let mut tmx = write::tmx(Encoding::Csv, &embedded, None);
+    tmx = tmx.replace(
+        "</map>",
+        "<objectgroup name=\"Spawns\"><object id=\"50\" name=\"start\" type=\"player\" x=\"15\" y=\"35\"><point/></object>\
+         <object id=\"51\" name=\"coin\" x=\"40\" y=\"30\" width=\"10\" height=\"4\"/></objectgroup></map>",
+    );
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("m.tmx"), tmx).unwrap();
+    std::fs::write(
+        dir.path().join("level.toml"),
+        scenario_text(
+            "m.tmx",
+            "[\"Ground?solid\"]",
+            "[tiled.spawn]\nplayer = \"box\"\ncoin = \"box\"\n",
+        ),
+    )
+    .unwrap();
+    let (s, summary) = load(dir.path()).unwrap();
+    // `Ground?solid`: only gid 2's tiles (5 of them, the tileset marks them solid).
+    assert_eq!(summary.tiles, 5);
+    assert_eq!(summary.spawns.get("box"), Some(&2));
+    // The point at pixel (15, 35) → world (1.5, (80 - 35) / 10); the coin's centre (45, 32).
+    let at: Vec<Vec2> = s.bodies.iter().map(|b| b.position).collect();
+    assert_eq!(at.len(), 2);
+    for (got, want) in at.iter().zip([Vec2::new(1.5, 4.5), Vec2::new(4.5, 4.8)]) {
+        assert!((*got - want).length() < 1e-12, "{got} {want}");
+    }
+    // Without the filter, the 12 floor tiles make one row of one shape.
+    std::fs::write(
+        dir.path().join("level.toml"),
+        scenario_text("m.tmx", "[\"Ground\"]", ""),
+    )
+    .unwrap();
+    let (s, summary) = load(dir.path()).unwrap();
+    assert_eq!(summary.tiles, write::tiles().len());
+    let floor = s
+        .tiles
+        .iter()
+        .flat_map(|t| &t.rows)
+        .find(|&&(_, n)| n == 12)
+        .expect("the floor's run");
+    // Cell (0, 7)'s centre: pixel (5, 75) → world (0.5, (80 - 75) / 10).
+    assert_eq!(floor.0, Vec2::new(0.5, 0.5));
+}
+
+/// The shipped level: `ricochet check` says what its map became, counted from the map file
+/// (`scenarios/tiled/maps/level1.tmx`: a 20-tile floor, a 4-tile ledge, a slope tile and a
+/// 5-tile raised floor; a ramp and a boulder; three coins, an enemy and the player).
+#[test]
+fn check_summarises_the_shipped_tiled_level() {
+    let level = crate::util::root().join("scenarios/tiled/tiled_level.toml");
+    let o = crate::util::ricochet(&["check", level.to_str().unwrap()], b"");
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        out.contains(
+            "tiled map: 30 static tiles, 2 solid bodies, 0 one-way pieces, 0 chains, \
+             spawns: 3 coin, 1 enemy, 1 player"
+        ),
+        "{out}"
+    );
+}
+
+/// A group named in `solid` takes every layer in it, offsets added (the group's and its
+/// layers'): here the group moves its layers back by the offset its tile layer adds.
+#[test]
+fn a_group_named_in_solid_takes_its_layers_with_their_offsets() {
+    let embedded = write::tileset_xml(" firstgid=\"1\"");
+    let tmx = write::tmx(Encoding::Csv, &embedded, None)
+        .replacen("<layer id=\"1\"", "<group name=\"Level\" offsetx=\"-3\" offsety=\"2\"><layer offsetx=\"3\" offsety=\"-2\" id=\"1\"", 1)
+        .replacen("<objectgroup id=\"2\" name=\"Shapes\">", "<objectgroup id=\"2\" name=\"Shapes\" offsetx=\"3\" offsety=\"-2\">", 1)
+        .replacen("</map>", "</group></map>", 1);
+    let dir = level_with(&[("m.tmx", tmx)], "m.tmx", "[\"Level\"]");
+    check_cover(dir.path(), 0, 0);
+}
+
+/// Object filters: class/type, name, and a property read from the object, then its template,
+/// then its tile's tileset entry (gid 2's says `solid = true`).
+#[test]
+fn object_filters_read_the_object_then_its_template_then_its_tile() {
+    let props = |v: &str| {
+        format!("<properties><property name=\"solid\" type=\"bool\" value=\"{v}\"/></properties>")
+    };
+    let objects = format!(
+        "<object id=\"1\" type=\"Boundaries\" x=\"0\" y=\"0\" width=\"5\" height=\"5\"/>\
+         <object id=\"2\" x=\"10\" y=\"0\" width=\"5\" height=\"5\">{}</object>\
+         <object id=\"3\" template=\"w.tx\" x=\"20\" y=\"0\"/>\
+         <object id=\"4\" gid=\"2\" x=\"30\" y=\"10\" width=\"10\" height=\"10\"/>\
+         <object id=\"5\" x=\"40\" y=\"0\" width=\"5\" height=\"5\">{}</object>\
+         <object id=\"6\" name=\"edge\" x=\"50\" y=\"0\" width=\"5\" height=\"5\"/>\
+         <object id=\"7\" template=\"w.tx\" x=\"60\" y=\"0\">{}</object>\
+         <object id=\"8\" gid=\"1\" x=\"70\" y=\"10\" width=\"10\" height=\"10\"/>",
+        props("true"),
+        props("false"),
+        props("false"),
+    );
+    let map = format!(
+        "<?xml version=\"1.0\"?><map version=\"1.10\" orientation=\"orthogonal\" width=\"10\" height=\"4\" \
+         tilewidth=\"10\" tileheight=\"10\">{}<objectgroup name=\"Objs\">{objects}</objectgroup></map>",
+        write::tileset_xml(" firstgid=\"1\"")
+    );
+    let tx = format!(
+        "<?xml version=\"1.0\"?><template><object width=\"5\" height=\"5\">{}</object></template>",
+        props("true")
+    );
+    let dir = level_with(
+        &[("m.tmx", map), ("w.tx", tx)],
+        "m.tmx",
+        "[\"Objs?type=Boundaries\", \"Objs?solid\", \"Objs?name=edge\"]",
+    );
+    let (s, summary) = load(dir.path()).unwrap();
+    // 1 (type), 2 (its own property), 3 (its template's), 4 (its tile's), 6 (name); not 5
+    // (false), 7 (its own false over its template's true), 8 (gid 1 has no property).
+    assert_eq!(summary.solids, 5);
+    let xs: Vec<f64> = s.bodies.iter().map(|b| b.position.x).collect();
+    assert_eq!(xs, [0.25, 1.25, 2.25, 3.5, 5.25]);
+}
