@@ -1,9 +1,3 @@
-// Pending ricochet-serve's rooms (serve_rooms, RoomMaker, RoomOptions, not on main yet):
-// renamed to main.rs with the dependencies below in Cargo.toml once they are merged:
-//   ricochet-serve.workspace = true, anyhow.workspace = true, clap.workspace = true,
-//   ctrlc = { version = "3.4", features = ["termination"] }
-// Built and run against the g-rooms branch at 03:25: the web test passed (test.mjs).
-
 //! `ricochet-coin-rush`: a server of Coin Rush rooms, over the Foxglove WebSocket protocol.
 //!
 //! `cargo run -p ricochet-coin-rush -- --bind 127.0.0.1:8766` serves a room at each
