@@ -14,6 +14,12 @@
 //!   by a [`RoomMaker`], stepped on a bounded pool of threads (the client protocol:
 //!   `docs/protocol.md`).
 //!
+//! Its files import in one direction: the entry points (`realtime.rs`) → the transport
+//! (`server.rs`) → the room registry (`rooms.rs`, reached through `door.rs`) → a room
+//! (`room.rs`, or the plain session `serving.rs`) → the frame loop every mode shares
+//! (`ricochet_record::session::GameSession`); `sink.rs`, `hub.rs`, `protocol.rs` and
+//! `common.rs` are at the bottom.
+//!
 //! The messages are `ricochet-record`'s, the same a log holds; the inputs are its sessions'.
 //! This crate never lets the wall clock reach a message (it only paces the frames), never
 //! computes physics, and never prints, parses command lines or installs signal handlers:
@@ -30,6 +36,8 @@
 //! ```
 
 mod click;
+mod common;
+mod door;
 mod hub;
 mod load_path;
 mod protocol;
@@ -41,12 +49,12 @@ mod scenario_rooms;
 mod server;
 mod services;
 mod serving;
+mod sink;
 
+pub use common::{DEFAULT_BIND, Listener, MAX_CLIENTS, Note, SPEEDS, ServeError};
+pub use door::MAX_ROOM_NAME;
 pub use hub::{CLIENT_BUDGET, RECORDED_INPUT};
 pub use load_path::MAX_SCENARIO_BYTES;
-pub use realtime::{
-    DEFAULT_BIND, Listener, Note, Options, SPEEDS, ServeError, Served, cpu_seconds, serve,
-};
-pub use rooms::{MAX_ROOM_INPUTS, MAX_THREADS, RoomMaker, RoomOptions, ServedRooms, serve_rooms};
+pub use realtime::{Options, Served, cpu_seconds, serve, serve_rooms};
+pub use rooms::{MAX_ROOM_INPUTS, MAX_THREADS, RoomMaker, RoomOptions, ServedRooms};
 pub use scenario_rooms::ScenarioRooms;
-pub use server::{MAX_CLIENTS, MAX_ROOM_NAME};

@@ -8,171 +8,24 @@
 //! it never reaches a message. The WebSocket side runs on a tokio runtime of its own thread
 //! (`server.rs`); the two share the [`Hub`].
 
-use std::net::SocketAddr;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
-use ricochet_log::{ChannelId, LogError, LogWriter, MessageSink, Schema};
-use ricochet_record::session::{SCENARIO_ATTACHMENT, Session, StepError};
 use ricochet_sim::Scenario;
 
-use crate::hub::{Hub, LiveSink};
-use crate::serving::{Asker, Serving};
+use crate::common::{Lateness, Listener, Note, SPEEDS, ServeError};
+use crate::hub::Hub;
+use crate::rooms::{RoomMaker, RoomOptions, ServedRooms, host};
+use crate::serving::{Asker, PlainOptions, Serving};
+use crate::sink::{finish, start};
 use crate::{server, services};
-
-/// Where `serve` listens unless told: what Foxglove's "Open connection" suggests.
-pub const DEFAULT_BIND: &str = "127.0.0.1:8765";
-
-/// Simulation seconds per wall second a server may run at (`--speed`, `/speed`, the
-/// timeline): a frame's wait, dt / speed, stays a duration (1e-300 made it infinite, and
-/// the loop panicked).
-pub const SPEEDS: std::ops::RangeInclusive<f64> = 0.01..=100.0;
 
 /// The longest the loop sleeps before it looks at the stop flag and its clients' calls
 /// again (paused, or before a frame is due): what SIGTERM or a call may wait, besides a
 /// seek's or step's slice.
 const POLL: Duration = Duration::from_millis(5);
-
-/// Where a served session's messages go: the live stream, and the recording if any.
-pub(crate) struct ServeSink {
-    pub(crate) live: LiveSink,
-    /// The recording, with its channel for each live channel id.
-    pub(crate) file: Option<(LogWriter, Vec<ChannelId>)>,
-    /// While a seek re-simulates: the recording gets every frame, the clients none.
-    pub(crate) muted: bool,
-}
-
-impl MessageSink for ServeSink {
-    fn add_protobuf_channel(&mut self, topic: &str, schema: Schema) -> Result<ChannelId, LogError> {
-        if let Some((file, ids)) = &mut self.file {
-            let id = file.add_protobuf_channel(topic, schema.clone())?;
-            ids.push(id);
-        }
-        self.live.add_protobuf_channel(topic, schema)
-    }
-
-    fn write<M: prost::Message + Clone + Send + 'static>(
-        &mut self,
-        channel: ChannelId,
-        time_ns: u64,
-        message: M,
-    ) -> Result<(), LogError> {
-        if let Some((file, ids)) = &mut self.file {
-            let id = ids[usize::from(channel.index()) - 1];
-            file.write(id, time_ns, message.clone())?;
-        }
-        if self.muted {
-            return Ok(());
-        }
-        self.live.write(channel, time_ns, message)
-    }
-
-    fn add_json_channel(
-        &mut self,
-        topic: &str,
-        schema_name: &str,
-        schema_json: &str,
-    ) -> Result<ChannelId, LogError> {
-        if let Some((file, ids)) = &mut self.file {
-            let id = file.add_json_channel(topic, schema_name, schema_json)?;
-            ids.push(id);
-        }
-        self.live.add_json_channel(topic, schema_name, schema_json)
-    }
-
-    fn attach(&mut self, name: &str, media_type: &str, data: &[u8]) -> Result<(), LogError> {
-        match &mut self.file {
-            Some((file, _)) => file.attach(name, media_type, data),
-            None => Ok(()),
-        }
-    }
-
-    fn write_json_bytes(
-        &mut self,
-        channel: ChannelId,
-        time_ns: u64,
-        json: Vec<u8>,
-    ) -> Result<(), LogError> {
-        if let Some((file, ids)) = &mut self.file {
-            let id = ids[usize::from(channel.index()) - 1];
-            file.write_json_bytes(id, time_ns, json.clone())?;
-        }
-        if self.muted {
-            return Ok(());
-        }
-        self.live.write_json_bytes(channel, time_ns, json)
-    }
-
-    fn write_live<M: prost::Message + Clone + Send + 'static>(
-        &mut self,
-        channel: ChannelId,
-        time_ns: u64,
-        message: M,
-    ) -> Result<(), LogError> {
-        if self.muted {
-            return Ok(());
-        }
-        self.live.write(channel, time_ns, message)
-    }
-}
-
-/// The recording of segment `k` of a session recorded to `path`: `path` itself, then
-/// `NAME-1.mcap`, `NAME-2.mcap`, ... (a reset or a load starts a new file).
-pub(crate) fn segment(path: &Path, k: u32) -> PathBuf {
-    if k == 0 {
-        return path.to_path_buf();
-    }
-    let stem = path
-        .file_stem()
-        .map_or_else(|| "session".into(), |s| s.to_string_lossy());
-    let ext = path
-        .extension()
-        .map_or_else(|| "mcap".into(), |s| s.to_string_lossy());
-    path.with_file_name(format!("{stem}-{k}.{ext}"))
-}
-
-/// A new session of `scenario` (whose file's text is `text`, attached to the recording
-/// when not empty, for `ricochet replay`) for `hub`, recording to segment `k` of `record` if
-/// asked.
-pub(crate) fn start(
-    scenario: &Scenario,
-    text: &str,
-    hub: &Hub,
-    record: Option<&Path>,
-    k: u32,
-) -> Result<Session<ServeSink>, ServeError> {
-    let file = match record {
-        None => None,
-        Some(path) => {
-            let path = segment(path, k);
-            let mut file = LogWriter::create(&path, ricochet_record::LIBRARY)?;
-            if !text.is_empty() {
-                file.attach(SCENARIO_ATTACHMENT, "application/toml", text.as_bytes())?;
-            }
-            Some((file, Vec::new()))
-        }
-    };
-    let sink = ServeSink {
-        live: LiveSink::new(hub.clone()),
-        file,
-        muted: false,
-    };
-    Ok(Session::new(scenario, sink)?)
-}
-
-/// Finishes a session's recording, if it has one.
-pub(crate) fn finish(session: Session<ServeSink>) -> Result<(), ServeError> {
-    if let Some((file, _)) = session.into_sink().file {
-        file.finish()?;
-    }
-    Ok(())
-}
-
-/// Where the server's notes go (a client connected, a frame overflowed, how late frames
-/// were): a line each, without a newline. Losing one is no failure.
-pub type Note = Arc<dyn Fn(&str) + Send + Sync>;
 
 /// How to serve.
 pub struct Options {
@@ -190,7 +43,7 @@ pub struct Options {
     pub note: Note,
     /// Also host rooms of the scenario's game on `/rooms/NAME` (each a fresh simulation of
     /// the scenario), besides the single session on the plain URL.
-    pub rooms: Option<crate::RoomOptions>,
+    pub rooms: Option<RoomOptions>,
 }
 
 impl Default for Options {
@@ -207,64 +60,6 @@ impl Default for Options {
     }
 }
 
-/// Why serving failed or could not start.
-#[derive(Debug, thiserror::Error)]
-pub enum ServeError {
-    /// An option is out of range.
-    #[error("{0}")]
-    Options(String),
-    /// The address could not be listened on.
-    #[error("cannot listen on {addr}: {source}")]
-    Bind {
-        /// The address asked for.
-        addr: SocketAddr,
-        /// Why.
-        source: std::io::Error,
-    },
-    /// The WebSocket runtime or its thread could not start.
-    #[error("starting the WebSocket server: {0}")]
-    Runtime(std::io::Error),
-    /// Writing the recording (or the live stream's bookkeeping) failed.
-    #[error(transparent)]
-    Log(#[from] LogError),
-    /// Recording a frame failed.
-    #[error(transparent)]
-    Step(#[from] StepError),
-}
-
-/// A bound WebSocket listener, not serving yet (so the caller can say where it listens).
-pub struct Listener {
-    pub(crate) runtime: tokio::runtime::Runtime,
-    pub(crate) listener: tokio::net::TcpListener,
-    local: SocketAddr,
-}
-
-impl Listener {
-    /// Listens on `addr` (port 0: any free port).
-    pub fn bind(addr: SocketAddr) -> Result<Listener, ServeError> {
-        let runtime = tokio::runtime::Builder::new_current_thread()
-            .enable_all()
-            .build()
-            .map_err(ServeError::Runtime)?;
-        let listener = runtime
-            .block_on(tokio::net::TcpListener::bind(addr))
-            .map_err(|source| ServeError::Bind { addr, source })?;
-        let local = listener
-            .local_addr()
-            .map_err(|source| ServeError::Bind { addr, source })?;
-        Ok(Listener {
-            runtime,
-            listener,
-            local,
-        })
-    }
-
-    /// The address it listens on (the port chosen, for port 0).
-    pub fn local_addr(&self) -> SocketAddr {
-        self.local
-    }
-}
-
 /// What a served session did.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Served {
@@ -277,7 +72,7 @@ pub struct Served {
     /// Messages slow clients lost.
     pub dropped: u64,
     /// What the rooms did, if it hosted rooms.
-    pub rooms: Option<crate::ServedRooms>,
+    pub rooms: Option<ServedRooms>,
 }
 
 /// Serves `scenario` (a file's, or one a game builds in code; `text` is its file, attached
@@ -311,7 +106,7 @@ pub fn serve(
         .saturating_mul((scenario.world.dt * 1e9).round() as u64);
     let session = start(&scenario, &text, &hub, o.record.as_deref(), 0)?;
     let hosted = match &o.rooms {
-        Some(ro) => Some(crate::rooms::host(
+        Some(ro) => Some(host(
             crate::scenario_rooms::ScenarioRooms::new(scenario.clone(), text.clone()),
             ro,
         )?),
@@ -334,7 +129,14 @@ pub fn serve(
             runtime.block_on(server::accept(listener, routes, note))
         })
         .map_err(ServeError::Runtime)?;
-    let mut serving = Serving::new(session, scenario, text, o);
+    let plain = PlainOptions {
+        speed: o.speed,
+        paused: o.paused,
+        frames: o.frames,
+        record: o.record.clone(),
+        note: o.note.clone(),
+    };
+    let mut serving = Serving::new(session, scenario, text, plain);
     let real_time = run_loop(&mut serving, &hub, stop, &o.note);
     let rooms = hosted.map(crate::rooms::Hosted::stop);
     let real_time = real_time?;
@@ -470,62 +272,38 @@ fn run_loop(
         "frame starts late against the real-time schedule: p50 {:.3} ms, p99 {:.3} ms, max {:.3} ms",
         lateness.quantile(0.5),
         lateness.quantile(0.99),
-        lateness.max_ms
+        lateness.max_ms()
     ));
     Ok(frames)
 }
 
-/// How late frames start, in a fixed histogram (bounded memory however long the server
-/// runs): 0.05 ms buckets up to 100 ms, then one for all later.
-pub(crate) struct Lateness {
-    buckets: [u64; 2001],
-    count: u64,
-    max_ms: f64,
-}
-
-impl Default for Lateness {
-    fn default() -> Self {
-        Lateness {
-            buckets: [0; 2001],
-            count: 0,
-            max_ms: 0.0,
-        }
+/// Serves rooms of `maker`'s game on `listener` (`ws://HOST:PORT/rooms/NAME`; any other
+/// path is refused with HTTP 400) until `stop` is set; then closes every room, each
+/// recording finished.
+pub fn serve_rooms<M: RoomMaker>(
+    listener: Listener,
+    maker: M,
+    options: &RoomOptions,
+    stop: &AtomicBool,
+) -> Result<ServedRooms, ServeError> {
+    let hosted = host(maker, options)?;
+    let routes = server::Routes {
+        plain: None,
+        rooms: Some(Arc::clone(&hosted.door)),
+    };
+    let note = options.note.clone();
+    let Listener {
+        runtime, listener, ..
+    } = listener;
+    let spawned = std::thread::Builder::new()
+        .name("serve".into())
+        .spawn(move || runtime.block_on(server::accept(listener, routes, note)));
+    if let Err(e) = spawned {
+        hosted.stop();
+        return Err(ServeError::Runtime(e));
     }
-}
-
-impl Lateness {
-    /// Adds `other`'s counts.
-    pub(crate) fn merge(&mut self, other: &Lateness) {
-        for (a, b) in self.buckets.iter_mut().zip(other.buckets.iter()) {
-            *a += b;
-        }
-        self.count += other.count;
-        self.max_ms = self.max_ms.max(other.max_ms);
+    while !stop.load(Ordering::SeqCst) {
+        std::thread::sleep(POLL);
     }
-
-    /// The latest, ms.
-    pub(crate) fn max_ms(&self) -> f64 {
-        self.max_ms
-    }
-
-    pub(crate) fn add(&mut self, late: Duration) {
-        let ms = late.as_secs_f64() * 1e3;
-        let bucket = ((ms / 0.05) as usize).min(self.buckets.len() - 1);
-        self.buckets[bucket] += 1;
-        self.count += 1;
-        self.max_ms = self.max_ms.max(ms);
-    }
-
-    /// The `q` quantile, ms (the upper edge of its bucket).
-    pub(crate) fn quantile(&self, q: f64) -> f64 {
-        let want = (q * self.count as f64).ceil() as u64;
-        let mut seen = 0;
-        for (i, n) in self.buckets.iter().enumerate() {
-            seen += n;
-            if seen >= want.max(1) {
-                return ((i + 1) as f64 * 0.05).min(self.max_ms);
-            }
-        }
-        self.max_ms
-    }
+    Ok(hosted.stop())
 }

@@ -20,7 +20,7 @@ use tokio_tungstenite::tungstenite::Message;
 
 use crate::hub::Hub;
 use crate::protocol::{self, Service, ServiceSchema};
-use crate::realtime::ServeSink;
+use crate::sink::ServeSink;
 
 /// A room's services, ids 1 to 3.
 pub const JOIN: u32 = 1;

@@ -26,11 +26,12 @@ use std::time::{Duration, Instant};
 use ricochet_record::session::GameSession;
 use ricochet_sim::Simulation;
 
+use crate::common::{Lateness, MAX_CLIENTS, Note, ServeError, metadata};
+use crate::door::{Door, Entered, check_room_name};
 use crate::hub::{ClientQueue, Hub, LiveSink};
 use crate::protocol::{self, ServerMessage};
-use crate::realtime::{Lateness, Listener, Note, ServeError, ServeSink};
 use crate::room::{self, Closing, Room, RoomsRequest, Stats};
-use crate::server::{self, Door, Entered, check_room_name};
+use crate::sink::ServeSink;
 
 /// What a server hosts: each new room's simulation and game.
 pub trait RoomMaker: Send + Sync + 'static {
@@ -92,7 +93,7 @@ impl Default for RoomOptions {
             record: None,
             grace: Duration::from_secs(10),
             max_rooms: 1000,
-            max_clients_per_room: crate::server::MAX_CLIENTS,
+            max_clients_per_room: MAX_CLIENTS,
             max_clients: 1000,
             threads: std::thread::available_parallelism().map_or(1, usize::from),
             note: Arc::new(|text: &str| eprintln!("{text}")),
@@ -343,7 +344,7 @@ impl<M: RoomMaker> Door for Registry<M> {
             name: "ricochet",
             capabilities: &["time", "clientPublish", "services"],
             supported_encodings: &["json"],
-            metadata: server::metadata(),
+            metadata: metadata(),
             session_id: &format!("ricochet-room-{name}"),
             data_start_time: protocol::Time::from_ns(0),
             data_end_time: protocol::Time::from_ns(0),
@@ -540,35 +541,4 @@ impl Hosted {
         ];
         served
     }
-}
-
-/// Serves rooms of `maker`'s game on `listener` (`ws://HOST:PORT/rooms/NAME`; any other
-/// path is refused with HTTP 400) until `stop` is set; then closes every room, each
-/// recording finished.
-pub fn serve_rooms<M: RoomMaker>(
-    listener: Listener,
-    maker: M,
-    options: &RoomOptions,
-    stop: &AtomicBool,
-) -> Result<ServedRooms, ServeError> {
-    let hosted = host(maker, options)?;
-    let routes = server::Routes {
-        plain: None,
-        rooms: Some(Arc::clone(&hosted.door)),
-    };
-    let note = options.note.clone();
-    let Listener {
-        runtime, listener, ..
-    } = listener;
-    let spawned = std::thread::Builder::new()
-        .name("serve".into())
-        .spawn(move || runtime.block_on(server::accept(listener, routes, note)));
-    if let Err(e) = spawned {
-        hosted.stop();
-        return Err(ServeError::Runtime(e));
-    }
-    while !stop.load(Ordering::SeqCst) {
-        std::thread::sleep(POLL);
-    }
-    Ok(hosted.stop())
 }

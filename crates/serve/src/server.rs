@@ -23,13 +23,11 @@ use tokio_tungstenite::tungstenite::{Error as WsError, Message};
 
 use std::sync::Arc;
 
+use crate::common::{MAX_CLIENTS, Note, metadata};
+use crate::door::{Door, PLAIN_ROOMS, check_room_name};
 use crate::hub::{ClientQueue, Hub, client_queue};
 use crate::protocol::{self, ClientMessage, ServerMessage};
-use crate::realtime::Note;
 
-/// Clients served at once; more are told so (a status) and closed with 1013 (Try Again
-/// Later).
-pub const MAX_CLIENTS: usize = 64;
 /// The largest message a client may send (a subscribe of every channel is a few hundred
 /// bytes). A larger one closes the connection with status 1009 (Message Too Big) and a
 /// reason naming the limit.
@@ -63,52 +61,6 @@ pub struct Routes {
     pub plain: Option<(Hub, String)>,
     /// The rooms.
     pub rooms: Option<Arc<dyn Door>>,
-}
-
-/// The rooms, as connections see them (`rooms.rs`).
-pub trait Door: Send + Sync {
-    /// Admits a client with `queue` into room `name`, creating the room if it has none;
-    /// or says why not (too many clients, in the room or the server; too many rooms).
-    fn enter(&self, name: &str, queue: ClientQueue) -> Result<Entered, String>;
-    /// The client left room `hub`.
-    fn left(&self, hub: &Hub, client: u64);
-    /// `/rooms`: the rooms (making the one asked for), as JSON, or why not.
-    fn rooms_call(&self, payload: &[u8]) -> Result<String, String>;
-}
-
-/// `/rooms`' id on the plain URL, after the plain server's eight services (on a room's
-/// connection it is 3).
-pub const PLAIN_ROOMS: u32 = 9;
-
-/// A client admitted into a room.
-pub struct Entered {
-    /// The room's hub.
-    pub hub: Hub,
-    /// The client's id there.
-    pub id: u64,
-    /// Ends the connection when the room closes.
-    pub kicked: oneshot::Receiver<String>,
-    /// `serverInfo`, `advertise`, `advertiseServices`.
-    pub hello: [String; 3],
-}
-
-/// A room's name: 1 to [`MAX_ROOM_NAME`] of `A-Z a-z 0-9 _ -`.
-pub const MAX_ROOM_NAME: usize = 64;
-
-/// Whether `name` is a room's name, or why not.
-pub fn check_room_name(name: &str) -> Result<(), String> {
-    let ok = (1..=MAX_ROOM_NAME).contains(&name.len())
-        && name
-            .bytes()
-            .all(|b| b.is_ascii_alphanumeric() || b == b'_' || b == b'-');
-    if ok {
-        Ok(())
-    } else {
-        Err(format!(
-            "room name {:?}: 1 to {MAX_ROOM_NAME} of A-Z, a-z, 0-9, _ and -",
-            name.chars().take(80).collect::<String>()
-        ))
-    }
 }
 
 /// Where a connection goes.
@@ -175,15 +127,6 @@ pub async fn accept(listener: TcpListener, routes: Routes, note: Note) {
             }
         });
     }
-}
-
-/// The server's metadata: `ROS_DISTRO`, because Lichtblick's (and Foxglove Studio's) 3D
-/// panel offers its publish tools ("Publish point": `/clicked_point`, `click.rs`) only to
-/// a ROS data source, which it recognises by that key. Any value but a ROS 1 distro makes
-/// it a ROS 2 source; `humble` picks the message definitions it ships for that. Ricochet
-/// speaks no ROS otherwise: every channel stays protobuf, every schema Foxglove's or its own.
-pub(crate) fn metadata() -> std::collections::BTreeMap<String, String> {
-    [("ROS_DISTRO".to_owned(), "humble".to_owned())].into()
 }
 
 /// The handshake's answer: the subprotocol chosen, or HTTP 400 naming the ones accepted;

@@ -175,7 +175,7 @@ pub fn parse(id: u32, payload: &[u8]) -> Result<Command, String> {
         }
         7 => {
             let r: SpeedRequest = serde_json::from_slice(body).map_err(bad)?;
-            if !(r.speed.is_finite() && crate::realtime::SPEEDS.contains(&r.speed)) {
+            if !(r.speed.is_finite() && crate::common::SPEEDS.contains(&r.speed)) {
                 return Err(format!(
                     "speed must be 0.01 to 100, got {}",
                     ricochet_geom::Number(r.speed)

@@ -19,10 +19,11 @@ use std::time::{Duration, Instant};
 use ricochet_sim::{Scenario, Simulation};
 use tokio_tungstenite::tungstenite::Message;
 
+use crate::common::{Note, ServeError};
 use crate::hub::{Hub, LiveSink};
 use crate::protocol;
-use crate::realtime::{Options, ServeError, ServeSink, finish, segment, start};
 use crate::services;
+use crate::sink::{ServeSink, finish, segment, start};
 use ricochet_record::session::{Session, StepError};
 
 /// Frames between two snapshots of a session that is not recorded.
@@ -128,7 +129,21 @@ pub struct Serving {
     pub running: Option<Running>,
     /// Frames stepped in all (seeks' and steps' included).
     pub stepped: u64,
-    note: crate::realtime::Note,
+    note: Note,
+}
+
+/// What the plain server's options say to its session (`crate::Options`, less the rooms).
+pub struct PlainOptions {
+    /// Simulation seconds per wall second.
+    pub speed: f64,
+    /// Start paused.
+    pub paused: bool,
+    /// The last frame after frame 0, if bounded.
+    pub frames: Option<u64>,
+    /// Where the session records.
+    pub record: Option<PathBuf>,
+    /// Where notes go.
+    pub note: Note,
 }
 
 impl Serving {
@@ -138,7 +153,7 @@ impl Serving {
         session: Session<ServeSink>,
         scenario: Scenario,
         text: String,
-        o: &Options,
+        o: PlainOptions,
     ) -> Serving {
         Serving {
             session,
@@ -155,8 +170,8 @@ impl Serving {
             } else {
                 "the most a log holds"
             },
-            record: o.record.clone(),
-            note: o.note.clone(),
+            record: o.record,
+            note: o.note,
             running: None,
             stepped: 0,
         }

@@ -1,0 +1,146 @@
+//! Where a served session's messages go: the live stream (the room's hub) and its
+//! recording, if any; and a session's start and finish on them.
+
+use std::path::{Path, PathBuf};
+
+use ricochet_log::{ChannelId, LogError, LogWriter, MessageSink, Schema};
+use ricochet_record::session::{SCENARIO_ATTACHMENT, Session};
+use ricochet_sim::Scenario;
+
+use crate::common::ServeError;
+use crate::hub::{Hub, LiveSink};
+
+/// Where a served session's messages go: the live stream, and the recording if any.
+pub(crate) struct ServeSink {
+    pub(crate) live: LiveSink,
+    /// The recording, with its channel for each live channel id.
+    pub(crate) file: Option<(LogWriter, Vec<ChannelId>)>,
+    /// While a seek re-simulates: the recording gets every frame, the clients none.
+    pub(crate) muted: bool,
+}
+
+impl MessageSink for ServeSink {
+    fn add_protobuf_channel(&mut self, topic: &str, schema: Schema) -> Result<ChannelId, LogError> {
+        if let Some((file, ids)) = &mut self.file {
+            let id = file.add_protobuf_channel(topic, schema.clone())?;
+            ids.push(id);
+        }
+        self.live.add_protobuf_channel(topic, schema)
+    }
+
+    fn write<M: prost::Message + Clone + Send + 'static>(
+        &mut self,
+        channel: ChannelId,
+        time_ns: u64,
+        message: M,
+    ) -> Result<(), LogError> {
+        if let Some((file, ids)) = &mut self.file {
+            let id = ids[usize::from(channel.index()) - 1];
+            file.write(id, time_ns, message.clone())?;
+        }
+        if self.muted {
+            return Ok(());
+        }
+        self.live.write(channel, time_ns, message)
+    }
+
+    fn add_json_channel(
+        &mut self,
+        topic: &str,
+        schema_name: &str,
+        schema_json: &str,
+    ) -> Result<ChannelId, LogError> {
+        if let Some((file, ids)) = &mut self.file {
+            let id = file.add_json_channel(topic, schema_name, schema_json)?;
+            ids.push(id);
+        }
+        self.live.add_json_channel(topic, schema_name, schema_json)
+    }
+
+    fn attach(&mut self, name: &str, media_type: &str, data: &[u8]) -> Result<(), LogError> {
+        match &mut self.file {
+            Some((file, _)) => file.attach(name, media_type, data),
+            None => Ok(()),
+        }
+    }
+
+    fn write_json_bytes(
+        &mut self,
+        channel: ChannelId,
+        time_ns: u64,
+        json: Vec<u8>,
+    ) -> Result<(), LogError> {
+        if let Some((file, ids)) = &mut self.file {
+            let id = ids[usize::from(channel.index()) - 1];
+            file.write_json_bytes(id, time_ns, json.clone())?;
+        }
+        if self.muted {
+            return Ok(());
+        }
+        self.live.write_json_bytes(channel, time_ns, json)
+    }
+
+    fn write_live<M: prost::Message + Clone + Send + 'static>(
+        &mut self,
+        channel: ChannelId,
+        time_ns: u64,
+        message: M,
+    ) -> Result<(), LogError> {
+        if self.muted {
+            return Ok(());
+        }
+        self.live.write(channel, time_ns, message)
+    }
+}
+
+/// The recording of segment `k` of a session recorded to `path`: `path` itself, then
+/// `NAME-1.mcap`, `NAME-2.mcap`, ... (a reset or a load starts a new file).
+pub(crate) fn segment(path: &Path, k: u32) -> PathBuf {
+    if k == 0 {
+        return path.to_path_buf();
+    }
+    let stem = path
+        .file_stem()
+        .map_or_else(|| "session".into(), |s| s.to_string_lossy());
+    let ext = path
+        .extension()
+        .map_or_else(|| "mcap".into(), |s| s.to_string_lossy());
+    path.with_file_name(format!("{stem}-{k}.{ext}"))
+}
+
+/// A new session of `scenario` (whose file's text is `text`, attached to the recording
+/// when not empty, for `ricochet replay`) for `hub`, recording to segment `k` of `record` if
+/// asked.
+pub(crate) fn start(
+    scenario: &Scenario,
+    text: &str,
+    hub: &Hub,
+    record: Option<&Path>,
+    k: u32,
+) -> Result<Session<ServeSink>, ServeError> {
+    let file = match record {
+        None => None,
+        Some(path) => {
+            let path = segment(path, k);
+            let mut file = LogWriter::create(&path, ricochet_record::LIBRARY)?;
+            if !text.is_empty() {
+                file.attach(SCENARIO_ATTACHMENT, "application/toml", text.as_bytes())?;
+            }
+            Some((file, Vec::new()))
+        }
+    };
+    let sink = ServeSink {
+        live: LiveSink::new(hub.clone()),
+        file,
+        muted: false,
+    };
+    Ok(Session::new(scenario, sink)?)
+}
+
+/// Finishes a session's recording, if it has one.
+pub(crate) fn finish(session: Session<ServeSink>) -> Result<(), ServeError> {
+    if let Some((file, _)) = session.into_sink().file {
+        file.finish()?;
+    }
+    Ok(())
+}
