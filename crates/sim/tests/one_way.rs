@@ -302,6 +302,31 @@ position = [0.3, 0.75]"#;
     assert!(s.position(b).unwrap().y + 0.5 < -TOP, "fell through");
 }
 
+/// A `one_way` pair names two layers (the second the platforms'): one layer paired with
+/// itself can't say which body is the platform, and is a located error.
+#[test]
+fn a_one_way_pair_of_one_layer_is_refused() {
+    let text = r#"
+name = "bad"
+layers = ["a"]
+[[collide]]
+a = "a"
+b = "a"
+response = "one_way"
+"#;
+    let e = load_scenario(text, "bad.toml").unwrap_err();
+    assert_eq!(e.field, "collide[0].response");
+    assert!(e.problem.contains("needs two layers"), "{}", e.problem);
+    let e = load_scenario(
+        &text
+            .replace("[\"a\"]", "[\"a\", \"b\"]")
+            .replace("b = \"a\"", "b = \"b\"\ndestroy = \"a\""),
+        "bad.toml",
+    )
+    .unwrap_err();
+    assert_eq!(e.field, "collide[0].destroy");
+}
+
 /// A body shape for the proptest, with its bottom below its centre.
 fn shape(kind: u8, size: f64) -> (String, f64) {
     match kind {
