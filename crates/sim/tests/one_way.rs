@@ -327,6 +327,28 @@ response = "one_way"
     assert_eq!(e.field, "collide[0].destroy");
 }
 
+/// The demo scene (`tests/data/one-way.toml`): after 240 frames the ball, which jumped up
+/// through the platform, rides it (its bottom on the top, y = 2.25, moving with it), and the
+/// crate, dropped at frame 120, rests on the solid ground (its bottom on y = -0.5).
+#[test]
+fn the_demo_scene_ends_with_the_ball_riding_and_the_crate_on_the_ground() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../tests/data/one-way.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut s = Simulation::new(&load_scenario(&text, "one-way.toml").unwrap());
+    for _ in 0..=240 {
+        s.step();
+    }
+    let (ball, krate, p) = (
+        entity(&s, "ball"),
+        entity(&s, "crate"),
+        entity(&s, "platform"),
+    );
+    assert!((s.position(ball).unwrap().y - 0.4 - 2.25).abs() <= SLOP);
+    assert_eq!(s.carrier(ball).unwrap(), Some(p));
+    assert!((s.position(krate).unwrap().y - 0.4 + 0.5).abs() <= SLOP);
+    assert!(s.grounded(krate).unwrap() && s.grounded(ball).unwrap());
+}
+
 /// A body shape for the proptest, with its bottom below its centre.
 fn shape(kind: u8, size: f64) -> (String, f64) {
     match kind {
