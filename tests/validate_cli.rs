@@ -124,3 +124,21 @@ fn a_disc_two_world_widths_a_frame_keeps_its_contact_and_validate_passes() {
     // Radii 5 + 5 less the 3 between the centres.
     assert_eq!(depths, vec![7.0; 61]);
 }
+
+/// Issue 36: a scene with one-way platforms (a ball jumping up through one and riding it, a
+/// crate dropping through onto solid ground) runs, and the referee passes: rapier has no
+/// one-way response, so those pairs are left out, and the crate's ground contacts are
+/// compared as usual. Before one-way platforms, the scenario was refused (exit 2).
+#[test]
+fn a_scene_with_one_way_platforms_validates() {
+    let scenario = crate::util::data("one-way.toml");
+    let o = ricochet(&["validate", scenario.to_str().unwrap()], b"");
+    let table = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{table}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(table.contains("unexplained mismatches     0"), "{table}");
+}

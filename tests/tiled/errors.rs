@@ -62,16 +62,20 @@ fn a_too_eccentric_ellipse_is_located() {
 }
 
 #[test]
-fn polylines_and_one_way_entries_are_not_supported_yet() {
+fn polylines_are_not_supported_yet() {
     let o = "<object id=\"5\" x=\"0\" y=\"0\"><polyline points=\"0,0 10,0 20,5\"/></object>";
     let got = check(&[("m.tmx", map_with(o))], "[\"Bad\"]", "");
     assert_error(
         got,
-        &[
-            "layer \"Bad\", object 5",
-            "one-way platforms / chains are not supported yet",
-        ],
+        &["layer \"Bad\", object 5", "chains are not supported yet"],
     );
+}
+
+/// One-way platforms exist now: a `one_way` entry needs the scenario layer its platforms go
+/// to, and that layer must be the platform side of a `one_way` pair (else the pieces would
+/// silently be whatever that layer's pairs say).
+#[test]
+fn one_way_entries_need_a_one_way_platform_layer() {
     let got = check(
         &[("m.tmx", map_with(""))],
         "[\"Ground\"]",
@@ -79,10 +83,32 @@ fn polylines_and_one_way_entries_are_not_supported_yet() {
     );
     assert_error(
         got,
+        &["level.toml", "tiled.one_way_layer", "one_way_layer = "],
+    );
+    let got = check(
+        &[("m.tmx", map_with(""))],
+        "[\"Ground\"]",
+        "one_way = [\"Shapes\"]\none_way_layer = \"box\"",
+    );
+    assert_error(
+        got,
+        &[
+            "tiled.one_way_layer",
+            "no [[collide]] pair makes layer \"box\" one-way",
+        ],
+    );
+    let got = check(
+        &[("m.tmx", map_with(""))],
+        "[\"Ground\"]",
+        "one_way = [\"Nowhere\"]\none_way_layer = \"box\"\n\
+         [[collide]]\na = \"tile\"\nb = \"box\"\nresponse = \"one_way\"",
+    );
+    assert_error(
+        got,
         &[
             "m.tmx",
-            "one_way entry \"Shapes\"",
-            "one-way platforms / chains are not supported yet",
+            "one_way entry for layer \"Nowhere\"",
+            "no layer named",
         ],
     );
 }

@@ -286,6 +286,46 @@ fn whole_cell_tiles_become_tile_rows_and_spawns_become_bodies() {
     assert_eq!(floor.0, Vec2::new(0.5, 0.5));
 }
 
+/// `one_way` entries: the tiles and objects they take become static bodies of
+/// `one_way_layer` (the platform side of a `one_way` pair), counted as one-way pieces; the
+/// same layers listed in `solid` instead give as many solids on `layer`.
+#[test]
+fn one_way_entries_become_one_way_statics_on_their_layer() {
+    let embedded = write::tileset_xml(" firstgid=\"1\"");
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("m.tmx"),
+        write::tmx(Encoding::Csv, &embedded, None),
+    )
+    .unwrap();
+    let one_way = "one_way_layer = \"box\"\n[[collide]]\na = \"tile\"\nb = \"box\"\n\
+                   response = \"one_way\"\n";
+    std::fs::write(
+        dir.path().join("level.toml"),
+        scenario_text("m.tmx", "[\"Shapes\"]", ""),
+    )
+    .unwrap();
+    let (_, as_solid) = load(dir.path()).unwrap();
+    assert!(as_solid.solids > 0);
+    std::fs::write(
+        dir.path().join("level.toml"),
+        scenario_text(
+            "m.tmx",
+            "[]",
+            &format!("one_way = [\"Ground\", \"Shapes\"]\n{one_way}"),
+        ),
+    )
+    .unwrap();
+    let (s, summary) = load(dir.path()).unwrap();
+    assert_eq!(summary.tiles, 0);
+    assert_eq!(summary.solids, 0);
+    assert_eq!(summary.one_way, write::tiles().len() + as_solid.solids);
+    // Layer 1 is "box", the platform layer; nothing went to "tile".
+    assert!(s.tiles.iter().all(|t| t.layer == 1));
+    assert_eq!(s.bodies.len(), as_solid.solids);
+    assert!(s.bodies.iter().all(|b| b.layer == 1));
+}
+
 /// The shipped level: `ricochet check` says what its map became, counted from the map file
 /// (`scenarios/tiled/maps/level1.tmx`: a 20-tile floor, a 4-tile ledge, a slope tile and a
 /// 5-tile raised floor; a ramp and a boulder; three coins, an enemy and the player).

@@ -27,7 +27,11 @@ pub(crate) fn layer_filter(layers: &Layers, layer: LayerId) -> Result<Filter, Bo
     let mut mask = 0u64;
     for other in 0..count {
         let other = LayerId::try_from(other).unwrap_or(LayerId::MAX);
-        if layers.response(layer, other) != Response::Ignore {
+        if !matches!(
+            layers.response(layer, other),
+            // Box2D's filter can't say one-way: the pair is left out, as the referee does.
+            Response::Ignore | Response::OneWay(_)
+        ) {
             mask |= 1 << other;
         }
     }

@@ -53,7 +53,11 @@ impl<'a> LayerFilter<'a> {
         let mut filter = 0u32;
         for other in 0..self.layers.names().len() {
             let other = LayerId::try_from(other).unwrap_or(LayerId::MAX);
-            if self.layers.response(layer, other) != Response::Ignore {
+            if !matches!(
+                self.layers.response(layer, other),
+                // One-way platforms are the referee's blind spot: left out (docs/validation.md).
+                Response::Ignore | Response::OneWay(_)
+            ) {
                 filter |= 1 << other;
             }
         }
@@ -80,7 +84,11 @@ impl PhysicsHooks for LayerFilter<'_> {
     fn filter_contact_pair(&self, ctx: &PairFilterContext) -> Option<SolverFlags> {
         let layer = |h| ctx.colliders.get(h).and_then(layer);
         let (a, b) = (layer(ctx.collider1)?, layer(ctx.collider2)?);
-        (self.layers.response(a, b) != Response::Ignore).then_some(SolverFlags::default())
+        (!matches!(
+            self.layers.response(a, b),
+            Response::Ignore | Response::OneWay(_)
+        ))
+        .then_some(SolverFlags::default())
     }
 }
 

@@ -73,6 +73,8 @@ fn input_text(input: &ScriptInput) -> String {
         ScriptInput::Jump(JumpOutcome::Jumped) => "jump".to_owned(),
         ScriptInput::Jump(JumpOutcome::NotGrounded) => "jump ignored: not grounded".to_owned(),
         ScriptInput::Jump(JumpOutcome::NotARunner) => "jump ignored: not a runner".to_owned(),
+        ScriptInput::Drop(true) => "drop".to_owned(),
+        ScriptInput::Drop(false) => "drop ignored: not grounded".to_owned(),
         ScriptInput::Fire(FireOutcome::Fired) => "fire".to_owned(),
         ScriptInput::Fire(FireOutcome::NotAShip) => "fire ignored: not a ship".to_owned(),
         ScriptInput::Fire(FireOutcome::NoTemplate(t)) => format!("fire ignored: no template {t}"),

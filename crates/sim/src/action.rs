@@ -31,6 +31,9 @@ pub enum Action {
     Move(f64),
     /// A runner jumps if it is grounded.
     Jump,
+    /// A grounded dynamic body drops through the one-way platforms it stands on
+    /// (`stages/one_way.rs`).
+    Drop,
 }
 
 impl Action {
@@ -47,6 +50,7 @@ impl Action {
             Action::Fire => "fire",
             Action::Move(_) => "move",
             Action::Jump => "jump",
+            Action::Drop => "drop",
         }
     }
 

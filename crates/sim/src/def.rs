@@ -160,6 +160,20 @@ pub enum Response {
     Destroy(Doomed),
     /// Pushed apart: per axis for boxes, along the normal otherwise.
     Separate,
+    /// A one-way platform (`one_way` in a `[[collide]]` entry, the second layer the
+    /// platform's): solid only to a dynamic body that was above the platform's top at the
+    /// start of the step and is not moving up relative to it; passed through otherwise
+    /// (`stages/one_way.rs`).
+    OneWay(Platform),
+}
+
+/// Which body of a [`Response::OneWay`] pair is the platform.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Platform {
+    /// The body in the first layer of the pair.
+    First,
+    /// The body in the second layer.
+    Second,
 }
 
 impl Response {
@@ -171,6 +185,7 @@ impl Response {
             Response::Report => "report",
             Response::Destroy(_) => "destroy",
             Response::Separate => "separate",
+            Response::OneWay(_) => "one_way",
         }
     }
 }
@@ -285,6 +300,8 @@ impl Layers {
         let mirrored = match response {
             Response::Destroy(Doomed::First) => Response::Destroy(Doomed::Second),
             Response::Destroy(Doomed::Second) => Response::Destroy(Doomed::First),
+            Response::OneWay(Platform::First) => Response::OneWay(Platform::Second),
+            Response::OneWay(Platform::Second) => Response::OneWay(Platform::First),
             other => other,
         };
         if a != b {

@@ -124,6 +124,9 @@ pub enum ScriptInput {
     Jump(JumpOutcome),
     /// `fire`, and whether it happened.
     Fire(FireOutcome),
+    /// `drop`: whether the body was grounded (and now drops through the one-way platforms
+    /// it stands on) or ignored it.
+    Drop(bool),
 }
 
 /// The outcome of a `jump` input.

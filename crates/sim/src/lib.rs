@@ -198,8 +198,8 @@ pub use check::ScenarioError;
 pub use control::{ControlError, NonFinite};
 pub use def::{
     ActiveRegion, BodyDef, BodyKind, Controller, Doomed, LayerId, Layers, MAX_CONTROLLER_VALUE,
-    MAX_FRAMES, MAX_MASS, MIN_MASS, Response, RunLengthError, Split, WorldBounds, WorldDef,
-    controller_out_of_range, shape_reach,
+    MAX_FRAMES, MAX_MASS, MIN_MASS, Platform, Response, RunLengthError, Split, WorldBounds,
+    WorldDef, controller_out_of_range, shape_reach,
 };
 pub use entity::{Entity, EntityAllocator};
 pub use event::{FireOutcome, GameEvent, JumpOutcome, Removal, ScriptInput};

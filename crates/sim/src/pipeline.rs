@@ -17,6 +17,7 @@
 //! | `move_y` | a rider first moves by its carrier's `vy * dt`; then `y += vy * dt` |
 //! | `resolve_y` | per-axis separation along y; a push upwards sets `grounded` and the carrier a box rides next frame; `crushed` as along x |
 //! | `turn` | `angle += angular_velocity * dt` |
+//! | (`one_way`) | only with a `one_way` layer pair, and not a counted stage (the stats' stage list is in every log): lands the bodies that came down onto a one-way platform (`stages/one_way.rs`) |
 //! | `detect` | broad phase, exact narrow phase, `report`/`destroy`/`separate` responses |
 //! | `lifetimes` | count down lifetimes; remove expired bodies |
 //! | `bounds` | wrap around (Asteroids) or remove bodies that left the world |
@@ -44,6 +45,7 @@ use crate::parallel::Workers;
 use crate::scenario::Scenario;
 use crate::stage_set::Stage;
 use crate::stages::detect::DetectState;
+use crate::stages::one_way::{self, OneWayState};
 use crate::stages::separate::SeparateState;
 use crate::stages::touch::TouchState;
 use crate::stages::{
@@ -99,6 +101,8 @@ pub struct Simulation {
     pub(crate) detect: DetectState,
     /// The obstacle grids of `resolve_x` and `resolve_y`.
     pub(crate) separate: SeparateState,
+    /// The one-way platforms' pass (`stages/one_way.rs`).
+    pub(crate) one_way: OneWayState,
     /// The pairs touching at the end of the last frame (`touch`).
     pub(crate) touch: TouchState,
     /// The threads of the parallel stages (`parallel.rs`); one by default.
@@ -205,6 +209,7 @@ impl Simulation {
         Simulation {
             detect: DetectState::new(layers, scenario.world.broad_phase),
             separate: SeparateState::new(layers),
+            one_way: OneWayState::new(layers),
             touch: TouchState::new(layers),
             scenario,
             world,
@@ -315,6 +320,7 @@ impl Simulation {
     fn run(&mut self, stage: Stage, out: &mut FrameOutput) {
         let dt = self.scenario.world.dt;
         let due = self.due_events().len();
+        let carries = self.carries();
         let mut ctx = StageCtx {
             world: &mut self.world,
             def: &self.scenario.world,
@@ -335,9 +341,9 @@ impl Simulation {
             Stage::Unground => motion::unground(ctx.world),
             Stage::Controls => motion::controls(ctx.world),
             Stage::Forces => motion::forces(ctx.world, ctx.def),
-            Stage::MoveX => motion::move_x(ctx.world, dt, self.separate.carries()),
+            Stage::MoveX => motion::move_x(ctx.world, dt, carries),
             Stage::ResolveX => separate::resolve_x(&mut ctx, &mut self.separate),
-            Stage::MoveY => motion::move_y(ctx.world, dt, self.separate.carries()),
+            Stage::MoveY => motion::move_y(ctx.world, dt, carries),
             Stage::ResolveY => separate::resolve_y(&mut ctx, &mut self.separate),
             Stage::Turn => motion::turn(ctx.world, dt),
             Stage::Detect => detect::run(
@@ -376,6 +382,12 @@ impl Simulation {
         }
     }
 
+    /// Whether a body may ride a carrier: a per-axis (`separate`) pair of boxes, or a
+    /// `one_way` pair (a kinematic platform carries).
+    fn carries(&self) -> bool {
+        self.separate.carries() || self.one_way.any()
+    }
+
     /// Runs one frame and reports what happened.
     pub fn step(&mut self) -> FrameOutput {
         self.queries.invalidate(&self.world);
@@ -394,7 +406,21 @@ impl Simulation {
                 // Run (or skipped) with `move_x`.
                 continue;
             }
-            if allowed && stage == Stage::MoveX && !self.separate.carries() {
+            if stage == Stage::Detect
+                && self.frame > 0
+                && one_way::has_work(&self.world, &self.one_way)
+            {
+                // The one-way platforms' pass: not a counted stage (the stage list is in
+                // every log's stats), run only in a scene with a `one_way` pair.
+                let mut ctx = StageCtx {
+                    world: &mut self.world,
+                    def: &self.scenario.world,
+                    templates: &self.scenario.templates,
+                    out: &mut out,
+                };
+                one_way::run(&mut ctx, &mut self.one_way);
+            }
+            if allowed && stage == Stage::MoveX && !self.carries() {
                 fused = true;
                 self.run_motion(&mut out);
                 continue;

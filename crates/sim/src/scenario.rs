@@ -65,6 +65,9 @@ pub struct TiledDef {
     pub one_way: Vec<String>,
     /// The scenario layer the map's static bodies go to.
     pub layer: LayerId,
+    /// The scenario layer the map's one-way platforms go to (`layer` when `one_way` is
+    /// empty): the platform layer of a `one_way` layer pair.
+    pub one_way_layer: LayerId,
     /// Object class, type or name → template name (a template the scenario has).
     pub spawn: BTreeMap<String, String>,
 }

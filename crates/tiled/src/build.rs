@@ -13,7 +13,8 @@ use crate::{MAX_ELLIPSE_RATIO, MAX_POLYGON_POINTS, MapSummary, PieceKind, TiledE
 
 /// What a map became.
 pub(crate) struct Built {
-    pub(crate) tiles: Vec<TileRows>,
+    /// Tile rows, each with what its tiles become.
+    pub(crate) tiles: Vec<(PieceKind, TileRows)>,
     pub(crate) pieces: Vec<TiledPiece>,
     pub(crate) spawns: Vec<BodyDef>,
     spawned: BTreeMap<String, usize>,
@@ -22,21 +23,38 @@ pub(crate) struct Built {
 impl Built {
     pub(crate) fn summary(&self) -> MapSummary {
         MapSummary {
-            tiles: self.tiles.iter().map(TileRows::len).sum(),
+            tiles: self
+                .tiles
+                .iter()
+                .filter(|t| t.0 == PieceKind::Solid)
+                .map(|t| t.1.len())
+                .sum(),
             solids: self
                 .pieces
                 .iter()
                 .filter(|p| p.kind == PieceKind::Solid)
                 .count(),
-            one_way: 0,
+            one_way: self
+                .pieces
+                .iter()
+                .filter(|p| p.kind == PieceKind::OneWay)
+                .count()
+                + self
+                    .tiles
+                    .iter()
+                    .filter(|t| t.0 == PieceKind::OneWay)
+                    .map(|t| t.1.len())
+                    .sum::<usize>(),
             chains: 0,
             spawns: self.spawned.clone(),
         }
     }
 }
 
-/// One `solid` entry: `LAYER`, `LAYER?PROP` or `LAYER?PROP=VALUE`.
+/// One `solid` or `one_way` entry: `LAYER`, `LAYER?PROP` or `LAYER?PROP=VALUE`.
 pub(crate) struct Entry {
+    /// What the shapes it takes become.
+    kind: PieceKind,
     layer: String,
     prop: Option<String>,
     value: Option<String>,
@@ -44,7 +62,7 @@ pub(crate) struct Entry {
 }
 
 impl Entry {
-    fn parse(s: &str) -> Entry {
+    fn parse(s: &str, kind: PieceKind) -> Entry {
         let (layer, filter) = s.split_once('?').map_or((s, None), |(l, f)| (l, Some(f)));
         let (prop, value) = match filter {
             None => (None, None),
@@ -54,6 +72,7 @@ impl Entry {
             },
         };
         Entry {
+            kind,
             layer: layer.to_owned(),
             prop,
             value,
@@ -82,8 +101,14 @@ fn value_text(v: &PropertyValue) -> Option<String> {
 }
 
 impl Traits<'_> {
-    pub(crate) fn matches(&self, entries: &[&Entry]) -> bool {
-        entries.iter().any(|e| {
+    /// What the first entry that takes this tile or object makes of it (`solid` entries
+    /// come first: a shape both list is solid), or `None`.
+    pub(crate) fn kind(&self, entries: &[&Entry]) -> Option<PieceKind> {
+        entries.iter().find(|e| self.takes(e)).map(|e| e.kind)
+    }
+
+    fn takes(&self, e: &Entry) -> bool {
+        {
             let Some(prop) = &e.prop else { return true };
             let found: Option<String> = match prop.as_str() {
                 "class" | "type" => Some(self.class.to_owned()),
@@ -99,7 +124,7 @@ impl Traits<'_> {
                 (None, Some(f)) => f == "true",
                 (_, None) => false,
             }
-        })
+        }
     }
 }
 
@@ -217,8 +242,8 @@ fn outlines(obj: &ObjectData, to_world: &dyn Fn(f64, f64) -> Vec2) -> Result<Vec
         }
         ObjectShape::Polyline { .. } => {
             return Err(
-                "a polyline is a terrain chain: one-way platforms / chains are not \
-                        supported yet; draw a polygon, or leave the layer out of `solid`"
+                "a polyline is a terrain chain: chains are not supported yet; draw a \
+                        polygon, or leave the layer out of `solid` and `one_way`"
                     .to_owned(),
             );
         }
@@ -349,7 +374,16 @@ pub(crate) fn build(
         ));
     }
     ctx.s = def.units_per_tile / f64::from(map.tile_width);
-    let mut entries: Vec<Entry> = def.solid.iter().map(|s| Entry::parse(s)).collect();
+    let mut entries: Vec<Entry> = def
+        .solid
+        .iter()
+        .map(|s| Entry::parse(s, PieceKind::Solid))
+        .chain(
+            def.one_way
+                .iter()
+                .map(|s| Entry::parse(s, PieceKind::OneWay)),
+        )
+        .collect();
     let mut built = Built {
         tiles: Vec::new(),
         pieces: Vec::new(),
@@ -370,7 +404,15 @@ pub(crate) fn build(
     }
     if let Some(e) = entries.iter().find(|e| !e.used) {
         return Err(ctx.err(
-            format!("[tiled] solid entry for layer \"{}\"", e.layer),
+            format!(
+                "[tiled] {} entry for layer \"{}\"",
+                if e.kind == PieceKind::OneWay {
+                    "one_way"
+                } else {
+                    "solid"
+                },
+                e.layer
+            ),
             format!(
                 "the map has no layer named \"{}\"; its layers: {}",
                 e.layer,
@@ -446,9 +488,9 @@ fn walk(
                     name: &obj.name,
                     props,
                 };
-                if !traits.matches(&mine) {
+                let Some(kind) = traits.kind(&mine) else {
                     continue;
-                }
+                };
                 let outs =
                     object_outlines(ctx, &obj, offset).map_err(|p| ctx.err(at.clone(), p))?;
                 let (position, shape) = body_of(&outs).map_err(|p| ctx.err(at.clone(), p))?;
@@ -458,7 +500,7 @@ fn walk(
                     obj.name.clone()
                 };
                 built.pieces.push(TiledPiece {
-                    kind: PieceKind::Solid,
+                    kind,
                     name,
                     shape,
                     position,

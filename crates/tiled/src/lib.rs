@@ -26,8 +26,11 @@
 //! to at most [`MAX_CELLS`] × 4 bytes per map; a tile layer covers at most [`MAX_CELLS`]
 //! cells; a polygon has at most [`MAX_POLYGON_POINTS`] points.
 //!
-//! Not supported yet (a located error, never a silently missing wall): `one_way` entries,
-//! polylines (terrain chains), text objects, and maps that are not orthogonal.
+//! `one_way` entries take tiles and objects like `solid` ones and make them static bodies of
+//! `one_way_layer` (one-way platforms: `ricochet-sim`'s `stages/one_way.rs`).
+//!
+//! Not supported yet (a located error, never a silently missing wall): polylines (terrain
+//! chains), text objects, and maps that are not orthogonal.
 
 mod build;
 pub mod json;
@@ -66,13 +69,14 @@ pub struct TiledError {
     pub problem: String,
 }
 
-/// What a piece of the map becomes. Only `Solid` is built today; one-way platforms and
-/// chains are refused with a located error until the physics has them.
+/// What a piece of the map becomes: a solid, or a one-way platform (`one_way` entries, on
+/// `[tiled] one_way_layer`). Chains are refused with a located error until the physics has
+/// them.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub enum PieceKind {
     /// A static solid.
     Solid,
-    /// A one-way platform (not supported yet).
+    /// A one-way platform: a static body of `[tiled] one_way_layer`.
     OneWay,
     /// A terrain chain (not supported yet).
     Chain,
@@ -98,7 +102,7 @@ pub struct MapSummary {
     pub tiles: usize,
     /// Static bodies from objects.
     pub solids: usize,
-    /// One-way pieces (0 until supported).
+    /// One-way pieces: objects and tiles.
     pub one_way: usize,
     /// Chains (0 until supported).
     pub chains: usize,
@@ -120,27 +124,20 @@ pub fn add_map(
     let dir = scenario_path.parent().unwrap_or(Path::new(""));
     let map_path = dir.join(&def.map);
     let file = map_path.display().to_string();
-    if let Some(entry) = def.one_way.first() {
-        return Err(TiledError {
-            file,
-            place: format!("[tiled] one_way entry \"{entry}\""),
-            problem: "one-way platforms / chains are not supported yet; list the layer in \
-                      `solid` for now, or leave it out"
-                .to_owned(),
-        });
-    }
     let map = read::load_map(&map_path)?;
     let built = build::build(&map, def, &scenario.templates, &file)?;
     let summary = built.summary();
-    let layer = def.layer;
-    for mut rows in built.tiles {
-        rows.layer = layer;
-        scenario.tiles.push(rows);
-    }
+    // Each tile row already has its layer: `layer`, or `one_way_layer` for one-way tiles.
+    scenario
+        .tiles
+        .extend(built.tiles.into_iter().map(|(_, rows)| rows));
     for p in built.pieces {
         scenario.bodies.push(ricochet_sim::BodyDef {
             name: p.name,
-            layer,
+            layer: match p.kind {
+                PieceKind::OneWay => def.one_way_layer,
+                _ => def.layer,
+            },
             kind: ricochet_sim::BodyKind::Static,
             shape: p.shape,
             position: p.position,

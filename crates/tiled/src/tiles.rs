@@ -8,9 +8,9 @@ use ricochet_geom::Vec2;
 use ricochet_sim::TileRows;
 use tiled::TileLayer;
 
-use crate::MAX_CELLS;
 use crate::TiledError;
 use crate::build::{Built, Ctx, Entry, Traits, body_of, tile_outlines};
+use crate::{MAX_CELLS, PieceKind};
 
 /// A tile layer as runs of identical tiles along each row, one [`TileRows`] per distinct
 /// tile (gid and flips), in first-seen order.
@@ -67,6 +67,8 @@ pub(crate) fn tile_layer(
     let mut kinds: BTreeMap<Key, usize> = BTreeMap::new();
     let mut rows: Vec<(Vec2, TileRows)> = Vec::new();
     let mut skip: BTreeMap<Key, bool> = BTreeMap::new();
+    // What each of `rows` becomes.
+    let mut row_kinds: Vec<PieceKind> = Vec::new();
     for y in y0..y0 + h {
         let mut run: Option<(Key, i64, u32)> = None;
         let flush = |run: &mut Option<(Key, i64, u32)>,
@@ -99,9 +101,9 @@ pub(crate) fn tile_layer(
                     name: "",
                     props: entry.iter().map(|e| &e.properties).collect(),
                 };
-                let keep = traits.matches(entries);
-                slot.insert(!keep);
-                if keep {
+                let kind = traits.kind(entries);
+                slot.insert(kind.is_none());
+                if let Some(kind) = kind {
                     // Cell (0, 0)'s tile: drawn with its bottom-left on the cell's, moved by
                     // the tileset's offset.
                     let (tx, ty) = (
@@ -130,11 +132,16 @@ pub(crate) fn tile_layer(
                         )
                     })?;
                     kinds.insert(key, rows.len());
+                    row_kinds.push(kind);
                     rows.push((
                         base,
                         TileRows {
                             name: name.to_owned(),
-                            layer: ctx.def.layer,
+                            layer: if kind == PieceKind::OneWay {
+                                ctx.def.one_way_layer
+                            } else {
+                                ctx.def.layer
+                            },
                             shape,
                             step: Vec2::new(mtw * ctx.s, 0.0),
                             rows: Vec::new(),
@@ -157,9 +164,11 @@ pub(crate) fn tile_layer(
         flush(&mut run, &mut rows, &kinds);
     }
     built.tiles.extend(
-        rows.into_iter()
-            .map(|(_, r)| r)
-            .filter(|r| !r.rows.is_empty()),
+        row_kinds
+            .into_iter()
+            .zip(rows)
+            .map(|(k, (_, r))| (k, r))
+            .filter(|(_, r)| !r.rows.is_empty()),
     );
     Ok(())
 }

@@ -40,7 +40,8 @@ impl FramePairs {
         let mut pairs = FramePairs::default();
         for c in &out.contacts {
             let key = (c.a, c.b);
-            if wrapped(sim, c.a) || wrapped(sim, c.b) {
+            // One-way platforms: rapier never pairs them (`pairs.rs`), so neither does this.
+            if wrapped(sim, c.a) || wrapped(sim, c.b) || matches!(c.response, Response::OneWay(_)) {
                 pairs.excluded += 1;
                 continue;
             }

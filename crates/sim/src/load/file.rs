@@ -58,9 +58,12 @@ pub struct TiledFile {
     /// Map layers (`LAYER`, `LAYER?PROP`, `LAYER?PROP=VALUE`) whose shapes are static solids.
     #[serde(default)]
     pub solid: Vec<Spanned<String>>,
-    /// Map layers whose shapes are one-way platforms (not supported yet: refused).
+    /// Map layers whose shapes are one-way platforms.
     #[serde(default)]
     pub one_way: Vec<Spanned<String>>,
+    /// The scenario layer the one-way pieces go to: the platform layer of a `one_way`
+    /// `[[collide]]` pair (needed when `one_way` lists something).
+    pub one_way_layer: Option<Spanned<String>>,
     /// The scenario layer the map's static bodies go to.
     pub layer: Spanned<String>,
     /// Object class, type or name → the template spawned at the object's centre.
@@ -324,6 +327,11 @@ pub enum ActionFile {
         /// Body name.
         body: String,
     },
+    /// A grounded body drops through the one-way platforms it stands on.
+    Drop {
+        /// Body name.
+        body: String,
+    },
 }
 
 fn yes() -> bool {
@@ -347,6 +355,7 @@ impl ActionFile {
             ActionFile::Fire { body } => (body, Action::Fire),
             ActionFile::Move { body, input } => (body, Action::Move(*input)),
             ActionFile::Jump { body } => (body, Action::Jump),
+            ActionFile::Drop { body } => (body, Action::Drop),
         })
     }
 }

@@ -166,6 +166,7 @@ pub(crate) fn script(
             ActionFile::Fire { body: b } => named(b, Action::Fire)?,
             ActionFile::Move { body: b, input: x } => named(b, Action::Move(input(*x)?))?,
             ActionFile::Jump { body: b } => named(b, Action::Jump)?,
+            ActionFile::Drop { body: b } => named(b, Action::Drop)?,
         };
         events.push(Event {
             frame: frame.unsigned_abs(),

@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 use super::context::{Ctx, unknown};
 use super::file::TiledFile;
 use crate::check::ScenarioError;
-use crate::def::{BodyDef, WorldDef};
+use crate::def::{BodyDef, Platform, Response, WorldDef};
 use crate::scenario::TiledDef;
 use toml::Spanned;
 
@@ -84,12 +84,53 @@ pub(super) fn tiled_def(
             })
             .collect()
     };
+    let one_way = entries(&t.one_way, "one_way")?;
+    let one_way_layer = match (&t.one_way_layer, t.one_way.first()) {
+        (None, None) => layer,
+        (None, Some(first)) => {
+            return Err(ctx.err(
+                first.span(),
+                "tiled.one_way_layer",
+                "`one_way` lists map layers: say which scenario layer their platforms go to \
+                 with `one_way_layer = \"...\"` (the second layer of a `one_way` [[collide]] pair)",
+            ));
+        }
+        (Some(l), _) => {
+            let id = world.layers.id(l.get_ref()).ok_or_else(|| {
+                unknown(
+                    ctx,
+                    l.span(),
+                    "tiled.one_way_layer".to_owned(),
+                    "layer",
+                    l.get_ref(),
+                    world.layers.names().iter(),
+                )
+            })?;
+            let n = world.layers.names().len();
+            let platform = (0..n)
+                .any(|a| world.layers.response(a as u8, id) == Response::OneWay(Platform::Second));
+            if !platform {
+                return Err(ctx.err(
+                    l.span(),
+                    "tiled.one_way_layer",
+                    format!(
+                        "no [[collide]] pair makes layer \"{}\" one-way: add one with \
+                         response = \"one_way\" and b = \"{}\"",
+                        l.get_ref(),
+                        l.get_ref()
+                    ),
+                ));
+            }
+            id
+        }
+    };
     Ok(TiledDef {
         map: t.map.get_ref().clone(),
         units_per_tile,
         solid: entries(&t.solid, "solid")?,
-        one_way: entries(&t.one_way, "one_way")?,
+        one_way,
         layer,
+        one_way_layer,
         spawn,
     })
 }

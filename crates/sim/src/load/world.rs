@@ -3,8 +3,8 @@
 
 use crate::broad_phase::BroadPhaseKind;
 use crate::def::{
-    ActiveRegion, Doomed, LayerId, Layers, MAX_FRAMES, Response, RunLengthError, WorldBounds,
-    WorldDef,
+    ActiveRegion, Doomed, LayerId, Layers, MAX_FRAMES, Platform, Response, RunLengthError,
+    WorldBounds, WorldDef,
 };
 use crate::load::context::{Ctx, ScenarioError, finite, unknown, vec2};
 use crate::load::file::ScenarioFile;
@@ -106,6 +106,7 @@ fn layers(ctx: &Ctx<'_>, raw: &ScenarioFile) -> Result<Layers, ScenarioError> {
             ("ignore", None) => Response::Ignore,
             ("report", None) => Response::Report,
             ("separate", None) => Response::Separate,
+            ("one_way", None) => Response::OneWay(Platform::Second),
             ("destroy", None | Some("both")) => Response::Destroy(Doomed::Both),
             ("destroy", Some("a")) => Response::Destroy(Doomed::First),
             ("destroy", Some("b")) => Response::Destroy(Doomed::Second),
@@ -116,7 +117,7 @@ fn layers(ctx: &Ctx<'_>, raw: &ScenarioFile) -> Result<Layers, ScenarioError> {
                     format!("expected \"a\", \"b\" or \"both\", got \"{other}\""),
                 ));
             }
-            ("ignore" | "report" | "separate", Some(_)) => {
+            ("ignore" | "report" | "separate" | "one_way", Some(_)) => {
                 return Err(ctx.err(
                     c.span(),
                     format!("{field}.destroy"),
@@ -127,10 +128,19 @@ fn layers(ctx: &Ctx<'_>, raw: &ScenarioFile) -> Result<Layers, ScenarioError> {
                 return Err(ctx.err(
                     c.span(),
                     format!("{field}.response"),
-                    format!("expected ignore, report, destroy or separate, got \"{other}\""),
+                    format!(
+                        "expected ignore, report, destroy, separate or one_way, got \"{other}\""
+                    ),
                 ));
             }
         };
+        if a == b && matches!(response, Response::OneWay(_)) {
+            return Err(ctx.err(
+                c.span(),
+                format!("{field}.response"),
+                format!("a `one_way` pair needs two layers (the second is the platforms'), got \"{}\" twice", r.a),
+            ));
+        }
         layers.set(a, b, response);
         if let Some(sweep) = r.sweep {
             layers.set_sweep(a, b, sweep);

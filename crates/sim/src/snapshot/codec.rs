@@ -75,7 +75,9 @@ pub(crate) trait Sink {
         self.f64(p.angle);
     }
     fn inputs(&mut self, i: &Inputs) {
-        self.bool(i.thrust);
+        // One byte: bit 0 the engine, bit 1 dropping through one-way platforms (so a
+        // snapshot without a `drop` is the same bytes as before it existed).
+        self.u8(u8::from(i.thrust) | (u8::from(i.drop) << 1));
         self.f64(i.turn);
         self.f64(i.run);
     }
@@ -195,6 +197,7 @@ pub(crate) trait Sink {
                 self.f64(*x);
             }
             Action::Jump => self.u8(8),
+            Action::Drop => self.u8(9),
         }
     }
 }
@@ -344,10 +347,15 @@ impl<'a> Reader<'a> {
         Ok(Pose::new(self.vec2()?, self.f64()?))
     }
     pub(crate) fn inputs(&mut self) -> Result<Inputs, SnapshotError> {
+        let flags = self.u8()?;
+        if flags > 3 {
+            return Err(bad("the input flags"));
+        }
         Ok(Inputs {
-            thrust: self.bool()?,
+            thrust: flags & 1 != 0,
             turn: self.f64()?,
             run: self.f64()?,
+            drop: flags & 2 != 0,
         })
     }
     pub(crate) fn shape(&mut self) -> Result<Shape, SnapshotError> {
@@ -432,6 +440,7 @@ impl<'a> Reader<'a> {
             6 => Action::Fire,
             7 => Action::Move(self.f64()?),
             8 => Action::Jump,
+            9 => Action::Drop,
             _ => return Err(bad("an action tag")),
         })
     }

@@ -131,7 +131,8 @@ impl DetectState {
 /// The layer pairs `detect` pairs up, given which layers hold only boxes.
 fn interactions(layers: &Layers, box_only: &[bool]) -> Interactions {
     Interactions::from_fn(box_only.len(), |a, b| match layers.response(a, b) {
-        Response::Ignore => false,
+        // One-way pairs are answered by their own pass (`one_way.rs`), never here.
+        Response::Ignore | Response::OneWay(_) => false,
         Response::Separate => !(box_only[usize::from(a)] && box_only[usize::from(b)]),
         _ => true,
     })
@@ -570,7 +571,7 @@ fn respond(
     let mut resolved = Vec2::ZERO;
     let (ea, eb) = (w.entity[i], w.entity[j]);
     match response {
-        Response::Ignore | Response::Report => {}
+        Response::Ignore | Response::Report | Response::OneWay(_) => {}
         Response::Destroy(which) => {
             if matches!(which, Doomed::First | Doomed::Both) {
                 doomed.push((ea, eb));

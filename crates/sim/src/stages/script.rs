@@ -93,6 +93,13 @@ fn apply(ctx: &mut StageCtx, i: usize, action: &Action) {
             _ => JumpOutcome::NotARunner,
         }),
         Action::Fire => ScriptInput::Fire(fire(ctx, i)),
+        Action::Drop => {
+            let grounded = w.kind[i] == BodyKind::Dynamic && w.grounded(i);
+            if grounded {
+                w.inputs_mut(i).drop = true;
+            }
+            ScriptInput::Drop(grounded)
+        }
     };
     ctx.out.events.push(GameEvent::Input {
         body: entity,

@@ -58,6 +58,9 @@ pub struct Inputs {
     pub turn: f64,
     /// Runner horizontal input, -1 to 1.
     pub run: f64,
+    /// Dropping through one-way platforms (a `drop` input): set while the body overlaps one,
+    /// cleared by the `one_way` pass once it overlaps none (`stages/one_way.rs`).
+    pub drop: bool,
 }
 
 /// The row of a body that has none (scenery).

@@ -226,6 +226,7 @@ impl World {
         let (a, b) = (self.inputs(i), base.inputs(j));
         same_vec(self.force(i), base.force(j))
             && a.thrust == b.thrust
+            && a.drop == b.drop
             && a.turn.to_bits() == b.turn.to_bits()
             && a.run.to_bits() == b.run.to_bits()
             && self.grounded(i) == base.grounded(j)
