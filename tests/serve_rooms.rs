@@ -799,6 +799,22 @@ fn one_game_served_then_plain_golden_and_replayed_agree() {
     assert_eq!(plain.sim().checksum(), replayed.sim.checksum());
     assert_eq!(plain.game().state.pushes, 2);
 
+    // Every chunk of the game's logs has a message index: Lichtblick refuses a log with a
+    // chunk of channels alone (an attachment written after the channels made one).
+    for log in [&served, &again] {
+        let bytes = std::fs::read(log).unwrap();
+        let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
+        assert!(!summary.chunk_indexes.is_empty());
+        for chunk in &summary.chunk_indexes {
+            assert!(
+                !chunk.message_index_offsets.is_empty(),
+                "{}: a chunk without messages at {}",
+                log.display(),
+                chunk.chunk_start_offset
+            );
+        }
+    }
+
     // Golden: a session of its own, from the script, holds the served room's messages.
     let golden_path = dir.path().join("golden.mcap");
     let (sim, game) = new_game("every");

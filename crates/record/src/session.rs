@@ -152,8 +152,14 @@ impl<G: Game, S: MessageSink> GameSession<G, S> {
     /// lists every body, as a first frame does), writing to `sink`, with `/input` when
     /// `record_inputs` (a run that takes no commands, `ricochet run`'s, has none).
     pub fn start(sim: Simulation, game: G, sink: S, record_inputs: bool) -> Result<Self, LogError> {
-        let mut recorder = Recorder::new(sink, sim.dt(), Channels::default())?;
         let players = game.has_players();
+        let mut sink = sink;
+        if players {
+            // Before any channel: an attachment ends the chunk open, and a chunk of channels
+            // alone (no message, so no message index) is one Lichtblick refuses to open.
+            sink.attach(GAME_ATTACHMENT, "text/plain", game.name().as_bytes())?;
+        }
+        let mut recorder = Recorder::new(sink, sim.dt(), Channels::default())?;
         let input = match (record_inputs, players) {
             (false, _) => None,
             (true, false) => Some(
@@ -167,11 +173,6 @@ impl<G: Game, S: MessageSink> GameSession<G, S> {
                 GAME_INPUT_SCHEMA,
             )?),
         };
-        if players {
-            recorder
-                .sink_mut()
-                .attach(GAME_ATTACHMENT, "text/plain", game.name().as_bytes())?;
-        }
         let state = match game.state() {
             Some(_) => Some(recorder.sink_mut().add_json_channel(
                 "/game",
