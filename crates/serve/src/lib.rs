@@ -34,6 +34,7 @@ mod hub;
 mod load_path;
 mod protocol;
 mod query;
+mod queue;
 mod realtime;
 mod room;
 mod rooms;
