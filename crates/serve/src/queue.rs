@@ -12,7 +12,9 @@ use tokio_tungstenite::tungstenite::Message;
 /// Bytes of messages queued for one client before new ones are dropped for it: 8 MiB, a
 /// few frames of a scene of thousands of bodies (a 3,000-body frame is about 0.3 MB). A
 /// message larger than the budget is queued only when the queue is empty, so a client holds
-/// at most `max(CLIENT_BUDGET, its largest message)` (plus the one being written).
+/// at most `max(CLIENT_BUDGET, its largest message)` (plus the one being written), and a
+/// newer whole state replacing a queued one may pass it by their difference: at most one
+/// message per whole-state channel more.
 ///
 /// Dropping whole messages, not disconnecting: each message on a channel is whole (a pose
 /// set, a stats record, a scene), so a viewer that missed some shows the next ones right;
