@@ -100,7 +100,7 @@ fn a_slow_client_gets_the_latest_scene_and_a_reading_one_every_frame() {
             (paused_at, scenes)
         };
         let (frames, (paused_at, scenes)) = tokio::join!(reading, pausing);
-        assert!(frames.len() > 60, "{} frames read", frames.len());
+        assert!(frames.len() > 30, "{} frames read", frames.len());
         assert!(
             frames.windows(2).all(|w| w[1] == w[0] + 1),
             "the reading client missed frames"
