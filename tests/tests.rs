@@ -25,6 +25,7 @@ mod serve_query;
 mod serve_rooms;
 mod serve_session;
 mod serve_siege;
+mod serve_slow;
 mod serve_ws;
 mod stress;
 mod suite_cli;

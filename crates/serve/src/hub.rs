@@ -3,122 +3,23 @@
 //! messages) and the WebSocket tasks (which add and drop clients and subscriptions).
 //!
 //! Publishing never waits on a client: each has a queue bounded in bytes
-//! ([`CLIENT_BUDGET`]); a message that does not fit is dropped whole for that client
-//! (counted, and the client is told once by a status message when it catches up, and sent
-//! the latest `/scene` again if it missed one). The simulation and the recording never
-//! lose a frame.
+//! ([`CLIENT_BUDGET`]). On a whole-state topic ([`LATEST`]: `/scene`, `/scene/static`,
+//! `/tf`, `/scene/contacts`) a client's queue holds at most the latest undelivered message:
+//! a newer one replaces the queued older one in place, so a slow viewer gets the latest
+//! state, not a backlog. On the other topics a message that does not fit is dropped whole
+//! for that client (counted, and the client is told once by a status message when it
+//! catches up, and sent the latest `/scene` again if it missed one). The simulation and
+//! the recording never lose a frame.
 
 use std::collections::{BTreeMap, BTreeSet};
-use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard};
 
 use ricochet_log::{ChannelId, LogError, MessageSink, Schema};
-use tokio::sync::mpsc;
 use tokio_tungstenite::tungstenite::Message;
 
 use crate::protocol::{self, Channel};
 
-/// Bytes of messages queued for one client before new ones are dropped for it: 8 MiB, a
-/// few frames of a scene of thousands of bodies (a 3,000-body frame is about 0.3 MB). A
-/// message larger than the budget is queued only when the queue is empty, so a client holds
-/// at most `max(CLIENT_BUDGET, its largest message)` (plus the one being written).
-///
-/// Dropping whole messages, not disconnecting: each message on a channel is whole (a pose
-/// set, a stats record, a scene), so a viewer that missed some shows the next ones right;
-/// a stall of a second (a tab in the background) should not cost the connection. The
-/// latched `/scene` is sent again when it catches up.
-pub const CLIENT_BUDGET: usize = 8 << 20;
-
-/// Room beyond the budget for the server's answers (status, service responses, playback
-/// states: small, and a client waits for them), so they are not lost with the data.
-const ANSWER_ROOM: usize = 1 << 20;
-
-/// What one queued message is counted as beyond its payload: the queue's slot and the
-/// message's allocation (so a flood of tiny messages is bounded too).
-const MESSAGE_OVERHEAD: usize = 64;
-
-/// A client's outgoing queue: unbounded in count, bounded in bytes by [`CLIENT_BUDGET`]
-/// (the connection's task gives the bytes back as it writes each message).
-#[derive(Clone)]
-pub struct ClientQueue {
-    sender: mpsc::UnboundedSender<Message>,
-    queued: Arc<AtomicUsize>,
-}
-
-/// The connection's end of a [`ClientQueue`].
-pub struct ClientQueueReceiver {
-    receiver: mpsc::UnboundedReceiver<Message>,
-    queued: Arc<AtomicUsize>,
-}
-
-/// A new queue for one client.
-pub fn client_queue() -> (ClientQueue, ClientQueueReceiver) {
-    let (sender, receiver) = mpsc::unbounded_channel();
-    let queued = Arc::new(AtomicUsize::new(0));
-    (
-        ClientQueue {
-            sender,
-            queued: Arc::clone(&queued),
-        },
-        ClientQueueReceiver { receiver, queued },
-    )
-}
-
-/// The bytes a message is counted as.
-fn weight(message: &Message) -> usize {
-    message.len() + MESSAGE_OVERHEAD
-}
-
-impl ClientQueue {
-    /// Queues a data message if it fits the budget; `false` if it was dropped.
-    pub fn offer(&self, message: Message) -> bool {
-        self.offer_within(message, CLIENT_BUDGET)
-    }
-
-    /// Queues one of the server's answers (status, service response, playback state), which
-    /// may use [`ANSWER_ROOM`] beyond the budget; `false` if it was dropped.
-    pub fn answer(&self, message: Message) -> bool {
-        self.offer_within(message, CLIENT_BUDGET + ANSWER_ROOM)
-    }
-
-    fn offer_within(&self, message: Message, budget: usize) -> bool {
-        let weight = weight(&message);
-        // Producers hold the hub's lock, but for the client's own task (its statuses): two
-        // may pass the check at once, so a queue may exceed its budget by one message.
-        let queued = self.queued.load(Ordering::Acquire);
-        if queued > 0 && queued + weight > budget {
-            return false;
-        }
-        self.queued.fetch_add(weight, Ordering::AcqRel);
-        if self.sender.send(message).is_err() {
-            self.queued.fetch_sub(weight, Ordering::AcqRel);
-            return false;
-        }
-        true
-    }
-
-    /// Bytes queued now.
-    pub fn queued(&self) -> usize {
-        self.queued.load(Ordering::Acquire)
-    }
-}
-
-impl ClientQueueReceiver {
-    /// The next message to write (its bytes are given back to the budget), `None` once
-    /// every sender is gone.
-    pub async fn recv(&mut self) -> Option<Message> {
-        let message = self.receiver.recv().await?;
-        self.queued.fetch_sub(weight(&message), Ordering::AcqRel);
-        Some(message)
-    }
-
-    /// The next message if one is queued now.
-    pub fn try_recv(&mut self) -> Result<Message, mpsc::error::TryRecvError> {
-        let message = self.receiver.try_recv()?;
-        self.queued.fetch_sub(weight(&message), Ordering::AcqRel);
-        Ok(message)
-    }
-}
+pub use crate::queue::{CLIENT_BUDGET, ClientQueue, client_queue};
 
 /// Channels one client may advertise (`clientPublish`): Foxglove's panels advertise a few
 /// (the 3D panel's click tools, a Publish panel each); more are refused with a status, so
@@ -129,6 +30,13 @@ pub const MAX_CLIENT_CHANNELS: usize = 256;
 /// state (`/scene` and `/scene/static` are sent only when their bodies change, `/tf`, the
 /// camera's frame, only when it moves).
 const LATCHED: [&str; 3] = ["/scene", "/scene/static", "/tf"];
+
+/// Topics each of whose messages is a whole state replacing the one before: a client's
+/// queue holds at most the latest undelivered one of each (see [`ClientQueue::offer_latest`]).
+/// What a viewer that can't keep up wants is the latest state, not a backlog (Foxglove's
+/// SDK keeps the latest too). The other topics (`/bodies` deltas, `/events`, `/stats`,
+/// `/contacts`, ...) are queued in order and dropped past the budget.
+pub const LATEST: [&str; 4] = ["/scene", "/scene/static", "/tf", "/scene/contacts"];
 
 /// Inputs waiting for the next frame, from all clients, beyond which new ones are refused.
 pub const MAX_PENDING_INPUTS: usize = 10_000;
@@ -283,7 +191,7 @@ impl Shared {
             c.subscriptions.insert(channel, subscription);
             if let Some((time, payload)) = latched {
                 let data = protocol::message_data(subscription, time, &payload);
-                if !c.queue.offer(Message::binary(data)) {
+                if !c.queue.offer_latest(channel, Message::binary(data)) {
                     c.dropped += 1;
                     c.stale.insert(channel);
                 }
@@ -436,16 +344,20 @@ impl Shared {
     /// Publishes a message on `channel` to its subscribers.
     fn publish(&mut self, channel: u32, time_ns: u64, payload: Vec<u8>) {
         let mut dropped = 0;
-        let latched = self
-            .channels
-            .iter()
-            .any(|c| c.id == channel && LATCHED.contains(&c.topic.as_str()));
+        let topic = self.channels.iter().find(|c| c.id == channel);
+        let latched = topic.is_some_and(|c| LATCHED.contains(&c.topic.as_str()));
+        let latest = topic.is_some_and(|c| LATEST.contains(&c.topic.as_str()));
         for c in self.clients.values_mut() {
             let Some(&sub) = c.subscriptions.get(&channel) else {
                 continue;
             };
             let data = Message::binary(protocol::message_data(sub, time_ns, &payload));
-            if !c.queue.offer(data) {
+            let queued = if latest {
+                c.queue.offer_latest(channel, data)
+            } else {
+                c.queue.offer(data)
+            };
+            if !queued {
                 c.dropped += 1;
                 dropped += 1;
                 if latched {
@@ -477,7 +389,7 @@ impl Shared {
                         continue;
                     };
                     let data = protocol::message_data(sub, *time, payload);
-                    if !c.queue.offer(Message::binary(data)) {
+                    if !c.queue.offer_latest(stale, Message::binary(data)) {
                         c.stale.insert(stale);
                     }
                 }

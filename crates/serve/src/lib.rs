@@ -42,6 +42,7 @@ mod hub;
 mod load_path;
 mod protocol;
 mod query;
+mod queue;
 mod realtime;
 mod room;
 mod rooms;

@@ -1,0 +1,251 @@
+//! A client's outgoing queue: bounded in bytes ([`CLIENT_BUDGET`]), in order, but for
+//! whole-state messages, each of which replaces, in its place, its channel's message still
+//! waiting (see [`ClientQueue::offer_latest`]).
+
+use std::collections::BTreeMap;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex, MutexGuard};
+
+use tokio::sync::mpsc;
+use tokio_tungstenite::tungstenite::Message;
+
+/// Bytes of messages queued for one client before new ones are dropped for it: 8 MiB, a
+/// few frames of a scene of thousands of bodies (a 3,000-body frame is about 0.3 MB). A
+/// message larger than the budget is queued only when the queue is empty, so a client holds
+/// at most `max(CLIENT_BUDGET, its largest message)` (plus the one being written), and a
+/// newer whole state replacing a queued one may pass it by their difference: at most one
+/// message per whole-state channel more.
+///
+/// Dropping whole messages, not disconnecting: each message on a channel is whole (a pose
+/// set, a stats record, a scene), so a viewer that missed some shows the next ones right;
+/// a stall of a second (a tab in the background) should not cost the connection. The
+/// latched `/scene` is sent again when it catches up.
+pub const CLIENT_BUDGET: usize = 8 << 20;
+
+/// Room beyond the budget for the server's answers (status, service responses, playback
+/// states: small, and a client waits for them), so they are not lost with the data.
+const ANSWER_ROOM: usize = 1 << 20;
+
+/// What one queued message is counted as beyond its payload: the queue's slot and the
+/// message's allocation (so a flood of tiny messages is bounded too).
+const MESSAGE_OVERHEAD: usize = 64;
+
+/// A queued message whose content a newer one may replace until it is written: the
+/// latest state of one channel.
+type Slot = Arc<Mutex<Option<Message>>>;
+
+/// One entry of a client's queue.
+enum Queued {
+    /// Written as it is, in order.
+    Message(Message),
+    /// Written with whatever the slot holds when its turn comes.
+    Latest(Slot),
+}
+
+/// A client's outgoing queue: unbounded in count, bounded in bytes by [`CLIENT_BUDGET`]
+/// (the connection's task gives the bytes back as it writes each message).
+#[derive(Clone)]
+pub struct ClientQueue {
+    sender: mpsc::UnboundedSender<Queued>,
+    queued: Arc<AtomicUsize>,
+    /// By channel id: the slot of its latest message, still queued if the slot is full
+    /// (one per whole-state channel, so bounded by the channel count).
+    latest: Arc<Mutex<BTreeMap<u32, Slot>>>,
+}
+
+/// The connection's end of a [`ClientQueue`].
+pub struct ClientQueueReceiver {
+    receiver: mpsc::UnboundedReceiver<Queued>,
+    queued: Arc<AtomicUsize>,
+}
+
+/// A new queue for one client.
+pub fn client_queue() -> (ClientQueue, ClientQueueReceiver) {
+    let (sender, receiver) = mpsc::unbounded_channel();
+    let queued = Arc::new(AtomicUsize::new(0));
+    (
+        ClientQueue {
+            sender,
+            queued: Arc::clone(&queued),
+            latest: Arc::default(),
+        },
+        ClientQueueReceiver { receiver, queued },
+    )
+}
+
+/// Locks `m`, recovering from poison (the guarded values stay consistent: each is replaced
+/// whole).
+fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
+/// The bytes a message is counted as.
+fn weight(message: &Message) -> usize {
+    message.len() + MESSAGE_OVERHEAD
+}
+
+impl ClientQueue {
+    /// Queues a data message if it fits the budget; `false` if it was dropped.
+    pub fn offer(&self, message: Message) -> bool {
+        self.offer_within(message, CLIENT_BUDGET)
+    }
+
+    /// Queues one of the server's answers (status, service response, playback state), which
+    /// may use [`ANSWER_ROOM`] beyond the budget; `false` if it was dropped.
+    pub fn answer(&self, message: Message) -> bool {
+        self.offer_within(message, CLIENT_BUDGET + ANSWER_ROOM)
+    }
+
+    /// Queues the latest whole state of `channel`: it replaces, in its place in the queue,
+    /// the channel's message still waiting there, if any (a replacement always fits: the
+    /// queue holds at most one message per such channel); else it is queued if it fits the
+    /// budget. `false` if it was dropped.
+    pub fn offer_latest(&self, channel: u32, message: Message) -> bool {
+        let mut latest = lock(&self.latest);
+        if let Some(slot) = latest.get(&channel) {
+            let mut held = lock(slot);
+            if let Some(old) = held.as_ref() {
+                // Add before taking away, so the count never underflows for the reader.
+                self.queued.fetch_add(weight(&message), Ordering::AcqRel);
+                self.queued.fetch_sub(weight(old), Ordering::AcqRel);
+                *held = Some(message);
+                return true;
+            }
+        }
+        let weight = weight(&message);
+        if !self.fits(weight, CLIENT_BUDGET) {
+            return false;
+        }
+        let slot: Slot = Arc::new(Mutex::new(Some(message)));
+        self.queued.fetch_add(weight, Ordering::AcqRel);
+        if self.sender.send(Queued::Latest(Arc::clone(&slot))).is_err() {
+            self.queued.fetch_sub(weight, Ordering::AcqRel);
+            return false;
+        }
+        latest.insert(channel, slot);
+        true
+    }
+
+    /// Whether `weight` more bytes fit `budget` (a message larger than the budget fits an
+    /// empty queue).
+    fn fits(&self, weight: usize, budget: usize) -> bool {
+        let queued = self.queued.load(Ordering::Acquire);
+        queued == 0 || queued + weight <= budget
+    }
+
+    fn offer_within(&self, message: Message, budget: usize) -> bool {
+        let weight = weight(&message);
+        // Producers hold the hub's lock, but for the client's own task (its statuses): two
+        // may pass the check at once, so a queue may exceed its budget by one message.
+        if !self.fits(weight, budget) {
+            return false;
+        }
+        self.queued.fetch_add(weight, Ordering::AcqRel);
+        if self.sender.send(Queued::Message(message)).is_err() {
+            self.queued.fetch_sub(weight, Ordering::AcqRel);
+            return false;
+        }
+        true
+    }
+
+    /// Bytes queued now.
+    pub fn queued(&self) -> usize {
+        self.queued.load(Ordering::Acquire)
+    }
+}
+
+impl ClientQueueReceiver {
+    /// The next message to write (its bytes are given back to the budget), `None` once
+    /// every sender is gone.
+    pub async fn recv(&mut self) -> Option<Message> {
+        loop {
+            let queued = self.receiver.recv().await?;
+            if let Some(message) = self.take(queued) {
+                return Some(message);
+            }
+        }
+    }
+
+    /// The next message if one is queued now.
+    pub fn try_recv(&mut self) -> Result<Message, mpsc::error::TryRecvError> {
+        loop {
+            let queued = self.receiver.try_recv()?;
+            if let Some(message) = self.take(queued) {
+                return Ok(message);
+            }
+        }
+    }
+
+    /// The message an entry holds now (its bytes given back to the budget); `None` for a
+    /// slot already emptied.
+    fn take(&self, queued: Queued) -> Option<Message> {
+        let message = match queued {
+            Queued::Message(message) => message,
+            Queued::Latest(slot) => lock(&slot).take()?,
+        };
+        self.queued.fetch_sub(weight(&message), Ordering::AcqRel);
+        Some(message)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn text(t: &str) -> Message {
+        Message::text(t.to_owned())
+    }
+
+    #[test]
+    fn a_newer_state_replaces_the_queued_one_in_place_and_others_keep_their_order() {
+        let (queue, mut receiver) = client_queue();
+        assert!(queue.offer(text("stats 1")));
+        assert!(queue.offer_latest(1, text("scene 1")));
+        assert!(queue.offer(text("stats 2")));
+        assert!(queue.offer_latest(1, text("scene 2")));
+        assert!(queue.offer_latest(2, text("tf 2")));
+        assert!(queue.offer(text("stats 3")));
+        assert!(queue.offer_latest(1, text("scene 3")));
+        let mut got = Vec::new();
+        while let Ok(m) = receiver.try_recv() {
+            got.push(m.into_text().unwrap().to_string());
+        }
+        // scene 3 in scene 1's place; tf in its own.
+        assert_eq!(got, ["stats 1", "scene 3", "stats 2", "tf 2", "stats 3"]);
+        assert_eq!(queue.queued(), 0);
+        // Once written, the channel's next state is queued anew, after what came before.
+        assert!(queue.offer(text("stats 4")));
+        assert!(queue.offer_latest(1, text("scene 4")));
+        let got: Vec<String> = std::iter::from_fn(|| receiver.try_recv().ok())
+            .map(|m| m.into_text().unwrap().to_string())
+            .collect();
+        assert_eq!(got, ["stats 4", "scene 4"]);
+        assert_eq!(queue.queued(), 0);
+    }
+
+    #[test]
+    fn states_past_the_budget_take_one_place_while_other_messages_are_dropped() {
+        let (queue, mut receiver) = client_queue();
+        let big = |c: char| Message::text(c.to_string().repeat(CLIENT_BUDGET / 4));
+        let mut taken = 0;
+        for c in ['a', 'b', 'c', 'd', 'e', 'f', 'g', 'h'] {
+            taken += usize::from(queue.offer(big(c)));
+        }
+        // Three fit beside each other (with their overhead, not four).
+        assert_eq!(taken, 3);
+        // A full queue takes no new state, but replaces one already queued.
+        assert!(!queue.offer_latest(1, big('s')));
+        let (queue2, mut receiver2) = client_queue();
+        assert!(queue2.offer_latest(1, big('s')));
+        for c in ['t', 'u', 'v', 'w', 'x', 'y', 'z'] {
+            assert!(queue2.offer_latest(1, big(c)));
+        }
+        assert_eq!(queue2.queued(), weight(&big('z')));
+        let got = receiver2.try_recv().unwrap().into_text().unwrap();
+        assert!(got.starts_with('z'));
+        assert!(receiver2.try_recv().is_err());
+        assert_eq!(queue2.queued(), 0);
+        let n = std::iter::from_fn(|| receiver.try_recv().ok()).count();
+        assert_eq!(n, 3);
+    }
+}
