@@ -46,7 +46,7 @@ fn a_client_of_either_subprotocol_gets_the_channels_and_decodable_messages() {
                     "/contacts",
                     "/stats",
                     "/events",
-                    "/input"
+                    "/input/recorded"
                 ]
             );
             for c in channels {

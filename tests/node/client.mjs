@@ -27,7 +27,7 @@ const client = new FoxgloveClient({
   ws: new WebSocket(url, [FoxgloveClient.SUPPORTED_SUBPROTOCOL]),
 });
 const expected = [
-  "/scene", "/scene/static", "/tf", "/scene/contacts", "/bodies", "/contacts", "/stats", "/events", "/input",
+  "/scene", "/scene/static", "/tf", "/scene/contacts", "/bodies", "/contacts", "/stats", "/events", "/input/recorded",
 ];
 let info;
 let channels = [];

@@ -406,35 +406,23 @@ impl Shared {
 /// published to the clients subscribed to its channel.
 pub struct LiveSink {
     hub: Hub,
-    /// The topic the session's own `/input` (what it records) is advertised as live.
-    input_topic: &'static str,
 }
 
-/// The topic a room advertises its recorded commands on: `/input` is what its clients
-/// publish (the game's input, JSON), so the server's record of them is told apart (the
-/// recording keeps `/input`, which replays read).
+/// The topic a session (a room's, or the plain server's) advertises its recorded commands
+/// on: `/input` is what its clients publish (the game's input, JSON), so the server's
+/// record of them is told apart (the recording keeps `/input`, which replays read).
 pub const RECORDED_INPUT: &str = "/input/recorded";
 
 impl LiveSink {
-    /// A sink publishing through `hub`.
+    /// A sink publishing through `hub`; the session's recorded `/input` is advertised as
+    /// [`RECORDED_INPUT`].
     pub fn new(hub: Hub) -> LiveSink {
-        LiveSink {
-            hub,
-            input_topic: "/input",
-        }
-    }
-
-    /// A room's sink: its recorded `/input` is advertised as [`RECORDED_INPUT`].
-    pub fn for_room(hub: Hub) -> LiveSink {
-        LiveSink {
-            hub,
-            input_topic: RECORDED_INPUT,
-        }
+        LiveSink { hub }
     }
 
     fn topic<'a>(&self, topic: &'a str) -> &'a str {
         if topic == "/input" {
-            self.input_topic
+            RECORDED_INPUT
         } else {
             topic
         }

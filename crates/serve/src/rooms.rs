@@ -182,7 +182,7 @@ impl<M: RoomMaker> Registry<M> {
             }
         };
         let sink = ServeSink {
-            live: LiveSink::for_room(hub.clone()),
+            live: LiveSink::new(hub.clone()),
             file,
             muted: false,
         };
@@ -256,7 +256,7 @@ impl<M: RoomMaker> Registry<M> {
     /// forgotten (a new client makes a new room of that name).
     fn close_if(&self, room: &mut Room<M::Game>, now: Instant, closing: Option<Closing>) -> bool {
         let why = {
-            let mut inner = self.lock();
+            let inner = self.lock();
             let why = match closing {
                 Some(Closing::Failed(why)) => Some((why, true)),
                 Some(Closing::Done(why)) => Some((why, false)),
@@ -273,10 +273,12 @@ impl<M: RoomMaker> Registry<M> {
                 }
             };
             if why.is_some() {
-                inner.rooms.remove(&room.name);
-                // Under the registry's lock: no client enters it from now.
+                // Under the registry's lock: no client enters it from now. It stays listed
+                // (and its name taken) until its recording is finished below, so a new room
+                // of that name never records to the same file.
                 room.hub.lock().closed = true;
             }
+            drop(inner);
             why
         };
         let Some((why, failed)) = why else {
@@ -302,6 +304,7 @@ impl<M: RoomMaker> Registry<M> {
         if let Some(e) = room.close(&told) {
             (self.options.note)(&format!("error: {e}"));
         }
+        self.lock().rooms.remove(&room.name);
         failed
     }
 }
@@ -330,6 +333,11 @@ impl<M: RoomMaker> Door for Registry<M> {
             None => self.open(&mut inner, name)?,
         };
         let mut s = hub.lock();
+        if s.closed {
+            return Err(format!(
+                "room {name} is closing (its recording being finished); try again in a moment"
+            ));
+        }
         let per_room = self.options.max_clients_per_room;
         if s.client_count() >= per_room {
             return Err(format!("room {name} is full, at most {per_room} clients"));
