@@ -19,7 +19,7 @@ use tokio_tungstenite::tungstenite::Message;
 
 use crate::protocol::{self, Channel};
 
-pub use crate::queue::{CLIENT_BUDGET, ClientQueue, client_queue};
+pub use crate::queue::{CLIENT_BUDGET, ClientQueue, Latest, client_queue};
 
 /// Channels one client may advertise (`clientPublish`): Foxglove's panels advertise a few
 /// (the 3D panel's click tools, a Publish panel each); more are refused with a status, so
@@ -191,9 +191,13 @@ impl Shared {
             c.subscriptions.insert(channel, subscription);
             if let Some((time, payload)) = latched {
                 let data = protocol::message_data(subscription, time, &payload);
-                if !c.queue.offer_latest(channel, Message::binary(data)) {
-                    c.dropped += 1;
-                    c.stale.insert(channel);
+                match c.queue.offer_latest(channel, Message::binary(data)) {
+                    Latest::Queued => {}
+                    Latest::Replaced => c.dropped += 1,
+                    Latest::Dropped => {
+                        c.dropped += 1;
+                        c.stale.insert(channel);
+                    }
                 }
             }
         }
@@ -353,7 +357,16 @@ impl Shared {
             };
             let data = Message::binary(protocol::message_data(sub, time_ns, &payload));
             let queued = if latest {
-                c.queue.offer_latest(channel, data)
+                match c.queue.offer_latest(channel, data) {
+                    Latest::Queued => true,
+                    Latest::Replaced => {
+                        // The latest is queued; the older state it replaced is lost.
+                        c.dropped += 1;
+                        dropped += 1;
+                        true
+                    }
+                    Latest::Dropped => false,
+                }
             } else {
                 c.queue.offer(data)
             };
@@ -389,7 +402,7 @@ impl Shared {
                         continue;
                     };
                     let data = protocol::message_data(sub, *time, payload);
-                    if !c.queue.offer_latest(stale, Message::binary(data)) {
+                    if c.queue.offer_latest(stale, Message::binary(data)) == Latest::Dropped {
                         c.stale.insert(stale);
                     }
                 }

@@ -99,8 +99,8 @@ impl ClientQueue {
     /// Queues the latest whole state of `channel`: it replaces, in its place in the queue,
     /// the channel's message still waiting there, if any (a replacement always fits: the
     /// queue holds at most one message per such channel); else it is queued if it fits the
-    /// budget. `false` if it was dropped.
-    pub fn offer_latest(&self, channel: u32, message: Message) -> bool {
+    /// budget.
+    pub fn offer_latest(&self, channel: u32, message: Message) -> Latest {
         let mut latest = lock(&self.latest);
         if let Some(slot) = latest.get(&channel) {
             let mut held = lock(slot);
@@ -109,21 +109,21 @@ impl ClientQueue {
                 self.queued.fetch_add(weight(&message), Ordering::AcqRel);
                 self.queued.fetch_sub(weight(old), Ordering::AcqRel);
                 *held = Some(message);
-                return true;
+                return Latest::Replaced;
             }
         }
         let weight = weight(&message);
         if !self.fits(weight, CLIENT_BUDGET) {
-            return false;
+            return Latest::Dropped;
         }
         let slot: Slot = Arc::new(Mutex::new(Some(message)));
         self.queued.fetch_add(weight, Ordering::AcqRel);
         if self.sender.send(Queued::Latest(Arc::clone(&slot))).is_err() {
             self.queued.fetch_sub(weight, Ordering::AcqRel);
-            return false;
+            return Latest::Dropped;
         }
         latest.insert(channel, slot);
-        true
+        Latest::Queued
     }
 
     /// Whether `weight` more bytes fit `budget` (a message larger than the budget fits an
@@ -188,6 +188,18 @@ impl ClientQueueReceiver {
     }
 }
 
+/// What became of a whole state offered to a client ([`ClientQueue::offer_latest`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Latest {
+    /// Queued.
+    Queued,
+    /// Queued in place of the channel's older state, which the client never gets (a
+    /// message dropped for a slow client, counted as one).
+    Replaced,
+    /// Dropped: it did not fit the budget.
+    Dropped,
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -200,12 +212,12 @@ mod tests {
     fn a_newer_state_replaces_the_queued_one_in_place_and_others_keep_their_order() {
         let (queue, mut receiver) = client_queue();
         assert!(queue.offer(text("stats 1")));
-        assert!(queue.offer_latest(1, text("scene 1")));
+        assert_eq!(queue.offer_latest(1, text("scene 1")), Latest::Queued);
         assert!(queue.offer(text("stats 2")));
-        assert!(queue.offer_latest(1, text("scene 2")));
-        assert!(queue.offer_latest(2, text("tf 2")));
+        assert_eq!(queue.offer_latest(1, text("scene 2")), Latest::Replaced);
+        assert_eq!(queue.offer_latest(2, text("tf 2")), Latest::Queued);
         assert!(queue.offer(text("stats 3")));
-        assert!(queue.offer_latest(1, text("scene 3")));
+        assert_eq!(queue.offer_latest(1, text("scene 3")), Latest::Replaced);
         let mut got = Vec::new();
         while let Ok(m) = receiver.try_recv() {
             got.push(m.into_text().unwrap().to_string());
@@ -215,7 +227,7 @@ mod tests {
         assert_eq!(queue.queued(), 0);
         // Once written, the channel's next state is queued anew, after what came before.
         assert!(queue.offer(text("stats 4")));
-        assert!(queue.offer_latest(1, text("scene 4")));
+        assert_eq!(queue.offer_latest(1, text("scene 4")), Latest::Queued);
         let got: Vec<String> = std::iter::from_fn(|| receiver.try_recv().ok())
             .map(|m| m.into_text().unwrap().to_string())
             .collect();
@@ -234,11 +246,11 @@ mod tests {
         // Three fit beside each other (with their overhead, not four).
         assert_eq!(taken, 3);
         // A full queue takes no new state, but replaces one already queued.
-        assert!(!queue.offer_latest(1, big('s')));
+        assert_eq!(queue.offer_latest(1, big('s')), Latest::Dropped);
         let (queue2, mut receiver2) = client_queue();
-        assert!(queue2.offer_latest(1, big('s')));
+        assert_eq!(queue2.offer_latest(1, big('s')), Latest::Queued);
         for c in ['t', 'u', 'v', 'w', 'x', 'y', 'z'] {
-            assert!(queue2.offer_latest(1, big(c)));
+            assert_eq!(queue2.offer_latest(1, big(c)), Latest::Replaced);
         }
         assert_eq!(queue2.queued(), weight(&big('z')));
         let got = receiver2.try_recv().unwrap().into_text().unwrap();
