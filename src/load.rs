@@ -55,3 +55,14 @@ pub fn load_all(path: Option<&Path>) -> Result<(Scenario, String, Option<MapSumm
     };
     Ok((scenario, text, summary))
 }
+
+/// A scenario file's text read from `path`, with its `[tiled]` map's bodies added when it
+/// has one: what `ricochet test` steps. Errors are the loader's, as text.
+pub fn scenario_with_map(text: &str, path: &Path) -> Result<Scenario, String> {
+    let (mut scenario, tiled) =
+        load_scenario_and_map(text, &path.display().to_string()).map_err(|e| e.to_string())?;
+    if let Some(def) = tiled {
+        ricochet_tiled::add_map(&mut scenario, &def, path).map_err(|e| e.to_string())?;
+    }
+    Ok(scenario)
+}

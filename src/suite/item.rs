@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use ricochet_log::LogFile;
-use ricochet_sim::{Simulation, load_scenario};
+use ricochet_sim::Simulation;
 use serde::{Deserialize, Serialize};
 
 use super::read::{open_regular, read_golden, read_scenario, same_bytes};
@@ -234,7 +234,7 @@ fn judge(
         ));
     }
     let text = read_scenario(path)?;
-    let scenario = load_scenario(&text, &path.display().to_string()).map_err(|e| e.to_string())?;
+    let scenario = crate::load::scenario_with_map(&text, path)?;
     drop(text);
     scenario
         .world

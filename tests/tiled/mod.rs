@@ -3,6 +3,7 @@
 //! pixels), and bad maps are located errors.
 
 mod errors;
+mod suite;
 mod write;
 
 use std::path::Path;

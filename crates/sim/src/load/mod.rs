@@ -39,7 +39,7 @@ pub fn load_scenario(text: &str, file: &str) -> Result<Scenario, ScenarioError> 
             "tiled",
             "this scenario takes its level from a Tiled map, which this loader does not read \
              (it does no I/O): load it with `load_scenario_and_map` and \
-             `ricochet_tiled::add_map` (the `ricochet` binary's run, check, validate and serve do)",
+             `ricochet_tiled::add_map` (the `ricochet` binary's run, check, validate, serve and test do)",
         )),
     }
 }
