@@ -32,12 +32,14 @@ mod error;
 mod escape;
 mod log_file;
 mod reader;
+mod stream;
 mod writer;
 
 pub use bodies::BodyStates;
 pub use error::LogError;
 pub use escape::escape_controls;
-pub use log_file::{ChannelInfo, LogFile, Messages, RawMessage};
+pub use log_file::{ChannelInfo, LogFile, RawMessage};
 pub use messages::Schema;
 pub use reader::{LogMessage, read_log, read_log_file};
+pub use stream::Messages;
 pub use writer::{ChannelId, LogWriter, MessageSink, Threading};
