@@ -110,7 +110,7 @@
 //! before and after each step, the state its players see) and runs in a [`GameLoop`], the
 //! one frame loop that `ricochet-record` (recording, golden checks, replays) and
 //! `ricochet-serve` (rooms) drive too. [`ScenarioGame`] is the game of a scenario file.
-//! README's "Run a game" has a whole one.
+//! README's "Embed the simulation in a game" has a whole one.
 //!
 //! # Lag compensation
 //!
