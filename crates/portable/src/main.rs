@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use ricochet_portable::{MAX_FILE_FRAMES, builtin_scenes, run};
-use ricochet_sim::load_scenario;
+use ricochet_sim::load_scenario_and_map;
 
 fn main() -> ExitCode {
     match main_inner() {
@@ -58,8 +58,11 @@ fn main_inner() -> Result<(), String> {
     for path in &files {
         let source =
             std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-        let scenario =
-            load_scenario(&source, &path.display().to_string()).map_err(|e| e.to_string())?;
+        let (mut scenario, tiled) = load_scenario_and_map(&source, &path.display().to_string())
+            .map_err(|e| e.to_string())?;
+        if let Some(def) = tiled {
+            ricochet_tiled::add_map(&mut scenario, &def, path).map_err(|e| e.to_string())?;
+        }
         let name = path.file_stem().map_or_else(
             || path.display().to_string(),
             |s| s.to_string_lossy().into_owned(),

@@ -9,6 +9,11 @@ use base64::Engine;
 
 use crate::{MAX_CELLS, MAX_FILE_BYTES, TiledError};
 
+/// What a zstd-compressed layer gets from a build without the `zstd` feature.
+#[cfg(not(feature = "zstd"))]
+const NO_ZSTD: &str = "tile data compression \"zstd\" needs ricochet-tiled's `zstd` feature, \
+     which this build leaves off; save the layer as CSV, or zlib or gzip base64";
+
 /// Reads a map through the `tiled` crate, with the checks above on every file.
 pub(crate) fn load_map(path: &Path) -> Result<tiled::Map, TiledError> {
     let file = path.display().to_string();
@@ -174,10 +179,13 @@ fn compressed_sizes(xml: &str) -> Result<u64, String> {
             let n = match compression {
                 "zlib" => count(flate2::read::ZlibDecoder::new(&bytes[..]), budget),
                 "gzip" => count(flate2::read::GzDecoder::new(&bytes[..]), budget),
+                #[cfg(feature = "zstd")]
                 "zstd" => count(
                     zstd::stream::read::Decoder::new(&bytes[..]).map_err(|e| e.to_string())?,
                     budget,
                 ),
+                #[cfg(not(feature = "zstd"))]
+                "zstd" => return Err(NO_ZSTD.to_owned()),
                 other => {
                     return Err(format!(
                         "tile data compression \"{other}\" is not one of zlib, gzip, zstd"
@@ -300,8 +308,11 @@ fn decode_gids(tag: &str, text: &str) -> Result<Vec<u32>, String> {
         Some("gzip") => flate2::read::GzDecoder::new(&bytes[..])
             .take(limit)
             .read_to_end(&mut raw),
+        #[cfg(feature = "zstd")]
         Some("zstd") => zstd::stream::read::Decoder::new(&bytes[..])
             .and_then(|d| d.take(limit).read_to_end(&mut raw)),
+        #[cfg(not(feature = "zstd"))]
+        Some("zstd") => return Err(NO_ZSTD.to_owned()),
         Some(other) => {
             return Err(format!(
                 "tile data compression \"{other}\" is not one of zlib, gzip, zstd"
