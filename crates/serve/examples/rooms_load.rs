@@ -20,6 +20,7 @@ use ricochet_sim::prelude::*;
 use ricochet_sim::{Game, Player};
 use tokio_tungstenite::tungstenite::Message;
 use tokio_tungstenite::tungstenite::client::IntoClientRequest;
+use tokio_tungstenite::tungstenite::protocol::WebSocketConfig;
 
 /// A ball per player, pushed by `{"push": [vx, vy]}`; the state counts the pushes.
 #[derive(Default)]
@@ -107,6 +108,43 @@ impl RoomMaker for Crowded {
     }
 }
 
+/// CPU seconds (user + system) of this process's threads so far, by thread name, from
+/// /proc (Linux; empty elsewhere): the room workers (`rooms-N`), the WebSocket thread
+/// (`serve`) and the load client (the main thread, `rooms_load`).
+fn cpu_by_thread() -> BTreeMap<String, f64> {
+    let mut by = BTreeMap::new();
+    let Ok(tasks) = std::fs::read_dir("/proc/self/task") else {
+        return by;
+    };
+    // Clock ticks a second: 100 on Linux's common configurations.
+    let hz = 100.0;
+    for task in tasks.flatten() {
+        let Ok(stat) = std::fs::read_to_string(task.path().join("stat")) else {
+            continue;
+        };
+        // `pid (comm) state ...`: the fields after the name's closing parenthesis.
+        let (Some(open), Some(close)) = (stat.find('('), stat.rfind(')')) else {
+            continue;
+        };
+        let comm = stat[open + 1..close].to_owned();
+        let fields: Vec<&str> = stat[close + 2..].split_whitespace().collect();
+        let ticks = |i: usize| {
+            fields
+                .get(i)
+                .and_then(|f| f.parse::<f64>().ok())
+                .unwrap_or(0.0)
+        };
+        // utime and stime are fields 14 and 15, 12 and 13 after the state (field 3).
+        let name = if comm.starts_with("rooms-") {
+            "room workers".to_owned()
+        } else {
+            comm
+        };
+        *by.entry(name).or_insert(0.0) += (ticks(11) + ticks(12)) / hz;
+    }
+    by
+}
+
 /// The process's resident memory, bytes (Linux; 0 elsewhere).
 fn rss() -> u64 {
     let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
@@ -142,7 +180,10 @@ async fn player(url: &str, name: &str) -> Ws {
         "Sec-WebSocket-Protocol",
         "foxglove.websocket.v1".parse().expect("a header"),
     );
-    let (mut ws, _) = tokio_tungstenite::connect_async(request)
+    // A small read buffer, as the server's: tungstenite's default (128 KiB) is zeroed
+    // before every read, which would make this client, sharing the server's cores, the cost.
+    let config = WebSocketConfig::default().read_buffer_size(4096);
+    let (mut ws, _) = tokio_tungstenite::connect_async_with_config(request, Some(config), false)
         .await
         .expect("connected");
     let mut game = None;
@@ -203,7 +244,7 @@ fn main() {
         .enable_all()
         .build()
         .expect("a runtime");
-    let (pushes, after) = runtime.block_on(async {
+    let (pushes, after, cpu) = runtime.block_on(async {
         let mut sinks = Vec::new();
         let mut readers = Vec::new();
         for r in 0..rooms {
@@ -230,10 +271,11 @@ fn main() {
             }
         }
         let after = rss();
+        let cpu = cpu_by_thread();
         for r in readers {
             r.abort();
         }
-        (pushes, after)
+        (pushes, after, cpu)
     });
     stop.store(true, Ordering::SeqCst);
     let served = server.join().expect("the server thread");
@@ -252,5 +294,10 @@ fn main() {
         before as f64 / 1_048_576.0,
         after as f64 / 1_048_576.0,
         after.saturating_sub(before) as f64 / 1_048_576.0 / rooms as f64,
+    );
+    let cpu: Vec<String> = cpu.iter().map(|(t, s)| format!("{t} {s:.2} s")).collect();
+    println!(
+        "CPU time by thread, connecting included: {}",
+        cpu.join(", ")
     );
 }
