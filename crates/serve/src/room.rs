@@ -64,6 +64,8 @@ pub struct Room<G: Game> {
     input_schema: Arc<str>,
     /// Where its recording goes, for messages.
     pub recording: Option<PathBuf>,
+    /// When its worker last took its clients' calls.
+    looked: Instant,
 }
 
 /// The room services' list (advertised to a room's clients).
@@ -147,7 +149,19 @@ impl<G: Game> Room<G> {
             empty_since: Some(Instant::now()),
             input_schema,
             recording,
+            looked: Instant::now(),
         }
+    }
+
+    /// Whether its worker should look at it now: its frame is due, or `poll` has passed
+    /// since it was last looked at (then it is marked looked at).
+    pub fn worth_a_look(&mut self, now: Instant, poll: Duration) -> bool {
+        let due = self.due() <= now;
+        if due || now.saturating_duration_since(self.looked) >= poll {
+            self.looked = now;
+            return true;
+        }
+        false
     }
 
     /// When its next frame is due.
