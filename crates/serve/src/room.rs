@@ -475,6 +475,24 @@ mod tests {
     }
 
     #[test]
+    fn a_worker_looks_at_a_room_when_its_frame_is_due_or_a_poll_after_it_last_did() {
+        let (mut room, _, _) = room();
+        let poll = Duration::from_millis(5);
+        let start = room.start;
+        room.looked = start;
+        // Frame 0 is due at the start.
+        assert!(room.worth_a_look(start, poll));
+        room.step().map_err(|_| "a step failed").unwrap();
+        // Frame 1 is due 16 ms after the start: 1 ms and 4 ms in, nothing to do.
+        assert!(!room.worth_a_look(start + Duration::from_millis(1), poll));
+        assert!(!room.worth_a_look(start + Duration::from_millis(4), poll));
+        // 5 ms after it was last looked at: its calls are taken.
+        assert!(room.worth_a_look(start + Duration::from_millis(5), poll));
+        assert!(!room.worth_a_look(start + Duration::from_millis(9), poll));
+        assert!(room.worth_a_look(start + Duration::from_millis(16), poll));
+    }
+
+    #[test]
     fn a_client_subscribing_later_gets_the_whole_scene_at_the_next_frame() {
         let (mut room, client, mut rx) = room();
         for _ in 0..5 {
