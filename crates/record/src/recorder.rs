@@ -71,6 +71,15 @@ pub struct Recorder<S: MessageSink = LogWriter> {
     /// Where the camera's frame was last sent, and where it looks without a focus body or
     /// world bounds (the centre of the bodies' extent at the first frame recorded).
     view: Option<(Vec2, Vec2)>,
+    /// The channels whose messages [`Recorder::record`] builds (all by default): a live
+    /// stream that nobody watches and nothing records skips the others (see
+    /// [`Recorder::build_only`]).
+    wanted: Channels,
+    /// The scene's channels were skipped since they were last built: the next frame that
+    /// builds them sends every one of them whole (what a new viewer needs).
+    scene_skipped: bool,
+    /// Messages `record` built, all channels.
+    built: u64,
 }
 
 /// A new log file at `path` (a temporary file renamed onto it when finished), with
@@ -134,6 +143,9 @@ impl<S: MessageSink> Recorder<S> {
             normals_shown: false,
             style: None,
             view: None,
+            wanted: Channels::default(),
+            scene_skipped: false,
+            built: 0,
         })
     }
 
@@ -220,14 +232,29 @@ impl<S: MessageSink> Recorder<S> {
         Ok(())
     }
 
-    /// Writes one frame on every channel.
+    /// From the next frame, [`Recorder::record`] builds only `wanted`'s channels' messages
+    /// (all, by default). For a live stream only (a room nobody records): a recording must
+    /// get every message. The bodies are still tracked every frame, so `/bodies` goes on
+    /// from the right state; the scene's channels, when wanted again, are sent whole at
+    /// once (`/scene/static` too, which is otherwise sent only when a static body changes).
+    pub fn build_only(&mut self, wanted: Channels) {
+        self.wanted = wanted;
+    }
+
+    /// Messages [`Recorder::record`] built so far, all channels (a test's count of what
+    /// was skipped).
+    pub fn built(&self) -> u64 {
+        self.built
+    }
+
+    /// Writes one frame on every channel (every one [`Recorder::build_only`] wants).
     pub fn record(&mut self, sim: &Simulation, out: &FrameOutput) -> Result<(), LogError> {
         let t = out.frame * self.dt_ns;
         let ts = timestamp(t);
         let w = sim.world();
         let layers = &sim.scenario().world.layers;
-        let want_bodies = self.topics.bodies.is_some();
-        if self.topics.scene.is_some() || want_bodies {
+        let want_bodies = self.topics.bodies.is_some() && self.wanted.bodies;
+        if self.topics.scene.is_some() || self.topics.bodies.is_some() {
             let style = self.style(w);
             let mut changes = self.tracker.frame(
                 w,
@@ -236,42 +263,58 @@ impl<S: MessageSink> Recorder<S> {
                 want_bodies,
                 style == scene::Style::PerBody,
             );
-            for (channel, statics, changed) in [
-                (self.topics.statics, true, changes.static_changed),
-                (self.topics.scene, false, changes.scene_changed),
-            ] {
-                if let (Some(ch), true) = (channel, changed) {
-                    let message = scene::snapshot(w, layers, statics, style, ts);
-                    self.writer.write(ch, t, message)?;
+            if self.wanted.scene {
+                let whole = std::mem::take(&mut self.scene_skipped);
+                for (channel, statics, changed) in [
+                    (self.topics.statics, true, changes.static_changed),
+                    (self.topics.scene, false, changes.scene_changed),
+                ] {
+                    if let (Some(ch), true) = (channel, changed || whole) {
+                        let message = scene::snapshot(w, layers, statics, style, ts);
+                        self.writer.write(ch, t, message)?;
+                        self.built += 1;
+                    }
+                }
+                if let Some(ch) = self.topics.tf {
+                    let at = self.view_at(sim);
+                    if whole || self.view.is_none_or(|(sent, _)| !same_point(sent, at)) {
+                        self.view = Some((at, self.fallback_view(sim)));
+                        let transforms = vec![scene::view_transform(ts, at)];
+                        self.writer.write(ch, t, FrameTransforms { transforms })?;
+                        self.built += 1;
+                    }
+                }
+                if let Some(ch) = self.topics.normals
+                    && (!out.contacts.is_empty() || self.normals_shown)
+                {
+                    self.writer
+                        .write(ch, t, scene::contact_normals(&out.contacts, ts))?;
+                    self.normals_shown = !out.contacts.is_empty();
+                    self.built += 1;
+                }
+            } else if self.topics.scene.is_some() {
+                self.scene_skipped = true;
+                if self.view.is_none() {
+                    // The camera's fallback is where the bodies were at the first frame,
+                    // whether or not it was sent then.
+                    self.view = Some((self.view_at(sim), self.fallback_view(sim)));
                 }
             }
-            if let Some(ch) = self.topics.tf {
-                let at = self.view_at(sim);
-                if self.view.is_none_or(|(sent, _)| !same_point(sent, at)) {
-                    self.view = Some((at, self.fallback_view(sim)));
-                    let transforms = vec![scene::view_transform(ts, at)];
-                    self.writer.write(ch, t, FrameTransforms { transforms })?;
-                }
-            }
-            if let Some(ch) = self.topics.normals
-                && (!out.contacts.is_empty() || self.normals_shown)
-            {
-                self.writer
-                    .write(ch, t, scene::contact_normals(&out.contacts, ts))?;
-                self.normals_shown = !out.contacts.is_empty();
-            }
-            if let Some(ch) = self.topics.bodies {
+            if let (Some(ch), true) = (self.topics.bodies, want_bodies) {
                 changes.bodies.time = out.frame as f64 * self.dt;
                 self.writer.write(ch, t, changes.bodies)?;
+                self.built += 1;
             }
         }
-        if let Some(ch) = self.topics.contacts {
+        if let (Some(ch), true) = (self.topics.contacts, self.wanted.contacts) {
             self.writer.write(ch, t, contacts_message(out))?;
+            self.built += 1;
         }
-        if let Some(ch) = self.topics.stats {
+        if let (Some(ch), true) = (self.topics.stats, self.wanted.stats) {
             self.writer.write(ch, t, stats_message(out, layers))?;
+            self.built += 1;
         }
-        if let Some(ch) = self.topics.events {
+        if let (Some(ch), true) = (self.topics.events, self.wanted.events) {
             for e in &out.events {
                 let line = crate::events::line(e, w, out);
                 let msg = Log {
@@ -283,6 +326,7 @@ impl<S: MessageSink> Recorder<S> {
                     line: 0,
                 };
                 self.writer.write(ch, t, msg)?;
+                self.built += 1;
             }
         }
         Ok(())

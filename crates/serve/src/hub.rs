@@ -163,6 +163,19 @@ impl Shared {
         }
     }
 
+    /// Whether some client subscribes to `topic` (a room nobody records builds only what
+    /// is watched).
+    pub fn watched(&self, topic: &str) -> bool {
+        self.channels
+            .iter()
+            .find(|c| c.topic == topic)
+            .is_some_and(|c| {
+                self.clients
+                    .values()
+                    .any(|k| k.subscriptions.contains_key(&c.id))
+            })
+    }
+
     /// How many clients are connected.
     pub fn client_count(&self) -> usize {
         self.clients.len()

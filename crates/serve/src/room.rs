@@ -13,12 +13,13 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
+use ricochet_record::channels::Channels;
 use ricochet_record::session::{GameSession, StepError};
 use ricochet_sim::{Game, Player};
 use serde::Deserialize;
 use tokio_tungstenite::tungstenite::Message;
 
-use crate::hub::Hub;
+use crate::hub::{Hub, LATEST};
 use crate::protocol::{self, Service, ServiceSchema};
 use crate::sink::ServeSink;
 
@@ -63,6 +64,8 @@ pub struct Room<G: Game> {
     input_schema: Arc<str>,
     /// Where its recording goes, for messages.
     pub recording: Option<PathBuf>,
+    /// When its worker last took its clients' calls.
+    looked: Instant,
 }
 
 /// The room services' list (advertised to a room's clients).
@@ -146,7 +149,19 @@ impl<G: Game> Room<G> {
             empty_since: Some(Instant::now()),
             input_schema,
             recording,
+            looked: Instant::now(),
         }
+    }
+
+    /// Whether its worker should look at it now: its frame is due, or `poll` has passed
+    /// since it was last looked at (then it is marked looked at).
+    pub fn worth_a_look(&mut self, now: Instant, poll: Duration) -> bool {
+        let due = self.due() <= now;
+        if due || now.saturating_duration_since(self.looked) >= poll {
+            self.looked = now;
+            return true;
+        }
+        false
     }
 
     /// When its next frame is due.
@@ -290,9 +305,23 @@ impl<G: Game> Room<G> {
                 ricochet_sim::MAX_FRAMES
             )));
         }
-        self.hub
-            .lock()
-            .broadcast(&Message::binary(protocol::time(t)));
+        let wanted = {
+            let mut s = self.hub.lock();
+            s.broadcast(&Message::binary(protocol::time(t)));
+            // A room nobody records builds only the messages some client subscribes to:
+            // building every channel's for nobody was most of a room's frame
+            // (BENCHMARKS.md, "Rooms"). A recorded room builds them all, as before.
+            self.recording.is_none().then(|| Channels {
+                scene: LATEST.iter().any(|topic| s.watched(topic)),
+                bodies: s.watched("/bodies"),
+                contacts: s.watched("/contacts"),
+                stats: s.watched("/stats"),
+                events: s.watched("/events"),
+            })
+        };
+        if let (Some(wanted), Some(session)) = (wanted, self.session.as_mut()) {
+            session.recorder().build_only(wanted);
+        }
         match self.guarded("a frame", GameSession::step)? {
             Ok(_) => {}
             Err(StepError::Overflow { frame, what }) => {
@@ -337,5 +366,151 @@ impl<G: Game> Room<G> {
                     .map_or(String::new(), |p| p.display().to_string())
             )
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use ricochet_sim::prelude::*;
+
+    use super::*;
+    use crate::hub::{LiveSink, client_queue};
+    use crate::queue::ClientQueueReceiver;
+
+    /// A game whose state (on `/game`) counts the frames stepped.
+    struct Frames(u64);
+
+    impl Game for Frames {
+        type Input = u64;
+        type State = u64;
+
+        fn name(&self) -> &str {
+            "frames"
+        }
+
+        fn input(&mut self, _: &mut Simulation, _: Player, _: u64) -> Result<(), String> {
+            Ok(())
+        }
+
+        fn after_step(&mut self, _sim: &mut Simulation, _out: &FrameOutput) {
+            self.0 += 1;
+        }
+
+        fn state(&self) -> Option<&u64> {
+            Some(&self.0)
+        }
+    }
+
+    /// An unrecorded room of a wall and three balls crossing it (so `/scene`, `/bodies`,
+    /// `/stats` and `/contacts` change every frame), and a client of it.
+    fn room() -> (Room<Frames>, u64, ClientQueueReceiver) {
+        let mut sim = Simulation::from_def(WorldDef {
+            gravity: Vec2::ZERO,
+            ..WorldDef::default()
+        })
+        .unwrap();
+        sim.spawn(&BodyDef {
+            kind: BodyKind::Static,
+            shape: Shape::aabb(Vec2::new(10.0, 1.0)).unwrap(),
+            ..BodyDef::default()
+        });
+        for i in 0..3u32 {
+            sim.spawn(&BodyDef {
+                shape: Shape::circle(0.5).unwrap(),
+                position: Vec2::new(f64::from(i) * 2.0, 3.0),
+                velocity: Vec2::new(0.0, -10.0),
+                ..BodyDef::default()
+            });
+        }
+        let hub = Hub::default();
+        let sink = ServeSink {
+            live: LiveSink::new(hub.clone()),
+            file: None,
+            muted: false,
+        };
+        let session = GameSession::start(sim, Frames(0), sink, true).unwrap();
+        let dt = Duration::from_millis(16);
+        let room = Room::new("r".into(), hub.clone(), session, dt, "{}".into(), None);
+        let (queue, rx) = client_queue();
+        let (client, _kicked) = hub.lock().connect(queue);
+        (room, client, rx)
+    }
+
+    fn subscribe(room: &Room<Frames>, client: u64, topic: &str, subscription: u32) {
+        let mut s = room.hub.lock();
+        let id = s.channels().iter().find(|c| c.topic == topic).unwrap().id;
+        s.subscribe(client, subscription, id).unwrap();
+    }
+
+    /// The subscription ids of the messages `rx` holds, with their times (ns), in order.
+    fn received(rx: &mut ClientQueueReceiver) -> Vec<(u32, u64)> {
+        let mut got = Vec::new();
+        while let Ok(m) = rx.try_recv() {
+            let data = m.into_data();
+            if data.first() == Some(&protocol::OP_MESSAGE_DATA) {
+                let sub = u32::from_le_bytes(data[1..5].try_into().unwrap());
+                let time = u64::from_le_bytes(data[5..13].try_into().unwrap());
+                got.push((sub, time));
+            }
+        }
+        got
+    }
+
+    #[test]
+    fn an_unrecorded_room_builds_no_message_nobody_subscribed_to() {
+        let (mut room, client, mut rx) = room();
+        subscribe(&room, client, "/game", 7);
+        for _ in 0..10 {
+            room.step().map_err(|_| "a step failed").unwrap();
+        }
+        let built = room.session.as_mut().unwrap().recorder().built();
+        assert_eq!(
+            built, 0,
+            "no client watches the scene, bodies, stats or contacts"
+        );
+        // Its `/game` still came, one a frame: frame n at n × 16 ms.
+        let dt_ns = room.session.as_ref().unwrap().dt_ns();
+        let game: Vec<(u32, u64)> = (0..10).map(|n| (7, n * dt_ns)).collect();
+        assert_eq!(received(&mut rx), game);
+    }
+
+    #[test]
+    fn a_worker_looks_at_a_room_when_its_frame_is_due_or_a_poll_after_it_last_did() {
+        let (mut room, _, _) = room();
+        let poll = Duration::from_millis(5);
+        let start = room.start;
+        room.looked = start;
+        // Frame 0 is due at the start.
+        assert!(room.worth_a_look(start, poll));
+        room.step().map_err(|_| "a step failed").unwrap();
+        // Frame 1 is due 16 ms after the start: 1 ms and 4 ms in, nothing to do.
+        assert!(!room.worth_a_look(start + Duration::from_millis(1), poll));
+        assert!(!room.worth_a_look(start + Duration::from_millis(4), poll));
+        // 5 ms after it was last looked at: its calls are taken.
+        assert!(room.worth_a_look(start + Duration::from_millis(5), poll));
+        assert!(!room.worth_a_look(start + Duration::from_millis(9), poll));
+        assert!(room.worth_a_look(start + Duration::from_millis(16), poll));
+    }
+
+    #[test]
+    fn a_client_subscribing_later_gets_the_whole_scene_at_the_next_frame() {
+        let (mut room, client, mut rx) = room();
+        for _ in 0..5 {
+            room.step().map_err(|_| "a step failed").unwrap();
+        }
+        for (topic, sub) in [
+            ("/scene/static", 1),
+            ("/scene", 2),
+            ("/tf", 3),
+            ("/stats", 4),
+        ] {
+            subscribe(&room, client, topic, sub);
+        }
+        room.step().map_err(|_| "a step failed").unwrap();
+        let t5 = 5 * room.session.as_ref().unwrap().dt_ns();
+        let mut got = received(&mut rx);
+        got.sort_unstable();
+        // The static wall never changes, yet its scene comes whole, with the camera's frame.
+        assert_eq!(got, [(1, t5), (2, t5), (3, t5), (4, t5)]);
     }
 }

@@ -32,6 +32,15 @@ use crate::protocol::{self, ClientMessage, ServerMessage};
 /// bytes). A larger one closes the connection with status 1009 (Message Too Big) and a
 /// reason naming the limit.
 pub const MAX_CLIENT_MESSAGE: usize = 64 * 1024;
+
+/// A connection's read buffer, bytes (tungstenite's default is 128 KiB, zeroed before
+/// every read).
+const READ_BUFFER: usize = 4096;
+
+/// Queued messages written to a client with one flush, at most: the connection reads its
+/// client between batches.
+const MAX_BATCH: usize = 64;
+
 /// How long a connection the server closes (a message too big, too many clients) is still
 /// read, what comes dropped, after the close frame: so that the kernel ends it with a FIN
 /// rather than a reset, which could discard the close frame before the client reads it.
@@ -180,7 +189,12 @@ async fn client(
     evicted: oneshot::Receiver<()>,
     note: &Note,
 ) -> Result<(), String> {
+    // tungstenite zeroes its whole free read buffer before each read (128 KiB by default):
+    // with hundreds of connections each reading a few small inputs a second, that memset
+    // was most of this thread's time (BENCHMARKS.md, "Rooms"), and 128 KiB resident per
+    // client. A client's messages are small (inputs, calls); a larger one grows the buffer.
     let config = tokio_tungstenite::tungstenite::protocol::WebSocketConfig::default()
+        .read_buffer_size(READ_BUFFER)
         .max_message_size(Some(MAX_CLIENT_MESSAGE))
         .max_frame_size(Some(MAX_CLIENT_MESSAGE));
     let chosen = std::sync::Mutex::new(None);
@@ -241,7 +255,16 @@ async fn client(
         loop {
             tokio::select! {
                 sent = pending.recv() => match sent {
-                    Some(m) => out.send(m).await.map_err(|e| Ended::Failed(e.to_string()))?,
+                    Some(m) => {
+                        // What else is queued goes in the same write (a frame's `time` and
+                        // its messages): one system call, not one a message.
+                        out.feed(m).await.map_err(|e| Ended::Failed(e.to_string()))?;
+                        for _ in 1..MAX_BATCH {
+                            let Ok(m) = pending.try_recv() else { break };
+                            out.feed(m).await.map_err(|e| Ended::Failed(e.to_string()))?;
+                        }
+                        out.flush().await.map_err(|e| Ended::Failed(e.to_string()))?;
+                    }
                     None => return Ok(()),
                 },
                 Ok(why) = &mut kicked => {
