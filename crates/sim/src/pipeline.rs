@@ -47,6 +47,7 @@ use crate::stage_set::Stage;
 use crate::stages::detect::DetectState;
 use crate::stages::one_way::{self, OneWayState};
 use crate::stages::separate::SeparateState;
+use crate::stages::slope::SlopeState;
 use crate::stages::touch::TouchState;
 use crate::stages::{
     StageCtx, bounds, cull, detect, lifetimes, motion, script, separate, sleep, touch,
@@ -105,6 +106,8 @@ pub struct Simulation {
     pub(crate) one_way: OneWayState,
     /// The pairs touching at the end of the last frame (`touch`).
     pub(crate) touch: TouchState,
+    /// The snap of controlled bodies to sloped ground (`stages/slope.rs`).
+    pub(crate) slopes: SlopeState,
     /// The threads of the parallel stages (`parallel.rs`); one by default.
     pub(crate) workers: Workers,
     /// The scene queries' trees (`query/index.rs`): built by the first query after a
@@ -211,6 +214,7 @@ impl Simulation {
             separate: SeparateState::new(layers),
             one_way: OneWayState::new(layers),
             touch: TouchState::new(layers),
+            slopes: SlopeState::default(),
             scenario,
             world,
             frame: 0,
@@ -420,6 +424,11 @@ impl Simulation {
                 };
                 one_way::run(&mut ctx, &mut self.one_way);
             }
+            if stage == Stage::Unground && self.frame > 0 {
+                // Who was grounded at the end of the last frame, for the snap after
+                // `detect`: `unground` is about to forget it. Not a counted stage.
+                self.slopes.start_frame(&self.world, &self.scenario.world);
+            }
             if allowed && stage == Stage::MoveX && !self.carries() {
                 fused = true;
                 self.run_motion(&mut out);
@@ -430,6 +439,11 @@ impl Simulation {
                 out.stats.stages_run.insert(stage);
             } else {
                 out.stats.stages_skipped.insert(stage);
+            }
+            if stage == Stage::Detect && self.frame > 0 && self.slopes.has_work() {
+                // The snap to sloped ground (`stages/slope.rs`): only in a scene with a
+                // sloped static body, and not a counted stage (as the one-way pass).
+                self.slopes.snap(&mut self.world, &self.scenario.world);
             }
         }
         out.stats.bodies = self.world.len();
