@@ -18,7 +18,8 @@
 //! | `resolve_y` | per-axis separation along y; a push upwards sets `grounded` and the carrier a box rides next frame; `crushed` as along x |
 //! | `turn` | `angle += angular_velocity * dt` |
 //! | (`one_way`) | only with a `one_way` layer pair, and not a counted stage (the stats' stage list is in every log): lands the bodies that came down onto a one-way platform (`stages/one_way.rs`) |
-//! | `detect` | broad phase, exact narrow phase, `report`/`destroy`/`separate` responses |
+//! | `detect` | broad phase, exact narrow phase, `report`/`destroy`/`separate` responses (a runner or walker on a slope: `stages/slope.rs`) |
+//! | (`snap`) | only in a scene with a static body that is not an axis-aligned box, and not a counted stage: a runner or walker grounded at the end of the last frame (noted before `unground`) and in the air now is snapped down onto a slope (`stages/slope.rs`) |
 //! | `lifetimes` | count down lifetimes; remove expired bodies |
 //! | `bounds` | wrap around (Asteroids) or remove bodies that left the world |
 //! | `sleep` | count the frames each dynamic body rested; put to sleep those that rested long enough |
@@ -346,7 +347,7 @@ impl Simulation {
             Stage::Controls => motion::controls(ctx.world),
             Stage::Forces => motion::forces(ctx.world, ctx.def),
             Stage::MoveX => motion::move_x(ctx.world, dt, carries),
-            Stage::ResolveX => separate::resolve_x(&mut ctx, &mut self.separate),
+            Stage::ResolveX => separate::resolve_x(&mut ctx, &mut self.separate, &self.slopes),
             Stage::MoveY => motion::move_y(ctx.world, dt, carries),
             Stage::ResolveY => separate::resolve_y(&mut ctx, &mut self.separate),
             Stage::Turn => motion::turn(ctx.world, dt),

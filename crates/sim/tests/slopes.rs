@@ -102,7 +102,8 @@ fn actor(s: &Simulation) -> Entity {
 }
 
 /// Runs a runner with input `input` for `frames` frames; every frame it must be grounded
-/// with its bottom on the ground under it. Returns its final x.
+/// with its bottom on the ground under it, and have moved `input × run_speed × dt` along x
+/// (never held back, at the crest either). Returns its final x.
 fn walk(angle: f64, start_x: f64, input: f64, frames: u32) -> f64 {
     let y = ground_under(angle, start_x) + HH;
     let mut s = scene(angle, "", &runner(start_x, y));
@@ -110,9 +111,16 @@ fn walk(angle: f64, start_x: f64, input: f64, frames: u32) -> f64 {
     s.step();
     s.apply(a, Action::Move(input)).unwrap();
     let mut top = f64::NEG_INFINITY;
+    let mut x = start_x;
     for frame in 1..=frames {
         s.step();
         let p = s.position(a).unwrap();
+        let step = p.x - x;
+        x = p.x;
+        assert!(
+            (step - input * 5.0 / 60.0).abs() <= TOL,
+            "{angle}°, frame {frame}: moved {step} along x to {x}"
+        );
         let bottom = p.y - HH;
         let want = ground_under(angle, p.x);
         assert!(

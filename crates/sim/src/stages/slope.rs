@@ -26,6 +26,11 @@
 //! off a ledge it falls as before (a ledge drops further than the reach). The snap only
 //! runs in a scene with a static body that is not an axis-aligned box in a `separate`
 //! layer: a scene of box tiles runs exactly as it always did.
+//!
+//! A crest onto a box tile: in such a scene, `resolve_x` does not stop a body noted for the
+//! snap at the side of a static box whose top is above its bottom by no more than that
+//! reach ([`SlopeState::steps_onto`]); `resolve_y` lifts it on top. A ramp meeting a tile
+//! of its plateau's height would otherwise hold the body back for a frame at the crest.
 
 use std::f64::consts::PI;
 
@@ -189,6 +194,28 @@ impl SlopeState {
                 self.grounded.push(w.entity[i]);
             }
         }
+    }
+
+    /// Whether `resolve_x` lets body `i` (bounds `bi`) walk onto the static box `bj` it
+    /// overlaps instead of stopping it: `i` is a runner or walker that started the frame
+    /// grounded in a scene with a sloped static (noted by [`SlopeState::start_frame`]), and
+    /// its bottom is below the box's top by no more than a climbable slope rises over its
+    /// move along x this frame (plus [`SLOP`]). That is a ramp's crest meeting a tile of
+    /// the plateau's height: without it the tile's side would hold the body back for the
+    /// frame it is still below the crest. `resolve_y` then lifts it on top.
+    pub(crate) fn steps_onto(
+        &self,
+        w: &World,
+        def: &WorldDef,
+        i: usize,
+        (bi, bj): (&ricochet_geom::Bounds, &ricochet_geom::Bounds),
+    ) -> bool {
+        let rise = bj.max.y - bi.min.y;
+        if self.grounded.is_empty() || rise <= 0.0 || !self.grounded.contains(&w.entity[i]) {
+            return false;
+        }
+        let dx = (w.position[i].x - w.start_position(i).x).abs();
+        rise <= Climb::of(def).drop_over(dx) + SLOP
     }
 
     /// Whether a body may snap this frame.
