@@ -184,6 +184,46 @@ fn an_idle_runner_stays_put_on_30_and_45_degree_ramps() {
     }
 }
 
+#[test]
+fn an_idle_runner_stays_put_on_a_rotated_box_ramp() {
+    for angle in [30.0f64, 45.0] {
+        // A static `obb` of half extents [3, 0.5] at (-15, 0) (over the floor, far from
+        // the ramp) turned by `angle`: its top face is the line through
+        // (-15, 0) + 0.5 (-sin, cos), of slope tan(angle). The runner's bottom right corner
+        // (the highest ground under it) is on it.
+        let (sin, cos) = (libm::sin(angle.to_radians()), libm::cos(angle.to_radians()));
+        let (fx, fy) = (-15.0 - 0.5 * sin, 0.5 * cos);
+        let x = -15.6;
+        let start = (x, fy + (x + HW - fx) * tan(angle) + HH);
+        let body = format!(
+            r#"{}
+[[bodies]]
+name = "tilted"
+layer = "ground"
+kind = "static"
+shape = {{ kind = "obb", half_extents = [3, 0.5] }}
+position = [-15, 0]
+angle = {:?}"#,
+            runner(start.0, start.1),
+            angle.to_radians()
+        );
+        let mut s = scene(angle, "", &body);
+        let a = actor(&s);
+        for frame in 0..=600 {
+            s.step();
+            let p = s.position(a).unwrap();
+            let moved = ((p.x - start.0).powi(2) + (p.y - start.1).powi(2)).sqrt();
+            assert!(
+                moved < 1e-9,
+                "{angle}°, frame {frame}: moved {moved} to {p:?}"
+            );
+            if frame > 0 {
+                assert!(s.grounded(a).unwrap(), "{angle}°, frame {frame}");
+            }
+        }
+    }
+}
+
 /// A runner running right at a 60° ramp from the floor for 2 s, with `world` lines; its
 /// final position. Every frame it is grounded, and its bottom is on the floor or, with
 /// `climbs`, on the ramp under its right edge.
