@@ -158,6 +158,11 @@ fn each_error_class_is_named_with_its_location() {
         ],
     );
     case(
+        "max-climb-angle-90",
+        "6:19",
+        &["world.max_climb_angle", "from 0 to less than 90", "got 90"],
+    );
+    case(
         "sleep-after-zero",
         "6:15",
         &["world.sleep_after", "from 1 to 4294967295", "got 0"],

@@ -441,7 +441,20 @@ pub struct WorldDef {
     /// Dynamic bodies resting on static geometry for this many frames fall asleep
     /// (default: `None`, nothing sleeps).
     pub sleep_after: Option<u32>,
+    /// The steepest surface a `runner` or `walker` walks up and down, in degrees from the
+    /// horizontal (`[world] max_climb_angle`, default [`DEFAULT_MAX_CLIMB_ANGLE`], from 0 to
+    /// less than [`MAX_CLIMB_ANGLE_LIMIT`]); a steeper one is a wall to it
+    /// (`stages/slope.rs`).
+    pub max_climb_angle: f64,
 }
+
+/// The default [`WorldDef::max_climb_angle`], degrees: rapier's character controller's
+/// default too.
+pub const DEFAULT_MAX_CLIMB_ANGLE: f64 = 45.0;
+
+/// [`WorldDef::max_climb_angle`] is below this, degrees: at 90° every wall would be ground,
+/// and the reach of the snap to the ground (`tan` of the angle) would be unbounded.
+pub const MAX_CLIMB_ANGLE_LIMIT: f64 = 90.0;
 
 /// A region around a focus body (the player): moving bodies entirely outside it are frozen,
 /// neither moved nor tested, until the region reaches them again.
@@ -463,6 +476,7 @@ impl Default for WorldDef {
             broad_phase: BroadPhaseKind::Auto,
             active_region: None,
             sleep_after: None,
+            max_climb_angle: DEFAULT_MAX_CLIMB_ANGLE,
         }
     }
 }

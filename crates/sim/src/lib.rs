@@ -197,9 +197,9 @@ pub use action::{Action, Event, ScriptAction};
 pub use check::ScenarioError;
 pub use control::{ControlError, NonFinite};
 pub use def::{
-    ActiveRegion, BodyDef, BodyKind, Controller, Doomed, LayerId, Layers, MAX_CONTROLLER_VALUE,
-    MAX_FRAMES, MAX_MASS, MIN_MASS, Platform, Response, RunLengthError, Split, WorldBounds,
-    WorldDef, controller_out_of_range, shape_reach,
+    ActiveRegion, BodyDef, BodyKind, Controller, DEFAULT_MAX_CLIMB_ANGLE, Doomed, LayerId, Layers,
+    MAX_CLIMB_ANGLE_LIMIT, MAX_CONTROLLER_VALUE, MAX_FRAMES, MAX_MASS, MIN_MASS, Platform,
+    Response, RunLengthError, Split, WorldBounds, WorldDef, controller_out_of_range, shape_reach,
 };
 pub use entity::{Entity, EntityAllocator};
 pub use event::{FireOutcome, GameEvent, JumpOutcome, Removal, ScriptInput};

@@ -28,6 +28,21 @@ pub const MAX_FRAMES: u64 = 100_000_000;
 /// of them was queried.
 pub const MAX_HISTORY: usize = 256;
 
+/// Whether `degrees` is a [`WorldDef::max_climb_angle`] the stages can use: finite, from 0
+/// to less than [`crate::def::MAX_CLIMB_ANGLE_LIMIT`].
+pub(crate) fn climb_angle_ok(degrees: f64) -> bool {
+    degrees.is_finite() && (0.0..crate::def::MAX_CLIMB_ANGLE_LIMIT).contains(&degrees)
+}
+
+/// The problem with a `max_climb_angle` that is not [`climb_angle_ok`].
+pub(crate) fn climb_angle_problem(degrees: f64) -> String {
+    format!(
+        "must be a number of degrees from 0 to less than {}, got {}",
+        Number(crate::def::MAX_CLIMB_ANGLE_LIMIT),
+        Number(degrees)
+    )
+}
+
 /// Why a run's length or timestep cannot be logged: every frame's time must be a distinct
 /// whole number of nanoseconds that fits in a `u64` (`log_time = frame * dt_ns`).
 #[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]

@@ -18,7 +18,8 @@
 //! | `resolve_y` | per-axis separation along y; a push upwards sets `grounded` and the carrier a box rides next frame; `crushed` as along x |
 //! | `turn` | `angle += angular_velocity * dt` |
 //! | (`one_way`) | only with a `one_way` layer pair, and not a counted stage (the stats' stage list is in every log): lands the bodies that came down onto a one-way platform (`stages/one_way.rs`) |
-//! | `detect` | broad phase, exact narrow phase, `report`/`destroy`/`separate` responses |
+//! | `detect` | broad phase, exact narrow phase, `report`/`destroy`/`separate` responses (a runner or walker on a slope: `stages/slope.rs`) |
+//! | (`snap`) | only in a scene with a static body that is not an axis-aligned box, and not a counted stage: a runner or walker grounded at the end of the last frame (noted before `unground`) and in the air now is snapped down onto a slope (`stages/slope.rs`) |
 //! | `lifetimes` | count down lifetimes; remove expired bodies |
 //! | `bounds` | wrap around (Asteroids) or remove bodies that left the world |
 //! | `sleep` | count the frames each dynamic body rested; put to sleep those that rested long enough |
@@ -47,6 +48,7 @@ use crate::stage_set::Stage;
 use crate::stages::detect::DetectState;
 use crate::stages::one_way::{self, OneWayState};
 use crate::stages::separate::SeparateState;
+use crate::stages::slope::SlopeState;
 use crate::stages::touch::TouchState;
 use crate::stages::{
     StageCtx, bounds, cull, detect, lifetimes, motion, script, separate, sleep, touch,
@@ -105,6 +107,8 @@ pub struct Simulation {
     pub(crate) one_way: OneWayState,
     /// The pairs touching at the end of the last frame (`touch`).
     pub(crate) touch: TouchState,
+    /// The snap of controlled bodies to sloped ground (`stages/slope.rs`).
+    pub(crate) slopes: SlopeState,
     /// The threads of the parallel stages (`parallel.rs`); one by default.
     pub(crate) workers: Workers,
     /// The scene queries' trees (`query/index.rs`): built by the first query after a
@@ -211,6 +215,7 @@ impl Simulation {
             separate: SeparateState::new(layers),
             one_way: OneWayState::new(layers),
             touch: TouchState::new(layers),
+            slopes: SlopeState::default(),
             scenario,
             world,
             frame: 0,
@@ -342,7 +347,7 @@ impl Simulation {
             Stage::Controls => motion::controls(ctx.world),
             Stage::Forces => motion::forces(ctx.world, ctx.def),
             Stage::MoveX => motion::move_x(ctx.world, dt, carries),
-            Stage::ResolveX => separate::resolve_x(&mut ctx, &mut self.separate),
+            Stage::ResolveX => separate::resolve_x(&mut ctx, &mut self.separate, &self.slopes),
             Stage::MoveY => motion::move_y(ctx.world, dt, carries),
             Stage::ResolveY => separate::resolve_y(&mut ctx, &mut self.separate),
             Stage::Turn => motion::turn(ctx.world, dt),
@@ -420,6 +425,11 @@ impl Simulation {
                 };
                 one_way::run(&mut ctx, &mut self.one_way);
             }
+            if stage == Stage::Unground && self.frame > 0 {
+                // Who was grounded at the end of the last frame, for the snap after
+                // `detect`: `unground` is about to forget it. Not a counted stage.
+                self.slopes.start_frame(&self.world, &self.scenario.world);
+            }
             if allowed && stage == Stage::MoveX && !self.carries() {
                 fused = true;
                 self.run_motion(&mut out);
@@ -430,6 +440,11 @@ impl Simulation {
                 out.stats.stages_run.insert(stage);
             } else {
                 out.stats.stages_skipped.insert(stage);
+            }
+            if stage == Stage::Detect && self.frame > 0 && self.slopes.has_work() {
+                // The snap to sloped ground (`stages/slope.rs`): only in a scene with a
+                // sloped static body, and not a counted stage (as the one-way pass).
+                self.slopes.snap(&mut self.world, &self.scenario.world);
             }
         }
         out.stats.bodies = self.world.len();

@@ -130,6 +130,12 @@ fn check_world(at: &At<'_>, world: &WorldDef, frames: u64) -> Result<(), Scenari
             ),
         ));
     }
+    if !crate::limits::climb_angle_ok(world.max_climb_angle) {
+        return Err(at.err(
+            "world.max_climb_angle",
+            crate::limits::climb_angle_problem(world.max_climb_angle),
+        ));
+    }
     if let Some(r) = &world.active_region {
         let h = r.half_extents;
         if !(h.is_finite() && h.min_element() > 0.0) {

@@ -92,6 +92,8 @@ pub struct WorldFile {
     /// Frames at rest on static geometry before a dynamic body sleeps, >= 1 (default:
     /// nothing sleeps).
     pub sleep_after: Option<Spanned<i64>>,
+    /// The steepest slope a runner or walker climbs, degrees, 0 to < 90 (default 45).
+    pub max_climb_angle: Option<Spanned<f64>>,
     /// Moving bodies outside a box around a focus body are frozen (default: none).
     pub active_region: Option<ActiveRegionFile>,
 }

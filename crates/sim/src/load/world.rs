@@ -6,6 +6,7 @@ use crate::def::{
     ActiveRegion, Doomed, LayerId, Layers, MAX_FRAMES, Platform, Response, RunLengthError,
     WorldBounds, WorldDef,
 };
+use crate::limits::{climb_angle_ok, climb_angle_problem};
 use crate::load::context::{Ctx, ScenarioError, finite, unknown, vec2};
 use crate::load::file::ScenarioFile;
 use ricochet_geom::{Number, Numbers};
@@ -259,6 +260,13 @@ pub(crate) fn world_settings(
             )
         })?;
         world.sleep_after = Some(frames);
+    }
+    if let Some(a) = &raw.world.max_climb_angle {
+        let v = *a.get_ref();
+        if !climb_angle_ok(v) {
+            return Err(ctx.err(a.span(), "world.max_climb_angle", climb_angle_problem(v)));
+        }
+        world.max_climb_angle = v;
     }
     if let Some(r) = &raw.world.active_region {
         let h = *r.half_extents.get_ref();

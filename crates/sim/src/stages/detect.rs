@@ -52,6 +52,7 @@ use crate::stages::far_path;
 use crate::stages::push::{Statics, separate_along_normal};
 use crate::stages::remove::remove;
 use crate::stages::separate::is_box;
+use crate::stages::slope::Climb;
 use crate::stages::sweep_normal;
 use crate::stages::wrap::{self, Seam};
 use crate::stages::{SLOP, StageCtx};
@@ -582,7 +583,9 @@ fn respond(
         }
         Response::Separate => {
             let statics = Some((push_statics, &ctx.def.layers));
-            resolved = separate_along_normal(ctx.world, statics, (i, j), c.normal, c.depth);
+            let climb = Climb::of(ctx.def);
+            resolved =
+                separate_along_normal(ctx.world, statics, (i, j), (c.normal, c.depth), climb);
         }
     }
     ctx.out.contacts.push(ContactRecord {

@@ -26,6 +26,7 @@ pub(crate) mod rider;
 pub(crate) mod script;
 pub(crate) mod separate;
 pub(crate) mod sleep;
+pub(crate) mod slope;
 pub(crate) mod sweep_axis;
 pub(crate) mod sweep_normal;
 pub(crate) mod touch;

@@ -18,6 +18,7 @@ use crate::broad_phase::FixedGrid;
 use crate::def::{BodyKind, Layers, Response};
 use crate::stages::SLOP;
 use crate::stages::obstacles::static_index;
+use crate::stages::slope::{self, Climb};
 use crate::world::World;
 
 /// How many times a clipped push is checked against the static bodies again before it is
@@ -40,7 +41,7 @@ pub(crate) struct Statics {
 
 impl Statics {
     /// Rebuilds the grid if the static bodies changed.
-    fn refresh(&mut self, w: &World, layers: &Layers) {
+    pub(crate) fn refresh(&mut self, w: &World, layers: &Layers) {
         if self.generation == Some(w.static_generation()) {
             return;
         }
@@ -63,9 +64,14 @@ impl Statics {
         self.grid = FixedGrid::new(&entries);
     }
 
+    /// The static bodies the last [`Statics::near`] found, as dense indices, ascending.
+    pub(crate) fn found(&self) -> &[u32] {
+        &self.found
+    }
+
     /// Into `found`, the static bodies whose bounds meet `q` and that body `i` `separate`s
-    /// from, in id order.
-    fn near(&mut self, w: &World, layers: &Layers, i: usize, q: &ricochet_geom::Bounds) {
+    /// from, in id order (after [`Statics::refresh`]).
+    pub(crate) fn near(&mut self, w: &World, layers: &Layers, i: usize, q: &ricochet_geom::Bounds) {
         self.found.clear();
         let (movers, layer, found) = (w.movers(), w.layer[i], &mut self.found);
         self.grid.query(q, |s, _, l| {
@@ -180,13 +186,21 @@ struct Touch {
 /// removes the velocity that drives them into each other. Two dynamic bodies' pushes are
 /// clipped by `statics` (statics win, see the module docs). Returns the push on the body
 /// that moved (`j`'s when both did).
+/// A controlled body (`runner`, `walker`) on a sloped surface is lifted or stopped instead
+/// (`slope.rs`, by the world's `climb`).
 pub(crate) fn separate_along_normal(
     w: &mut World,
     statics: Option<(&mut Statics, &Layers)>,
     (i, j): (usize, usize),
-    normal: Vec2,
-    depth: f64,
+    (normal, depth): (Vec2, f64),
+    climb: Climb,
 ) -> Vec2 {
+    if let Some(s) = slope::surface(w, i, j, -normal, climb) {
+        return slope::stand(w, (i, j), -normal, depth, s);
+    }
+    if let Some(s) = slope::surface(w, j, i, normal, climb) {
+        return slope::stand(w, (j, i), normal, depth, s);
+    }
     let (di, dj) = (
         w.kind[i] == BodyKind::Dynamic,
         w.kind[j] == BodyKind::Dynamic,

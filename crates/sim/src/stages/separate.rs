@@ -37,6 +37,7 @@ use crate::stages::obstacles::{
 };
 use crate::stages::pass_order::{self, PassOrder};
 use crate::stages::rider::rider;
+use crate::stages::slope::SlopeState;
 use crate::stages::sweep_axis::{self, Swept};
 use crate::stages::{SLOP, StageCtx};
 use crate::world::World;
@@ -55,14 +56,16 @@ pub(crate) fn has_work(w: &World, st: &SeparateState) -> bool {
         })
 }
 
-/// The `resolve_x` stage: the pass along x.
-pub(crate) fn resolve_x(ctx: &mut StageCtx, st: &mut SeparateState) {
-    resolve(ctx, st, 0);
+/// The `resolve_x` stage: the pass along x. A runner or walker walking from a ramp onto a
+/// static box no higher than the ramp would have risen is not stopped by its side
+/// (`slopes`: `stages/slope.rs`); `resolve_y` lifts it on top.
+pub(crate) fn resolve_x(ctx: &mut StageCtx, st: &mut SeparateState, slopes: &SlopeState) {
+    resolve(ctx, st, 0, Some(slopes));
 }
 
 /// The `resolve_y` stage: the pass along y.
 pub(crate) fn resolve_y(ctx: &mut StageCtx, st: &mut SeparateState) {
-    resolve(ctx, st, 1);
+    resolve(ctx, st, 1, None);
 }
 
 /// What the per-axis stages keep between passes.
@@ -159,7 +162,7 @@ fn contains(outer: &Bounds, inner: &Bounds) -> bool {
 }
 
 /// One per-axis pass: settles every dynamic box along `axis`, lowest first.
-fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
+fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize, slopes: Option<&SlopeState>) {
     let phase = if axis == 0 { Phase::X } else { Phase::Y };
     let out = &mut *ctx.out;
     let layers = &ctx.def.layers;
@@ -290,6 +293,9 @@ fn resolve(ctx: &mut StageCtx, st: &mut SeparateState, axis: usize) {
                     continue;
                 }
                 if overlap(&bi, &bj, 0) <= SLOP || overlap(&bi, &bj, 1) <= SLOP {
+                    continue;
+                }
+                if !o.moving && slopes.is_some_and(|s| s.steps_onto(w, ctx.def, i, (&bi, &bj))) {
                     continue;
                 }
                 let mut by = push_out(&bi, &bj, axis);

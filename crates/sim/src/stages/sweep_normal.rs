@@ -20,6 +20,7 @@ use ricochet_geom::{Contact, Impact, Sweep, Vec2, contact, time_of_impact};
 use crate::def::{BodyKind, Response};
 use crate::output::{ContactRecord, Phase};
 use crate::stages::push::separate_along_normal;
+use crate::stages::slope::Climb;
 use crate::stages::{SLOP, StageCtx};
 use crate::world::World;
 
@@ -68,6 +69,7 @@ pub(crate) fn stop(
 /// still removes the velocity into the surface and grounds a landing), and logs the
 /// contact (phase `swept`, at the touching poses).
 pub(crate) fn apply(ctx: &mut StageCtx, (i, j): (usize, usize), impact: &Impact) {
+    let climb = Climb::of(ctx.def);
     let w = &mut *ctx.world;
     let (d, at) = if w.kind[i] == BodyKind::Dynamic {
         (i, impact.pose_a.position)
@@ -83,7 +85,7 @@ pub(crate) fn apply(ctx: &mut StageCtx, (i, j): (usize, usize), impact: &Impact)
         (impact.contact.normal, 0.0)
     };
     // One dynamic body against a static or kinematic one: no push between dynamic bodies.
-    separate_along_normal(w, None, (i, j), normal, depth);
+    separate_along_normal(w, None, (i, j), (normal, depth), climb);
     let resolved = w.position[d] - end;
     let (ea, eb) = (w.entity[i], w.entity[j]);
     ctx.out.contacts.push(ContactRecord {
