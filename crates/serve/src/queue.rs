@@ -380,4 +380,29 @@ mod tests {
         let n = std::iter::from_fn(|| receiver.try_recv().ok()).count();
         assert_eq!(n, 3);
     }
+
+    /// A whole state written holds its channel's next back for its bytes at
+    /// [`STATE_RATE`] (4 MB: 2 s, far longer than this test between two calls): what was
+    /// queued after the held state goes first, a newer state replaces the held one without
+    /// counting as a drop, and a closing connection still gets it.
+    #[tokio::test]
+    async fn a_written_state_holds_its_channels_next_back_and_others_pass_it() {
+        let (queue, mut receiver) = client_queue();
+        let big = Message::binary(vec![0u8; 4_000_000]);
+        assert_eq!(queue.offer_latest(1, big), Latest::Queued);
+        assert_eq!(receiver.recv().await.unwrap().len(), 4_000_000);
+        assert_eq!(queue.offer_latest(1, text("scene 2")), Latest::Queued);
+        assert!(queue.offer(text("stats 2")));
+        assert_eq!(queue.offer_latest(2, text("tf 2")), Latest::Queued);
+        let got = receiver.recv().await.unwrap().into_text().unwrap();
+        assert_eq!(got.as_str(), "stats 2");
+        // Another channel has its own pace.
+        let got = receiver.recv().await.unwrap().into_text().unwrap();
+        assert_eq!(got.as_str(), "tf 2");
+        assert_eq!(queue.offer_latest(1, text("scene 3")), Latest::Thinned);
+        let got = receiver.try_recv().unwrap().into_text().unwrap();
+        assert_eq!(got.as_str(), "scene 3");
+        assert!(receiver.try_recv().is_err());
+        assert_eq!(queue.queued(), 0);
+    }
 }
