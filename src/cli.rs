@@ -75,8 +75,9 @@ pub enum Command {
     /// subprotocols are accepted: foxglove.websocket.v1 (Lichtblick, @foxglove/ws-protocol)
     /// and foxglove.sdk.v1 (current Foxglove). A slow client loses messages (and is told),
     /// never the simulation or the recording; of /scene, /scene/static, /tf and
-    /// /scene/contacts it gets the latest, not a backlog. Ctrl-C or SIGTERM stops, finishing
-    /// --record.
+    /// /scene/contacts it gets the latest, not a backlog, and at most 2 MB/s of each (a
+    /// 10,000-body /scene about once a second: a browser viewer draws every scene it is
+    /// sent). Ctrl-C or SIGTERM stops, finishing --record.
     ///
     /// Bounds, whatever clients do: at most 64 clients, each with an 8 MiB queue (+1 MiB for
     /// answers), 256 advertised channels and 2,000 inputs a second of at most 4 KB; inputs

@@ -1,6 +1,7 @@
 //! A client that reads slowly gets the latest `/scene`, not a backlog (issue #37, item 2):
 //! `ricochet serve` of a 2,000-body level at real speed, one client that stops reading for
-//! 2 s, and one that reads all along.
+//! 2 s, and one that reads all along; and a client that reads as fast as it can is sent
+//! whole states no faster than the server's pace for them (`STATE_RATE`).
 
 use std::cell::Cell;
 use std::time::{Duration, Instant};
@@ -49,14 +50,7 @@ async fn connect_small(url: &str) -> Ws {
 #[test]
 fn a_slow_client_gets_the_latest_scene_and_a_reading_one_every_frame() {
     let dir = tempfile::tempdir().unwrap();
-    let level = dir.path().join("level.toml");
-    let out = std::process::Command::new("python3")
-        .arg(crate::util::root().join("scripts/asteroids_level.py"))
-        .arg("2000")
-        .output()
-        .unwrap();
-    assert!(out.status.success());
-    std::fs::write(&level, &out.stdout).unwrap();
+    let level = level_2000(dir.path());
     let server = serve(&[level.to_str().unwrap(), "--speed", "1"]);
     runtime().block_on(async {
         let mut slow = connect_small(&server.url).await;
@@ -122,6 +116,63 @@ fn a_slow_client_gets_the_latest_scene_and_a_reading_one_every_frame() {
              and two scenes of {largest}: {scenes:?}",
             old,
             scenes.len() - 1
+        );
+    });
+}
+
+/// The 2,000-body level of `scripts/asteroids_level.py`, in `dir`.
+fn level_2000(dir: &std::path::Path) -> std::path::PathBuf {
+    let level = dir.join("level.toml");
+    let out = std::process::Command::new("python3")
+        .arg(crate::util::root().join("scripts/asteroids_level.py"))
+        .arg("2000")
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    std::fs::write(&level, &out.stdout).unwrap();
+    level
+}
+
+/// A viewer that reads every message at once is not sent every scene: after writing a
+/// whole state of `n` bytes, the server waits `n / STATE_RATE` before that channel's next
+/// (newer ones replace it meanwhile). Here the level runs at 4 times real speed, 240
+/// scenes of about 0.3 MB a second (72 MB/s, far past the pace), and the bound
+/// checked holds on any machine however loaded: each scene is written no sooner than the
+/// bytes of those before it at the pace, counted from the subscription, so the bytes of
+/// all the scenes read but the last are at most `STATE_RATE` times the time from the
+/// subscription to the last one's arrival. Without the pace, a reading client was sent
+/// every scene the loop made.
+#[test]
+fn a_reading_client_is_sent_whole_states_no_faster_than_their_pace() {
+    let dir = tempfile::tempdir().unwrap();
+    let level = level_2000(dir.path());
+    let server = serve(&[level.to_str().unwrap(), "--speed", "4"]);
+    runtime().block_on(async {
+        let (mut ws, _) = connect(&server.url, "foxglove.websocket.v1").await.unwrap();
+        let _ = next_json(&mut ws).await;
+        let channels = next_json(&mut ws).await;
+        let subscribed = Instant::now();
+        subscribe_to(&mut ws, &channels, "/scene", 1).await;
+        // (arrival, bytes as sent: the payload and the 13 bytes of the message's header)
+        let mut scenes = Vec::new();
+        let until = subscribed + Duration::from_secs(3);
+        while Instant::now() < until {
+            let (sub, _, payload) = next_data(&mut ws).await;
+            if sub == 1 {
+                scenes.push((Instant::now(), payload.len() + 13));
+            }
+        }
+        assert!(scenes.len() >= 2, "{} scenes in 3 s", scenes.len());
+        let (last, _) = *scenes.last().unwrap();
+        let before_last: usize = scenes[..scenes.len() - 1].iter().map(|&(_, n)| n).sum();
+        let allowed = ricochet_serve::STATE_RATE * (last - subscribed).as_secs_f64();
+        assert!(
+            before_last as f64 <= allowed,
+            "{} scenes read in {:.3} s, {before_last} bytes before the last, more than the \
+             {allowed:.0} of {} bytes a second",
+            scenes.len(),
+            (last - subscribed).as_secs_f64(),
+            ricochet_serve::STATE_RATE
         );
     });
 }

@@ -6,7 +6,8 @@
 //! ([`CLIENT_BUDGET`]). On a whole-state topic ([`LATEST`]: `/scene`, `/scene/static`,
 //! `/tf`, `/scene/contacts`) a client's queue holds at most the latest undelivered message:
 //! a newer one replaces the queued older one in place, so a slow viewer gets the latest
-//! state, not a backlog. On the other topics a message that does not fit is dropped whole
+//! state, not a backlog; and each is written at most at [`STATE_RATE`] bytes a second (a
+//! browser viewer drains its socket faster than it can draw). On the other topics a message that does not fit is dropped whole
 //! for that client (counted, and the client is told once by a status message when it
 //! catches up, and sent the latest `/scene` again if it missed one). The simulation and
 //! the recording never lose a frame.
@@ -19,7 +20,7 @@ use tokio_tungstenite::tungstenite::Message;
 
 use crate::protocol::{self, Channel};
 
-pub use crate::queue::{CLIENT_BUDGET, ClientQueue, Latest, client_queue};
+pub use crate::queue::{CLIENT_BUDGET, ClientQueue, Latest, STATE_RATE, client_queue};
 
 /// Channels one client may advertise (`clientPublish`): Foxglove's panels advertise a few
 /// (the 3D panel's click tools, a Publish panel each); more are refused with a status, so
@@ -205,7 +206,7 @@ impl Shared {
             if let Some((time, payload)) = latched {
                 let data = protocol::message_data(subscription, time, &payload);
                 match c.queue.offer_latest(channel, Message::binary(data)) {
-                    Latest::Queued => {}
+                    Latest::Queued | Latest::Thinned => {}
                     Latest::Replaced => c.dropped += 1,
                     Latest::Dropped => {
                         c.dropped += 1;
@@ -364,14 +365,20 @@ impl Shared {
         let topic = self.channels.iter().find(|c| c.id == channel);
         let latched = topic.is_some_and(|c| LATCHED.contains(&c.topic.as_str()));
         let latest = topic.is_some_and(|c| LATEST.contains(&c.topic.as_str()));
+        // One message per subscription id, shared by the clients that chose the same id (two
+        // viewers of one layout do): its bytes are copied once, not once per client.
+        let mut built: BTreeMap<u32, Message> = BTreeMap::new();
         for c in self.clients.values_mut() {
             let Some(&sub) = c.subscriptions.get(&channel) else {
                 continue;
             };
-            let data = Message::binary(protocol::message_data(sub, time_ns, &payload));
+            let data = built
+                .entry(sub)
+                .or_insert_with(|| Message::binary(protocol::message_data(sub, time_ns, &payload)))
+                .clone();
             let queued = if latest {
                 match c.queue.offer_latest(channel, data) {
-                    Latest::Queued => true,
+                    Latest::Queued | Latest::Thinned => true,
                     Latest::Replaced => {
                         // The latest is queued; the older state it replaced is lost.
                         c.dropped += 1;

@@ -1,10 +1,14 @@
 //! A client's outgoing queue: bounded in bytes ([`CLIENT_BUDGET`]), in order, but for
 //! whole-state messages, each of which replaces, in its place, its channel's message still
-//! waiting (see [`ClientQueue::offer_latest`]).
+//! waiting (see [`ClientQueue::offer_latest`]), and is written at most at [`STATE_RATE`]
+//! (held back until due, while newer states replace it).
 
 use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard};
+use std::time::Duration;
+
+use tokio::time::Instant;
 
 use tokio::sync::mpsc;
 use tokio_tungstenite::tungstenite::Message;
@@ -30,16 +34,36 @@ const ANSWER_ROOM: usize = 1 << 20;
 /// message's allocation (so a flood of tiny messages is bounded too).
 const MESSAGE_OVERHEAD: usize = 64;
 
+/// Bytes a second of one whole-state channel (`/scene`, ...) written to one client at most:
+/// after writing a state of `n` bytes, the server waits `n / STATE_RATE` before the
+/// channel's next (newer states replace it meanwhile). 2 MB/s: a 10,000-body `/scene`
+/// (about 1.5 MB) goes about once a second, a 2,000-body one (0.3 MB) 6 times, a 250-body
+/// one every frame at 60 Hz. A browser viewer (Lichtblick) decodes and draws every scene it
+/// is sent, and its socket drains as fast as the server writes, so the connection's own
+/// pace does not hold it back: on the project's 2-core machine it froze at 90 MB/s (every
+/// 10,000-body frame) and at 8 MB/s, lagged by seconds at 4 MB/s, and kept up at 2 MB/s
+/// (BENCHMARKS.md, "Live at 10,000 bodies").
+pub const STATE_RATE: f64 = 2e6;
+
 /// A queued message whose content a newer one may replace until it is written: the
 /// latest state of one channel.
-type Slot = Arc<Mutex<Option<Message>>>;
+type Slot = Arc<Mutex<Held>>;
+
+/// What a [`Slot`] holds.
+#[derive(Default)]
+struct Held {
+    message: Option<Message>,
+    /// Held back by [`STATE_RATE`]: a newer state replacing it is thinning, not loss.
+    paced: bool,
+}
 
 /// One entry of a client's queue.
 enum Queued {
     /// Written as it is, in order.
     Message(Message),
-    /// Written with whatever the slot holds when its turn comes.
-    Latest(Slot),
+    /// Written with whatever the slot holds when its turn comes (and its channel's pace
+    /// allows).
+    Latest(u32, Slot),
 }
 
 /// A client's outgoing queue: unbounded in count, bounded in bytes by [`CLIENT_BUDGET`]
@@ -57,6 +81,12 @@ pub struct ClientQueue {
 pub struct ClientQueueReceiver {
     receiver: mpsc::UnboundedReceiver<Queued>,
     queued: Arc<AtomicUsize>,
+    /// By whole-state channel: when its next state may be written.
+    due: BTreeMap<u32, Instant>,
+    /// By whole-state channel: its slot, held back until due (still replaced in place).
+    paced: BTreeMap<u32, Slot>,
+    /// The whole state last returned (channel, bytes): written once the next is asked for.
+    writing: Option<(u32, usize)>,
 }
 
 /// A new queue for one client.
@@ -69,7 +99,13 @@ pub fn client_queue() -> (ClientQueue, ClientQueueReceiver) {
             queued: Arc::clone(&queued),
             latest: Arc::default(),
         },
-        ClientQueueReceiver { receiver, queued },
+        ClientQueueReceiver {
+            receiver,
+            queued,
+            due: BTreeMap::new(),
+            paced: BTreeMap::new(),
+            writing: None,
+        },
     )
 }
 
@@ -104,21 +140,32 @@ impl ClientQueue {
         let mut latest = lock(&self.latest);
         if let Some(slot) = latest.get(&channel) {
             let mut held = lock(slot);
-            if let Some(old) = held.as_ref() {
+            if let Some(old) = held.message.as_ref() {
                 // Add before taking away, so the count never underflows for the reader.
                 self.queued.fetch_add(weight(&message), Ordering::AcqRel);
                 self.queued.fetch_sub(weight(old), Ordering::AcqRel);
-                *held = Some(message);
-                return Latest::Replaced;
+                held.message = Some(message);
+                return if held.paced {
+                    Latest::Thinned
+                } else {
+                    Latest::Replaced
+                };
             }
         }
         let weight = weight(&message);
         if !self.fits(weight, CLIENT_BUDGET) {
             return Latest::Dropped;
         }
-        let slot: Slot = Arc::new(Mutex::new(Some(message)));
+        let slot: Slot = Arc::new(Mutex::new(Held {
+            message: Some(message),
+            paced: false,
+        }));
         self.queued.fetch_add(weight, Ordering::AcqRel);
-        if self.sender.send(Queued::Latest(Arc::clone(&slot))).is_err() {
+        if self
+            .sender
+            .send(Queued::Latest(channel, Arc::clone(&slot)))
+            .is_err()
+        {
             self.queued.fetch_sub(weight, Ordering::AcqRel);
             return Latest::Dropped;
         }
@@ -156,35 +203,105 @@ impl ClientQueue {
 
 impl ClientQueueReceiver {
     /// The next message to write (its bytes are given back to the budget), `None` once
-    /// every sender is gone.
+    /// every sender is gone. A whole state whose channel is not yet due (by
+    /// [`STATE_RATE`], from when the channel's last state was written: when this is called
+    /// again) is held back, in its slot, and the messages after it go first.
     pub async fn recv(&mut self) -> Option<Message> {
+        self.written(Instant::now());
         loop {
-            let queued = self.receiver.recv().await?;
-            if let Some(message) = self.take(queued) {
+            let now = Instant::now();
+            if let Some(message) = self.take_due(now) {
+                return Some(message);
+            }
+            let wake = self.paced.keys().filter_map(|c| self.due.get(c)).min();
+            let queued = match wake.copied() {
+                Some(at) => tokio::select! {
+                    biased;
+                    queued = self.receiver.recv() => queued?,
+                    () = tokio::time::sleep_until(at) => continue,
+                },
+                None => self.receiver.recv().await?,
+            };
+            if let Some(message) = self.take(queued, Instant::now()) {
                 return Some(message);
             }
         }
     }
 
-    /// The next message if one is queued now.
+    /// The next message if one is queued now, paced or not (a connection closing sends what
+    /// it holds).
     pub fn try_recv(&mut self) -> Result<Message, mpsc::error::TryRecvError> {
+        self.writing = None;
         loop {
-            let queued = self.receiver.try_recv()?;
-            if let Some(message) = self.take(queued) {
+            let queued = match self.receiver.try_recv() {
+                Ok(queued) => queued,
+                Err(e) => match self.paced.pop_first() {
+                    Some((_, slot)) => match self.take_slot(&slot) {
+                        Some(message) => return Ok(message),
+                        None => continue,
+                    },
+                    None => return Err(e),
+                },
+            };
+            let message = match queued {
+                Queued::Message(message) => Some(self.taken(message)),
+                Queued::Latest(_, slot) => self.take_slot(&slot),
+            };
+            if let Some(message) = message {
                 return Ok(message);
             }
         }
     }
 
-    /// The message an entry holds now (its bytes given back to the budget); `None` for a
-    /// slot already emptied.
-    fn take(&self, queued: Queued) -> Option<Message> {
-        let message = match queued {
-            Queued::Message(message) => message,
-            Queued::Latest(slot) => lock(&slot).take()?,
-        };
-        self.queued.fetch_sub(weight(&message), Ordering::AcqRel);
+    /// The state returned last was written (at `now`): its channel's next is due after its
+    /// bytes at [`STATE_RATE`].
+    fn written(&mut self, now: Instant) {
+        if let Some((channel, bytes)) = self.writing.take() {
+            let wait = Duration::from_secs_f64(bytes as f64 / STATE_RATE);
+            self.due.insert(channel, now + wait);
+        }
+    }
+
+    /// A held-back state whose channel is due at `now`, if any.
+    fn take_due(&mut self, now: Instant) -> Option<Message> {
+        let channel = *self
+            .paced
+            .keys()
+            .find(|c| self.due.get(c).is_none_or(|&at| at <= now))?;
+        let slot = self.paced.remove(&channel)?;
+        let message = self.take_slot(&slot)?;
+        self.writing = Some((channel, message.len()));
         Some(message)
+    }
+
+    /// The message an entry holds now (its bytes given back to the budget); `None` for a
+    /// slot already emptied, or held back until its channel is due.
+    fn take(&mut self, queued: Queued, now: Instant) -> Option<Message> {
+        match queued {
+            Queued::Message(message) => Some(self.taken(message)),
+            Queued::Latest(channel, slot) => {
+                if self.due.get(&channel).is_some_and(|&at| at > now) {
+                    lock(&slot).paced = true;
+                    self.paced.insert(channel, slot);
+                    return None;
+                }
+                let message = self.take_slot(&slot)?;
+                self.writing = Some((channel, message.len()));
+                Some(message)
+            }
+        }
+    }
+
+    /// A slot's message, if it still holds one (its bytes given back to the budget).
+    fn take_slot(&self, slot: &Slot) -> Option<Message> {
+        let message = lock(slot).message.take()?;
+        Some(self.taken(message))
+    }
+
+    /// `message`, its bytes given back to the budget.
+    fn taken(&self, message: Message) -> Message {
+        self.queued.fetch_sub(weight(&message), Ordering::AcqRel);
+        message
     }
 }
 
@@ -196,6 +313,9 @@ pub enum Latest {
     /// Queued in place of the channel's older state, which the client never gets (a
     /// message dropped for a slow client, counted as one).
     Replaced,
+    /// Queued in place of the channel's older state held back by [`STATE_RATE`]: the
+    /// client gets fewer, fresher states by design, not because it is slow (not counted).
+    Thinned,
     /// Dropped: it did not fit the budget.
     Dropped,
 }
@@ -259,5 +379,30 @@ mod tests {
         assert_eq!(queue2.queued(), 0);
         let n = std::iter::from_fn(|| receiver.try_recv().ok()).count();
         assert_eq!(n, 3);
+    }
+
+    /// A whole state written holds its channel's next back for its bytes at
+    /// [`STATE_RATE`] (4 MB: 2 s, far longer than this test between two calls): what was
+    /// queued after the held state goes first, a newer state replaces the held one without
+    /// counting as a drop, and a closing connection still gets it.
+    #[tokio::test]
+    async fn a_written_state_holds_its_channels_next_back_and_others_pass_it() {
+        let (queue, mut receiver) = client_queue();
+        let big = Message::binary(vec![0u8; 4_000_000]);
+        assert_eq!(queue.offer_latest(1, big), Latest::Queued);
+        assert_eq!(receiver.recv().await.unwrap().len(), 4_000_000);
+        assert_eq!(queue.offer_latest(1, text("scene 2")), Latest::Queued);
+        assert!(queue.offer(text("stats 2")));
+        assert_eq!(queue.offer_latest(2, text("tf 2")), Latest::Queued);
+        let got = receiver.recv().await.unwrap().into_text().unwrap();
+        assert_eq!(got.as_str(), "stats 2");
+        // Another channel has its own pace.
+        let got = receiver.recv().await.unwrap().into_text().unwrap();
+        assert_eq!(got.as_str(), "tf 2");
+        assert_eq!(queue.offer_latest(1, text("scene 3")), Latest::Thinned);
+        let got = receiver.try_recv().unwrap().into_text().unwrap();
+        assert_eq!(got.as_str(), "scene 3");
+        assert!(receiver.try_recv().is_err());
+        assert_eq!(queue.queued(), 0);
     }
 }
