@@ -228,6 +228,22 @@ impl ClientQueueReceiver {
         }
     }
 
+    /// The message [`recv`](Self::recv) would return now, without waiting, if any: paced
+    /// the same way (a whole state not yet due stays held back). What a connection adds to
+    /// the write it is making.
+    pub fn ready(&mut self) -> Option<Message> {
+        self.written(Instant::now());
+        if let Some(message) = self.take_due(Instant::now()) {
+            return Some(message);
+        }
+        loop {
+            let queued = self.receiver.try_recv().ok()?;
+            if let Some(message) = self.take(queued, Instant::now()) {
+                return Some(message);
+            }
+        }
+    }
+
     /// The next message if one is queued now, paced or not (a connection closing sends what
     /// it holds).
     pub fn try_recv(&mut self) -> Result<Message, mpsc::error::TryRecvError> {
@@ -404,5 +420,24 @@ mod tests {
         assert_eq!(got.as_str(), "scene 3");
         assert!(receiver.try_recv().is_err());
         assert_eq!(queue.queued(), 0);
+    }
+
+    /// What a connection adds to a write without waiting ([`ClientQueueReceiver::ready`]) is
+    /// paced as [`recv`](ClientQueueReceiver::recv) is: a state whose channel is not yet due
+    /// stays held back while the messages after it go.
+    #[tokio::test]
+    async fn a_batched_write_holds_a_state_back_as_recv_does() {
+        let (queue, mut receiver) = client_queue();
+        assert_eq!(
+            queue.offer_latest(1, Message::binary(vec![0u8; 4_000_000])),
+            Latest::Queued
+        );
+        assert_eq!(receiver.recv().await.unwrap().len(), 4_000_000);
+        assert_eq!(queue.offer_latest(1, text("scene 2")), Latest::Queued);
+        assert!(queue.offer(text("stats 2")));
+        let got = receiver.ready().unwrap().into_text().unwrap();
+        assert_eq!(got.as_str(), "stats 2");
+        assert!(receiver.ready().is_none(), "scene 2 is not due for 2 s");
+        assert_eq!(queue.offer_latest(1, text("scene 3")), Latest::Thinned);
     }
 }

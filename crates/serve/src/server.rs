@@ -260,7 +260,8 @@ async fn client(
                         // its messages): one system call, not one a message.
                         out.feed(m).await.map_err(|e| Ended::Failed(e.to_string()))?;
                         for _ in 1..MAX_BATCH {
-                            let Ok(m) = pending.try_recv() else { break };
+                            // Paced as `recv` is: `try_recv` is for a closing connection.
+                            let Some(m) = pending.ready() else { break };
                             out.feed(m).await.map_err(|e| Ended::Failed(e.to_string()))?;
                         }
                         out.flush().await.map_err(|e| Ended::Failed(e.to_string()))?;
