@@ -4,7 +4,7 @@
 
 use std::collections::BTreeMap;
 
-use ricochet_geom::{Primitive, Shape, Vec2};
+use ricochet_geom::{MAX_CHAIN_POINTS, Primitive, Shape, Vec2};
 use ricochet_sim::{BodyDef, TileRows, TiledDef};
 use tiled::{LayerType, ObjectData, ObjectShape, PropertyValue};
 
@@ -45,7 +45,11 @@ impl Built {
                     .filter(|t| t.0 == PieceKind::OneWay)
                     .map(|t| t.1.len())
                     .sum::<usize>(),
-            chains: 0,
+            chains: self
+                .pieces
+                .iter()
+                .filter(|p| p.kind == PieceKind::Chain)
+                .count(),
             spawns: self.spawned.clone(),
         }
     }
@@ -240,13 +244,12 @@ fn outlines(obj: &ObjectData, to_world: &dyn Fn(f64, f64) -> Vec2) -> Result<Vec
                     .collect(),
             )]
         }
-        ObjectShape::Polyline { .. } => {
-            return Err(
-                "a polyline is a terrain chain: chains are not supported yet; draw a \
-                        polygon, or leave the layer out of `solid` and `one_way`"
-                    .to_owned(),
-            );
-        }
+        ObjectShape::Polyline { points } => vec![Outline::Line(
+            points
+                .iter()
+                .map(|&(u, v)| f(f64::from(u), f64::from(v)))
+                .collect(),
+        )],
         ObjectShape::Point(..) => {
             return Err(
                 "a point has no area: give it a class, type or name listed in \
@@ -311,6 +314,44 @@ fn shape_of(parts: Vec<Primitive>) -> Result<Shape, String> {
     }
 }
 
+/// A polyline's chains, each a body (position: the centre of its points' bounds): one
+/// chain of up to [`MAX_CHAIN_POINTS`] points, or several that share their end points and
+/// name each other's as ghosts, so the joints between them are as smooth as the rest.
+pub(crate) fn chains(points: &[Vec2]) -> Result<Vec<(Vec2, Shape)>, String> {
+    if points.len() < 2 {
+        return Err(format!(
+            "a polyline of {} point(s): a chain needs at least 2",
+            points.len()
+        ));
+    }
+    if let Some(k) = (1..points.len()).find(|&k| points[k] == points[k - 1]) {
+        return Err(format!(
+            "polyline point {k} is on point {}: a chain's segments must have a length; \
+             remove the repeated point",
+            k - 1
+        ));
+    }
+    let step = MAX_CHAIN_POINTS - 1;
+    let mut out = Vec::new();
+    let mut start = 0;
+    while start + 1 < points.len() {
+        let end = (start + step).min(points.len() - 1);
+        let part = &points[start..=end];
+        let (lo, hi) = part.iter().fold(
+            (Vec2::splat(f64::INFINITY), Vec2::splat(f64::NEG_INFINITY)),
+            |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+        );
+        let origin = (lo + hi) * 0.5;
+        let local: Vec<Vec2> = part.iter().map(|p| *p - origin).collect();
+        let prev = start.checked_sub(1).map(|k| points[k] - origin);
+        let next = points.get(end + 1).map(|p| *p - origin);
+        let shape = Shape::chain(&local, prev, next).map_err(|e| e.to_string())?;
+        out.push((origin, shape));
+        start = end;
+    }
+    Ok(out)
+}
+
 /// The outlines' body: its position (the centre of their bounds) and shape.
 pub(crate) fn body_of(outs: &[Outline]) -> Result<(Vec2, Shape), String> {
     let mut lo = Vec2::splat(f64::INFINITY);
@@ -331,7 +372,7 @@ pub(crate) fn body_of(outs: &[Outline]) -> Result<(Vec2, Shape), String> {
                 }
                 v
             }
-            Outline::Ring(r) => r.clone(),
+            Outline::Ring(r) | Outline::Line(r) => r.clone(),
         };
         for p in pts {
             lo = lo.min(p);
@@ -493,12 +534,31 @@ fn walk(
                 };
                 let outs =
                     object_outlines(ctx, &obj, offset).map_err(|p| ctx.err(at.clone(), p))?;
-                let (position, shape) = body_of(&outs).map_err(|p| ctx.err(at.clone(), p))?;
                 let name = if obj.name.is_empty() {
                     layer.name.clone()
                 } else {
                     obj.name.clone()
                 };
+                if let [Outline::Line(points)] = outs.as_slice() {
+                    if kind == PieceKind::OneWay {
+                        return Err(ctx.err(
+                            at,
+                            "a polyline in a `one_way` entry: a one-way platform is a ledge \
+                             (its top is its bounding box's), not a line; draw a rectangle, \
+                             or list the layer in `solid` to make the polyline a chain",
+                        ));
+                    }
+                    for (position, shape) in chains(points).map_err(|p| ctx.err(at.clone(), p))? {
+                        built.pieces.push(TiledPiece {
+                            kind: PieceKind::Chain,
+                            name: name.clone(),
+                            shape,
+                            position,
+                        });
+                    }
+                    continue;
+                }
+                let (position, shape) = body_of(&outs).map_err(|p| ctx.err(at.clone(), p))?;
                 built.pieces.push(TiledPiece {
                     kind,
                     name,

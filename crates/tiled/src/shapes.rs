@@ -23,6 +23,8 @@ pub(crate) enum Outline {
     Capsule { a: Vec2, b: Vec2, radius: f64 },
     /// A closed outline, either orientation, convex or not (not crossing itself).
     Ring(Vec<Vec2>),
+    /// An open line: a polyline, which becomes terrain chains (`build::chains`).
+    Line(Vec<Vec2>),
 }
 
 fn cross(a: Vec2, b: Vec2) -> f64 {
@@ -50,6 +52,11 @@ pub(crate) fn primitives(outline: &Outline, origin: Vec2) -> Result<Vec<Primitiv
             let ring: Vec<Vec2> = points.iter().map(|p| *p - origin).collect();
             ring_primitives(&ring)
         }
+        Outline::Line(_) => Err(
+            "a polyline among a tile's collision shapes: a chain is a body of its own; draw \
+             it on an object layer"
+                .to_owned(),
+        ),
     }
 }
 
