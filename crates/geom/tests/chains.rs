@@ -59,16 +59,20 @@ fn a_lone_segment_catches_a_box_at_its_end_a_chain_segment_does_not() {
 fn at_a_convex_crest_the_box_is_pushed_along_the_slope_normal() {
     // Flat to (0, 0), then down at 45° to (2, -2): the joint turns away from the box
     // (convex). The first segment's end-cap push (0.001 along +x) points past the slope's
-    // normal (1, 1)/√2, so it is the slope's: along that normal, the box's lowest corner
-    // (-0.001, -0.01) is (0.001 + 0.01)/√2 below the line through the joint.
+    // normal (1, 1)/√2: the box is over the slope, so the flat segment leaves it to the
+    // slope (no contact from it), and the slope's is along its normal: the box's lowest
+    // corner (-0.001, -0.01) is (0.001 + 0.01)/√2 below the slope's line.
     let (b, at) = straddling_box();
     let crest = chain(&[(-2.0, 0.0), (0.0, 0.0), (2.0, -2.0)]);
-    let h = std::f64::consts::FRAC_1_SQRT_2;
-    let want = (0.011 * h, v(-h, -h));
     let c = contact(&b, &at, &part(&crest, 0), &Pose::default());
-    assert_contact(c, want.0, want.1, "flat segment at the crest");
+    assert_eq!(
+        c.depth,
+        f64::NEG_INFINITY,
+        "flat segment at the crest: {c:?}"
+    );
+    let h = std::f64::consts::FRAC_1_SQRT_2;
     let c = contact(&b, &at, &crest, &Pose::default());
-    assert_contact(c, want.0, want.1, "whole crest");
+    assert_contact(c, 0.011 * h, v(-h, -h), "whole crest");
 }
 
 #[test]

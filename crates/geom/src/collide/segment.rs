@@ -4,7 +4,7 @@
 //!
 //! The idea is Box2D's chain shape with ghost vertices (Erin Catto, "Ghost Collisions"):
 //! each segment knows its neighbours' far points, so it knows which normals belong to it.
-//! Seen from the side of the segment the body's centre is on (chains are two-sided), with
+//! Seen from the side of the chain the body's centre is on (chains are two-sided), with
 //! `up` the segment's normal on that side, a contact's normal `m` (from the segment to the
 //! body) is measured as an angle from `up`, positive towards `b`:
 //! - at an open end the segment's rounded end is real: every angle up to ±π is allowed;
@@ -15,12 +15,13 @@
 //!   is the segment's: the body is over the neighbour, or in the corner.
 //!
 //! A normal within [`ANGLE_TOLERANCE`] of `up` is the face's, computed from the projections
-//! (exactly `up`). A contact outside the allowed range is not this segment's. Apart, it is dropped (depth
-//! `-∞`): the neighbour shares the joint's point, so it is at most as far and answers for
-//! it. Overlapping, it is replaced by the push along the nearest allowed direction (the
-//! segment's `up` at a straight or concave joint, the neighbour's `up` at a convex one),
-//! as deep as the body reaches past the segment along it. A box on a flat chain is pushed
-//! straight up at every joint, never sideways.
+//! (exactly `up`). A contact outside the allowed range is not this segment's. Past a convex
+//! joint it is dropped (depth `-∞`): the body is over the neighbour, whose own contact
+//! answers for it (apart, the neighbour holds the joint's point, so it is at most as far).
+//! Past a straight or concave joint it is replaced by the push along the segment's `up`, as
+//! deep as the body reaches below the segment's line (a body flush on a flat chain at a
+//! joint touches the face, not an end); but a body apart from the segment that reaches
+//! below its line is beside the neighbour, and that contact is dropped. A box on a flat chain is pushed straight up at every joint, never sideways.
 
 use crate::contact::Contact;
 use crate::cores::{Core, collide_cores};
@@ -50,9 +51,19 @@ fn admit(c: Contact, body: &Core, s: &PlacedSegment) -> Contact {
     let e = s.b - s.a;
     let t = e.normalize();
     let points = &body.points[..body.count];
+    let m = -c.normal;
+    // The side the body is on: +1 left of `a -> b`, -1 right. The side of the chain its
+    // centre is on: of this segment's line where the centre is beside the segment, of the
+    // neighbour's where it is past an end that has one (on a crest, a body beside the
+    // slope's start is above the chain though below the slope's line).
     let centre = points.iter().fold(Vec2::ZERO, |sum, p| sum + *p) / points.len() as f64;
-    // The side the body is on: +1 left of `a -> b`, -1 right.
-    let side = if cross(e, centre - s.a) >= 0.0 {
+    let along_e = (centre - s.a).dot(t);
+    let (from, dir) = match (s.prev, s.next) {
+        (Some(p), _) if along_e < 0.0 => (p, s.a - p),
+        (_, Some(n)) if along_e > e.length() => (s.b, n - s.b),
+        _ => (s.a, e),
+    };
+    let side = if cross(dir, centre - from) >= 0.0 {
         1.0
     } else {
         -1.0
@@ -71,7 +82,6 @@ fn admit(c: Contact, body: &Core, s: &PlacedSegment) -> Contact {
         Some(p) if side * cross(s.a - p, e) < 0.0 => angle(left(s.a - p) * side),
         Some(_) => 0.0,
     };
-    let m = -c.normal;
     let theta = angle(m);
     // The push along allowed direction `bound`, as deep as the body reaches past the
     // segment along it (minus the gap when apart).
@@ -97,11 +107,23 @@ fn admit(c: Contact, body: &Core, s: &PlacedSegment) -> Contact {
     if (lo - ANGLE_TOLERANCE..=hi + ANGLE_TOLERANCE).contains(&theta) {
         return c;
     }
-    if c.depth <= 0.0 {
-        return Contact {
-            depth: f64::NEG_INFINITY,
-            ..c
-        };
+    // Past a convex joint the body is over the neighbour, whose own contact answers (the
+    // neighbour's line through the joint is not this segment's to push along); apart, the
+    // neighbour holds the joint's point, so it is at most as far.
+    let bound = if theta > hi { hi } else { lo };
+    let dropped = Contact {
+        depth: f64::NEG_INFINITY,
+        ..c
+    };
+    if bound != 0.0 {
+        return dropped;
     }
-    along(if theta > hi { hi } else { lo })
+    let face = along(0.0);
+    // Apart or touching, the face's answer only where the body is not below the line (a
+    // body flush on the chain at a joint touches the face; one past a concave joint and
+    // below this segment's line is beside the neighbour, which answers for it).
+    if c.depth <= 0.0 && face.depth > 0.0 {
+        return dropped;
+    }
+    face
 }
