@@ -499,6 +499,11 @@ impl Shape {
                 return Err(ShapeError::new("next", "is the chain's last point"));
             }
         }
+        // A closed loop (last point on the first, at least a triangle) is smooth at its
+        // closing joint too: each end's ghost is the point across the joint.
+        let closed = n >= 4 && points[0] == points[n - 1];
+        let prev = prev.or(if closed { Some(points[n - 2]) } else { None });
+        let next = next.or(if closed { Some(points[1]) } else { None });
         let parts = (0..n - 1)
             .map(|i| {
                 Primitive::Segment(Segment {
