@@ -357,7 +357,9 @@ fn polylines_become_chains_covering_exactly_their_points() {
     let zig: Vec<(f64, f64)> = (0..2500)
         .map(|k| (f64::from(k) * 4.0, if k % 2 == 0 { 0.0 } else { -3.0 }))
         .collect();
-    let lines: [(f64, f64, f64, Vec<(f64, f64)>); 3] = [
+    // Each: object x, y (px), rotation (degrees), points.
+    type Line = (f64, f64, f64, Vec<(f64, f64)>);
+    let lines: [Line; 3] = [
         (
             5.0,
             35.0,
@@ -395,7 +397,7 @@ fn polylines_become_chains_covering_exactly_their_points() {
     };
     let mut sampled = 0;
     for (x, y, rot, pts) in &lines {
-        let (s, c) = (rot.to_radians().sin(), rot.to_radians().cos());
+        let (s, c) = (libm::sin(rot.to_radians()), libm::cos(rot.to_radians()));
         // Tiled turns an object clockwise on screen (y down) about its anchor.
         let at = |u: f64, v: f64| (x + u * c - v * s, y + u * s + v * c);
         for w in pts.windows(2) {

@@ -71,10 +71,6 @@ pub struct PlacedSegment {
 
 /// A primitive placed in a frame (world coordinates, or coordinates relative to an origin).
 #[derive(Clone, Copy, Debug, PartialEq)]
-#[expect(
-    clippy::large_enum_variant,
-    reason = "placed primitives live briefly on the stack; boxing a polygon would allocate in the narrow phase"
-)]
 pub enum PlacedPrimitive {
     /// A placed circle.
     Circle(PlacedCircle),

@@ -245,10 +245,6 @@ impl Polygon {
 
 /// One convex piece: every shape kind except a compound.
 #[derive(Clone, Copy, Debug, PartialEq)]
-#[expect(
-    clippy::large_enum_variant,
-    reason = "polygons are stored inline (272 bytes) so a primitive is Copy and the narrow phase never chases a pointer"
-)]
 pub enum Primitive {
     /// A disc.
     Circle(Circle),
