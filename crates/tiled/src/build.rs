@@ -4,11 +4,11 @@
 
 use std::collections::BTreeMap;
 
-use ricochet_geom::{MAX_CHAIN_POINTS, Primitive, Shape, Vec2};
+use ricochet_geom::{Primitive, Shape, Vec2};
 use ricochet_sim::{BodyDef, TileRows, TiledDef};
 use tiled::{LayerType, ObjectData, ObjectShape, PropertyValue};
 
-use crate::shapes::{ELLIPSE_POINTS, Outline, primitives};
+use crate::shapes::{ELLIPSE_POINTS, Outline, chains, primitives};
 use crate::{MAX_ELLIPSE_RATIO, MAX_POLYGON_POINTS, MapSummary, PieceKind, TiledError, TiledPiece};
 
 /// What a map became.
@@ -312,44 +312,6 @@ fn shape_of(parts: Vec<Primitive>) -> Result<Shape, String> {
     } else {
         Shape::compound(parts).map_err(|e| e.to_string())
     }
-}
-
-/// A polyline's chains, each a body (position: the centre of its points' bounds): one
-/// chain of up to [`MAX_CHAIN_POINTS`] points, or several that share their end points and
-/// name each other's as ghosts, so the joints between them are as smooth as the rest.
-pub(crate) fn chains(points: &[Vec2]) -> Result<Vec<(Vec2, Shape)>, String> {
-    if points.len() < 2 {
-        return Err(format!(
-            "a polyline of {} point(s): a chain needs at least 2",
-            points.len()
-        ));
-    }
-    if let Some(k) = (1..points.len()).find(|&k| points[k] == points[k - 1]) {
-        return Err(format!(
-            "polyline point {k} is on point {}: a chain's segments must have a length; \
-             remove the repeated point",
-            k - 1
-        ));
-    }
-    let step = MAX_CHAIN_POINTS - 1;
-    let mut out = Vec::new();
-    let mut start = 0;
-    while start + 1 < points.len() {
-        let end = (start + step).min(points.len() - 1);
-        let part = &points[start..=end];
-        let (lo, hi) = part.iter().fold(
-            (Vec2::splat(f64::INFINITY), Vec2::splat(f64::NEG_INFINITY)),
-            |(lo, hi), p| (lo.min(*p), hi.max(*p)),
-        );
-        let origin = (lo + hi) * 0.5;
-        let local: Vec<Vec2> = part.iter().map(|p| *p - origin).collect();
-        let prev = start.checked_sub(1).map(|k| points[k] - origin);
-        let next = points.get(end + 1).map(|p| *p - origin);
-        let shape = Shape::chain(&local, prev, next).map_err(|e| e.to_string())?;
-        out.push((origin, shape));
-        start = end;
-    }
-    Ok(out)
 }
 
 /// The outlines' body: its position (the centre of their bounds) and shape.
