@@ -23,6 +23,20 @@ pub fn check(path: &Path) -> anyhow::Result<ExitCode> {
         s.world.dt,
         s.frames
     ))?;
+    // Terrain chains, from the file or a map: bodies, and segments they hold.
+    let chains: Vec<usize> = s
+        .bodies
+        .iter()
+        .filter(|b| b.shape.is_chain())
+        .map(|b| b.shape.primitives().len())
+        .collect();
+    if !chains.is_empty() {
+        crate::out::print(&format!(
+            "  terrain chains: {} bodies, {} segments\n",
+            chains.len(),
+            chains.iter().sum::<usize>()
+        ))?;
+    }
     if let Some(m) = map {
         let spawns: Vec<String> = m.spawns.iter().map(|(t, n)| format!("{n} {t}")).collect();
         crate::out::print(&format!(

@@ -693,6 +693,8 @@ fn compare_drawing(e: &Value, bodies: &[&Value], report: &mut impl FnMut(String)
                     indices.extend((1..n - 1).flat_map(|k| [first, first + k, first + k + 1]));
                     fans.push((first, what));
                 }
+                // Chain segments are lines, not cubes, cylinders or triangles.
+                PlacedPrimitive::Segment(_) => {}
             }
         }
     }

@@ -142,3 +142,27 @@ fn a_scene_with_one_way_platforms_validates() {
     );
     assert!(table.contains("unexplained mismatches     0"), "{table}");
 }
+
+/// Issue 36: a scene with a terrain chain (every shape sliding over its joints, a crest and
+/// a slope) runs and the referee passes, rapier's polyline for the chain
+/// (docs/validation.md); `check` counts the chain. Before chains, the scene was refused
+/// (exit 2: an unknown shape kind).
+#[test]
+fn a_scene_with_a_terrain_chain_validates() {
+    let scenario = crate::util::data("chains.toml");
+    let o = ricochet(&["validate", scenario.to_str().unwrap()], b"");
+    let table = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{table}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(table.contains("unexplained mismatches     0"), "{table}");
+    let o = ricochet(&["check", scenario.to_str().unwrap()], b"");
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        out.contains("terrain chains: 1 bodies, 11 segments"),
+        "{out}"
+    );
+}

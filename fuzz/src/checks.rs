@@ -155,6 +155,7 @@ fn moderate_scale(case: &Case) -> Option<f64> {
                 Primitive::Polygon(p) => {
                     numbers.extend(p.vertices().iter().flat_map(|v| [v.x, v.y]))
                 }
+                Primitive::Segment(s) => numbers.extend([s.a.x, s.a.y, s.b.x, s.b.y]),
             }
         }
     }

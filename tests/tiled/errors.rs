@@ -61,13 +61,27 @@ fn a_too_eccentric_ellipse_is_located() {
     );
 }
 
+/// A polyline is a chain of `solid` entries; in a `one_way` entry (a ledge by its top) or
+/// with a repeated point (a segment of no length) it is a located error.
 #[test]
-fn polylines_are_not_supported_yet() {
+fn polylines_that_cannot_be_chains_are_located() {
     let o = "<object id=\"5\" x=\"0\" y=\"0\"><polyline points=\"0,0 10,0 20,5\"/></object>";
+    let one_way = "one_way = [\"Bad\"]\none_way_layer = \"box\"\n[[collide]]\na = \"tile\"\n\
+                   b = \"box\"\nresponse = \"one_way\"";
+    let got = check(&[("m.tmx", map_with(o))], "[]", one_way);
+    assert_error(
+        got,
+        &[
+            "layer \"Bad\", object 5",
+            "a polyline in a `one_way` entry",
+            "`solid`",
+        ],
+    );
+    let o = "<object id=\"6\" x=\"0\" y=\"0\"><polyline points=\"0,0 10,0 10,0 20,5\"/></object>";
     let got = check(&[("m.tmx", map_with(o))], "[\"Bad\"]", "");
     assert_error(
         got,
-        &["layer \"Bad\", object 5", "chains are not supported yet"],
+        &["layer \"Bad\", object 6", "polyline point 2 is on point 1"],
     );
 }
 

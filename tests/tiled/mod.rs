@@ -345,6 +345,97 @@ fn check_summarises_the_shipped_tiled_level() {
     );
 }
 
+/// Polylines of a `solid` layer become chains covering exactly their points: sampled on
+/// every segment (ends, joints and between) and off it (half a pixel to either side, and
+/// past the ends), the answers from the map's own numbers (a polyline at object `(x, y)`,
+/// turned by `rotation` degrees clockwise on screen, its points relative to the object).
+/// A polyline of more points than a chain holds becomes several chains.
+#[test]
+fn polylines_become_chains_covering_exactly_their_points() {
+    let h_px = f64::from(H) * TILE;
+    // Object 1: at (5, 35) px, unrotated. Object 2: at (60, 70) px, turned 30°. Object 3: a
+    // zigzag of 2,500 points (4 px apart along x, up and down 3 px), at (0, 75) px.
+    let zig: Vec<(f64, f64)> = (0..2500)
+        .map(|k| (f64::from(k) * 4.0, if k % 2 == 0 { 0.0 } else { -3.0 }))
+        .collect();
+    // Each: object x, y (px), rotation (degrees), points.
+    type Line = (f64, f64, f64, Vec<(f64, f64)>);
+    let lines: [Line; 3] = [
+        (
+            5.0,
+            35.0,
+            0.0,
+            vec![(0.0, 0.0), (30.0, 0.0), (50.0, -20.0), (80.0, -20.0)],
+        ),
+        (60.0, 70.0, 30.0, vec![(0.0, 0.0), (20.0, 5.0), (40.0, 0.0)]),
+        (0.0, 75.0, 0.0, zig),
+    ];
+    let mut objects = String::new();
+    for (i, (x, y, rot, pts)) in lines.iter().enumerate() {
+        let points: Vec<String> = pts.iter().map(|(u, v)| format!("{u},{v}")).collect();
+        objects += &format!(
+            "<object id=\"{}\" x=\"{x}\" y=\"{y}\" rotation=\"{rot}\"><polyline points=\"{}\"/></object>",
+            i + 1,
+            points.join(" ")
+        );
+    }
+    let map = write::tmx(Encoding::Csv, &write::tileset_xml(" firstgid=\"1\""), None).replace(
+        "</map>",
+        &format!("<objectgroup id=\"9\" name=\"Lines\">{objects}</objectgroup></map>"),
+    );
+    let dir = level_with(&[("m.tmx", map)], "m.tmx", "[\"Lines\"]");
+    let (scenario, summary) = load(dir.path()).unwrap_or_else(|e| panic!("{e}"));
+    // 1 + 1 + ceil(2,499 segments / 1,024 a chain) = 5.
+    assert_eq!(summary.chains, 5);
+    assert_eq!(summary.solids, 0);
+    let sim = Simulation::new(&scenario);
+    let filter = QueryFilter::default();
+    let probe = ricochet_sim::Shape::circle(1e-4).unwrap();
+    let hits = |px: f64, py: f64| {
+        let world = Vec2::new(px / TILE, (h_px - py) / TILE);
+        !sim.overlap_shape(&probe, ricochet_sim::Pose::new(world, 0.0), &filter)
+            .is_empty()
+    };
+    let mut sampled = 0;
+    for (x, y, rot, pts) in &lines {
+        let (s, c) = (libm::sin(rot.to_radians()), libm::cos(rot.to_radians()));
+        // Tiled turns an object clockwise on screen (y down) about its anchor.
+        let at = |u: f64, v: f64| (x + u * c - v * s, y + u * s + v * c);
+        for w in pts.windows(2) {
+            let (a, b) = (at(w[0].0, w[0].1), at(w[1].0, w[1].1));
+            let (dx, dy) = (b.0 - a.0, b.1 - a.1);
+            let len = (dx * dx + dy * dy).sqrt();
+            // Half a pixel to the side, in pixels.
+            let (nx, ny) = (-dy / len * 0.5, dx / len * 0.5);
+            for k in 0..=8 {
+                let t = f64::from(k) / 8.0;
+                let (px, py) = (a.0 + dx * t, a.1 + dy * t);
+                assert!(hits(px, py), "on the line: pixel ({px}, {py})");
+                if (1..8).contains(&k) {
+                    assert!(
+                        !hits(px + nx, py + ny),
+                        "beside: ({}, {})",
+                        px + nx,
+                        py + ny
+                    );
+                    assert!(
+                        !hits(px - nx, py - ny),
+                        "beside: ({}, {})",
+                        px - nx,
+                        py - ny
+                    );
+                }
+                sampled += 1;
+            }
+        }
+        // Past the first point, along the first segment backwards.
+        let (a, b) = (at(pts[0].0, pts[0].1), at(pts[1].0, pts[1].1));
+        let back = (a.0 - (b.0 - a.0) * 0.1, a.1 - (b.1 - a.1) * 0.1);
+        assert!(!hits(back.0, back.1), "past the start: {back:?}");
+    }
+    assert!(sampled > 20_000, "{sampled}");
+}
+
 /// A group named in `solid` takes every layer in it, offsets added (the group's and its
 /// layers'): here the group moves its layers back by the offset its tile layer adds.
 #[test]

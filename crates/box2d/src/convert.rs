@@ -68,7 +68,7 @@ pub(crate) fn placement(shape: &Shape, pose: &Pose) -> Result<Placement, Box2dEr
         Primitive::Circle(c) => (p0 + rot.apply(c.center), 0.0),
         Primitive::Aabb(b) => (p0 + rot.apply(b.center), 0.0),
         Primitive::Obb(b) => (p0 + rot.apply(b.center), pose.angle + b.angle),
-        Primitive::Capsule(_) | Primitive::Polygon(_) => (p0, pose.angle),
+        Primitive::Capsule(_) | Primitive::Polygon(_) | Primitive::Segment(_) => (p0, pose.angle),
     };
     Ok(Placement {
         position,
@@ -116,6 +116,12 @@ pub(crate) fn local_shape(shape: &Shape) -> Result<LocalShape, Box2dError> {
                 )));
             }
             LocalShape::Polygon(hull)
+        }
+        // Only a chain holds segments, and a chain is a compound (refused above).
+        Primitive::Segment(_) => {
+            return Err(Box2dError::Conversion(
+                "terrain chains are not supported by the benchmark's Box2D scene".to_owned(),
+            ));
         }
     })
 }

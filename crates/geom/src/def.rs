@@ -69,6 +69,18 @@ pub enum ShapeDef {
         #[serde(default, skip_serializing_if = "is_origin")]
         center: [f64; 2],
     },
+    /// `{"kind": "chain", "points": [[x, y], ...]}`: a terrain chain of segments, two-sided,
+    /// that bodies slide along without catching on its joints ([`Shape::chain`]).
+    Chain {
+        /// 2 to [`crate::MAX_CHAIN_POINTS`] points, no two in a row equal.
+        points: Vec<[f64; 2]>,
+        /// Where the terrain goes on before the first point (another chain's), if it does.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        prev: Option<[f64; 2]>,
+        /// Where the terrain goes on after the last point, if it does.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        next: Option<[f64; 2]>,
+    },
     /// `{"kind": "compound", "parts": [SHAPE, ...]}`: parts carry their own `center`.
     Compound {
         /// The parts; none may itself be a compound.
@@ -93,6 +105,14 @@ impl ShapeDef {
                     out.push(p);
                 }
                 Shape::compound(out)
+            }
+            ShapeDef::Chain { points, prev, next } => {
+                // Counted before any point is read: a huge list is refused at once.
+                if points.len() > crate::MAX_CHAIN_POINTS {
+                    return Shape::chain(&[Vec2::ZERO; crate::MAX_CHAIN_POINTS + 1], None, None);
+                }
+                let ps: Vec<Vec2> = points.iter().map(|p| v2(*p)).collect();
+                Shape::chain(&ps, prev.map(v2), next.map(v2))
             }
             _ => self.to_primitive().map(Shape::Primitive),
         }
@@ -134,6 +154,10 @@ impl ShapeDef {
                 "kind",
                 "a compound part cannot itself be a compound",
             )),
+            ShapeDef::Chain { .. } => Err(ShapeError::new(
+                "kind",
+                "a compound part cannot be a chain (a chain is a body's whole shape)",
+            )),
         }
     }
 
@@ -143,9 +167,14 @@ impl ShapeDef {
     pub fn from_shape(shape: &Shape) -> ShapeDef {
         match shape {
             Shape::Primitive(p) => ShapeDef::from_primitive(p),
-            Shape::Compound(c) => ShapeDef::Compound {
-                parts: c.parts().iter().map(ShapeDef::from_primitive).collect(),
-            },
+            Shape::Compound(c) => {
+                if let Some(def) = chain_def(c.parts()) {
+                    return def;
+                }
+                ShapeDef::Compound {
+                    parts: c.parts().iter().map(ShapeDef::from_primitive).collect(),
+                }
+            }
         }
     }
 
@@ -175,6 +204,31 @@ impl ShapeDef {
                 vertices: poly.vertices().iter().map(|v| a(*v)).collect(),
                 center: [0.0, 0.0],
             },
+            // Only a chain holds segments, and a chain is described whole (`chain_def`).
+            Primitive::Segment(s) => ShapeDef::Chain {
+                points: vec![a(s.a), a(s.b)],
+                prev: s.prev.map(a),
+                next: s.next.map(a),
+            },
         }
     }
+}
+
+/// The description of a compound made by [`Shape::chain`]: its points and ghosts.
+fn chain_def(parts: &[Primitive]) -> Option<ShapeDef> {
+    let a = |v: Vec2| [v.x, v.y];
+    let mut points = Vec::with_capacity(parts.len() + 1);
+    let (mut prev, mut next) = (None, None);
+    for (i, p) in parts.iter().enumerate() {
+        let Primitive::Segment(s) = p else {
+            return None;
+        };
+        if i == 0 {
+            points.push(a(s.a));
+            prev = s.prev.map(a);
+        }
+        points.push(a(s.b));
+        next = s.next.map(a);
+    }
+    Some(ShapeDef::Chain { points, prev, next })
 }

@@ -1,7 +1,7 @@
 //! Ricochet's exact 2D collision geometry.
 //!
 //! **Owns:** the shapes a body can carry ([`Shape`]: circle, AABB, OBB, capsule, convex
-//! polygon, and a compound of those), the [`Pose`] that places a shape in the world, the
+//! polygon, a compound of those, and a terrain chain of segments: [`Shape::chain`]), the [`Pose`] that places a shape in the world, the
 //! bounding box of any shape at any pose ([`Bounds`]), the scenario/case-file description of a
 //! shape ([`ShapeDef`]) with its validation, and the narrow phase: a cheap boolean
 //! [`overlaps`] and a full [`contact`] (signed depth, unit normal from `a` to `b`, a contact
@@ -69,13 +69,13 @@ pub use def::ShapeDef;
 pub use math::{Pose, Rot, Vec2};
 pub use number::{Number, Numbers};
 pub use placed::{
-    PlacedAabb, PlacedCapsule, PlacedCircle, PlacedObb, PlacedPolygon, PlacedPrimitive, place,
-    place_rotated,
+    PlacedAabb, PlacedCapsule, PlacedCircle, PlacedObb, PlacedPolygon, PlacedPrimitive,
+    PlacedSegment, place, place_rotated,
 };
 pub use ray::{Ray, RayIntersection, cast_placed, cast_ray, contains_placed, contains_point};
 pub use shape::{
-    Aabb, Capsule, Circle, Compound, MAX_COMPOUND_PARTS, MAX_COORDINATE, MAX_POLYGON_VERTICES,
-    MIN_SIZE, Obb, Polygon, Primitive, Shape, ShapeError, ShapeKind,
+    Aabb, Capsule, Circle, Compound, MAX_CHAIN_POINTS, MAX_COMPOUND_PARTS, MAX_COORDINATE,
+    MAX_POLYGON_VERTICES, MIN_SIZE, Obb, Polygon, Primitive, Segment, Shape, ShapeError, ShapeKind,
 };
 pub use toi::{Impact, Sweep, time_of_impact};
 

@@ -56,12 +56,21 @@ pub struct PlacedPolygon {
     pub count: usize,
 }
 
+/// A chain segment in a frame, with its neighbours' far points (see [`crate::Segment`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlacedSegment {
+    /// First end.
+    pub a: Vec2,
+    /// Second end.
+    pub b: Vec2,
+    /// The previous segment's first end, if any.
+    pub prev: Option<Vec2>,
+    /// The next segment's second end, if any.
+    pub next: Option<Vec2>,
+}
+
 /// A primitive placed in a frame (world coordinates, or coordinates relative to an origin).
 #[derive(Clone, Copy, Debug, PartialEq)]
-#[expect(
-    clippy::large_enum_variant,
-    reason = "placed primitives live briefly on the stack; boxing a polygon would allocate in the narrow phase"
-)]
 pub enum PlacedPrimitive {
     /// A placed circle.
     Circle(PlacedCircle),
@@ -73,6 +82,8 @@ pub enum PlacedPrimitive {
     Capsule(PlacedCapsule),
     /// A placed polygon.
     Polygon(PlacedPolygon),
+    /// A placed chain segment.
+    Segment(PlacedSegment),
 }
 
 /// Places `primitive` at `pose`, in a frame whose origin is the world point `origin`.
@@ -154,6 +165,15 @@ pub(crate) fn place_with(
                 count: n,
             })
         }
+        Primitive::Segment(s) => {
+            let at = |v: Vec2| position + rot.apply(v);
+            PlacedPrimitive::Segment(PlacedSegment {
+                a: at(s.a),
+                b: at(s.b),
+                prev: s.prev.map(at),
+                next: s.next.map(at),
+            })
+        }
     }
 }
 
@@ -178,6 +198,10 @@ impl PlacedPrimitive {
                 }
             }
             PlacedPrimitive::Polygon(p) => Bounds::of_points(&p.vertices[..p.count]),
+            PlacedPrimitive::Segment(s) => Bounds {
+                min: s.a.min(s.b),
+                max: s.a.max(s.b),
+            },
         }
     }
 
@@ -191,6 +215,7 @@ impl PlacedPrimitive {
             PlacedPrimitive::Obb(b) => b.core(),
             PlacedPrimitive::Capsule(c) => c.core(),
             PlacedPrimitive::Polygon(p) => p.core(),
+            PlacedPrimitive::Segment(s) => s.core(),
         }
     }
 }
@@ -218,6 +243,12 @@ impl PlacedObb {
 impl PlacedCapsule {
     pub(crate) fn core(&self) -> Core {
         Core::segment(self.a, self.b, self.radius)
+    }
+}
+
+impl PlacedSegment {
+    pub(crate) fn core(&self) -> Core {
+        Core::segment(self.a, self.b, 0.0)
     }
 }
 

@@ -17,7 +17,8 @@
 
 use crate::math::{Pose, Rot, Vec2};
 use crate::placed::{
-    PlacedAabb, PlacedCapsule, PlacedCircle, PlacedObb, PlacedPolygon, PlacedPrimitive, place,
+    PlacedAabb, PlacedCapsule, PlacedCircle, PlacedObb, PlacedPolygon, PlacedPrimitive,
+    PlacedSegment, place,
 };
 use crate::shape::Shape;
 
@@ -143,6 +144,8 @@ pub fn contains_placed(prim: &PlacedPrimitive, p: Vec2) -> bool {
         PlacedPrimitive::Aabb(b) => inside_box(p - b.center, b.half),
         PlacedPrimitive::Obb(b) => inside_box(b.rot.apply_inverse(p - b.center), b.half),
         PlacedPrimitive::Capsule(c) => segment_distance_squared(p, c.a, c.b) < c.radius * c.radius,
+        // Zero thickness: no point is inside.
+        PlacedPrimitive::Segment(_) => false,
         PlacedPrimitive::Polygon(g) => {
             (0..g.count).all(|i| g.normals[i].dot(p - g.vertices[i]) < 0.0)
         }
@@ -179,6 +182,7 @@ pub fn cast_placed(prim: &PlacedPrimitive, o: Vec2, d: Vec2, max: f64) -> Option
         PlacedPrimitive::Obb(b) => ray_obb(b, o, d),
         PlacedPrimitive::Capsule(c) => ray_capsule(c, o, d),
         PlacedPrimitive::Polygon(g) => ray_polygon(g, o, d),
+        PlacedPrimitive::Segment(s) => ray_segment(s, o, d),
     };
     hit.filter(|&(t, _)| t <= max)
 }
@@ -274,6 +278,24 @@ fn ray_capsule(c: &PlacedCapsule, o: Vec2, d: Vec2) -> Option<(f64, Vec2)> {
         }
     }
     best
+}
+
+/// Where the ray crosses the segment (a ray along it misses: zero thickness), with the
+/// segment's normal facing the ray.
+fn ray_segment(s: &PlacedSegment, o: Vec2, d: Vec2) -> Option<(f64, Vec2)> {
+    let e = s.b - s.a;
+    let den = crate::math::cross(d, e);
+    if den == 0.0 {
+        return None;
+    }
+    let ao = s.a - o;
+    let t = crate::math::cross(ao, e) / den;
+    let along = crate::math::cross(ao, d) / den;
+    if t < 0.0 || !(0.0..=1.0).contains(&along) {
+        return None;
+    }
+    let n = Vec2::new(e.y, -e.x).normalize();
+    Some((t, if n.dot(d) > 0.0 { -n } else { n }))
 }
 
 /// Cyrus–Beck: the ray clipped by each edge's half-plane.

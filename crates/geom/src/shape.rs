@@ -138,6 +138,28 @@ pub struct Capsule {
     pub radius: f64,
 }
 
+/// The most points a terrain chain may have: one segment per compound part
+/// ([`MAX_COMPOUND_PARTS`]), so a chain's cost is bounded like a compound's. A longer line is
+/// several chains that name each other's end points as ghosts ([`Shape::chain`]).
+pub const MAX_CHAIN_POINTS: usize = MAX_COMPOUND_PARTS + 1;
+
+/// One segment `a`–`b` of a terrain chain, of zero thickness, with its neighbours' far
+/// points (`prev` before `a`, `next` after `b`; Box2D's "ghost vertices"). A contact at a
+/// joint takes a normal the neighbouring segment would also allow, so a body sliding along
+/// the chain never catches on a joint (see `collide/segment.rs`). Two-sided: a body is
+/// pushed out to the side of the segment its centre is on. Built only by [`Shape::chain`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Segment {
+    /// First end, local coordinates.
+    pub a: Vec2,
+    /// Second end, local coordinates.
+    pub b: Vec2,
+    /// The previous segment's first end, if the chain goes on before `a`.
+    pub prev: Option<Vec2>,
+    /// The next segment's second end, if the chain goes on after `b`.
+    pub next: Option<Vec2>,
+}
+
 /// A convex, counter-clockwise polygon of 3 to [`MAX_POLYGON_VERTICES`] vertices.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Polygon {
@@ -223,10 +245,6 @@ impl Polygon {
 
 /// One convex piece: every shape kind except a compound.
 #[derive(Clone, Copy, Debug, PartialEq)]
-#[expect(
-    clippy::large_enum_variant,
-    reason = "polygons are stored inline (272 bytes) so a primitive is Copy and the narrow phase never chases a pointer"
-)]
 pub enum Primitive {
     /// A disc.
     Circle(Circle),
@@ -238,6 +256,8 @@ pub enum Primitive {
     Capsule(Capsule),
     /// A convex polygon.
     Polygon(Polygon),
+    /// A segment of a terrain chain.
+    Segment(Segment),
 }
 
 /// The error for a compound of `n` parts, more than [`MAX_COMPOUND_PARTS`].
@@ -306,6 +326,8 @@ pub enum ShapeKind {
     Capsule,
     /// [`Polygon`].
     Polygon,
+    /// [`Segment`] (of a chain).
+    Segment,
 }
 
 impl ShapeKind {
@@ -318,6 +340,7 @@ impl ShapeKind {
             ShapeKind::Obb => "obb",
             ShapeKind::Capsule => "capsule",
             ShapeKind::Polygon => "polygon",
+            ShapeKind::Segment => "segment",
         }
     }
 }
@@ -332,6 +355,7 @@ impl Primitive {
             Primitive::Obb(_) => ShapeKind::Obb,
             Primitive::Capsule(_) => ShapeKind::Capsule,
             Primitive::Polygon(_) => ShapeKind::Polygon,
+            Primitive::Segment(_) => ShapeKind::Segment,
         }
     }
 
@@ -431,6 +455,73 @@ impl Shape {
         Compound::new(parts).map(Shape::Compound)
     }
 
+    /// A terrain chain through `points` (2 to [`MAX_CHAIN_POINTS`], finite, no segment of
+    /// zero length): a compound of [`Segment`]s, each knowing its neighbours. `prev` and
+    /// `next` are ghost points: where the terrain goes on beyond the first and last point
+    /// (another chain's), so the end joints are smooth too; `None` is an open end.
+    pub fn chain(
+        points: &[Vec2],
+        prev: Option<Vec2>,
+        next: Option<Vec2>,
+    ) -> Result<Shape, ShapeError> {
+        let n = points.len();
+        if !(2..=MAX_CHAIN_POINTS).contains(&n) {
+            return Err(ShapeError::new(
+                "points",
+                format!(
+                    "a chain needs 2 to {MAX_CHAIN_POINTS} points, got {n}; split a longer \
+                     line into several chains"
+                ),
+            ));
+        }
+        for (i, p) in points.iter().enumerate() {
+            finite_vec(&format!("points[{i}]"), *p)?;
+            if i > 0 && points[i - 1] == *p {
+                return Err(ShapeError::new(
+                    format!("points[{i}]"),
+                    "repeats the previous point: a chain's segments must have a length",
+                ));
+            }
+        }
+        if let Some(g) = prev {
+            finite_vec("prev", g)?;
+            if g == points[0] {
+                return Err(ShapeError::new("prev", "is the chain's first point"));
+            }
+        }
+        if let Some(g) = next {
+            finite_vec("next", g)?;
+            if g == points[n - 1] {
+                return Err(ShapeError::new("next", "is the chain's last point"));
+            }
+        }
+        // A closed loop (last point on the first, at least a triangle) is smooth at its
+        // closing joint too: each end's ghost is the point across the joint.
+        let closed = n >= 4 && points[0] == points[n - 1];
+        let prev = prev.or(if closed { Some(points[n - 2]) } else { None });
+        let next = next.or(if closed { Some(points[1]) } else { None });
+        let parts = (0..n - 1)
+            .map(|i| {
+                Primitive::Segment(Segment {
+                    a: points[i],
+                    b: points[i + 1],
+                    prev: if i == 0 { prev } else { Some(points[i - 1]) },
+                    next: points
+                        .get(i + 2)
+                        .copied()
+                        .or(if i + 2 == n { next } else { None }),
+                })
+            })
+            .collect();
+        Shape::compound(parts)
+    }
+
+    /// Whether this shape is a terrain chain (a compound of segments).
+    #[must_use]
+    pub fn is_chain(&self) -> bool {
+        matches!(self, Shape::Compound(c) if c.parts().iter().all(|p| matches!(p, Primitive::Segment(_))))
+    }
+
     /// The rotation a body at `angle` applies to this shape, skipping the trigonometry when
     /// no part turns with the body.
     #[must_use]
@@ -469,6 +560,8 @@ impl Shape {
             .map(|p| match p {
                 Primitive::Circle(c) => 2.0 * c.radius,
                 Primitive::Capsule(c) => 2.0 * c.radius,
+                // Zero thickness: anything moving may cross it in one frame, so it is swept.
+                Primitive::Segment(_) => 0.0,
                 Primitive::Aabb(b) => 2.0 * b.half_extents.min_element(),
                 Primitive::Obb(b) => 2.0 * b.half_extents.min_element(),
                 Primitive::Polygon(g) => g

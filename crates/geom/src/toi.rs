@@ -68,7 +68,10 @@ pub fn time_of_impact(a: &Shape, sweep_a: &Sweep, b: &Shape, sweep_b: &Sweep) ->
     };
     let mut first: Option<f64> = None;
     let mut search = |pa: &Primitive, pb: &Primitive| {
-        let (part_a, part_b) = (Shape::Primitive(*pa), Shape::Primitive(*pb));
+        // A chain segment alone, without its joint rule: the first touch of the chain is the
+        // earliest of its segments' as lines (a convex gap), whichever segment then answers
+        // for the contact's normal (`contact` of the whole shapes, below).
+        let (part_a, part_b) = (Shape::Primitive(bare(*pa)), Shape::Primitive(bare(*pb)));
         let gap = |t: f64| {
             let (pa, pb) = poses(t);
             -contact(&part_a, &pa, &part_b, &pb).depth
@@ -101,6 +104,18 @@ pub fn time_of_impact(a: &Shape, sweep_a: &Sweep, b: &Shape, sweep_b: &Sweep) ->
         pose_a,
         pose_b,
     })
+}
+
+/// A chain segment without its neighbours; any other part as it is.
+fn bare(p: Primitive) -> Primitive {
+    match p {
+        Primitive::Segment(s) => Primitive::Segment(crate::shape::Segment {
+            prev: None,
+            next: None,
+            ..s
+        }),
+        other => other,
+    }
 }
 
 /// The box each part of a shape sweeps over the step (the union of its boxes at both ends:

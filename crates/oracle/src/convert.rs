@@ -76,6 +76,11 @@ fn primitive(
             )?;
             (PPose::from_parts(to_vector(position), to_rot(rot)), shape)
         }
+        // One segment of a chain, without Ricochet's joint rule (parry has none).
+        Primitive::Segment(g) => (
+            PPose::from_parts(to_vector(position), to_rot(rot)),
+            SharedShape::segment(to_vector(g.a), to_vector(g.b)),
+        ),
     })
 }
 
@@ -91,6 +96,22 @@ pub(crate) fn place(
     let rot = shape.rotation(pose.angle);
     match shape {
         Shape::Primitive(p) => primitive(p, position, rot, pose.angle),
+        // A terrain chain is parry's polyline (a line strip, two-sided like Ricochet's).
+        Shape::Compound(c) if shape.is_chain() => {
+            let mut points = Vec::with_capacity(c.parts().len() + 1);
+            for (i, p) in c.parts().iter().enumerate() {
+                if let Primitive::Segment(g) = p {
+                    if i == 0 {
+                        points.push(to_vector(g.a));
+                    }
+                    points.push(to_vector(g.b));
+                }
+            }
+            Ok((
+                PPose::from_parts(to_vector(position), to_rot(rot)),
+                SharedShape::polyline(points, None),
+            ))
+        }
         Shape::Compound(c) => {
             let parts = c
                 .parts()

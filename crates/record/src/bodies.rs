@@ -86,6 +86,21 @@ pub fn shape_message(def: &ShapeDef) -> pb::Shape {
         ShapeDef::Compound { parts } => Kind::Compound(pb::Compound {
             parts: parts.iter().map(shape_message).collect(),
         }),
+        // The log's schema has no chain: a chain is written as a compound of its segments,
+        // each a capsule of radius 0 (the schema stays as it is, so every log stays readable
+        // by the viewers; the ghost points are the neighbours' ends, not written).
+        ShapeDef::Chain { points, .. } => Kind::Compound(pb::Compound {
+            parts: points
+                .windows(2)
+                .map(|w| pb::Shape {
+                    kind: Some(Kind::Capsule(pb::Capsule {
+                        a: w[0].to_vec(),
+                        b: w[1].to_vec(),
+                        radius: 0.0,
+                    })),
+                })
+                .collect(),
+        }),
     };
     pb::Shape { kind: Some(kind) }
 }

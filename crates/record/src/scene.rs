@@ -58,6 +58,9 @@ pub const CHUNK_PARTS: usize = 1024;
 /// Thickness of drawn shapes along z.
 const DEPTH: f64 = 0.05;
 
+/// Width of a drawn terrain chain's lines, world units (a chain itself has none).
+const CHAIN_THICKNESS: f64 = 0.08;
+
 /// How bodies become entities.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Style {
@@ -214,6 +217,24 @@ fn draw(entity: &mut SceneEntity, prim: &Primitive, at: Vec2, angle: f64, color:
             }
         }
         Primitive::Polygon(p) => fill(entity, p.vertices().iter().map(|v| place(*v)), color),
+        // A chain segment (zero thickness) is drawn as a line of the entity's one line list.
+        Primitive::Segment(s) => {
+            if entity.lines.is_empty() {
+                entity.lines.push(LinePrimitive {
+                    r#type: line_primitive::Type::LineList as i32,
+                    pose: planar(Vec2::ZERO, 0.0),
+                    thickness: r(CHAIN_THICKNESS),
+                    scale_invariant: false,
+                    points: Vec::new(),
+                    color: Some(color),
+                    colors: Vec::new(),
+                    indices: Vec::new(),
+                });
+            }
+            entity.lines[0]
+                .points
+                .extend([place(s.a), place(s.b)].map(p3));
+        }
     }
 }
 

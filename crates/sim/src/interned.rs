@@ -8,7 +8,7 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use ricochet_geom::{Bounds, Primitive, Shape};
+use ricochet_geom::{Bounds, Primitive, Shape, Vec2};
 
 /// Values stored once, looked up by a key that is equal exactly when the values are.
 #[derive(Clone, Debug)]
@@ -290,6 +290,14 @@ pub(crate) fn shape_key(shape: &Shape, out: &mut Vec<u64>) {
             ),
             Primitive::Capsule(c) => {
                 out.extend([3.0, c.a.x, c.a.y, c.b.x, c.b.y, c.radius].map(bits));
+            }
+            Primitive::Segment(g) => {
+                out.extend([5.0, g.a.x, g.a.y, g.b.x, g.b.y].map(bits));
+                // A missing ghost is NaN: no point has NaN coordinates.
+                for v in [g.prev, g.next] {
+                    let v = v.unwrap_or(Vec2::NAN);
+                    out.extend([v.x, v.y].map(bits));
+                }
             }
             Primitive::Polygon(poly) => {
                 out.push(bits(4.0));

@@ -204,6 +204,7 @@ pub fn shape_reach(shape: &Shape) -> Vec2 {
             Primitive::Polygon(g) => {
                 Vec2::splat(g.vertices().iter().map(|v| v.length()).fold(0.0, f64::max))
             }
+            Primitive::Segment(g) => Vec2::splat(g.a.length().max(g.b.length())),
         })
         .fold(Vec2::ZERO, Vec2::max)
 }

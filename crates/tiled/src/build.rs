@@ -8,7 +8,7 @@ use ricochet_geom::{Primitive, Shape, Vec2};
 use ricochet_sim::{BodyDef, TileRows, TiledDef};
 use tiled::{LayerType, ObjectData, ObjectShape, PropertyValue};
 
-use crate::shapes::{ELLIPSE_POINTS, Outline, primitives};
+use crate::shapes::{ELLIPSE_POINTS, Outline, chains, primitives};
 use crate::{MAX_ELLIPSE_RATIO, MAX_POLYGON_POINTS, MapSummary, PieceKind, TiledError, TiledPiece};
 
 /// What a map became.
@@ -45,7 +45,11 @@ impl Built {
                     .filter(|t| t.0 == PieceKind::OneWay)
                     .map(|t| t.1.len())
                     .sum::<usize>(),
-            chains: 0,
+            chains: self
+                .pieces
+                .iter()
+                .filter(|p| p.kind == PieceKind::Chain)
+                .count(),
             spawns: self.spawned.clone(),
         }
     }
@@ -240,13 +244,12 @@ fn outlines(obj: &ObjectData, to_world: &dyn Fn(f64, f64) -> Vec2) -> Result<Vec
                     .collect(),
             )]
         }
-        ObjectShape::Polyline { .. } => {
-            return Err(
-                "a polyline is a terrain chain: chains are not supported yet; draw a \
-                        polygon, or leave the layer out of `solid` and `one_way`"
-                    .to_owned(),
-            );
-        }
+        ObjectShape::Polyline { points } => vec![Outline::Line(
+            points
+                .iter()
+                .map(|&(u, v)| f(f64::from(u), f64::from(v)))
+                .collect(),
+        )],
         ObjectShape::Point(..) => {
             return Err(
                 "a point has no area: give it a class, type or name listed in \
@@ -331,7 +334,7 @@ pub(crate) fn body_of(outs: &[Outline]) -> Result<(Vec2, Shape), String> {
                 }
                 v
             }
-            Outline::Ring(r) => r.clone(),
+            Outline::Ring(r) | Outline::Line(r) => r.clone(),
         };
         for p in pts {
             lo = lo.min(p);
@@ -493,12 +496,31 @@ fn walk(
                 };
                 let outs =
                     object_outlines(ctx, &obj, offset).map_err(|p| ctx.err(at.clone(), p))?;
-                let (position, shape) = body_of(&outs).map_err(|p| ctx.err(at.clone(), p))?;
                 let name = if obj.name.is_empty() {
                     layer.name.clone()
                 } else {
                     obj.name.clone()
                 };
+                if let [Outline::Line(points)] = outs.as_slice() {
+                    if kind == PieceKind::OneWay {
+                        return Err(ctx.err(
+                            at,
+                            "a polyline in a `one_way` entry: a one-way platform is a ledge \
+                             (its top is its bounding box's), not a line; draw a rectangle, \
+                             or list the layer in `solid` to make the polyline a chain",
+                        ));
+                    }
+                    for (position, shape) in chains(points).map_err(|p| ctx.err(at.clone(), p))? {
+                        built.pieces.push(TiledPiece {
+                            kind: PieceKind::Chain,
+                            name: name.clone(),
+                            shape,
+                            position,
+                        });
+                    }
+                    continue;
+                }
+                let (position, shape) = body_of(&outs).map_err(|p| ctx.err(at.clone(), p))?;
                 built.pieces.push(TiledPiece {
                     kind,
                     name,

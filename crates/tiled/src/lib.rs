@@ -29,8 +29,13 @@
 //! `one_way` entries take tiles and objects like `solid` ones and make them static bodies of
 //! `one_way_layer` (one-way platforms: `ricochet-sim`'s `stages/one_way.rs`).
 //!
-//! Not supported yet (a located error, never a silently missing wall): polylines (terrain
-//! chains), text objects, and maps that are not orthogonal.
+//! Polylines of `solid` entries become terrain chains (`ricochet-geom`'s `Shape::chain`,
+//! two-sided), one static body each, split into several chains that name each other's end
+//! points as ghosts past `MAX_CHAIN_POINTS`; a polyline of a `one_way` entry, or among a
+//! tile's collision shapes, is a located error.
+//!
+//! Not supported yet (a located error, never a silently missing wall): text objects, and maps
+//! that are not orthogonal.
 
 mod build;
 pub mod json;
@@ -69,16 +74,15 @@ pub struct TiledError {
     pub problem: String,
 }
 
-/// What a piece of the map becomes: a solid, or a one-way platform (`one_way` entries, on
-/// `[tiled] one_way_layer`). Chains are refused with a located error until the physics has
-/// them.
+/// What a piece of the map becomes: a solid, a one-way platform (`one_way` entries, on
+/// `[tiled] one_way_layer`), or a terrain chain (a polyline of a `solid` entry).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub enum PieceKind {
     /// A static solid.
     Solid,
     /// A one-way platform: a static body of `[tiled] one_way_layer`.
     OneWay,
-    /// A terrain chain (not supported yet).
+    /// A terrain chain (a polyline of a `solid` entry): a static body of `[tiled] layer`.
     Chain,
 }
 
@@ -104,7 +108,7 @@ pub struct MapSummary {
     pub solids: usize,
     /// One-way pieces: objects and tiles.
     pub one_way: usize,
-    /// Chains (0 until supported).
+    /// Terrain chains (polylines; a polyline longer than a chain's limit is several).
     pub chains: usize,
     /// Bodies spawned, by template.
     pub spawns: BTreeMap<String, usize>,

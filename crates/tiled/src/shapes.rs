@@ -7,7 +7,7 @@
 use std::collections::BTreeMap;
 
 use ricochet_geom::MAX_POLYGON_VERTICES;
-use ricochet_geom::{Primitive, Vec2};
+use ricochet_geom::{MAX_CHAIN_POINTS, Primitive, Shape, Vec2};
 
 /// How many points an ellipse's polygon has: the 32-gon inscribed in the ellipse (the
 /// affine image of a regular 32-gon in the unit circle) is within `1 - cos(pi/32)`, 0.48%, of
@@ -23,6 +23,8 @@ pub(crate) enum Outline {
     Capsule { a: Vec2, b: Vec2, radius: f64 },
     /// A closed outline, either orientation, convex or not (not crossing itself).
     Ring(Vec<Vec2>),
+    /// An open line: a polyline, which becomes terrain chains (`build::chains`).
+    Line(Vec<Vec2>),
 }
 
 fn cross(a: Vec2, b: Vec2) -> f64 {
@@ -50,6 +52,11 @@ pub(crate) fn primitives(outline: &Outline, origin: Vec2) -> Result<Vec<Primitiv
             let ring: Vec<Vec2> = points.iter().map(|p| *p - origin).collect();
             ring_primitives(&ring)
         }
+        Outline::Line(_) => Err(
+            "a polyline among a tile's collision shapes: a chain is a body of its own; draw \
+             it on an object layer"
+                .to_owned(),
+        ),
     }
 }
 
@@ -264,4 +271,42 @@ fn union(x: &[usize], y: &[usize], a: usize, b: usize) -> Option<Vec<usize>> {
     let mut out: Vec<usize> = (0..x.len()).map(|k| x[(ib + k) % x.len()]).collect();
     out.extend((1..y.len() - 1).map(|k| y[(ia + k) % y.len()]));
     Some(out)
+}
+
+/// A polyline's chains, each a body (position: the centre of its points' bounds): one
+/// chain of up to [`MAX_CHAIN_POINTS`] points, or several that share their end points and
+/// name each other's as ghosts, so the joints between them are as smooth as the rest.
+pub(crate) fn chains(points: &[Vec2]) -> Result<Vec<(Vec2, Shape)>, String> {
+    if points.len() < 2 {
+        return Err(format!(
+            "a polyline of {} point(s): a chain needs at least 2",
+            points.len()
+        ));
+    }
+    if let Some(k) = (1..points.len()).find(|&k| points[k] == points[k - 1]) {
+        return Err(format!(
+            "polyline point {k} is on point {}: a chain's segments must have a length; \
+             remove the repeated point",
+            k - 1
+        ));
+    }
+    let step = MAX_CHAIN_POINTS - 1;
+    let mut out = Vec::new();
+    let mut start = 0;
+    while start + 1 < points.len() {
+        let end = (start + step).min(points.len() - 1);
+        let part = &points[start..=end];
+        let (lo, hi) = part.iter().fold(
+            (Vec2::splat(f64::INFINITY), Vec2::splat(f64::NEG_INFINITY)),
+            |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+        );
+        let origin = (lo + hi) * 0.5;
+        let local: Vec<Vec2> = part.iter().map(|p| *p - origin).collect();
+        let prev = start.checked_sub(1).map(|k| points[k] - origin);
+        let next = points.get(end + 1).map(|p| *p - origin);
+        let shape = Shape::chain(&local, prev, next).map_err(|e| e.to_string())?;
+        out.push((origin, shape));
+        start = end;
+    }
+    Ok(out)
 }

@@ -18,6 +18,7 @@ pub(crate) mod obb_capsule;
 pub(crate) mod obb_obb;
 pub(crate) mod obb_polygon;
 pub(crate) mod polygon_polygon;
+pub(crate) mod segment;
 
 use crate::contact::Contact;
 use crate::cores::collide_cores_unless;
@@ -40,12 +41,17 @@ use obb_capsule::*;
 use obb_obb::*;
 use obb_polygon::*;
 use polygon_polygon::*;
+use segment::collide_segment;
 
 /// The contact of two primitives placed in one frame. The point is in that frame.
 #[must_use]
 pub fn contact_placed(a: &PlacedPrimitive, b: &PlacedPrimitive) -> Contact {
     use PlacedPrimitive as P;
     match (a, b) {
+        // A chain segment: any body's core against it, then the joint rule. Two segments
+        // (a chain is static, so only in direct geometry calls) use `a` as a plain segment.
+        (_, P::Segment(s)) => collide_segment(&a.core(), s),
+        (P::Segment(s), _) => collide_segment(&b.core(), s).flipped(),
         (P::Circle(a), P::Circle(b)) => collide_circle_circle(a, b),
         (P::Circle(a), P::Aabb(b)) => collide_circle_aabb(a, b),
         (P::Circle(a), P::Obb(b)) => collide_circle_obb(a, b),
@@ -90,7 +96,9 @@ pub(crate) fn contact_placed_unless(
     match (a, b) {
         (P::Circle(_), P::Circle(_) | P::Aabb(_) | P::Obb(_))
         | (P::Aabb(_) | P::Obb(_), P::Circle(_))
-        | (P::Aabb(_), P::Aabb(_)) => Some(contact_placed(a, b)),
+        | (P::Aabb(_), P::Aabb(_))
+        | (P::Segment(_), _)
+        | (_, P::Segment(_)) => Some(contact_placed(a, b)),
         (P::Circle(_), P::Capsule(_) | P::Polygon(_))
         | (P::Aabb(_), P::Obb(_) | P::Capsule(_) | P::Polygon(_))
         | (P::Obb(_), P::Obb(_) | P::Capsule(_) | P::Polygon(_))
@@ -110,6 +118,7 @@ pub(crate) fn contact_placed_unless(
 pub fn overlaps_placed(a: &PlacedPrimitive, b: &PlacedPrimitive) -> bool {
     use PlacedPrimitive as P;
     match (a, b) {
+        (P::Segment(_), _) | (_, P::Segment(_)) => contact_placed(a, b).overlaps(),
         (P::Circle(a), P::Circle(b)) => overlaps_circle_circle(a, b),
         (P::Circle(a), P::Aabb(b)) | (P::Aabb(b), P::Circle(a)) => overlaps_circle_aabb(a, b),
         (P::Circle(a), P::Obb(b)) | (P::Obb(b), P::Circle(a)) => overlaps_circle_obb(a, b),

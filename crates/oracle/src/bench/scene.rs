@@ -18,13 +18,18 @@ use crate::pairs::{LayerFilter, index, penetration};
 /// The pose of the rapier collider of `shape` at `pose`: the pose `convert::place` gives the
 /// primitive, in world coordinates.
 pub(super) fn collider_pose(shape: &Shape, pose: &Pose) -> Result<PPose, OracleError> {
+    let to_rot = |r: Rot| Rot2::from_cos_sin_unchecked(r.c, r.s);
+    if shape.is_chain() {
+        // A chain is one polyline collider in body coordinates (`convert::place`).
+        let rot = shape.rotation(pose.angle);
+        return Ok(PPose::from_parts(to_vector(pose.position), to_rot(rot)));
+    }
     let Shape::Primitive(p) = shape else {
         return Err(OracleError::Conversion(
             "compound shapes are not supported by the benchmark's rapier scene",
         ));
     };
     let rot = shape.rotation(pose.angle);
-    let to_rot = |r: Rot| Rot2::from_cos_sin_unchecked(r.c, r.s);
     let p0 = pose.position;
     Ok(match p {
         Primitive::Circle(c) => PPose::from_translation(to_vector(p0 + rot.apply(c.center))),
@@ -37,7 +42,7 @@ pub(super) fn collider_pose(shape: &Shape, pose: &Pose) -> Result<PPose, OracleE
             };
             PPose::from_parts(to_vector(p0 + rot.apply(b.center)), to_rot(own))
         }
-        Primitive::Capsule(_) | Primitive::Polygon(_) => {
+        Primitive::Capsule(_) | Primitive::Polygon(_) | Primitive::Segment(_) => {
             PPose::from_parts(to_vector(p0), to_rot(rot))
         }
     })

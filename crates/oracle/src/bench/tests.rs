@@ -9,6 +9,16 @@ use crate::convert::place;
 
 fn shapes() -> Vec<Shape> {
     vec![
+        Shape::chain(
+            &[
+                Vec2::new(-1.0, 0.0),
+                Vec2::new(0.5, 0.2),
+                Vec2::new(1.0, -0.3),
+            ],
+            None,
+            None,
+        )
+        .unwrap(),
         Shape::circle(0.5).unwrap(),
         Shape::Primitive(Primitive::circle(Vec2::new(0.3, -0.2), 0.5).unwrap()),
         Shape::aabb(Vec2::new(0.5, 0.25)).unwrap(),
@@ -77,6 +87,34 @@ fn small_scene() -> Scenario {
             body(1, BodyKind::Dynamic, triangle, 10.0, 0.0),
         ],
     )
+}
+
+/// Issue 36: the bench's rapier scene takes a terrain chain as one polyline collider. A ball
+/// (radius 0.5) moving right over a flat chain's joints, 0.2 into it (its centre at height
+/// 0.3), and a static box far away: every frame both find exactly the ball-chain pair, and
+/// its depth and normal agree.
+#[test]
+fn rapier_and_ricochet_agree_on_a_chain() {
+    let points: Vec<Vec2> = (0..8).map(|k| Vec2::new(f64::from(k) - 4.0, 0.0)).collect();
+    let chain = Shape::chain(&points, None, None).unwrap();
+    let mut ball = body(0, BodyKind::Dynamic, Shape::circle(0.5).unwrap(), -2.0, 1.0);
+    ball.position.y = 0.3;
+    let scenario = scene(
+        &["a", "b"],
+        &[(0, 1)],
+        vec![
+            body(1, BodyKind::Static, chain, 0.0, 0.0),
+            ball,
+            body(
+                1,
+                BodyKind::Static,
+                Shape::aabb(Vec2::splat(0.5)).unwrap(),
+                50.0,
+                0.0,
+            ),
+        ],
+    );
+    step_together(&scenario, 90, 1);
 }
 
 /// Two bodies overlapping by 0.2 along x and a third far away: rapier finds exactly the

@@ -180,6 +180,12 @@ fn check_body(
         return Err(at.err(f("position"), problem));
     }
     finite(at, f("angle"), def.angle)?;
+    if def.shape.is_chain() && def.kind != crate::BodyKind::Static {
+        return Err(at.err(
+            f("kind"),
+            "a chain is static terrain: only a static body may have a chain shape",
+        ));
+    }
     finite2(at, f("velocity"), def.velocity)?;
     finite(at, f("angular_velocity"), def.angular_velocity)?;
     finite2(at, f("force"), def.force)?;

@@ -159,6 +159,14 @@ pub(crate) fn body_def(
             ));
         }
     };
+    if shape.is_chain() && kind != BodyKind::Static {
+        return Err(fail(
+            "kind",
+            "a chain is static terrain: give this body kind = \"static\" (a moving line \
+             is a capsule or a polygon)"
+                .to_owned(),
+        ));
+    }
     let mass = num("mass", b.mass.unwrap_or(1.0))?;
     if let Some(problem) = mass_problem(mass) {
         return Err(fail("mass", problem));

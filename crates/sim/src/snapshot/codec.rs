@@ -127,6 +127,20 @@ pub(crate) trait Sink {
                     self.vec2(*v);
                 }
             }
+            Primitive::Segment(g) => {
+                self.u8(5);
+                self.vec2(g.a);
+                self.vec2(g.b);
+                for ghost in [g.prev, g.next] {
+                    match ghost {
+                        None => self.u8(0),
+                        Some(v) => {
+                            self.u8(1);
+                            self.vec2(v);
+                        }
+                    }
+                }
+            }
         }
     }
     fn controller(&mut self, c: Option<&Controller>) {
@@ -395,6 +409,21 @@ impl<'a> Reader<'a> {
                 let n = self.len(16)?;
                 let v = (0..n).map(|_| self.vec2()).collect::<Result<Vec<_>, _>>()?;
                 Primitive::Polygon(Polygon::new(&v).map_err(|e| bad(&format!("polygon: {e}")))?)
+            }
+            5 => {
+                let (a, b) = (self.vec2()?, self.vec2()?);
+                let mut ghost = || -> Result<Option<Vec2>, SnapshotError> {
+                    Ok(match self.u8()? {
+                        0 => None,
+                        1 => Some(self.vec2()?),
+                        _ => return Err(bad("a ghost point tag")),
+                    })
+                };
+                let (prev, next) = (ghost()?, ghost()?);
+                // Validated as a one-segment chain: finite, of some length.
+                let one = Shape::chain(&[a, b], prev, next)
+                    .map_err(|e| bad(&format!("chain segment: {e}")))?;
+                one.primitives()[0]
             }
             _ => return Err(bad("a primitive tag")),
         })
