@@ -133,11 +133,16 @@ pub fn ricochet_in(dir: &std::path::Path, args: &[&str]) -> Output {
         .expect("the ricochet binary starts")
 }
 
-/// A temporary folder holding a copy of `scenarios/*.toml` (the top level) and of
-/// `recordings/`, as a game's repository would: for tests that change or bless them.
+/// A temporary folder holding a copy of `scenarios/*.toml` (the top level), of the Tiled
+/// maps they read (`scenarios/maps/`) and of `recordings/`, as a game's repository would: for
+/// tests that change or bless them.
 pub fn suite_copy() -> tempfile::TempDir {
     let dir = tempfile::tempdir().expect("a temporary folder");
-    for (from, to) in [("scenarios", "scenarios"), ("recordings", "recordings")] {
+    for (from, to) in [
+        ("scenarios", "scenarios"),
+        ("scenarios/maps", "scenarios/maps"),
+        ("recordings", "recordings"),
+    ] {
         std::fs::create_dir(dir.path().join(to)).unwrap();
         for entry in std::fs::read_dir(root().join(from)).unwrap() {
             let path = entry.unwrap().path();

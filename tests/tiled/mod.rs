@@ -328,18 +328,20 @@ fn one_way_entries_become_one_way_statics_on_their_layer() {
 }
 
 /// The shipped level: `ricochet check` says what its map became, counted from the map file
-/// (`scenarios/tiled/maps/level1.tmx`: a 20-tile floor, a 4-tile ledge, a slope tile and a
-/// 5-tile raised floor; a ramp and a boulder; three coins, an enemy and the player).
+/// (`scenarios/maps/level1.tmx`): "Ground" holds a 40-tile floor, two 7-tile walls, a 2 x 5
+/// raised floor and a tile under its down slope (40 + 14 + 10 + 1 = 65 whole tiles) and 2
+/// slope tiles; "Terrain" a ramp polygon and the hills polyline (a chain); "Platforms" 5
+/// one-way tiles; "Spawns" the player, an enemy, a boulder and three coins.
 #[test]
 fn check_summarises_the_shipped_tiled_level() {
-    let level = crate::util::root().join("scenarios/tiled/tiled_level.toml");
+    let level = crate::util::root().join("scenarios/tiled_level.toml");
     let o = crate::util::ricochet(&["check", level.to_str().unwrap()], b"");
     let out = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(
         out.contains(
-            "tiled map: 30 static tiles, 2 solid bodies, 0 one-way pieces, 0 chains, \
-             spawns: 3 coin, 1 enemy, 1 player"
+            "tiled map: 67 static tiles, 1 solid bodies, 5 one-way pieces, 1 chains, \
+             spawns: 1 boulder, 3 coin, 1 enemy, 1 player"
         ),
         "{out}"
     );

@@ -4,11 +4,11 @@
 
 use crate::util::{ricochet_in, root};
 
-/// A folder holding `scenarios/tiled/tiled_level.toml` and its map, as a game's repository would.
+/// A folder holding `scenarios/tiled_level.toml` and its map, as a game's repository would.
 fn level_copy() -> tempfile::TempDir {
     let dir = tempfile::tempdir().expect("a temporary folder");
     std::fs::create_dir_all(dir.path().join("levels/maps")).unwrap();
-    let from = root().join("scenarios/tiled");
+    let from = root().join("scenarios");
     std::fs::copy(
         from.join("tiled_level.toml"),
         dir.path().join("levels/tiled_level.toml"),

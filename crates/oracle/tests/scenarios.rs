@@ -17,7 +17,12 @@ fn every_scenario_validates() {
     for path in &files {
         let text = std::fs::read_to_string(path).unwrap();
         let name = path.display().to_string();
-        let scenario = ricochet_sim::load_scenario(&text, &name).unwrap_or_else(|e| panic!("{e}"));
+        // A scenario may take its level from a Tiled map, as `ricochet validate` reads it.
+        let (mut scenario, tiled) =
+            ricochet_sim::load_scenario_and_map(&text, &name).unwrap_or_else(|e| panic!("{e}"));
+        if let Some(def) = tiled {
+            ricochet_tiled::add_map(&mut scenario, &def, path).unwrap_or_else(|e| panic!("{e}"));
+        }
         let summary = validate(&scenario, scenario.frames, Tolerances::default());
         let table = summary_table(&summary);
         println!("{table}");
