@@ -111,6 +111,18 @@ pub fn shape_def(v: &serde_json::Value) -> ricochet_geom::ShapeDef {
                 .collect(),
             center: [0.0, 0.0],
         },
+        // A chain is logged as a compound of its segments, each a capsule of radius 0 (its
+        // ghost points are not logged: a chain without `prev`/`next` is rebuilt whole).
+        "compound" if is_chain(&s["parts"]) => {
+            let parts = s["parts"].as_array().unwrap();
+            let mut points = vec![pair(&parts[0]["capsule"]["a"])];
+            points.extend(parts.iter().map(|p| pair(&p["capsule"]["b"])));
+            ShapeDef::Chain {
+                points,
+                prev: None,
+                next: None,
+            }
+        }
         "compound" => ShapeDef::Compound {
             parts: s["parts"]
                 .as_array()
@@ -121,6 +133,18 @@ pub fn shape_def(v: &serde_json::Value) -> ricochet_geom::ShapeDef {
         },
         other => panic!("unknown shape kind {other}"),
     }
+}
+
+/// Whether a logged compound's parts are a chain's segments: capsules of radius 0, each
+/// starting where the one before ends.
+fn is_chain(parts: &serde_json::Value) -> bool {
+    let parts = parts.as_array().expect("parts");
+    parts
+        .iter()
+        .all(|p| p["capsule"]["radius"].as_f64() == Some(0.0))
+        && parts
+            .windows(2)
+            .all(|w| w[0]["capsule"]["b"] == w[1]["capsule"]["a"])
 }
 
 /// Runs the built `ricochet` binary with `args` in the folder `dir`, stdin empty.
