@@ -161,26 +161,31 @@ fn a_runner_walks_down_30_and_45_degree_ramps_from_the_plateau_without_bouncing(
     }
 }
 
+/// Steps `s` 600 frames: the actor, idle at `start`, moves less than 1e-9 and is grounded
+/// from frame 1 on.
+fn stays_put(angle: f64, mut s: Simulation, start: (f64, f64)) {
+    let a = actor(&s);
+    for frame in 0..=600 {
+        s.step();
+        let p = s.position(a).unwrap();
+        let moved = ((p.x - start.0).powi(2) + (p.y - start.1).powi(2)).sqrt();
+        assert!(
+            moved < 1e-9,
+            "{angle}°, frame {frame}: moved {moved} to {p:?}"
+        );
+        if frame > 0 {
+            assert!(s.grounded(a).unwrap(), "{angle}°, frame {frame}");
+        }
+    }
+}
+
 #[test]
 fn an_idle_runner_stays_put_on_30_and_45_degree_ramps() {
     for angle in [30.0, 45.0] {
         // Halfway up, its bottom right corner on the ramp.
         let x = 2.0;
         let start = (x, ground_under(angle, x) + HH);
-        let mut s = scene(angle, "", &runner(start.0, start.1));
-        let a = actor(&s);
-        for frame in 0..=600 {
-            s.step();
-            let p = s.position(a).unwrap();
-            let moved = ((p.x - start.0).powi(2) + (p.y - start.1).powi(2)).sqrt();
-            assert!(
-                moved < 1e-9,
-                "{angle}°, frame {frame}: moved {moved} to {p:?}"
-            );
-            if frame > 0 {
-                assert!(s.grounded(a).unwrap(), "{angle}°, frame {frame}");
-            }
-        }
+        stays_put(angle, scene(angle, "", &runner(start.0, start.1)), start);
     }
 }
 
@@ -207,20 +212,7 @@ angle = {:?}"#,
             runner(start.0, start.1),
             angle.to_radians()
         );
-        let mut s = scene(angle, "", &body);
-        let a = actor(&s);
-        for frame in 0..=600 {
-            s.step();
-            let p = s.position(a).unwrap();
-            let moved = ((p.x - start.0).powi(2) + (p.y - start.1).powi(2)).sqrt();
-            assert!(
-                moved < 1e-9,
-                "{angle}°, frame {frame}: moved {moved} to {p:?}"
-            );
-            if frame > 0 {
-                assert!(s.grounded(a).unwrap(), "{angle}°, frame {frame}");
-            }
-        }
+        stays_put(angle, scene(angle, "", &body), start);
     }
 }
 
