@@ -1,13 +1,14 @@
-//! The scene queries' tree: a packed tree (sort-tile-recursive, as `broad_phase/
-//! static_tree.rs`, whose walk the step's broad phase keeps) over one set of bodies, with
-//! its members stored in tree order so that a leaf's boxes are contiguous and a member's
-//! position in the tree is its handle into the set's columns (`index.rs`).
+//! The scene queries' tree: a packed tree over one set of bodies, four wide (rapier's `Bvh`
+//! is too), built by median cuts, with its members stored in tree order so that a leaf's
+//! boxes are contiguous and a member's position in the tree is its handle into the set's
+//! columns (`index.rs`).
 //!
-//! Against the broad phase's tree: leaves of [`LEAF`] = 4 members (each member of a visited
-//! leaf costs a box test, and a query's answer is a handful of bodies), the walk stack on
-//! the thread's stack (no allocation a query), a node's children tested before they are
-//! pushed, and the ray's slab test with the direction inverted and the rounding margin
-//! taken once a walk.
+//! Leaves of [`LEAF`] = 4 members (each member of a visited leaf costs a box test, and a
+//! query's answer is a handful of bodies) and nodes of 4 children, each node's four boxes
+//! stored by coordinate ([`Quad`]) and tested together with no branch per child; half the
+//! levels of a binary tree, so fewer dependent loads. The walk's stack is on the thread's
+//! stack (no allocation a query), and the ray's slab test has the direction inverted and
+//! the rounding margin taken once a walk.
 
 use ricochet_geom::{Bounds, Vec2};
 
