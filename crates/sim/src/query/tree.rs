@@ -1,30 +1,92 @@
-//! The scene queries' tree: a packed tree (sort-tile-recursive, as `broad_phase/
-//! static_tree.rs`, whose walk the step's broad phase keeps) over one set of bodies, with
-//! its members stored in tree order so that a leaf's boxes are contiguous and a member's
-//! position in the tree is its handle into the set's columns (`index.rs`).
+//! The scene queries' tree: a packed tree over one set of bodies, four wide (rapier's `Bvh`
+//! is too), built by median cuts, with its members stored in tree order so that a leaf's
+//! boxes are contiguous and a member's position in the tree is its handle into the set's
+//! columns (`index.rs`).
 //!
-//! Against the broad phase's tree: leaves of [`LEAF`] = 4 members (each member of a visited
-//! leaf costs a box test, and a query's answer is a handful of bodies), the walk stack on
-//! the thread's stack (no allocation a query), a node's children tested before they are
-//! pushed, and the ray's slab test with the direction inverted and the rounding margin
-//! taken once a walk.
+//! Leaves of [`LEAF`] = 4 members (each member of a visited leaf costs a box test, and a
+//! query's answer is a handful of bodies) and nodes of 4 children, each node's four boxes
+//! stored by coordinate ([`Quad`]) and tested together with no branch per child; half the
+//! levels of a binary tree, so fewer dependent loads. The walk's stack is on the thread's
+//! stack (no allocation a query), and the ray's slab test has the direction inverted and
+//! the rounding margin taken once a walk.
 
 use ricochet_geom::{Bounds, Vec2};
 
-/// Members per leaf.
+/// Members per leaf, and children per node.
 const LEAF: usize = 4;
 
-/// Entries a walk's stack holds: one pending sibling per level (a tree over 2^32 members
-/// has < 32 levels), plus the node being expanded.
+/// Entries a walk's stack holds: up to three pending siblings per level (a tree over 2^32
+/// members has < 16 levels of four), plus the four children of the node being expanded.
 const STACK: usize = 64;
+
+/// Four boxes side by side, one array per coordinate, so that a walk tests a node's four
+/// children in one pass with no branch per child. A missing child is the empty box
+/// ([`Quad::EMPTY`]'s lanes), which nothing meets.
+#[derive(Clone, Copy, Debug)]
+struct Quad {
+    min_x: [f64; 4],
+    min_y: [f64; 4],
+    max_x: [f64; 4],
+    max_y: [f64; 4],
+}
+
+impl Quad {
+    /// Min at `+inf`, max at `-inf`: no box or segment meets it, and a hull ignores it.
+    const EMPTY: Quad = Quad {
+        min_x: [f64::INFINITY; 4],
+        min_y: [f64::INFINITY; 4],
+        max_x: [f64::NEG_INFINITY; 4],
+        max_y: [f64::NEG_INFINITY; 4],
+    };
+
+    /// Up to four boxes, the rest empty.
+    fn of(boxes: &[Bounds]) -> Quad {
+        let mut q = Quad::EMPTY;
+        for (j, b) in boxes.iter().enumerate() {
+            q.min_x[j] = b.min.x;
+            q.min_y[j] = b.min.y;
+            q.max_x[j] = b.max.x;
+            q.max_y[j] = b.max.y;
+        }
+        q
+    }
+
+    /// The box around the four (ignoring empty and NaN lanes, as [`hull`]).
+    fn hull(&self) -> Bounds {
+        (1..4).fold(self.lane(0), |u, j| hull(u, self.lane(j)))
+    }
+
+    fn lane(&self, j: usize) -> Bounds {
+        Bounds {
+            min: Vec2::new(self.min_x[j], self.min_y[j]),
+            max: Vec2::new(self.max_x[j], self.max_y[j]),
+        }
+    }
+
+    /// Bit `j` set when lane `j` overlaps `q` (touching counts), as [`meets`].
+    #[inline]
+    fn meets(&self, q: &Bounds) -> u32 {
+        let mut mask = 0;
+        for j in 0..4 {
+            let m = (self.min_x[j] <= q.max.x)
+                & (q.min.x <= self.max_x[j])
+                & (self.min_y[j] <= q.max.y)
+                & (q.min.y <= self.max_y[j]);
+            mask |= u32::from(m) << j;
+        }
+        mask
+    }
+}
 
 /// A packed tree over boxes, its members in tree order.
 #[derive(Debug, Default)]
 pub(crate) struct QueryTree {
-    /// Each member's box, in tree order: leaf `k` holds members `LEAF * k ..`.
-    boxes: Vec<Bounds>,
-    /// `levels[0][k]` bounds leaf `k`; `levels[j + 1][k]` bounds `levels[j][2k..2k + 2]`.
-    levels: Vec<Vec<Bounds>>,
+    /// `levels[0][k]` holds the boxes of members `4k .. 4k + 4` (in tree order);
+    /// `levels[j + 1][k]` holds the boxes around the members of `levels[j][4k .. 4k + 4]`.
+    /// The last level is one node, the root.
+    levels: Vec<Vec<Quad>>,
+    /// The box around every member.
+    all: Option<Bounds>,
 }
 
 impl QueryTree {
@@ -33,10 +95,10 @@ impl QueryTree {
     /// function of the boxes.
     ///
     /// Built top down by median cuts (`split`), not sort-tile-recursive: the implicit
-    /// layout pairs leaves `2k`, `2k + 1` at every level, and over STR's slices that pairs
+    /// layout groups leaves `4k .. 4k + 4` at every level, and over STR's slices that groups
     /// the end of one slice with the start of the next, boxes as tall as the world that a
-    /// query then walks into. A median cut along the longer side at every node keeps each
-    /// node's box compact.
+    /// query then walks into. A median cut along the longer side at every binary level
+    /// keeps each node's box compact; a node of four is two such levels.
     pub(crate) fn new(boxes: &[Bounds]) -> (QueryTree, Vec<u32>) {
         let mut order: Vec<u32> = (0..boxes.len() as u32).collect();
         if boxes.is_empty() {
@@ -49,64 +111,50 @@ impl QueryTree {
             &centers,
             LEAF << leaves.next_power_of_two().trailing_zeros(),
         );
-        let boxes: Vec<Bounds> = order.iter().map(|&k| boxes[k as usize]).collect();
-        let leaves: Vec<Bounds> = boxes
-            .chunks(LEAF)
-            .map(|c| c[1..].iter().fold(c[0], |u, b| hull(u, *b)))
-            .collect();
-        let mut levels = vec![leaves];
+        let sorted: Vec<Bounds> = order.iter().map(|&k| boxes[k as usize]).collect();
+        let mut levels = vec![sorted.chunks(LEAF).map(Quad::of).collect::<Vec<Quad>>()];
         while levels[levels.len() - 1].len() > 1 {
-            let next = levels[levels.len() - 1]
-                .chunks(2)
-                .map(|c| c[1..].iter().fold(c[0], |u, b| hull(u, *b)))
-                .collect();
-            levels.push(next);
+            let hulls: Vec<Bounds> = levels[levels.len() - 1].iter().map(Quad::hull).collect();
+            levels.push(hulls.chunks(LEAF).map(Quad::of).collect());
         }
-        (QueryTree { boxes, levels }, order)
+        let all = levels[levels.len() - 1][0].hull();
+        (
+            QueryTree {
+                levels,
+                all: Some(all),
+            },
+            order,
+        )
     }
 
     /// Calls `f` with every member whose box overlaps `q` (touching counts).
     #[inline]
     pub(crate) fn query(&self, q: &Bounds, f: &mut impl FnMut(usize)) {
-        let Some(top) = self.levels.len().checked_sub(1) else {
+        let Some(all) = self.all else {
             return;
         };
-        if !meets(&self.levels[top][0], q) {
+        if !meets(&all, q) {
             return;
         }
+        let top = self.levels.len() - 1;
         let mut stack = [(0u32, 0u32); STACK];
         let mut len = 0;
-        // The node walked now: descended into directly, the other child pushed.
         let (mut level, mut i) = (top, 0);
         loop {
+            let mut mask = self.levels[level][i].meets(q);
             if level == 0 {
-                let end = (i * LEAF + LEAF).min(self.boxes.len());
-                for k in i * LEAF..end {
-                    if meets(&self.boxes[k], q) {
-                        f(k);
-                    }
+                while mask != 0 {
+                    f(i * LEAF + mask.trailing_zeros() as usize);
+                    mask &= mask - 1;
                 }
             } else {
-                let below = &self.levels[level - 1];
-                let a = meets(&below[2 * i], q);
-                let b = below.get(2 * i + 1).is_some_and(|c| meets(c, q));
-                level -= 1;
-                match (a, b) {
-                    (true, true) => {
-                        stack[len] = (level as u32, (2 * i + 1) as u32);
-                        len += 1;
-                        i *= 2;
-                        continue;
-                    }
-                    (true, false) => {
-                        i *= 2;
-                        continue;
-                    }
-                    (false, true) => {
-                        i = 2 * i + 1;
-                        continue;
-                    }
-                    (false, false) => {}
+                // Pushed highest first, so the lowest is walked first.
+                let below = (level - 1) as u32;
+                while mask != 0 {
+                    let j = 31 - mask.leading_zeros();
+                    stack[len] = (below, (i * LEAF) as u32 + j);
+                    len += 1;
+                    mask &= !(1 << j);
                 }
             }
             if len == 0 {
@@ -119,9 +167,9 @@ impl QueryTree {
 
     /// Calls `f` on every member whose box the segment `origin + t * dir`, `t` in
     /// `[0, max]`, may cross (a slab test, touching counts). `f` returns the new `max`: a
-    /// first-hit search shrinks it, so boxes beyond the best hit so far are skipped. Of two
-    /// children, the one the segment enters first is walked first, so the first hit is
-    /// found early and prunes the rest.
+    /// first-hit search shrinks it, so boxes beyond the best hit so far are skipped. Of a
+    /// node's children, the ones the segment enters first are walked first, so the first
+    /// hit is found early and prunes the rest.
     pub(crate) fn ray(
         &self,
         origin: Vec2,
@@ -129,53 +177,46 @@ impl QueryTree {
         mut max: f64,
         f: &mut impl FnMut(usize, f64) -> f64,
     ) {
-        let Some(top) = self.levels.len().checked_sub(1) else {
+        let Some(all) = self.all else {
             return;
         };
-        let slab = Slab::new(origin, dir, &self.levels[top][0]);
-        if slab.enter(&self.levels[top][0], max).is_none() {
+        let slab = Slab::new(origin, dir, &all);
+        if slab.enter(&all, max).is_none() {
             return;
         }
+        let top = self.levels.len() - 1;
         // (level, index, entry distance) of the nodes put off.
         let mut stack = [(0u32, 0u32, 0.0f64); STACK];
         let mut len = 0;
-        // The node walked now: of two children met, the nearer is descended into directly
-        // and the farther pushed, so the first hit is found early and prunes the rest.
         let (mut level, mut i) = (top, 0);
         loop {
+            let (t, mut mask) = slab.enter4(&self.levels[level][i], max);
             if level == 0 {
-                let end = (i * LEAF + LEAF).min(self.boxes.len());
-                for k in i * LEAF..end {
-                    if slab.enter(&self.boxes[k], max).is_some() {
-                        max = f(k, max);
+                while mask != 0 {
+                    let j = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    // `max` may have shrunk since the four were tested.
+                    if t[j] <= max {
+                        max = f(i * LEAF + j, max);
                     }
                 }
             } else {
-                let below = &self.levels[level - 1];
-                let a = slab.enter(&below[2 * i], max);
-                let b = below.get(2 * i + 1).and_then(|c| slab.enter(c, max));
-                level -= 1;
-                match (a, b) {
-                    (Some(ta), Some(tb)) => {
-                        let (near, far, t) = if tb < ta {
-                            (2 * i + 1, 2 * i, ta)
-                        } else {
-                            (2 * i, 2 * i + 1, tb)
-                        };
-                        stack[len] = (level as u32, far as u32, t);
-                        len += 1;
-                        i = near;
-                        continue;
+                // Pushed farthest first, so the nearest is walked first (ties: the lower
+                // child first).
+                let below = (level - 1) as u32;
+                let start = len;
+                while mask != 0 {
+                    let j = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    let e = (below, (i * LEAF + j) as u32, t[j]);
+                    // Insertion among this node's entries, kept by distance, descending.
+                    let mut at = len;
+                    while at > start && stack[at - 1].2 <= e.2 {
+                        stack[at] = stack[at - 1];
+                        at -= 1;
                     }
-                    (Some(_), None) => {
-                        i *= 2;
-                        continue;
-                    }
-                    (None, Some(_)) => {
-                        i = 2 * i + 1;
-                        continue;
-                    }
-                    (None, None) => {}
+                    stack[at] = e;
+                    len += 1;
                 }
             }
             // The next node put off that the segment, as shortened, still reaches.
@@ -276,6 +317,56 @@ impl Slab {
         let enter = near_x.max(near_y).max(0.0);
         let exit = far_x.min(far_y).min(max);
         (enter <= exit).then_some(enter)
+    }
+
+    /// [`Slab::enter`] of the four lanes of `q` at once: each lane's entry distance, and
+    /// bit `j` set when lane `j` is met.
+    #[inline]
+    fn enter4(&self, q: &Quad, max: f64) -> ([f64; 4], u32) {
+        let mut t = [0.0; 4];
+        let mut mask = 0;
+        if self.flat {
+            for (j, tj) in t.iter_mut().enumerate() {
+                if let Some(e) = self.enter_flat(&q.lane(j), max) {
+                    *tj = e;
+                    mask |= 1 << j;
+                }
+            }
+            return (t, mask);
+        }
+        let (near_x, far_x) = if self.back[0] {
+            (&q.max_x, &q.min_x)
+        } else {
+            (&q.min_x, &q.max_x)
+        };
+        let (near_y, far_y) = if self.back[1] {
+            (&q.max_y, &q.min_y)
+        } else {
+            (&q.min_y, &q.max_y)
+        };
+        // The near face is padded against the origin by the one the direction meets first
+        // (`from_min` for a min face), as `enter` pads each face.
+        let (nx, fx) = if self.back[0] {
+            (self.from_max.x, self.from_min.x)
+        } else {
+            (self.from_min.x, self.from_max.x)
+        };
+        let (ny, fy) = if self.back[1] {
+            (self.from_max.y, self.from_min.y)
+        } else {
+            (self.from_min.y, self.from_max.y)
+        };
+        for j in 0..4 {
+            let enter = ((near_x[j] - nx) * self.inv.x)
+                .max((near_y[j] - ny) * self.inv.y)
+                .max(0.0);
+            let exit = ((far_x[j] - fx) * self.inv.x)
+                .min((far_y[j] - fy) * self.inv.y)
+                .min(max);
+            t[j] = enter;
+            mask |= u32::from(enter <= exit) << j;
+        }
+        (t, mask)
     }
 
     /// [`Slab::enter`] for a segment parallel to an axis' faces (`inv` infinite there).
