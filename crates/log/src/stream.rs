@@ -47,7 +47,7 @@ pub(crate) fn read_ahead(
     let _ = sender.send(Ahead::End);
 }
 
-/// The messages of a [`LogFile`], read and decoded one at a time. Chunk CRCs
+/// The messages of a [`LogFile`](crate::LogFile), read and decoded one at a time. Chunk CRCs
 /// are checked before a chunk's messages are yielded; the data section's CRC,
 /// the summary's and the message counts against the statistics at the end.
 /// After an error it yields nothing more.
