@@ -36,7 +36,13 @@ fn suite_junit_with_noncharacters_in_names_and_messages_parses() {
     let dir = suite_copy();
     let scenarios = dir.path().join("scenarios");
     for entry in std::fs::read_dir(&scenarios).unwrap() {
-        std::fs::remove_file(entry.unwrap().path()).unwrap();
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            // `maps/`: the Tiled level's map.
+            std::fs::remove_dir_all(path).unwrap();
+        } else {
+            std::fs::remove_file(path).unwrap();
+        }
     }
     // U+FFFE and U+FFFF are valid UTF-8 and legal in a file name, and XML 1.0 forbids them.
     std::fs::copy(
