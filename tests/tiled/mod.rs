@@ -21,11 +21,17 @@ pub fn scenario_text(map: &str, solid: &str, extra: &str) -> String {
 
 /// Loads `dir/level.toml` as the binary does.
 pub fn load(dir: &Path) -> Result<(ricochet_sim::Scenario, ricochet_tiled::MapSummary), String> {
-    let path = dir.join("level.toml");
-    let text = std::fs::read_to_string(&path).unwrap();
+    load_file(&dir.join("level.toml"))
+}
+
+/// Loads the scenario file `path` and its map as the binary does.
+pub fn load_file(
+    path: &Path,
+) -> Result<(ricochet_sim::Scenario, ricochet_tiled::MapSummary), String> {
+    let text = std::fs::read_to_string(path).unwrap();
     let (mut s, def) = ricochet_sim::load_scenario_and_map(&text, &path.display().to_string())
         .map_err(|e| e.to_string())?;
-    let summary = ricochet_tiled::add_map(&mut s, &def.expect("a [tiled] table"), &path)
+    let summary = ricochet_tiled::add_map(&mut s, &def.expect("a [tiled] table"), path)
         .map_err(|e| e.to_string())?;
     Ok((s, summary))
 }
@@ -345,6 +351,15 @@ fn check_summarises_the_shipped_tiled_level() {
         ),
         "{out}"
     );
+}
+
+/// No false refusal: the shipped Tiled level, its map's bodies added, passes the check a
+/// game runs on a scene before it steps (its script names the player the map spawns).
+#[test]
+fn the_shipped_tiled_level_passes_the_check() {
+    let level = crate::util::root().join("scenarios/tiled_level.toml");
+    let (scenario, _) = load_file(&level).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(scenario.check(), Ok(()));
 }
 
 /// Polylines of a `solid` layer become chains covering exactly their points: sampled on

@@ -155,6 +155,11 @@ fn every_scenario_the_loader_accepts_passes_the_check() {
         let path = entry.unwrap().path();
         if path.extension().is_some_and(|x| x == "toml") {
             let text = std::fs::read_to_string(&path).unwrap();
+            // A Tiled level's bodies come from its map, which this crate does not read: the
+            // root package's `tiled::the_shipped_tiled_level_passes_the_check` checks it.
+            if text.lines().any(|l| l.trim() == "[tiled]") {
+                continue;
+            }
             let scenario = load_scenario(&text, &path.display().to_string()).unwrap();
             assert_eq!(scenario.check(), Ok(()), "{}", path.display());
             n += 1;
