@@ -206,8 +206,10 @@ impl Shared {
             if let Some((time, payload)) = latched {
                 let data = protocol::message_data(subscription, time, &payload);
                 match c.queue.offer_latest(channel, Message::binary(data)) {
-                    Latest::Queued | Latest::Thinned => {}
-                    Latest::Replaced => c.dropped += 1,
+                    // Replaced: the client subscribed again (a viewer applying its layout
+                    // does) before the copy sent at its first subscription was written; it
+                    // gets the latest instead, and missed nothing.
+                    Latest::Queued | Latest::Thinned | Latest::Replaced => {}
                     Latest::Dropped => {
                         c.dropped += 1;
                         c.stale.insert(channel);
@@ -380,8 +382,9 @@ impl Shared {
                 match c.queue.offer_latest(channel, data) {
                     Latest::Queued | Latest::Thinned => true,
                     Latest::Replaced => {
-                        // The latest is queued; the older state it replaced is lost.
-                        c.dropped += 1;
+                        // The latest is queued; the older state it replaced is lost: counted
+                        // in the server's tally, but the client is not told it was too slow
+                        // (it gets the latest state, which is what it subscribed to).
                         dropped += 1;
                         true
                     }
@@ -526,5 +529,45 @@ impl MessageSink for LiveSink {
         message: M,
     ) -> Result<(), LogError> {
         self.write(channel, time_ns, message)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::queue::client_queue;
+
+    /// A client subscribing again to a whole-state topic before the state sent at its first
+    /// subscription was written (Lichtblick does, applying its layout) gets the latest in
+    /// its place: it missed nothing, so nothing is counted against it.
+    #[test]
+    fn subscribing_again_to_a_whole_state_drops_nothing() {
+        let hub = Hub::default();
+        let mut s = hub.lock();
+        s.channels
+            .push(Channel::json(1, "/scene/static", "x", "{}"));
+        s.publish(1, 0, b"{}".to_vec());
+        let (queue, _receiver) = client_queue();
+        let (id, _kicked) = s.connect(queue);
+        s.subscribe(id, 7, 1).unwrap();
+        s.subscribe(id, 8, 1).unwrap();
+        assert_eq!(s.clients[&id].dropped, 0);
+    }
+
+    /// A whole state replaced in a client's queue before it was written (a client a frame
+    /// behind) is counted in the server's tally of messages dropped, and the client is not
+    /// sent a "too slow" status for it: it gets the latest state, as documented. The real
+    /// viewer showed that status as a problem on small scenes whenever the machine was busy.
+    #[test]
+    fn a_replaced_state_is_tallied_but_not_told_to_the_client() {
+        let hub = Hub::default();
+        let mut s = hub.lock();
+        s.channels.push(Channel::json(1, "/scene", "x", "{}"));
+        let (queue, _receiver) = client_queue();
+        let (id, _kicked) = s.connect(queue);
+        s.subscribe(id, 7, 1).unwrap();
+        s.publish(1, 0, b"{}".to_vec());
+        s.publish(1, 1, b"{}".to_vec());
+        assert_eq!((s.clients[&id].dropped, s.dropped), (0, 1));
     }
 }
