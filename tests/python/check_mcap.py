@@ -37,8 +37,8 @@ section's, each chunk's, the summary's), and every message is decoded with
 - `/scene` (moving bodies) and `/scene/static` (static ones), as Foxglove shows them after a
   seek (the last message of each TOPIC at or before the time: so each message is whole):
   every message is a delete-all stamped at its time, then the entities of its topic, each
-  in `world`, not `frame_locked`, stamped then, with no lifetime, only cubes, cylinders and
-  one triangle list, every number an f32. Both are sent at frame 0. With at most 1000
+  in `world`, not `frame_locked`, stamped then, with no lifetime, only cubes, cylinders,
+  one triangle list and one line list (a terrain chain's segments), every number an f32. Both are sent at frame 0. With at most 1000
   bodies at frame 0, each live body is one entity `body/ID:GENERATION` on the topic of its
   kind, with metadata `name`, `id`, `layer`, `kind` (`static`, or `dynamic`/`kinematic`)
   and, moving, `velocity` and `angular_velocity` equal to `/bodies`' to the bit; with more,
@@ -264,6 +264,7 @@ def drawing(bodies):
     cubes and the cylinders, each `(x, y, yaw or None for any, width, height, whose)`, and
     the triangle list's points, its indices and whose polygon starts at each point."""
     cubes, cylinders, points, indices, owners = [], [], [], [], []
+    lines = []  # a terrain chain's segments, as the ends of a line list, in world coordinates
     for (i, g), b in bodies:
         (x, y), a = b["position"], b["angle"]
         s, c = math.sin(a), math.cos(a)
@@ -282,6 +283,10 @@ def drawing(bodies):
                 turn = 0.0 if kind == "aabb" else a + box.angle
                 w, h = 2 * box.half_extents[0], 2 * box.half_extents[1]
                 cubes.append((*at(*box.center), turn, w, h, whose))
+            elif kind == "capsule" and p.capsule.radius == 0:
+                # A loaded capsule's radius is above 0: radius 0 is a chain's segment
+                # (/bodies logs a chain as a compound of them), drawn as a line.
+                lines += [(at(*p.capsule.a), whose), (at(*p.capsule.b), whose)]
             elif kind == "capsule":
                 (ax, ay), (bx, by), r = at(*p.capsule.a), at(*p.capsule.b), p.capsule.radius
                 length = math.hypot(bx - ax, by - ay)
@@ -297,12 +302,29 @@ def drawing(bodies):
                 indices += [j for k in range(1, count - 1) for j in (first, first + k, first + k + 1)]
             else:
                 raise Problem(f"{whose}: a shape of kind {kind}")
-    return cubes, cylinders, points, indices, owners
+    return cubes, cylinders, points, indices, owners, lines
+
+
+def compare_lines(e, lines, what):
+    """Raises Problem unless `e` draws the chain segments `lines` as its one line list."""
+    if len(e.lines) != (1 if lines else 0):
+        raise Problem(f"{what}: {len(e.lines)} line lists, its bodies have {len(lines) // 2} chain segments")
+    if not lines:
+        return
+    ll = e.lines[0]
+    if ll.type != 2 or planar(ll.pose, f"{what}: the line list") != (0.0, 0.0, 0.0) or not ll.thickness > 0:
+        raise Problem(f"{what}: the chain's lines are not a line list in world coordinates (type {ll.type}, thickness {ll.thickness})")
+    if len(ll.points) != len(lines):
+        raise Problem(f"{what}: a line list of {len(ll.points)} points, its chains' segments have {len(lines)} ends")
+    for k, (p, ((x, y), whose)) in enumerate(zip(ll.points, lines)):
+        if not (is_f32(p.x) and is_f32(p.y) and p.z == 0.0 and close(p.x, x) and close(p.y, y)):
+            raise Problem(f"{what}: {whose} end {k % 2} drawn at ({p.x!r}, {p.y!r}, {p.z!r}), its shape at ({x!r}, {y!r})")
 
 
 def compare_drawing(e, bodies, what):
     """Raises Problem unless entity `e` draws `bodies` (in order) where their shapes are."""
-    cubes, cylinders, points, indices, owners = drawing(bodies)
+    cubes, cylinders, points, indices, owners, lines = drawing(bodies)
+    compare_lines(e, lines, what)
     for name, got, want in (("cubes", e.cubes, cubes), ("cylinders", e.cylinders, cylinders)):
         if len(got) != len(want):
             raise Problem(f"{what}: {len(got)} {name}, its bodies' shapes make {len(want)}")
@@ -640,9 +662,9 @@ class Log:
             what = f"{where}: entity {e.id}"
             if e.frame_id != WORLD or e.frame_locked or ts_ns(e.timestamp) != t or e.HasField("lifetime"):
                 raise Problem(f"{what} (frame {e.frame_id}, locked {e.frame_locked}, lifetime {e.HasField('lifetime')}) is not drawn in {WORLD!r} at {t} ns for ever")
-            if e.arrows or e.spheres or e.lines or e.texts or e.models:
-                raise Problem(f"{what}: draws more than cubes, cylinders and triangles")
-            for prim in (*e.cubes, *e.cylinders, *e.triangles):
+            if e.arrows or e.spheres or e.texts or e.models:
+                raise Problem(f"{what}: draws more than cubes, cylinders, triangles and lines")
+            for prim in (*e.cubes, *e.cylinders, *e.triangles, *e.lines):
                 check_color(prim.color, what)
         if self.batched:
             self.check_batches(where, s.entities, ours)
