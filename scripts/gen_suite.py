@@ -7,12 +7,14 @@ BENCHMARKS.md, and the cluster run of scripts/cluster-ci.sh).
 Variant i is shipped scenario i mod S (the S files of scenarios/*.toml, sorted), cut to F
 frames (default 60: one second at 60 Hz; its later script events dropped), with every
 `velocity = [x, y]` and `gravity = [x, y]` line scaled by 1 + (i // S) / 1000, so no two
-variants record the same log. It writes DIR/NAME-IIII.toml and nothing else: bless them
+variants record the same log. It writes DIR/NAME-IIII.toml, and copies scenarios/maps/ (the
+Tiled maps a shipped level reads) to DIR/maps/; nothing else: bless them
 with `ricochet test DIR --bless` (goldens in recordings/ beside DIR). The same N and F
 always give the same files.
 """
 
 import argparse
+import shutil
 import re
 import sys
 from pathlib import Path
@@ -92,6 +94,10 @@ def main():
         scale = 1 + (i // len(texts)) / 1000
         out = variant(text, name, args.frames, scale)
         (args.dir / f"{name}.toml").write_text(out, encoding="utf-8")
+    # A Tiled level's map, relative to its scenario file.
+    maps = ROOT / "scenarios" / "maps"
+    if maps.is_dir():
+        shutil.copytree(maps, args.dir / "maps", dirs_exist_ok=True)
     print(f"{args.count} scenarios in {args.dir}", file=sys.stderr)
 
 
