@@ -44,6 +44,7 @@ fn main() -> ExitCode {
         validate: false,
         channels: None,
         threads: None,
+        draw_every_frame: false,
     });
     // An error that ends a command is exit code 1 ("the run failed"), except for `diff`, whose
     // 1 means "the logs differ": there it is 2, like an unreadable file.
@@ -61,6 +62,7 @@ fn main() -> ExitCode {
             validate,
             channels,
             threads,
+            draw_every_frame,
         } => run::run(
             scenario.as_deref(),
             output,
@@ -68,6 +70,7 @@ fn main() -> ExitCode {
             validate,
             channels.as_deref(),
             threads.map(usize::from),
+            draw_every_frame,
         ),
         Command::Serve {
             scenario,

@@ -26,6 +26,7 @@ pub fn run(
     validate: bool,
     channels: Option<&str>,
     threads: Option<usize>,
+    draw_every_frame: bool,
 ) -> anyhow::Result<ExitCode> {
     let channels = match channels.map(Channels::parse).transpose() {
         Ok(c) => c.unwrap_or_default(),
@@ -84,6 +85,9 @@ pub fn run(
             return Ok(ExitCode::from(2));
         }
     };
+    if draw_every_frame {
+        recorder.draw_every_frame();
+    }
     let progress = (std::io::stderr().is_terminal() && frames >= PROGRESS_FROM).then(|| {
         let bar = indicatif::ProgressBar::new(frames + 1);
         bar.set_style(

@@ -57,7 +57,7 @@ use ricochet_scenes::Rng;
 use ricochet_sim::Scenario;
 use serde_json::Value;
 
-use crate::util::{full_bodies, record, root, shape_def};
+use crate::util::{full_bodies, record_with, root, shape_def};
 
 /// Allowed error, relative to max(1, |value|): a few f32 roundings.
 const TOL: f64 = 4.0 * f32::EPSILON as f64;
@@ -130,6 +130,40 @@ impl Planar {
     }
 }
 
+/// By frame, the frame whose drawing a seek to it shows, from the drawing's pace as
+/// README.md states it ("Drawing a big scene"): frame 0 draws; a drawing of `n` encoded
+/// bytes (the scene topics' messages of its frame, as the file holds them) lets the next
+/// frame draw `ceil(n / 64 KiB)` frames later; a frame allowed to draw that sends nothing
+/// changed nothing drawn, so it shows its own bodies as the last drawing does. With
+/// `--draw-every-frame`, every frame shows itself.
+fn shown_frames(log: &Path, dt_ns: u64, frames: usize, every_frame: bool) -> Vec<usize> {
+    const BUDGET: u64 = 64 * 1024;
+    let file = ricochet_log::LogFile::open(log).unwrap();
+    let mut bytes = vec![0_u64; frames];
+    let mut messages = file.messages().unwrap();
+    while let Some(m) = messages.next_raw() {
+        let m = m.unwrap();
+        if TOPICS.contains(&m.topic()) || ["/tf", "/scene/contacts"].contains(&m.topic()) {
+            bytes[(m.log_time() / dt_ns) as usize] += m.bytes().len() as u64;
+        }
+    }
+    let (mut next, mut last) = (0, 0);
+    (0..frames)
+        .map(|f| {
+            if every_frame || f >= next {
+                assert!(every_frame || f > 0 || bytes[0] > 0, "frame 0 draws");
+                last = f;
+                if bytes[f] > 0 {
+                    next = f + bytes[f].div_ceil(BUDGET).max(1) as usize;
+                }
+            } else {
+                assert_eq!(bytes[f], 0, "frame {f} draws before its pace allows");
+            }
+            last
+        })
+        .collect()
+}
+
 /// A recorded log, indexed as Foxglove holds it once open, with what it must show.
 struct Log {
     name: String,
@@ -149,6 +183,8 @@ struct Log {
     bodies: Vec<Value>,
     /// More than [`PER_BODY_LIMIT`] bodies at frame 0: batched entities.
     batched: bool,
+    /// By frame, the frame whose drawing the panel shows then (see [`shown_frames`]).
+    shown: Vec<usize>,
     /// Where the camera looks with no focus body and no bounds: the centre of the bodies'
     /// extent at frame 0.
     extent_centre: Vec2,
@@ -173,12 +209,17 @@ impl Log {
 
     /// Records the scenario at `path` with `ricochet run`, and reads the log.
     fn record(path: &Path) -> Log {
+        Log::record_with(path, &[])
+    }
+
+    /// Records the scenario at `path` with `ricochet run` and `args`, and reads the log.
+    fn record_with(path: &Path, args: &[&str]) -> Log {
         let name = path.file_stem().unwrap().to_string_lossy().into_owned();
         let text = std::fs::read_to_string(path).unwrap();
         let scenario = ricochet_sim::load_scenario(&text, &name).unwrap();
         let dir = tempfile::tempdir().unwrap();
         let out = dir.path().join(format!("{name}.mcap"));
-        record(path, &out);
+        record_with(path, &out, args);
         let log = ricochet_log::read_log_file(&out).unwrap();
         let bodies = full_bodies(&log);
         // Frame 1's `/bodies` (checked below: one a frame, from 0) is at `dt_ns`.
@@ -218,7 +259,14 @@ impl Log {
             (lo + hi) * 0.5
         });
         let end = log.last().unwrap().log_time;
+        let shown = shown_frames(
+            &out,
+            dt_ns,
+            bodies.len(),
+            args.contains(&"--draw-every-frame"),
+        );
         Log {
+            shown,
             name,
             scenario,
             dt_ns,
@@ -283,9 +331,13 @@ impl Log {
     /// Seeks to `t` and compares what is shown with `/bodies`, `/contacts` and the scenario:
     /// one line per difference.
     fn check(&self, t: u64) -> Vec<String> {
-        let frame = (t / self.dt_ns) as usize;
+        let frame = self.shown[(t / self.dt_ns) as usize];
         let frac = (t % self.dt_ns) as f64 / self.dt_ns as f64;
-        let at = format!("{} at t = {t} ns (frame {frame} + {frac:.3})", self.name);
+        let at = format!(
+            "{} at t = {t} ns (frame {} + {frac:.3}, drawn at {frame})",
+            self.name,
+            t / self.dt_ns
+        );
         let panel = self.panel(t, false);
         let mut problems = Vec::new();
         let mut report = |p: String| problems.push(format!("{at}: {p}"));
@@ -888,6 +940,21 @@ fn crowd() -> String {
         ));
     }
     text
+}
+
+/// With `--draw-every-frame`, a big scene is drawn in every frame it changes: a seek to any
+/// frame shows that frame's bodies.
+#[test]
+fn a_big_scene_drawn_every_frame_shows_every_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("crowd.toml");
+    std::fs::write(&path, crowd()).unwrap();
+    let paced = Log::record(&path);
+    let drawn_late = (0..paced.shown.len()).filter(|&f| paced.shown[f] != f);
+    assert!(drawn_late.count() > 10, "the crowd's drawing is paced");
+    let log = Log::record_with(&path, &["--draw-every-frame"]);
+    assert!(log.shown.iter().enumerate().all(|(f, &s)| s == f));
+    check_every_time(&log, 0xe7e4);
 }
 
 #[test]

@@ -47,15 +47,19 @@ pub fn scenarios() -> Vec<PathBuf> {
 
 /// Runs `ricochet run SCENARIO -o OUT` with the real binary; panics with its stderr if it fails.
 pub fn record(scenario: &std::path::Path, out: &std::path::Path) {
-    let o = ricochet(
-        &[
-            "run",
-            scenario.to_str().unwrap(),
-            "-o",
-            out.to_str().unwrap(),
-        ],
-        b"",
-    );
+    record_with(scenario, out, &[]);
+}
+
+/// [`record`], with more arguments for `ricochet run`.
+pub fn record_with(scenario: &std::path::Path, out: &std::path::Path, args: &[&str]) {
+    let mut all = vec![
+        "run",
+        scenario.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ];
+    all.extend_from_slice(args);
+    let o = ricochet(&all, b"");
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
 

@@ -35,10 +35,12 @@ mod bodies;
 pub mod channels;
 pub mod events;
 pub mod golden;
+mod pace;
 mod recorder;
 pub mod replay;
 pub mod scene;
 pub mod session;
 
 pub use channels::Channels;
+pub use pace::DRAW_BYTES_PER_FRAME;
 pub use recorder::{INLINE_ENV, LIBRARY, Level, Recorder, log_writer};

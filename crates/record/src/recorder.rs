@@ -3,7 +3,7 @@
 //!
 //! | topic | schema | content |
 //! |---|---|---|
-//! | `/scene` | `foxglove.SceneUpdate` | every moving body, in `world`: whole, in every frame one moved, appeared or went (`scene.rs`) |
+//! | `/scene` | `foxglove.SceneUpdate` | every moving body, in `world`: whole, in every drawn frame (`pace.rs`: every frame for small scenes) in which, or since whose last drawing, one moved, appeared or went (`scene.rs`) |
 //! | `/scene/static` | `foxglove.SceneUpdate` | every static body, the same way: whole, when one appeared, went or moved |
 //! | `/tf` | `foxglove.FrameTransforms` | one frame, `view`, where the layout's camera looks: the focus body, or the world's centre |
 //! | `/scene/contacts` | `foxglove.SceneUpdate` | the frame's contact normals, one line list |
@@ -16,7 +16,10 @@
 //! nanoseconds: nothing from the wall clock reaches the file. Messages are built here and
 //! encoded and compressed on the log's writer thread.
 
+use std::mem::take;
 use std::path::Path;
+
+use prost::Message;
 
 use ricochet_geom::Vec2;
 use ricochet_log::messages::fox::{FrameTransforms, Log, SceneUpdate, log};
@@ -26,6 +29,7 @@ use ricochet_sim::{FrameOutput, Layers, Simulation};
 
 use crate::bodies::Tracker;
 use crate::channels::Channels;
+use crate::pace::DrawPace;
 use crate::scene;
 
 /// The `library` field of every log's header.
@@ -80,6 +84,8 @@ pub struct Recorder<S: MessageSink = LogWriter> {
     scene_skipped: bool,
     /// Messages `record` built, all channels.
     built: u64,
+    /// Which frames draw the scene's channels (`pace.rs`).
+    pace: DrawPace,
 }
 
 /// A new log file at `path` (a temporary file renamed onto it when finished), with
@@ -146,6 +152,7 @@ impl<S: MessageSink> Recorder<S> {
             wanted: Channels::default(),
             scene_skipped: false,
             built: 0,
+            pace: DrawPace::default(),
         })
     }
 
@@ -241,6 +248,13 @@ impl<S: MessageSink> Recorder<S> {
         self.wanted = wanted;
     }
 
+    /// Draws the scene's channels in every frame, whatever their size (see `pace.rs`):
+    /// exact seeks in the viewer, slower recording of big scenes. Call before the first
+    /// frame.
+    pub fn draw_every_frame(&mut self) {
+        self.pace = DrawPace::every_frame();
+    }
+
     /// Messages [`Recorder::record`] built so far, all channels (a test's count of what
     /// was skipped).
     pub fn built(&self) -> u64 {
@@ -263,14 +277,22 @@ impl<S: MessageSink> Recorder<S> {
                 want_bodies,
                 style == scene::Style::PerBody,
             );
-            if self.wanted.scene {
+            self.pace.scene_pending |= changes.scene_changed;
+            self.pace.statics_pending |= changes.static_changed;
+            if self.wanted.scene && self.pace.due(out.frame) {
                 let whole = std::mem::take(&mut self.scene_skipped);
+                let mut bytes = 0;
                 for (channel, statics, changed) in [
-                    (self.topics.statics, true, changes.static_changed),
-                    (self.topics.scene, false, changes.scene_changed),
+                    (
+                        self.topics.statics,
+                        true,
+                        take(&mut self.pace.statics_pending),
+                    ),
+                    (self.topics.scene, false, take(&mut self.pace.scene_pending)),
                 ] {
                     if let (Some(ch), true) = (channel, changed || whole) {
                         let message = scene::snapshot(w, layers, statics, style, ts);
+                        bytes += message.encoded_len();
                         self.writer.write(ch, t, message)?;
                         self.built += 1;
                     }
@@ -279,20 +301,25 @@ impl<S: MessageSink> Recorder<S> {
                     let at = self.view_at(sim);
                     if whole || self.view.is_none_or(|(sent, _)| !same_point(sent, at)) {
                         self.view = Some((at, self.fallback_view(sim)));
-                        let transforms = vec![scene::view_transform(ts, at)];
-                        self.writer.write(ch, t, FrameTransforms { transforms })?;
+                        let transforms = FrameTransforms {
+                            transforms: vec![scene::view_transform(ts, at)],
+                        };
+                        bytes += transforms.encoded_len();
+                        self.writer.write(ch, t, transforms)?;
                         self.built += 1;
                     }
                 }
                 if let Some(ch) = self.topics.normals
                     && (!out.contacts.is_empty() || self.normals_shown)
                 {
-                    self.writer
-                        .write(ch, t, scene::contact_normals(&out.contacts, ts))?;
+                    let normals = scene::contact_normals(&out.contacts, ts);
+                    bytes += normals.encoded_len();
+                    self.writer.write(ch, t, normals)?;
                     self.normals_shown = !out.contacts.is_empty();
                     self.built += 1;
                 }
-            } else if self.topics.scene.is_some() {
+                self.pace.drawn(out.frame, bytes as u64);
+            } else if self.topics.scene.is_some() && !self.wanted.scene {
                 self.scene_skipped = true;
                 if self.view.is_none() {
                     // The camera's fallback is where the bodies were at the first frame,

@@ -11,8 +11,10 @@
 //! So:
 //! - `/scene` draws the moving bodies and `/scene/static` the static ones, each message whole
 //!   (a delete-all, then every entity of its topic): the last message of a topic at any time
-//!   is all of its bodies then. `/scene` is sent in a frame when a moving body moved,
-//!   turned, appeared or went, `/scene/static` when a static body did (usually once);
+//!   is all of its bodies at its last drawing. `/scene` is sent in a frame that draws
+//!   (every frame for a small scene: see `pace.rs`) when a moving body moved, turned,
+//!   appeared or went since the last drawing, `/scene/static` when a static body did
+//!   (usually once);
 //! - every entity is in `world`, its primitives placed at the bodies' poses: no frame per
 //!   body, no `/tf` for bodies;
 //! - [`Style::PerBody`] (scenes of at most [`PER_BODY_LIMIT`] bodies when recording starts):

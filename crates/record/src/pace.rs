@@ -1,0 +1,88 @@
+//! When the scene's channels are drawn: in every frame while the drawing is small, less
+//! often when it is big, so that recording keeps up with the simulation (issue #37).
+//!
+//! A frame's drawing (`/scene`, `/scene/static`, `/tf`, `/scene/contacts`) of `n` encoded
+//! bytes is followed by the next drawing no sooner than `ceil(n / DRAW_BYTES_PER_FRAME)`
+//! frames later. A scene whose drawing is at most [`DRAW_BYTES_PER_FRAME`] a frame (up to
+//! about 400 moving bodies; every shipped scenario) is drawn in every frame it changes, as
+//! before; 10,000 moving asteroids (1.5 MB a frame) are drawn every 24th frame (2.5 times
+//! a second of a 60 Hz game). The rule depends only on the bytes, never on time, so a log
+//! stays the same bytes on any machine and with any thread count.
+//!
+//! What the other channels do is unchanged: `/bodies`, `/contacts`, `/stats` and `/events`
+//! are exact in every frame. What a viewer shows at a time between two drawings is the
+//! earlier drawing (Foxglove takes each topic's last message at or before the time), and a
+//! body that lives only between two drawings is never drawn. [`DrawPace::every_frame`]
+//! draws every frame (`ricochet run --draw-every-frame`): exact seeks, at the recording
+//! speed issue #21 measured (about 190 frames/s for 10,000 moving bodies here).
+//!
+//! Why not a fixed rate in log time: what costs is bytes. Measured on the 2-core machine
+//! (BENCHMARKS.md, "Recording at the simulation's speed"), 10,000 asteroids drawn every
+//! frame record at about 5% of the simulation's rate, and a drawing of 10 Hz would still
+//! leave them below half; a scene of 200 bodies costs nothing to draw at 60 Hz.
+
+/// Encoded drawing bytes a frame may average (see the module docs).
+pub const DRAW_BYTES_PER_FRAME: u64 = 64 * 1024;
+
+/// Which frames draw the scene, and what changed since the last drawing.
+#[derive(Clone, Debug, Default)]
+pub struct DrawPace {
+    every_frame: bool,
+    /// The first frame that may draw again.
+    next: u64,
+    /// A moving (static) body changed since the last drawing: the next drawing sends
+    /// `/scene` (`/scene/static`).
+    pub scene_pending: bool,
+    /// See `scene_pending`.
+    pub statics_pending: bool,
+}
+
+impl DrawPace {
+    /// A pace that draws in every frame, whatever the drawing's size.
+    pub fn every_frame() -> DrawPace {
+        DrawPace {
+            every_frame: true,
+            ..DrawPace::default()
+        }
+    }
+
+    /// Whether `frame` draws.
+    pub fn due(&self, frame: u64) -> bool {
+        self.every_frame || frame >= self.next
+    }
+
+    /// Frame `frame` drew `bytes` encoded bytes (0: it had nothing to send).
+    pub fn drawn(&mut self, frame: u64, bytes: u64) {
+        if bytes > 0 {
+            let wait = bytes.div_ceil(DRAW_BYTES_PER_FRAME).max(1);
+            self.next = frame.saturating_add(wait);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_small_drawing_draws_every_frame_and_a_big_one_waits_its_bytes() {
+        let mut p = DrawPace::default();
+        assert!(p.due(0));
+        p.drawn(0, DRAW_BYTES_PER_FRAME);
+        assert!(p.due(1));
+        // 1.5 MB: 1_500_000 / 65_536 = 22.9, so 23 frames.
+        p.drawn(1, 1_500_000);
+        assert!(!p.due(23));
+        assert!(p.due(24));
+        // Nothing to send: the next change draws at once.
+        p.drawn(24, 0);
+        assert!(p.due(25));
+    }
+
+    #[test]
+    fn every_frame_ignores_the_bytes() {
+        let mut p = DrawPace::every_frame();
+        p.drawn(0, u64::MAX);
+        assert!(p.due(1));
+    }
+}
