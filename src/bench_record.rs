@@ -1,6 +1,7 @@
 //! `ricochet bench --record`: the cost of the log. Each built-in scene runs twice in this
 //! process: the simulation alone, then stepped and recorded with every channel, as
-//! `ricochet run` records (writer thread included). Prints frames per second both ways, the
+//! `ricochet run` records (writer thread included; the drawing at its pace, or in every
+//! frame with `--draw-every-frame`). Prints frames per second both ways, the
 //! log's size on disk per moving body per frame, and the raw (uncompressed) message bytes
 //! per channel. Figures, never assertions.
 //!
@@ -36,7 +37,13 @@ fn per_body_frame(bytes: u64, f: &Figures) -> f64 {
     bytes as f64 / f.frames as f64 / f.moving.max(1) as f64
 }
 
-fn measure(name: &str, scene: Scene, frames: u64, dir: &Path) -> anyhow::Result<Figures> {
+fn measure(
+    name: &str,
+    scene: Scene,
+    frames: u64,
+    dir: &Path,
+    draw_every_frame: bool,
+) -> anyhow::Result<Figures> {
     let scenario = scene.build(frames);
     let mut sim = Simulation::new(&scenario);
     let started = Instant::now();
@@ -54,6 +61,9 @@ fn measure(name: &str, scene: Scene, frames: u64, dir: &Path) -> anyhow::Result<
         .count();
     let started = Instant::now();
     let mut recorder = Recorder::create(&path, scenario.world.dt, Channels::default())?;
+    if draw_every_frame {
+        recorder.draw_every_frame();
+    }
     for _ in 0..=frames {
         let out = sim.step();
         recorder.record(&sim, &out)?;
@@ -81,7 +91,12 @@ fn measure(name: &str, scene: Scene, frames: u64, dir: &Path) -> anyhow::Result<
 
 /// Runs `--record` on the named scenes, `frames` frames each after frame 0; keeps the logs
 /// in `keep` if given (else in a temporary directory).
-pub fn run(scenes: &[String], frames: u64, keep: Option<&Path>) -> anyhow::Result<ExitCode> {
+pub fn run(
+    scenes: &[String],
+    frames: u64,
+    keep: Option<&Path>,
+    draw_every_frame: bool,
+) -> anyhow::Result<ExitCode> {
     if let Some(code) = crate::bench::bad_frames(frames)? {
         return Ok(code);
     }
@@ -106,7 +121,7 @@ pub fn run(scenes: &[String], frames: u64, keep: Option<&Path>) -> anyhow::Resul
             }
         };
         out::note(&format!("bench --record: {name}, {frames} frames"))?;
-        rows.push(measure(name, scene, frames, dir)?);
+        rows.push(measure(name, scene, frames, dir, draw_every_frame)?);
     }
     let mut text = String::from(
         "| scene | frames | moving bodies | simulation frames/s | recorded frames/s | log MB | bytes/moving body/frame (disk) | raw bytes/moving body/frame by channel |\n|---|---|---|---|---|---|---|---|\n",

@@ -66,9 +66,9 @@ pub enum Command {
         #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=256))]
         threads: Option<u16>,
         /// Draw the scene (/scene, /scene/static, /tf, /scene/contacts) in every frame. By
-        /// default a drawing of N encoded bytes waits N / 64 KiB frames before the next:
-        /// scenes up to a few hundred moving bodies are drawn every frame anyway, 10,000
-        /// asteroids about every 24th frame, so that recording keeps up with the simulation
+        /// default a drawing of N encoded bytes waits N / 32 KiB frames before the next:
+        /// scenes of at most 256 bodies are drawn every frame anyway, 10,000
+        /// asteroids about every 46th frame, so that recording keeps up with the simulation
         /// (drawing them every frame records at about 190 frames/s on 2 cores). /bodies,
         /// /contacts, /stats and /events are exact in every frame either way; in the viewer
         /// a time between two drawings shows the earlier one.
@@ -294,6 +294,10 @@ pub enum Command {
         /// With --record: keep the logs in this directory (NAME.mcap; created if missing).
         #[arg(long, value_name = "DIR", requires = "record")]
         keep: Option<PathBuf>,
+        /// With --record: draw the scene in every frame (`ricochet run --draw-every-frame`)
+        /// instead of at the drawing's pace, to measure what the pace saves.
+        #[arg(long, requires = "record")]
+        draw_every_frame: bool,
         /// Measure the scene queries instead: after --frames frames, the same 2000 seeded rays
         /// (20 units, from outside every body) and 2000 boxes (about a body's size) asked of
         /// Ricochet (cast_ray, overlap_aabb), rapier's QueryPipeline and Box2D

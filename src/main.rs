@@ -134,10 +134,11 @@ fn main() -> ExitCode {
             csv,
             record: true,
             keep,
+            draw_every_frame,
             ..
         } => {
             let _ = csv;
-            bench_record::run(&scenes, frames, keep.as_deref())
+            bench_record::run(&scenes, frames, keep.as_deref(), draw_every_frame)
         }
         Command::Bench {
             scenes,

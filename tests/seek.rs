@@ -131,13 +131,14 @@ impl Planar {
 }
 
 /// By frame, the frame whose drawing a seek to it shows, from the drawing's pace as
-/// README.md states it ("Drawing a big scene"): frame 0 draws; a drawing of `n` encoded
+/// README.md states it ("Drawing a big scene"): a scene drawn per body draws every frame;
+/// else frame 0 draws; a drawing of `n` encoded
 /// bytes (the scene topics' messages of its frame, as the file holds them) lets the next
-/// frame draw `ceil(n / 64 KiB)` frames later; a frame allowed to draw that sends nothing
+/// frame draw `ceil(n / 32 KiB)` frames later; a frame allowed to draw that sends nothing
 /// changed nothing drawn, so it shows its own bodies as the last drawing does. With
 /// `--draw-every-frame`, every frame shows itself.
 fn shown_frames(log: &Path, dt_ns: u64, frames: usize, every_frame: bool) -> Vec<usize> {
-    const BUDGET: u64 = 64 * 1024;
+    const BUDGET: u64 = 32 * 1024;
     let file = ricochet_log::LogFile::open(log).unwrap();
     let mut bytes = vec![0_u64; frames];
     let mut messages = file.messages().unwrap();
@@ -259,12 +260,8 @@ impl Log {
             (lo + hi) * 0.5
         });
         let end = log.last().unwrap().log_time;
-        let shown = shown_frames(
-            &out,
-            dt_ns,
-            bodies.len(),
-            args.contains(&"--draw-every-frame"),
-        );
+        let every_frame = args.contains(&"--draw-every-frame") || !batched;
+        let shown = shown_frames(&out, dt_ns, bodies.len(), every_frame);
         Log {
             shown,
             name,

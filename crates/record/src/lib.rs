@@ -41,6 +41,7 @@ pub mod replay;
 pub mod scene;
 pub mod session;
 
+pub use bodies::{KEYFRAME_BYTES_PER_FRAME, KEYFRAME_INTERVAL};
 pub use channels::Channels;
 pub use pace::DRAW_BYTES_PER_FRAME;
 pub use recorder::{INLINE_ENV, LIBRARY, Level, Recorder, log_writer};

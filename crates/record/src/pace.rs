@@ -3,11 +3,13 @@
 //!
 //! A frame's drawing (`/scene`, `/scene/static`, `/tf`, `/scene/contacts`) of `n` encoded
 //! bytes is followed by the next drawing no sooner than `ceil(n / DRAW_BYTES_PER_FRAME)`
-//! frames later. A scene whose drawing is at most [`DRAW_BYTES_PER_FRAME`] a frame (up to
-//! about 400 moving bodies; every shipped scenario) is drawn in every frame it changes, as
-//! before; 10,000 moving asteroids (1.5 MB a frame) are drawn every 24th frame (2.5 times
-//! a second of a 60 Hz game). The rule depends only on the bytes, never on time, so a log
-//! stays the same bytes on any machine and with any thread count.
+//! frames later. A scene drawn body by body (at most 256 bodies when recording starts:
+//! `scene::PER_BODY_LIMIT`; every shipped scenario) is drawn in every frame it changes, as
+//! before, and so is a bigger one whose drawing is at most [`DRAW_BYTES_PER_FRAME`] (about
+//! 200 moving bodies drawn in batches); 10,000 moving asteroids (1.5 MB a frame) are drawn every 46th frame (1.3 times
+//! a second of a 60 Hz game, about what the viewer redraws a live 10,000-body scene at).
+//! The rule depends only on the bytes, never on time, so a log stays the same bytes on any
+//! machine and with any thread count.
 //!
 //! What the other channels do is unchanged: `/bodies`, `/contacts`, `/stats` and `/events`
 //! are exact in every frame. What a viewer shows at a time between two drawings is the
@@ -16,13 +18,14 @@
 //! draws every frame (`ricochet run --draw-every-frame`): exact seeks, at the recording
 //! speed issue #21 measured (about 190 frames/s for 10,000 moving bodies here).
 //!
-//! Why not a fixed rate in log time: what costs is bytes. Measured on the 2-core machine
-//! (BENCHMARKS.md, "Recording at the simulation's speed"), 10,000 asteroids drawn every
-//! frame record at about 5% of the simulation's rate, and a drawing of 10 Hz would still
-//! leave them below half; a scene of 200 bodies costs nothing to draw at 60 Hz.
+//! Why bytes and not a fixed rate in log time: what costs is bytes. Measured on the 2-core
+//! machine (BENCHMARKS.md, "Recording at the simulation's speed"), 10,000 asteroids drawn
+//! every frame record at about 5% of the simulation's rate, at 64 KiB a frame the
+//! 10,000-asteroid level at about 40%, at 32 KiB about half; a scene of 200 bodies costs
+//! nothing to draw at 60 Hz.
 
 /// Encoded drawing bytes a frame may average (see the module docs).
-pub const DRAW_BYTES_PER_FRAME: u64 = 64 * 1024;
+pub const DRAW_BYTES_PER_FRAME: u64 = 32 * 1024;
 
 /// Which frames draw the scene, and what changed since the last drawing.
 #[derive(Clone, Debug, Default)]
@@ -70,13 +73,13 @@ mod tests {
         assert!(p.due(0));
         p.drawn(0, DRAW_BYTES_PER_FRAME);
         assert!(p.due(1));
-        // 1.5 MB: 1_500_000 / 65_536 = 22.9, so 23 frames.
+        // 1.5 MB: 1_500_000 / 32_768 = 45.8, so 46 frames.
         p.drawn(1, 1_500_000);
-        assert!(!p.due(23));
-        assert!(p.due(24));
+        assert!(!p.due(46));
+        assert!(p.due(47));
         // Nothing to send: the next change draws at once.
-        p.drawn(24, 0);
-        assert!(p.due(25));
+        p.drawn(47, 0);
+        assert!(p.due(48));
     }
 
     #[test]

@@ -279,7 +279,9 @@ impl<S: MessageSink> Recorder<S> {
             );
             self.pace.scene_pending |= changes.scene_changed;
             self.pace.statics_pending |= changes.static_changed;
-            if self.wanted.scene && self.pace.due(out.frame) {
+            // A scene drawn body by body (at most 256 bodies) is small: drawn every frame.
+            let due = style == scene::Style::PerBody || self.pace.due(out.frame);
+            if self.wanted.scene && due {
                 let whole = std::mem::take(&mut self.scene_skipped);
                 let mut bytes = 0;
                 for (channel, statics, changed) in [
@@ -329,6 +331,10 @@ impl<S: MessageSink> Recorder<S> {
             }
             if let (Some(ch), true) = (self.topics.bodies, want_bodies) {
                 changes.bodies.time = out.frame as f64 * self.dt;
+                if changes.bodies.keyframe {
+                    let bytes = changes.bodies.encoded_len() as u64;
+                    self.tracker.keyframe_written(out.frame, bytes);
+                }
                 self.writer.write(ch, t, changes.bodies)?;
                 self.built += 1;
             }

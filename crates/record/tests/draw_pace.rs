@@ -85,16 +85,92 @@ fn drawing_every_frame_draws_the_big_scene_in_every_frame() {
 }
 
 #[test]
-fn a_small_scene_is_drawn_every_frame_the_same_bytes_either_way() {
+fn a_scene_drawn_per_body_is_drawn_every_frame_the_same_bytes_either_way() {
     let dir = tempfile::tempdir().unwrap();
     let (paced, every) = (dir.path().join("p.mcap"), dir.path().join("e.mcap"));
-    let log = record("asteroids-200", 60, false, &paced);
+    let log = record("asteroids-100", 60, false, &paced);
+    // 201 bodies, drawn one entity each with its metadata: more than the budget a frame,
+    // drawn every frame all the same (a scene of at most 256 bodies is small).
     let biggest = log.values().map(|row| row[0]).max().unwrap();
-    assert!(
-        biggest <= DRAW_BYTES_PER_FRAME,
-        "{biggest} bytes: a small drawing"
-    );
+    assert!(biggest > DRAW_BYTES_PER_FRAME, "{biggest} bytes");
     assert!(log.values().all(|row| row[1] == 1), "/scene in every frame");
-    record("asteroids-200", 60, true, &every);
+    record("asteroids-100", 60, true, &every);
     assert!(std::fs::read(&paced).unwrap() == std::fs::read(&every).unwrap());
+}
+
+/// A big scene's keyframes wait for their bytes (`KEYFRAME_BYTES_PER_FRAME`), and every
+/// frame's bodies are still exact: `/bodies` rebuilt from the keyframe before it gives the
+/// simulation's states bit for bit.
+#[test]
+fn a_big_scenes_keyframes_wait_for_their_bytes_and_every_frame_stays_exact() {
+    use ricochet_log::{BodyStates, read_log_file};
+    use ricochet_record::{KEYFRAME_BYTES_PER_FRAME, KEYFRAME_INTERVAL};
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("k.mcap");
+    let frames = 130;
+    // 4,000 asteroids: a keyframe of about 700 KB, past the 480 KiB that 60 frames allow.
+    let scenario = Scene::parse("asteroids-4000").unwrap().build(frames);
+    let only = Channels::parse("bodies").unwrap();
+    let mut recorder = Recorder::create(&path, scenario.world.dt, only).unwrap();
+    let mut sim = Simulation::new(&scenario);
+    let mut want = Vec::new();
+    for _ in 0..=frames {
+        let out = sim.step();
+        recorder.record(&sim, &out).unwrap();
+        let w = sim.world();
+        let mut states: Vec<_> = (0..w.len())
+            .map(|i| {
+                let (p, v) = (w.position[i], w.velocity(i));
+                let bits = [p.x, p.y, w.angle[i], v.x, v.y, w.angular_velocity(i)];
+                (u64::from(w.entity[i].index), bits.map(f64::to_bits))
+            })
+            .collect();
+        states.sort_unstable();
+        want.push(states);
+    }
+    recorder.finish().unwrap();
+    // The keyframes, by frame, and their sizes as the file holds them.
+    let file = LogFile::open(&path).unwrap();
+    let mut sizes = Vec::new();
+    let mut raw = file.topic_messages("/bodies").unwrap();
+    while let Some(m) = raw.next_raw() {
+        sizes.push(m.unwrap().bytes().len() as u64);
+    }
+    let log = read_log_file(&path).unwrap();
+    let keyframes: Vec<u64> = log
+        .iter()
+        .filter(|m| m.data["keyframe"] == true)
+        .map(|m| m.data["frame"].as_u64().unwrap())
+        .collect();
+    let wait = sizes[0].div_ceil(KEYFRAME_BYTES_PER_FRAME);
+    assert!(
+        wait > KEYFRAME_INTERVAL,
+        "{} bytes: a big keyframe",
+        sizes[0]
+    );
+    let next = wait.next_multiple_of(KEYFRAME_INTERVAL);
+    assert_eq!(keyframes, [0, next], "keyframes of {frames} frames");
+    let mut states = BodyStates::default();
+    for (frame, m) in log.iter().filter(|m| m.topic == "/bodies").enumerate() {
+        let full = states.apply(&m.data);
+        let num = |v: &serde_json::Value| v.as_f64().unwrap().to_bits();
+        let mut got: Vec<_> = full["bodies"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|b| {
+                let bits = [
+                    num(&b["position"][0]),
+                    num(&b["position"][1]),
+                    num(&b["angle"]),
+                    num(&b["velocity"][0]),
+                    num(&b["velocity"][1]),
+                    num(&b["angular_velocity"]),
+                ];
+                (b["id"].as_u64().unwrap(), bits)
+            })
+            .collect();
+        got.sort_unstable();
+        assert!(got == want[frame], "frame {frame}: rebuilt states differ");
+    }
 }
