@@ -82,6 +82,11 @@ pub struct Recorder<S: MessageSink = LogWriter> {
     /// The scene's channels were skipped since they were last built: the next frame that
     /// builds them sends every one of them whole (what a new viewer needs).
     scene_skipped: bool,
+    /// Whether [`Recorder::record`] draws `/scene` (see [`Recorder::draw_moving`]).
+    draw_moving: bool,
+    /// `/scene` was not drawn since it was last sent: the next frame that draws it sends it
+    /// whether or not a body moved in that frame.
+    moving_skipped: bool,
     /// Messages `record` built, all channels.
     built: u64,
     /// Which frames draw the scene's channels (`pace.rs`).
@@ -151,6 +156,8 @@ impl<S: MessageSink> Recorder<S> {
             view: None,
             wanted: Channels::default(),
             scene_skipped: false,
+            draw_moving: true,
+            moving_skipped: false,
             built: 0,
             pace: DrawPace::default(),
         })
@@ -194,7 +201,25 @@ impl<S: MessageSink> Recorder<S> {
             self.writer
                 .write_live(ch, t, FrameTransforms { transforms })?;
         }
+        self.moving_skipped = false;
         Ok(())
+    }
+
+    /// Sends live viewers `/scene` at `frame`, the last frame recorded, if a frame's was
+    /// not drawn since it was last sent ([`Recorder::draw_moving`]): stepping stopped, so no
+    /// later frame will draw it. Never recorded.
+    pub fn show_moving_live(&mut self, sim: &Simulation, frame: u64) -> Result<(), LogError> {
+        let Some(ch) = self.topics.scene else {
+            return Ok(());
+        };
+        if !std::mem::take(&mut self.moving_skipped) {
+            return Ok(());
+        }
+        let t = frame * self.dt_ns;
+        let (w, layers) = (sim.world(), &sim.scenario().world.layers);
+        let style = self.style(w);
+        let message = scene::snapshot(w, layers, false, style, timestamp(t));
+        self.writer.write_live(ch, t, message)
     }
 
     /// How bodies become entities: chosen at the first frame from its body count, then kept.
@@ -255,6 +280,16 @@ impl<S: MessageSink> Recorder<S> {
         self.pace = DrawPace::every_frame();
     }
 
+    /// From the next frame, whether [`Recorder::record`] draws `/scene` (yes by default),
+    /// when [`Recorder::build_only`] wants the scene's channels: a live stream whose clients
+    /// are each sent a whole state at most so often draws it only in the frames one is due
+    /// (drawing 10,000 bodies is most of such a frame). For a live stream only: a recording
+    /// must get every message. The next frame that draws it sends it, moved or not;
+    /// `/scene/static`, `/tf` and `/scene/contacts` go on as [`Recorder::build_only`] says.
+    pub fn draw_moving(&mut self, draw: bool) {
+        self.draw_moving = draw;
+    }
+
     /// Messages [`Recorder::record`] built so far, all channels (a test's count of what
     /// was skipped).
     pub fn built(&self) -> u64 {
@@ -292,7 +327,12 @@ impl<S: MessageSink> Recorder<S> {
                     ),
                     (self.topics.scene, false, take(&mut self.pace.scene_pending)),
                 ] {
-                    if let (Some(ch), true) = (channel, changed || whole) {
+                    if !statics && !self.draw_moving {
+                        self.moving_skipped = true;
+                        continue;
+                    }
+                    let redraw = !statics && std::mem::take(&mut self.moving_skipped);
+                    if let (Some(ch), true) = (channel, changed || whole || redraw) {
                         let message = scene::snapshot(w, layers, statics, style, ts);
                         bytes += message.encoded_len();
                         self.writer.write(ch, t, message)?;

@@ -364,6 +364,13 @@ impl<G: Game, S: MessageSink> GameSession<G, S> {
         self.recorder.refresh_live(self.run.sim(), frame)
     }
 
+    /// Sends live viewers the last frame's `/scene` if it was not drawn
+    /// ([`Recorder::draw_moving`]). Never recorded.
+    pub fn show_moving_live(&mut self) -> Result<(), LogError> {
+        let frame = self.next.saturating_sub(1);
+        self.recorder.show_moving_live(self.run.sim(), frame)
+    }
+
     /// Sends live clients an `/events` line at the last frame stepped (the answer to a
     /// click): never recorded, so a replay never needs it (see [`MessageSink::write_live`]).
     pub fn event_live(&mut self, line: crate::events::EventLine) -> Result<(), LogError> {

@@ -177,6 +177,21 @@ impl Shared {
             })
     }
 
+    /// Whether some client subscribed to the whole-state `topic` wants a newer state by
+    /// `by` (the next frame's start; see [`ClientQueue::wants_latest`]): the plain server
+    /// draws `/scene` only then.
+    pub fn state_wanted(&self, topic: &str, by: std::time::Instant) -> bool {
+        let by = tokio::time::Instant::from_std(by);
+        self.channels
+            .iter()
+            .find(|c| c.topic == topic)
+            .is_some_and(|c| {
+                self.clients
+                    .values()
+                    .any(|k| k.subscriptions.contains_key(&c.id) && k.queue.wants_latest(c.id, by))
+            })
+    }
+
     /// How many clients are connected.
     pub fn client_count(&self) -> usize {
         self.clients.len()

@@ -75,14 +75,21 @@ pub struct ClientQueue {
     /// By channel id: the slot of its latest message, still queued if the slot is full
     /// (one per whole-state channel, so bounded by the channel count).
     latest: Arc<Mutex<BTreeMap<u32, Slot>>>,
+    /// By whole-state channel: when its next state may be written (the receiver's pace),
+    /// for [`ClientQueue::wants_latest`].
+    due: Due,
 }
+
+/// By whole-state channel: when its next state may be written, shared by a client's queue
+/// and its receiver (one entry per such channel, so bounded by the channel count).
+type Due = Arc<Mutex<BTreeMap<u32, Instant>>>;
 
 /// The connection's end of a [`ClientQueue`].
 pub struct ClientQueueReceiver {
     receiver: mpsc::UnboundedReceiver<Queued>,
     queued: Arc<AtomicUsize>,
     /// By whole-state channel: when its next state may be written.
-    due: BTreeMap<u32, Instant>,
+    due: Due,
     /// By whole-state channel: its slot, held back until due (still replaced in place).
     paced: BTreeMap<u32, Slot>,
     /// The whole state last returned (channel, bytes): written once the next is asked for.
@@ -93,16 +100,18 @@ pub struct ClientQueueReceiver {
 pub fn client_queue() -> (ClientQueue, ClientQueueReceiver) {
     let (sender, receiver) = mpsc::unbounded_channel();
     let queued = Arc::new(AtomicUsize::new(0));
+    let due = Due::default();
     (
         ClientQueue {
             sender,
             queued: Arc::clone(&queued),
             latest: Arc::default(),
+            due: Arc::clone(&due),
         },
         ClientQueueReceiver {
             receiver,
             queued,
-            due: BTreeMap::new(),
+            due,
             paced: BTreeMap::new(),
             writing: None,
         },
@@ -195,6 +204,22 @@ impl ClientQueue {
         true
     }
 
+    /// Whether a newer state of `channel` offered now would be written by `by`, or sooner:
+    /// none is waiting to be written in its queue (one is, behind other messages or a
+    /// socket that does not drain: it goes first, and whatever is built meanwhile would only
+    /// replace it), and its pace ([`STATE_RATE`]) lets the channel's next state go by then.
+    /// A state held back by the pace counts as none waiting: a newer one replaces it. The
+    /// server builds a costly whole state (`/scene`) only when some client wants it.
+    pub fn wants_latest(&self, channel: u32, by: Instant) -> bool {
+        if let Some(slot) = lock(&self.latest).get(&channel) {
+            let held = lock(slot);
+            if held.message.is_some() && !held.paced {
+                return false;
+            }
+        }
+        lock(&self.due).get(&channel).is_none_or(|&at| at <= by)
+    }
+
     /// Bytes queued now.
     pub fn queued(&self) -> usize {
         self.queued.load(Ordering::Acquire)
@@ -213,8 +238,11 @@ impl ClientQueueReceiver {
             if let Some(message) = self.take_due(now) {
                 return Some(message);
             }
-            let wake = self.paced.keys().filter_map(|c| self.due.get(c)).min();
-            let queued = match wake.copied() {
+            let wake = {
+                let due = lock(&self.due);
+                self.paced.keys().filter_map(|c| due.get(c)).min().copied()
+            };
+            let queued = match wake {
                 Some(at) => tokio::select! {
                     biased;
                     queued = self.receiver.recv() => queued?,
@@ -274,16 +302,19 @@ impl ClientQueueReceiver {
     fn written(&mut self, now: Instant) {
         if let Some((channel, bytes)) = self.writing.take() {
             let wait = Duration::from_secs_f64(bytes as f64 / STATE_RATE);
-            self.due.insert(channel, now + wait);
+            lock(&self.due).insert(channel, now + wait);
         }
     }
 
     /// A held-back state whose channel is due at `now`, if any.
     fn take_due(&mut self, now: Instant) -> Option<Message> {
-        let channel = *self
-            .paced
-            .keys()
-            .find(|c| self.due.get(c).is_none_or(|&at| at <= now))?;
+        let channel = {
+            let due = lock(&self.due);
+            *self
+                .paced
+                .keys()
+                .find(|c| due.get(c).is_none_or(|&at| at <= now))?
+        };
         let slot = self.paced.remove(&channel)?;
         let message = self.take_slot(&slot)?;
         self.writing = Some((channel, message.len()));
@@ -296,7 +327,8 @@ impl ClientQueueReceiver {
         match queued {
             Queued::Message(message) => Some(self.taken(message)),
             Queued::Latest(channel, slot) => {
-                if self.due.get(&channel).is_some_and(|&at| at > now) {
+                let held_back = lock(&self.due).get(&channel).is_some_and(|&at| at > now);
+                if held_back {
                     lock(&slot).paced = true;
                     self.paced.insert(channel, slot);
                     return None;
@@ -420,6 +452,32 @@ mod tests {
         assert_eq!(got.as_str(), "scene 3");
         assert!(receiver.try_recv().is_err());
         assert_eq!(queue.queued(), 0);
+    }
+
+    /// A client wants a newer state of a channel when none waits in its queue to be
+    /// written and its pace lets the next go by the time asked about: a state held back by
+    /// the pace counts as none (a newer one replaces it).
+    #[tokio::test]
+    async fn a_client_wants_a_state_only_when_one_would_be_written_by_then() {
+        let (queue, mut receiver) = client_queue();
+        let now = Instant::now();
+        assert!(queue.wants_latest(1, now), "never sent one");
+        assert_eq!(
+            queue.offer_latest(1, Message::binary(vec![0u8; 4_000_000])),
+            Latest::Queued
+        );
+        assert!(!queue.wants_latest(1, now), "one waits, not yet written");
+        assert_eq!(receiver.recv().await.unwrap().len(), 4_000_000);
+        assert_eq!(queue.offer_latest(1, text("scene 2")), Latest::Queued);
+        // Written: its next is due 2 s later, and scene 2 is held back till then.
+        assert!(receiver.ready().is_none());
+        let now = Instant::now();
+        assert!(!queue.wants_latest(1, now));
+        assert!(queue.wants_latest(1, now + Duration::from_secs(3)));
+        assert!(
+            queue.wants_latest(2, now),
+            "another channel has its own pace"
+        );
     }
 
     /// What a connection adds to a write without waiting ([`ClientQueueReceiver::ready`]) is

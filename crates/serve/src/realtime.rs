@@ -244,6 +244,7 @@ fn run_loop(
             continue;
         }
         if serving.paused {
+            serving.show_last()?;
             std::thread::sleep(POLL);
             anchor = (Instant::now(), frames);
             continue;

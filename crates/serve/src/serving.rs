@@ -26,6 +26,8 @@ use crate::services;
 use crate::sink::{ServeSink, finish, segment, start};
 use ricochet_record::session::{Session, StepError};
 
+mod drawing;
+
 /// Frames between two snapshots of a session that is not recorded.
 pub const SNAPSHOT_EVERY: u64 = 600;
 /// Snapshots kept at most: their memory is bounded whatever the session's length.
@@ -478,6 +480,7 @@ impl Serving {
     /// step overflowed (then the session is paused at its last good frame and every client
     /// told).
     fn step(&mut self, hub: &Hub) -> Result<bool, ServeError> {
+        self.choose_drawing(hub);
         match self.session.step() {
             Ok(_) => {}
             Err(StepError::Overflow { .. }) => {
