@@ -8,6 +8,7 @@ use ricochet_geom::{Primitive, Shape, Vec2};
 use ricochet_sim::{BodyDef, TileRows, TiledDef};
 use tiled::{LayerType, ObjectData, ObjectShape, PropertyValue};
 
+use crate::objects::{object_outlines, spawn};
 use crate::shapes::{ELLIPSE_POINTS, Outline, chains, primitives};
 use crate::{MAX_ELLIPSE_RATIO, MAX_POLYGON_POINTS, MapSummary, PieceKind, TiledError, TiledPiece};
 
@@ -17,7 +18,7 @@ pub(crate) struct Built {
     pub(crate) tiles: Vec<(PieceKind, TileRows)>,
     pub(crate) pieces: Vec<TiledPiece>,
     pub(crate) spawns: Vec<BodyDef>,
-    spawned: BTreeMap<String, usize>,
+    pub(crate) spawned: BTreeMap<String, usize>,
 }
 
 impl Built {
@@ -159,7 +160,10 @@ impl Ctx<'_> {
 
 /// An object's outlines, its local point `(u, v)` (pixels from its anchor, in its own
 /// rotated frame, y down) mapped to the world by `to_world` after the object's rotation.
-fn outlines(obj: &ObjectData, to_world: &dyn Fn(f64, f64) -> Vec2) -> Result<Vec<Outline>, String> {
+pub(crate) fn outlines(
+    obj: &ObjectData,
+    to_world: &dyn Fn(f64, f64) -> Vec2,
+) -> Result<Vec<Outline>, String> {
     let (sin, cos) = (
         libm::sin(f64::from(obj.rotation).to_radians()),
         libm::cos(f64::from(obj.rotation).to_radians()),
@@ -541,85 +545,5 @@ fn walk(
         }
         LayerType::Image(_) => {}
     }
-    Ok(())
-}
-
-/// A map object's outlines (a tile object: its tile's, stretched to the object's size; its
-/// anchor is its bottom-left corner).
-fn object_outlines(
-    ctx: &Ctx<'_>,
-    obj: &tiled::Object<'_>,
-    offset: (f64, f64),
-) -> Result<Vec<Outline>, String> {
-    let to_world = |px: f64, py: f64| ctx.world(px + offset.0, py + offset.1);
-    let Some(tile) = obj.get_tile() else {
-        return outlines(obj, &to_world);
-    };
-    let data = obj.tile_data().expect("a tile object has tile data");
-    let tileset = tile.get_tileset();
-    let entry = tile.get_tile();
-    let (tw, th) = (
-        f64::from(tileset.tile_width),
-        f64::from(tileset.tile_height),
-    );
-    let (w, h) = match obj.shape {
-        ObjectShape::Rect { width, height } if width > 0.0 && height > 0.0 => {
-            (f64::from(width), f64::from(height))
-        }
-        _ => (tw, th),
-    };
-    let (sin, cos) = (
-        libm::sin(f64::from(obj.rotation).to_radians()),
-        libm::cos(f64::from(obj.rotation).to_radians()),
-    );
-    let (x, y) = (f64::from(obj.x), f64::from(obj.y));
-    let place = |u: f64, v: f64| {
-        // Tile pixels → the object's frame (anchor bottom-left), then rotated about it.
-        let (lu, lv) = (u * w / tw, v * h / th - h);
-        to_world(x + lu * cos - lv * sin, y + lu * sin + lv * cos)
-    };
-    tile_outlines(
-        entry.as_ref(),
-        tileset,
-        (data.flip_h, data.flip_v, data.flip_d),
-        &place,
-    )
-}
-
-fn spawn(
-    ctx: &Ctx<'_>,
-    obj: &tiled::Object<'_>,
-    template: &str,
-    offset: (f64, f64),
-    built: &mut Built,
-) -> Result<(), String> {
-    let (w, h) = match obj.shape {
-        ObjectShape::Rect { width, height }
-        | ObjectShape::Ellipse { width, height }
-        | ObjectShape::Capsule { width, height } => (f64::from(width), f64::from(height)),
-        _ => (0.0, 0.0),
-    };
-    // The centre of the object's box: a tile object's anchor is its bottom-left corner.
-    let (u, v) = if obj.get_tile().is_some() {
-        (w / 2.0, -h / 2.0)
-    } else {
-        (w / 2.0, h / 2.0)
-    };
-    let (sin, cos) = (
-        libm::sin(f64::from(obj.rotation).to_radians()),
-        libm::cos(f64::from(obj.rotation).to_radians()),
-    );
-    let (x, y) = (f64::from(obj.x) + offset.0, f64::from(obj.y) + offset.1);
-    let position = ctx.world(x + u * cos - v * sin, y + u * sin + v * cos);
-    let Some(base) = ctx.templates.get(template) else {
-        return Err(format!(
-            "[tiled.spawn] names template \"{template}\", which the scenario lacks"
-        ));
-    };
-    built.spawns.push(BodyDef {
-        position,
-        ..base.clone()
-    });
-    *built.spawned.entry(template.to_owned()).or_insert(0) += 1;
     Ok(())
 }

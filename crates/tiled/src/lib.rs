@@ -39,6 +39,7 @@
 
 mod build;
 pub mod json;
+mod objects;
 mod read;
 mod shapes;
 mod tiles;

@@ -29,6 +29,7 @@ pub(crate) mod sleep;
 pub(crate) mod slope;
 pub(crate) mod sweep_axis;
 pub(crate) mod sweep_normal;
+pub(crate) mod swept_pairs;
 pub(crate) mod touch;
 pub(crate) mod wrap;
 
