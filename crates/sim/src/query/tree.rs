@@ -15,6 +15,10 @@ use ricochet_geom::{Bounds, Vec2};
 /// Members per leaf, and children per node.
 const LEAF: usize = 4;
 
+/// Levels a tree has at most: a member's handle is a `u32`, so at most `2^30` leaves, 16
+/// levels above them.
+const LEVELS: usize = 17;
+
 /// Entries a walk's stack holds: up to three pending siblings per level (a tree over 2^32
 /// members has < 16 levels of four), plus the four children of the node being expanded.
 const STACK: usize = 64;
@@ -22,31 +26,39 @@ const STACK: usize = 64;
 /// Four boxes side by side, one array per coordinate, so that a walk tests a node's four
 /// children in one pass with no branch per child. A missing child is the empty box
 /// ([`Quad::EMPTY`]'s lanes), which nothing meets.
+///
+/// The coordinates are indexed ([`MIN_X`], [`MIN_Y`], [`MAX_X`], [`MAX_Y`]) so that a ray's
+/// walk picks each axis' near face by an index set once a walk, not a branch per node.
 #[derive(Clone, Copy, Debug)]
 struct Quad {
-    min_x: [f64; 4],
-    min_y: [f64; 4],
-    max_x: [f64; 4],
-    max_y: [f64; 4],
+    c: [[f64; 4]; 4],
 }
+
+/// [`Quad::c`]'s rows: min x, min y, max x, max y (a max row is its min row + 2).
+const MIN_X: usize = 0;
+const MIN_Y: usize = 1;
+const MAX_X: usize = 2;
+const MAX_Y: usize = 3;
 
 impl Quad {
     /// Min at `+inf`, max at `-inf`: no box or segment meets it, and a hull ignores it.
     const EMPTY: Quad = Quad {
-        min_x: [f64::INFINITY; 4],
-        min_y: [f64::INFINITY; 4],
-        max_x: [f64::NEG_INFINITY; 4],
-        max_y: [f64::NEG_INFINITY; 4],
+        c: [
+            [f64::INFINITY; 4],
+            [f64::INFINITY; 4],
+            [f64::NEG_INFINITY; 4],
+            [f64::NEG_INFINITY; 4],
+        ],
     };
 
     /// Up to four boxes, the rest empty.
     fn of(boxes: &[Bounds]) -> Quad {
         let mut q = Quad::EMPTY;
         for (j, b) in boxes.iter().enumerate() {
-            q.min_x[j] = b.min.x;
-            q.min_y[j] = b.min.y;
-            q.max_x[j] = b.max.x;
-            q.max_y[j] = b.max.y;
+            q.c[MIN_X][j] = b.min.x;
+            q.c[MIN_Y][j] = b.min.y;
+            q.c[MAX_X][j] = b.max.x;
+            q.c[MAX_Y][j] = b.max.y;
         }
         q
     }
@@ -58,21 +70,40 @@ impl Quad {
 
     fn lane(&self, j: usize) -> Bounds {
         Bounds {
-            min: Vec2::new(self.min_x[j], self.min_y[j]),
-            max: Vec2::new(self.max_x[j], self.max_y[j]),
+            min: Vec2::new(self.c[MIN_X][j], self.c[MIN_Y][j]),
+            max: Vec2::new(self.c[MAX_X][j], self.c[MAX_Y][j]),
         }
     }
 
     /// Bit `j` set when lane `j` overlaps `q` (touching counts), as [`meets`].
     #[inline]
     fn meets(&self, q: &Bounds) -> u32 {
+        let [min_x, min_y, max_x, max_y] = &self.c;
         let mut mask = 0;
         for j in 0..4 {
-            let m = (self.min_x[j] <= q.max.x)
-                & (q.min.x <= self.max_x[j])
-                & (self.min_y[j] <= q.max.y)
-                & (q.min.y <= self.max_y[j]);
+            let m = (min_x[j] <= q.max.x)
+                & (q.min.x <= max_x[j])
+                & (min_y[j] <= q.max.y)
+                & (q.min.y <= max_y[j]);
             mask |= u32::from(m) << j;
+        }
+        mask
+    }
+
+    /// [`Quad::meets`] for a finite `q`, as differences: `a <= b` is `a - b <= 0` (a
+    /// difference is zero only between equal numbers, and keeps its sign when it overflows;
+    /// `+inf - q` of an empty lane is `+inf`), and the largest of four differences is
+    /// positive when any is. Written so, the four lanes compile to two-wide subtractions and
+    /// maxima (about 30 instructions against 60 for the comparisons one by one). No lane is
+    /// NaN: [`QueryTree::new`] stores a box with a NaN coordinate as the empty box.
+    #[inline]
+    fn meets_finite(&self, q: &Bounds) -> u32 {
+        let [min_x, min_y, max_x, max_y] = &self.c;
+        let mut mask = 0;
+        for j in 0..4 {
+            let below = larger(min_x[j] - q.max.x, min_y[j] - q.max.y);
+            let above = larger(q.min.x - max_x[j], q.min.y - max_y[j]);
+            mask |= u32::from(larger(below, above) <= 0.0) << j;
         }
         mask
     }
@@ -111,7 +142,22 @@ impl QueryTree {
             &centers,
             LEAF << leaves.next_power_of_two().trailing_zeros(),
         );
-        let sorted: Vec<Bounds> = order.iter().map(|&k| boxes[k as usize]).collect();
+        // A box with a NaN coordinate (a member whose pose is not a number) overlaps nothing
+        // and no ray hits its member: stored empty, so that no lane is NaN.
+        let sorted: Vec<Bounds> = order
+            .iter()
+            .map(|&k| boxes[k as usize])
+            .map(|b| {
+                if [b.min.x, b.min.y, b.max.x, b.max.y]
+                    .iter()
+                    .any(|v| v.is_nan())
+                {
+                    Quad::EMPTY.lane(0)
+                } else {
+                    b
+                }
+            })
+            .collect();
         let mut levels = vec![sorted.chunks(LEAF).map(Quad::of).collect::<Vec<Quad>>()];
         while levels[levels.len() - 1].len() > 1 {
             let hulls: Vec<Bounds> = levels[levels.len() - 1].iter().map(Quad::hull).collect();
@@ -136,32 +182,40 @@ impl QueryTree {
         if !meets(&all, q) {
             return;
         }
+        if q.min.is_finite() && q.max.is_finite() {
+            self.walk(q, f, Quad::meets_finite);
+        } else {
+            self.walk(q, f, Quad::meets);
+        }
+    }
+
+    /// [`QueryTree::query`]'s walk, depth first, lowest child first, with `meets` the box
+    /// test of a node's four children. No stack of nodes: the children still to walk of
+    /// the node being walked at each level are a mask, and a node's parent is its index
+    /// divided by four.
+    #[inline(always)]
+    fn walk(&self, q: &Bounds, f: &mut impl FnMut(usize), meets: impl Fn(&Quad, &Bounds) -> u32) {
         let top = self.levels.len() - 1;
-        let mut stack = [(0u32, 0u32); STACK];
-        let mut len = 0;
+        let mut pending = [0u32; LEVELS];
         let (mut level, mut i) = (top, 0);
+        pending[top] = meets(&self.levels[top][0], q);
         loop {
-            let mut mask = self.levels[level][i].meets(q);
+            let mask = pending[level];
+            if mask == 0 {
+                if level == top {
+                    return;
+                }
+                (level, i) = (level + 1, i / LEAF);
+                continue;
+            }
+            pending[level] = mask & (mask - 1);
+            let c = i * LEAF + mask.trailing_zeros() as usize;
             if level == 0 {
-                while mask != 0 {
-                    f(i * LEAF + mask.trailing_zeros() as usize);
-                    mask &= mask - 1;
-                }
+                f(c);
             } else {
-                // Pushed highest first, so the lowest is walked first.
-                let below = (level - 1) as u32;
-                while mask != 0 {
-                    let j = 31 - mask.leading_zeros();
-                    stack[len] = (below, (i * LEAF) as u32 + j);
-                    len += 1;
-                    mask &= !(1 << j);
-                }
+                (level, i) = (level - 1, c);
+                pending[level] = meets(&self.levels[level][i], q);
             }
-            if len == 0 {
-                return;
-            }
-            len -= 1;
-            (level, i) = (stack[len].0 as usize, stack[len].1 as usize);
         }
     }
 
@@ -277,20 +331,41 @@ struct Slab {
     /// `origin + pad` and `origin - pad`: `min - pad - origin` is `min - from_min`.
     from_min: Vec2,
     from_max: Vec2,
+    /// Per axis, the [`Quad`] row of the face the segment meets first, and of the other.
+    near: [usize; 2],
+    far: [usize; 2],
+    /// Per axis, the origin as padded against the near face and against the far face.
+    near_from: Vec2,
+    far_from: Vec2,
 }
 
 impl Slab {
     fn new(origin: Vec2, dir: Vec2, root: &Bounds) -> Slab {
         let inv = Vec2::new(1.0 / dir.x, 1.0 / dir.y);
         let pad = root.max.abs().max(root.min.abs()).max(origin.abs()) * 1e-12;
+        let back = [dir.x < 0.0, dir.y < 0.0];
+        let (from_min, from_max) = (origin + pad, origin - pad);
+        // The near face is padded against the origin by the one the direction meets first
+        // (`from_min` for a min face), as `enter` pads each face.
+        let pick = |axis: usize, b: bool| if b { from_max[axis] } else { from_min[axis] };
         Slab {
             origin,
             inv,
             flat: inv.x.is_infinite() || inv.y.is_infinite(),
-            back: [dir.x < 0.0, dir.y < 0.0],
+            back,
             pad,
-            from_min: origin + pad,
-            from_max: origin - pad,
+            from_min,
+            from_max,
+            near: [
+                if back[0] { MAX_X } else { MIN_X },
+                if back[1] { MAX_Y } else { MIN_Y },
+            ],
+            far: [
+                if back[0] { MIN_X } else { MAX_X },
+                if back[1] { MIN_Y } else { MAX_Y },
+            ],
+            near_from: Vec2::new(pick(0, back[0]), pick(1, back[1])),
+            far_from: Vec2::new(pick(0, !back[0]), pick(1, !back[1])),
         }
     }
 
@@ -321,50 +396,46 @@ impl Slab {
 
     /// [`Slab::enter`] of the four lanes of `q` at once: each lane's entry distance, and
     /// bit `j` set when lane `j` is met.
-    #[inline]
+    #[inline(always)]
     fn enter4(&self, q: &Quad, max: f64) -> ([f64; 4], u32) {
+        if self.flat {
+            return self.enter4_flat(q, max);
+        }
         let mut t = [0.0; 4];
         let mut mask = 0;
-        if self.flat {
-            for (j, tj) in t.iter_mut().enumerate() {
-                if let Some(e) = self.enter_flat(&q.lane(j), max) {
-                    *tj = e;
-                    mask |= 1 << j;
-                }
-            }
-            return (t, mask);
-        }
-        let (near_x, far_x) = if self.back[0] {
-            (&q.max_x, &q.min_x)
-        } else {
-            (&q.min_x, &q.max_x)
-        };
-        let (near_y, far_y) = if self.back[1] {
-            (&q.max_y, &q.min_y)
-        } else {
-            (&q.min_y, &q.max_y)
-        };
-        // The near face is padded against the origin by the one the direction meets first
-        // (`from_min` for a min face), as `enter` pads each face.
-        let (nx, fx) = if self.back[0] {
-            (self.from_max.x, self.from_min.x)
-        } else {
-            (self.from_min.x, self.from_max.x)
-        };
-        let (ny, fy) = if self.back[1] {
-            (self.from_max.y, self.from_min.y)
-        } else {
-            (self.from_min.y, self.from_max.y)
-        };
+        // Rows 0 to 3 (`& 3`: no bounds check).
+        let (near_x, near_y) = (&q.c[self.near[0] & 3], &q.c[self.near[1] & 3]);
+        let (far_x, far_y) = (&q.c[self.far[0] & 3], &q.c[self.far[1] & 3]);
+        let (nx, ny) = (self.near_from.x, self.near_from.y);
+        let (fx, fy) = (self.far_from.x, self.far_from.y);
         for j in 0..4 {
-            let enter = ((near_x[j] - nx) * self.inv.x)
-                .max((near_y[j] - ny) * self.inv.y)
-                .max(0.0);
-            let exit = ((far_x[j] - fx) * self.inv.x)
-                .min((far_y[j] - fy) * self.inv.y)
-                .min(max);
+            // `f64::max` and `min` without their NaN care (a compare and a select each): a
+            // lane is NaN only for a member whose pose is not finite, which no ray hits.
+            let enter = larger(
+                larger((near_x[j] - nx) * self.inv.x, (near_y[j] - ny) * self.inv.y),
+                0.0,
+            );
+            let exit = smaller(
+                smaller((far_x[j] - fx) * self.inv.x, (far_y[j] - fy) * self.inv.y),
+                max,
+            );
             t[j] = enter;
             mask |= u32::from(enter <= exit) << j;
+        }
+        (t, mask)
+    }
+
+    /// [`Slab::enter4`] for a segment parallel to an axis' faces.
+    #[cold]
+    #[inline(never)]
+    fn enter4_flat(&self, q: &Quad, max: f64) -> ([f64; 4], u32) {
+        let mut t = [0.0; 4];
+        let mut mask = 0;
+        for (j, tj) in t.iter_mut().enumerate() {
+            if let Some(e) = self.enter_flat(&q.lane(j), max) {
+                *tj = e;
+                mask |= 1 << j;
+            }
         }
         (t, mask)
     }
@@ -391,6 +462,18 @@ impl Slab {
         }
         (enter <= exit).then_some(enter)
     }
+}
+
+/// The larger of `a` and `b` (`b` if either is NaN).
+#[inline]
+fn larger(a: f64, b: f64) -> f64 {
+    if a > b { a } else { b }
+}
+
+/// The smaller of `a` and `b` (`b` if either is NaN).
+#[inline]
+fn smaller(a: f64, b: f64) -> f64 {
+    if a < b { a } else { b }
 }
 
 /// Whether `a` and `b` overlap, touching counted ([`Bounds::overlaps`]), with one branch

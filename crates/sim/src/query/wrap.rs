@@ -14,7 +14,7 @@
 //! one running along an edge forever) stops there. In a world without wrap a query is one
 //! segment, the direct image only.
 
-use ricochet_geom::Vec2;
+use ricochet_geom::{Bounds, Vec2};
 
 use crate::def::WorldBounds;
 
@@ -33,6 +33,87 @@ pub(crate) fn offsets(wrap: Option<&WorldBounds>) -> ([Vec2; 9], usize) {
         Some(b) => (b.image_offsets(), 9),
         None => ([Vec2::ZERO; 9], 1),
     }
+}
+
+/// The images of the bodies a query looks at: which of [`offsets`]' nine (a bit each, in
+/// that order), with no array built or copied a query.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Images {
+    size: Vec2,
+    mask: u16,
+}
+
+/// Each of [`WorldBounds::image_offsets`]' nine, as world sizes per axis, in its order.
+const STEPS: [(f64, f64); 9] = [
+    (0.0, 0.0),
+    (-1.0, -1.0),
+    (-1.0, 0.0),
+    (-1.0, 1.0),
+    (0.0, -1.0),
+    (0.0, 1.0),
+    (1.0, -1.0),
+    (1.0, 0.0),
+    (1.0, 1.0),
+];
+
+impl Images {
+    /// The offsets of the images looked at, in [`offsets`]' order (the same arithmetic,
+    /// so the same bits, as [`WorldBounds::image_offsets`]).
+    pub(crate) fn iter(self) -> impl Iterator<Item = Vec2> {
+        (0..9)
+            .filter(move |k| self.mask & (1 << k) != 0)
+            .map(move |k| {
+                let (sx, sy) = STEPS[k];
+                Vec2::new(sx * self.size.x, sy * self.size.y)
+            })
+    }
+}
+
+/// The images among [`offsets`]' at which the query box `q`, moved by `shift - offset`,
+/// meets `hull` (touching counts; the box around every member, [`super::index::hull`]);
+/// every image when `q` is `None` (an endless ray). The same arithmetic, axis by axis, as
+/// [`Bounds::translated`] and [`Bounds::overlaps`] in the per-set test that follows, so no
+/// image that test would walk is dropped: a query well inside the world looks at the
+/// direct image only, for six comparisons per axis instead of nine box tests per set.
+pub(crate) fn images(
+    wrap: Option<&WorldBounds>,
+    q: Option<&Bounds>,
+    shift: Vec2,
+    hull: Option<Bounds>,
+) -> Images {
+    let size = wrap.map_or(Vec2::ZERO, WorldBounds::size);
+    let all = if wrap.is_some() { 0x1ff } else { 1 };
+    let Some(hull) = hull else {
+        return Images { size, mask: 0 };
+    };
+    let Some(q) = q else {
+        return Images { size, mask: all };
+    };
+    // Whether the query meets the hull with the bodies moved by `s` world sizes on `axis`.
+    let meets = |axis: usize, s: f64| {
+        let d = shift[axis] - s * size[axis];
+        (q.min[axis] + d <= hull.max[axis]) & (hull.min[axis] <= q.max[axis] + d)
+    };
+    let direct = meets(0, 0.0) & meets(1, 0.0);
+    if wrap.is_none() {
+        return Images {
+            size,
+            mask: u16::from(direct),
+        };
+    }
+    let x = [meets(0, -1.0), meets(0, 0.0), meets(0, 1.0)];
+    let y = [meets(1, -1.0), meets(1, 0.0), meets(1, 1.0)];
+    if x == [false, true, false] && y == [false, true, false] {
+        // Well inside the world: the direct image only.
+        return Images { size, mask: 1 };
+    }
+    let mut mask = 0;
+    for (k, &(sx, sy)) in STEPS.iter().enumerate() {
+        // `s + 1`: the lane of -1, 0 or +1 world sizes.
+        let (i, j) = ((sx + 1.0) as usize, (sy + 1.0) as usize);
+        mask |= u16::from(x[i] & y[j]) << k;
+    }
+    Images { size, mask }
 }
 
 /// `p` moved by whole world sizes into `[min, max)` on each axis.
