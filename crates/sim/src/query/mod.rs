@@ -494,9 +494,13 @@ impl<B: Bodies> Scene<'_, B> {
             let room = len.min(limit - travelled);
             // The segment's box (none for an endless ray): an image whose box misses a tree
             // set's skips that set.
-            let reach = room
-                .is_finite()
-                .then(|| Bounds::of_points(&[from, from + dir * room.max(0.0)]));
+            let reach = room.is_finite().then(|| {
+                let to = from + dir * room.max(0.0);
+                Bounds {
+                    min: from.min(to),
+                    max: from.max(to),
+                }
+            });
             for o in wrap::images(wrap, reach.as_ref(), Vec2::ZERO, hull).iter() {
                 let seen = reach.map(|r| r.translated(-o));
                 let meets = |set: &index::Trees| seen.is_none_or(|q| set.may_meet(&q));

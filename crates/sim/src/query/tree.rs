@@ -10,10 +10,22 @@
 //! stack (no allocation a query), and the ray's slab test has the direction inverted and
 //! the rounding margin taken once a walk.
 
+use std::cell::RefCell;
+
 use ricochet_geom::{Bounds, Vec2};
 
 /// Members per leaf, and children per node.
 const LEAF: usize = 4;
+
+/// A ray walk's node put off: its level, its index there, and where the segment enters it.
+type Pending = (u32, u32, f64);
+
+thread_local! {
+    /// The ray walk's stack, one per thread: as an array on the thread's stack it was
+    /// 1 KiB zeroed every walk (a `memset` call, two walks a ray where static bodies and
+    /// moving ones are both met).
+    static RAY_STACK: RefCell<[Pending; STACK]> = const { RefCell::new([(0, 0, 0.0); STACK]) };
+}
 
 /// Levels a tree has at most: a member's handle is a `u32`, so at most `2^30` leaves, 16
 /// levels above them.
@@ -228,7 +240,7 @@ impl QueryTree {
         &self,
         origin: Vec2,
         dir: Vec2,
-        mut max: f64,
+        max: f64,
         f: &mut impl FnMut(usize, f64) -> f64,
     ) {
         let Some(all) = self.all else {
@@ -238,9 +250,23 @@ impl QueryTree {
         if slab.enter(&all, max).is_none() {
             return;
         }
+        RAY_STACK.with(|cell| match cell.try_borrow_mut() {
+            Ok(mut stack) => self.ray_walk(&slab, max, f, &mut stack),
+            // A walk from within a walk's `f` (none today): a stack of its own.
+            Err(_) => self.ray_walk(&slab, max, f, &mut [(0, 0, 0.0); STACK]),
+        });
+    }
+
+    /// [`QueryTree::ray`]'s walk from the root, `stack` its scratch.
+    #[inline(always)]
+    fn ray_walk(
+        &self,
+        slab: &Slab,
+        mut max: f64,
+        f: &mut impl FnMut(usize, f64) -> f64,
+        stack: &mut [Pending; STACK],
+    ) {
         let top = self.levels.len() - 1;
-        // (level, index, entry distance) of the nodes put off.
-        let mut stack = [(0u32, 0u32, 0.0f64); STACK];
         let mut len = 0;
         let (mut level, mut i) = (top, 0);
         loop {
