@@ -39,6 +39,7 @@
 mod filter;
 mod hits;
 pub(crate) mod index;
+mod slab;
 mod tree;
 mod wrap;
 

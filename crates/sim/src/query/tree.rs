@@ -6,13 +6,16 @@
 //! Leaves of [`LEAF`] = 4 members (each member of a visited leaf costs a box test, and a
 //! query's answer is a handful of bodies) and nodes of 4 children, each node's four boxes
 //! stored by coordinate ([`Quad`]) and tested together with no branch per child; half the
-//! levels of a binary tree, so fewer dependent loads. The walk's stack is on the thread's
-//! stack (no allocation a query), and the ray's slab test has the direction inverted and
-//! the rounding margin taken once a walk.
+//! levels of a binary tree, so fewer dependent loads. A box walk keeps, per level, a mask
+//! of the children still to walk (no stack); a ray walk's stack is kept per thread (no
+//! allocation and nothing zeroed a query), and its slab test (`slab.rs`) has the direction
+//! inverted and the rounding margin taken once a walk.
 
 use std::cell::RefCell;
 
 use ricochet_geom::{Bounds, Vec2};
+
+use super::slab::{Slab, larger};
 
 /// Members per leaf, and children per node.
 const LEAF: usize = 4;
@@ -42,15 +45,15 @@ const STACK: usize = 64;
 /// The coordinates are indexed ([`MIN_X`], [`MIN_Y`], [`MAX_X`], [`MAX_Y`]) so that a ray's
 /// walk picks each axis' near face by an index set once a walk, not a branch per node.
 #[derive(Clone, Copy, Debug)]
-struct Quad {
-    c: [[f64; 4]; 4],
+pub(super) struct Quad {
+    pub(super) c: [[f64; 4]; 4],
 }
 
 /// [`Quad::c`]'s rows: min x, min y, max x, max y (a max row is its min row + 2).
-const MIN_X: usize = 0;
-const MIN_Y: usize = 1;
-const MAX_X: usize = 2;
-const MAX_Y: usize = 3;
+pub(super) const MIN_X: usize = 0;
+pub(super) const MIN_Y: usize = 1;
+pub(super) const MAX_X: usize = 2;
+pub(super) const MAX_Y: usize = 3;
 
 impl Quad {
     /// Min at `+inf`, max at `-inf`: no box or segment meets it, and a hull ignores it.
@@ -80,7 +83,7 @@ impl Quad {
         (1..4).fold(self.lane(0), |u, j| hull(u, self.lane(j)))
     }
 
-    fn lane(&self, j: usize) -> Bounds {
+    pub(super) fn lane(&self, j: usize) -> Bounds {
         Bounds {
             min: Vec2::new(self.c[MIN_X][j], self.c[MIN_Y][j]),
             max: Vec2::new(self.c[MAX_X][j], self.c[MAX_Y][j]),
@@ -342,166 +345,6 @@ fn split(ids: &mut [u32], centers: &[Vec2], cap: usize) {
     split(right, centers, half);
 }
 
-/// A segment's slab test, set up once a walk.
-struct Slab {
-    origin: Vec2,
-    /// `1 / dir` per axis (infinite along an axis the segment is parallel to).
-    inv: Vec2,
-    /// Whether the segment is parallel to the faces of either axis.
-    flat: bool,
-    /// Per axis, whether the segment runs towards smaller coordinates (it meets a box's
-    /// `max` face first).
-    back: [bool; 2],
-    /// One rounding margin for the whole walk: the root's, which is at least any box's.
-    pad: Vec2,
-    /// `origin + pad` and `origin - pad`: `min - pad - origin` is `min - from_min`.
-    from_min: Vec2,
-    from_max: Vec2,
-    /// Per axis, the [`Quad`] row of the face the segment meets first, and of the other.
-    near: [usize; 2],
-    far: [usize; 2],
-    /// Per axis, the origin as padded against the near face and against the far face.
-    near_from: Vec2,
-    far_from: Vec2,
-}
-
-impl Slab {
-    fn new(origin: Vec2, dir: Vec2, root: &Bounds) -> Slab {
-        let inv = Vec2::new(1.0 / dir.x, 1.0 / dir.y);
-        let pad = root.max.abs().max(root.min.abs()).max(origin.abs()) * 1e-12;
-        let back = [dir.x < 0.0, dir.y < 0.0];
-        let (from_min, from_max) = (origin + pad, origin - pad);
-        // The near face is padded against the origin by the one the direction meets first
-        // (`from_min` for a min face), as `enter` pads each face.
-        let pick = |axis: usize, b: bool| if b { from_max[axis] } else { from_min[axis] };
-        Slab {
-            origin,
-            inv,
-            flat: inv.x.is_infinite() || inv.y.is_infinite(),
-            back,
-            pad,
-            from_min,
-            from_max,
-            near: [
-                if back[0] { MAX_X } else { MIN_X },
-                if back[1] { MAX_Y } else { MIN_Y },
-            ],
-            far: [
-                if back[0] { MIN_X } else { MAX_X },
-                if back[1] { MIN_Y } else { MAX_Y },
-            ],
-            near_from: Vec2::new(pick(0, back[0]), pick(1, back[1])),
-            far_from: Vec2::new(pick(0, !back[0]), pick(1, !back[1])),
-        }
-    }
-
-    /// Where the segment, `t` in `[0, max]`, enters `b` widened by the margin (touching
-    /// counts), or `None` if it misses. The margin covers rounding, so a segment that only
-    /// grazes a box is never lost (the exact test follows).
-    #[inline]
-    fn enter(&self, b: &Bounds, max: f64) -> Option<f64> {
-        if self.flat {
-            return self.enter_flat(b, max);
-        }
-        let to_min = (b.min - self.from_min) * self.inv;
-        let to_max = (b.max - self.from_max) * self.inv;
-        let (near_x, far_x) = if self.back[0] {
-            (to_max.x, to_min.x)
-        } else {
-            (to_min.x, to_max.x)
-        };
-        let (near_y, far_y) = if self.back[1] {
-            (to_max.y, to_min.y)
-        } else {
-            (to_min.y, to_max.y)
-        };
-        let enter = near_x.max(near_y).max(0.0);
-        let exit = far_x.min(far_y).min(max);
-        (enter <= exit).then_some(enter)
-    }
-
-    /// [`Slab::enter`] of the four lanes of `q` at once: each lane's entry distance, and
-    /// bit `j` set when lane `j` is met.
-    #[inline(always)]
-    fn enter4(&self, q: &Quad, max: f64) -> ([f64; 4], u32) {
-        if self.flat {
-            return self.enter4_flat(q, max);
-        }
-        let mut t = [0.0; 4];
-        let mut mask = 0;
-        // Rows 0 to 3 (`& 3`: no bounds check).
-        let (near_x, near_y) = (&q.c[self.near[0] & 3], &q.c[self.near[1] & 3]);
-        let (far_x, far_y) = (&q.c[self.far[0] & 3], &q.c[self.far[1] & 3]);
-        let (nx, ny) = (self.near_from.x, self.near_from.y);
-        let (fx, fy) = (self.far_from.x, self.far_from.y);
-        for j in 0..4 {
-            // `f64::max` and `min` without their NaN care (a compare and a select each): a
-            // lane is NaN only for a member whose pose is not finite, which no ray hits.
-            let enter = larger(
-                larger((near_x[j] - nx) * self.inv.x, (near_y[j] - ny) * self.inv.y),
-                0.0,
-            );
-            let exit = smaller(
-                smaller((far_x[j] - fx) * self.inv.x, (far_y[j] - fy) * self.inv.y),
-                max,
-            );
-            t[j] = enter;
-            mask |= u32::from(enter <= exit) << j;
-        }
-        (t, mask)
-    }
-
-    /// [`Slab::enter4`] for a segment parallel to an axis' faces.
-    #[cold]
-    #[inline(never)]
-    fn enter4_flat(&self, q: &Quad, max: f64) -> ([f64; 4], u32) {
-        let mut t = [0.0; 4];
-        let mut mask = 0;
-        for (j, tj) in t.iter_mut().enumerate() {
-            if let Some(e) = self.enter_flat(&q.lane(j), max) {
-                *tj = e;
-                mask |= 1 << j;
-            }
-        }
-        (t, mask)
-    }
-
-    /// [`Slab::enter`] for a segment parallel to an axis' faces (`inv` infinite there).
-    #[cold]
-    fn enter_flat(&self, b: &Bounds, max: f64) -> Option<f64> {
-        let (lo, hi) = (b.min - self.pad, b.max + self.pad);
-        let (mut enter, mut exit) = (0.0_f64, max);
-        for axis in 0..2 {
-            let (o, inv) = (self.origin[axis], self.inv[axis]);
-            if inv.is_infinite() {
-                // Inside the slab or never.
-                if o < lo[axis] || o > hi[axis] {
-                    return None;
-                }
-                continue;
-            }
-            let t1 = (lo[axis] - o) * inv;
-            let t2 = (hi[axis] - o) * inv;
-            let (near, far) = if t1 < t2 { (t1, t2) } else { (t2, t1) };
-            enter = enter.max(near);
-            exit = exit.min(far);
-        }
-        (enter <= exit).then_some(enter)
-    }
-}
-
-/// The larger of `a` and `b` (`b` if either is NaN).
-#[inline]
-fn larger(a: f64, b: f64) -> f64 {
-    if a > b { a } else { b }
-}
-
-/// The smaller of `a` and `b` (`b` if either is NaN).
-#[inline]
-fn smaller(a: f64, b: f64) -> f64 {
-    if a < b { a } else { b }
-}
-
 /// Whether `a` and `b` overlap, touching counted ([`Bounds::overlaps`]), with one branch
 /// for the caller instead of four.
 #[inline]
@@ -557,6 +400,76 @@ mod tests {
                 .collect();
             assert_eq!(got, want, "{q:?}");
         }
+    }
+
+    #[test]
+    fn the_box_test_by_differences_agrees_with_the_comparisons() {
+        // Lanes touching the query on each face, overlapping, apart by an ulp, empty,
+        // huge and tiny, against queries on and off the lattice.
+        let v = [
+            -1e300,
+            -3.0,
+            -1.0,
+            -0.0,
+            0.0,
+            1e-300,
+            0.5,
+            1.0,
+            1.0 + f64::EPSILON,
+            3.0,
+        ];
+        let mut lanes = Vec::new();
+        for &a in &v {
+            for &b in &v {
+                if a <= b {
+                    lanes.push((a, b));
+                }
+            }
+        }
+        let mut quads = Vec::new();
+        for (k, &(x0, x1)) in lanes.iter().enumerate() {
+            let (y0, y1) = lanes[(k * 7) % lanes.len()];
+            let b = Bounds {
+                min: Vec2::new(x0, y0),
+                max: Vec2::new(x1, y1),
+            };
+            let c = Bounds {
+                min: Vec2::new(y0, x0),
+                max: Vec2::new(y1, x1),
+            };
+            quads.push(Quad::of(&[b, c, b.translated(Vec2::splat(0.5))]));
+        }
+        let mut met = 0;
+        for &(qx0, qx1) in &lanes {
+            for &(qy0, qy1) in lanes.iter().step_by(3) {
+                let q = Bounds {
+                    min: Vec2::new(qx0, qy0),
+                    max: Vec2::new(qx1, qy1),
+                };
+                for quad in &quads {
+                    let m = quad.meets(&q);
+                    assert_eq!(quad.meets_finite(&q), m, "{quad:?} {q:?}");
+                    met += m.count_ones();
+                }
+            }
+        }
+        assert!(met > 1000, "{met}");
+    }
+
+    #[test]
+    fn a_member_box_with_a_nan_is_stored_empty_and_met_by_nothing() {
+        let mut boxes = boxes();
+        boxes[3].max.x = f64::NAN;
+        let (tree, order) = QueryTree::new(&boxes);
+        // Over every member but the far one; member 3's box, but for its NaN, is in it.
+        let q = Bounds::around(Vec2::splat(10.0), Vec2::splat(100.0));
+        let mut got = Vec::new();
+        tree.query(&q, &mut |k| got.push(order[k]));
+        got.sort_unstable();
+        let want: Vec<u32> = (0..boxes.len() as u32)
+            .filter(|&k| k != 3 && boxes[k as usize].overlaps(&q))
+            .collect();
+        assert_eq!(got, want);
     }
 
     #[test]

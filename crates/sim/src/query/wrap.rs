@@ -185,3 +185,80 @@ pub(crate) fn segments(
         p = next;
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The images the per-set test would walk: every one of the nine whose moved query box
+    /// meets the hull, by `Bounds::overlaps`.
+    fn brute(b: &WorldBounds, q: &Bounds, shift: Vec2, hull: &Bounds) -> Vec<Vec2> {
+        b.image_offsets()
+            .into_iter()
+            .filter(|&o| q.translated(shift - o).overlaps(hull))
+            .collect()
+    }
+
+    #[test]
+    fn the_images_kept_are_those_whose_query_box_meets_the_hull_in_order() {
+        let b = WorldBounds {
+            min: Vec2::new(-10.0, 0.0),
+            max: Vec2::new(30.0, 20.0),
+            wrap: true,
+        };
+        // The hull sticks out of the world by 1.5 on the left and 0.5 at the top.
+        let hull = Bounds {
+            min: Vec2::new(-11.5, 0.0),
+            max: Vec2::new(30.0, 20.5),
+        };
+        let mut cases = 0;
+        let mut several = 0;
+        // Boxes along both axes across the world and past its edges, some touching the
+        // hull's images exactly (the grid's steps of 0.5 land on its faces).
+        for ix in -4..=84 {
+            for iy in -4..=44 {
+                let c = Vec2::new(-10.0 + f64::from(ix) * 0.5, f64::from(iy) * 0.5);
+                for h in [Vec2::new(0.25, 0.5), Vec2::new(1.0, 0.25), Vec2::splat(6.0)] {
+                    let q = Bounds::around(c, h);
+                    let shift = wrap_point(&b, c) - c;
+                    let got: Vec<Vec2> = images(Some(&b), Some(&q), shift, Some(hull))
+                        .iter()
+                        .collect();
+                    let want = brute(&b, &q, shift, &hull);
+                    assert_eq!(got, want, "{q:?}");
+                    cases += 1;
+                    several += usize::from(want.len() > 1);
+                }
+            }
+        }
+        assert!(
+            several > cases / 20,
+            "{several} of {cases}: too few near the edges"
+        );
+        // No hull: nothing; an endless ray: all nine; no wrap: the direct image if met.
+        let q = Bounds::around(Vec2::new(5.0, 5.0), Vec2::ONE);
+        assert_eq!(
+            images(Some(&b), Some(&q), Vec2::ZERO, None).iter().count(),
+            0
+        );
+        assert_eq!(
+            images(Some(&b), None, Vec2::ZERO, Some(hull))
+                .iter()
+                .count(),
+            9
+        );
+        let far = Bounds::around(Vec2::new(500.0, 5.0), Vec2::ONE);
+        assert_eq!(
+            images(None, Some(&q), Vec2::ZERO, Some(hull))
+                .iter()
+                .count(),
+            1
+        );
+        assert_eq!(
+            images(None, Some(&far), Vec2::ZERO, Some(hull))
+                .iter()
+                .count(),
+            0
+        );
+    }
+}
