@@ -275,9 +275,22 @@ impl QueryTree {
         loop {
             let (t, mut mask) = slab.enter4(&self.levels[level][i], max);
             if level == 0 {
+                // The members met, nearest entry first (ties: the lower first), so that a
+                // first hit prunes the farther ones of the leaf before their exact test.
+                let mut near = [0usize; LEAF];
+                let mut n = 0;
                 while mask != 0 {
                     let j = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
+                    let mut at = n;
+                    while at > 0 && t[near[at - 1]] > t[j] {
+                        near[at] = near[at - 1];
+                        at -= 1;
+                    }
+                    near[at] = j;
+                    n += 1;
+                }
+                for &j in &near[..n] {
                     // `max` may have shrunk since the four were tested.
                     if t[j] <= max {
                         max = f(i * LEAF + j, max);
