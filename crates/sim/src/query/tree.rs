@@ -127,10 +127,16 @@ impl Quad {
 /// A packed tree over boxes, its members in tree order.
 #[derive(Debug, Default)]
 pub(crate) struct QueryTree {
-    /// `levels[0][k]` holds the boxes of members `4k .. 4k + 4` (in tree order);
-    /// `levels[j + 1][k]` holds the boxes around the members of `levels[j][4k .. 4k + 4]`.
+    /// Every level's nodes, one level after another (one allocation: a node is one load
+    /// from here, not two): node `k` of level `j` is `quads[start[j] + k]`. Level 0's node
+    /// `k` holds the boxes of members `4k .. 4k + 4` (in tree order); level `j + 1`'s node
+    /// `k` holds the boxes around level `j`'s nodes `4k .. 4k + 4`.
     /// The last level is one node, the root.
-    levels: Vec<Vec<Quad>>,
+    quads: Vec<Quad>,
+    /// Where each level starts in `quads`.
+    start: [usize; LEVELS],
+    /// The root's level (the last).
+    top: usize,
     /// The box around every member.
     all: Option<Bounds>,
 }
@@ -179,13 +185,28 @@ impl QueryTree {
             levels.push(hulls.chunks(LEAF).map(Quad::of).collect());
         }
         let all = levels[levels.len() - 1][0].hull();
+        let top = levels.len() - 1;
+        let mut start = [0; LEVELS];
+        let mut quads = Vec::with_capacity(levels.iter().map(Vec::len).sum());
+        for (j, level) in levels.iter().enumerate() {
+            start[j] = quads.len();
+            quads.extend_from_slice(level);
+        }
         (
             QueryTree {
-                levels,
+                quads,
+                start,
+                top,
                 all: Some(all),
             },
             order,
         )
+    }
+
+    /// Node `i` of level `level`.
+    #[inline(always)]
+    fn node(&self, level: usize, i: usize) -> &Quad {
+        &self.quads[self.start[level] + i]
     }
 
     /// Calls `f` with every member whose box overlaps `q` (touching counts).
@@ -210,10 +231,10 @@ impl QueryTree {
     /// divided by four.
     #[inline(always)]
     fn walk(&self, q: &Bounds, f: &mut impl FnMut(usize), meets: impl Fn(&Quad, &Bounds) -> u32) {
-        let top = self.levels.len() - 1;
+        let top = self.top;
         let mut pending = [0u32; LEVELS];
         let (mut level, mut i) = (top, 0);
-        pending[top] = meets(&self.levels[top][0], q);
+        pending[top] = meets(self.node(top, 0), q);
         loop {
             let mask = pending[level];
             if mask == 0 {
@@ -229,7 +250,7 @@ impl QueryTree {
                 f(c);
             } else {
                 (level, i) = (level - 1, c);
-                pending[level] = meets(&self.levels[level][i], q);
+                pending[level] = meets(self.node(level, i), q);
             }
         }
     }
@@ -269,11 +290,11 @@ impl QueryTree {
         f: &mut impl FnMut(usize, f64) -> f64,
         stack: &mut [Pending; STACK],
     ) {
-        let top = self.levels.len() - 1;
+        let top = self.top;
         let mut len = 0;
         let (mut level, mut i) = (top, 0);
         loop {
-            let (t, mut mask) = slab.enter4(&self.levels[level][i], max);
+            let (t, mut mask) = slab.enter4(self.node(level, i), max);
             if level == 0 {
                 // The members met, nearest entry first (ties: the lower first), so that a
                 // first hit prunes the farther ones of the leaf before their exact test.
