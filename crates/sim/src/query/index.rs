@@ -255,8 +255,8 @@ impl Trees {
 
 /// A query shape placed once about its own position (the frame of
 /// [`ricochet_geom::overlaps`]), for every candidate of the query. Its placed parts are
-/// the caller's: a placed part is the size of the largest polygon, so
-/// moving a probe that held it would copy that many bytes a query.
+/// the caller's: a placed part is the size of the largest polygon, so moving a probe that
+/// held one would copy that many bytes a query.
 pub(crate) struct Probe<'a> {
     pub(crate) shape: &'a Shape,
     pub(crate) angle: f64,
@@ -285,9 +285,9 @@ impl QueryCache {
         }
     }
 
-    /// The static trees and the moving trees of `world`, built if needed, lent (no `Arc`
-    /// count touched: a query is a few hundred nanoseconds, and an atomic increment and
-    /// decrement per set were a tenth of it).
+    /// The static trees and the moving trees of `world`, built if needed, lent: no `Arc`
+    /// count is touched (two atomic increments and decrements a query of a few hundred
+    /// nanoseconds).
     pub(crate) fn trees(&self, world: &World) -> [Lent<'_>; 2] {
         let generation = world.static_generation();
         let build_statics = || {

@@ -369,7 +369,7 @@ impl<B: Bodies> Scene<'_, B> {
         let center = bounds.center();
         // `shape.bounds` at `center`, angle 0, and the box placed about its centre: a box
         // turns with no rotation, so its centre moves by exactly zero (the same bits as
-        // `Shape::bounds` and `index::place_probe`, without placing it).
+        // `Shape::bounds` and `overlap_shape`'s placement, without the general placing).
         let q = Bounds::around(center, half);
         let one = [PlacedPrimitive::Aabb(PlacedAabb {
             center: Vec2::ZERO,
