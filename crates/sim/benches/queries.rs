@@ -4,7 +4,8 @@
 //! point outside every body) and 2000 boxes (0.5–1.5 × the median body's half size), as the
 //! bench draws them. Prints each scene's queries per second (the median pass) and a sum of
 //! the answers, so nothing is optimised away. `QUERY_PASSES=0` measures the set-up alone,
-//! to subtract from an instruction count.
+//! to subtract from an instruction count; `QUERY_SCENE=rain` runs only the scenes whose
+//! name holds `rain`.
 //!
 //! Run: `cargo bench -p ricochet-sim --bench queries` (or the built binary under `perf`).
 
@@ -48,7 +49,12 @@ fn main() {
         ("rain-10000", ricochet_scenes::bench::rain(10_000, 10)),
     ];
     let all = QueryFilter::all();
+    // `QUERY_SCENE=rain`: only the scenes whose name holds it (to profile one).
+    let only = std::env::var("QUERY_SCENE").unwrap_or_default();
     for (name, scenario) in scenes {
+        if !name.contains(only.as_str()) {
+            continue;
+        }
         let mut sim = Simulation::new(&scenario);
         for _ in 0..=10 {
             sim.step();

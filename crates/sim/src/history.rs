@@ -27,7 +27,7 @@ use crate::entity::Entity;
 use crate::interned::ShapeTable;
 use crate::limits::MAX_HISTORY;
 use crate::pipeline::Simulation;
-use crate::query::index::Trees;
+use crate::query::index::{Lent, Trees};
 use crate::query::{Bodies, QueryFilter, RayHit, Scene, ShapeHit};
 use crate::world::World;
 
@@ -122,19 +122,18 @@ impl Bodies for &Kept {
         Pose::new(self.position[i], self.angle[i])
     }
 
-    fn trees(&self) -> [Arc<Trees>; 2] {
-        self.trees
-            .get_or_init(|| {
-                let l = &self.layout;
-                let all = Trees::over(
-                    0,
-                    &l.entity,
-                    &l.layer,
-                    (0..l.entity.len()).map(|i| (i, self.shape(i), self.pose(i))),
-                );
-                [Arc::new(all), Arc::new(Trees::default())]
-            })
-            .clone()
+    fn trees(&self) -> [Lent<'_>; 2] {
+        let [all, none] = self.trees.get_or_init(|| {
+            let l = &self.layout;
+            let all = Trees::over(
+                0,
+                &l.entity,
+                &l.layer,
+                (0..l.entity.len()).map(|i| (i, self.shape(i), self.pose(i))),
+            );
+            [Arc::new(all), Arc::new(Trees::default())]
+        });
+        [Lent::Kept(all), Lent::Kept(none)]
     }
 }
 

@@ -239,7 +239,7 @@ impl Trees {
     ) -> bool {
         let r = &self.ready[handle];
         let parts = shape.primitives();
-        let placed = probe.placed();
+        let placed = probe.placed;
         if placed.len() * parts.len() > ALL_PAIRS {
             let pose = Pose::new(r.position, r.angle);
             return ricochet_geom::overlaps(probe.shape, &Pose::new(at, probe.angle), shape, &pose);
@@ -254,40 +254,14 @@ impl Trees {
 }
 
 /// A query shape placed once about its own position (the frame of
-/// [`ricochet_geom::overlaps`]), for every candidate of the query.
+/// [`ricochet_geom::overlaps`]), for every candidate of the query. Its placed parts are
+/// the caller's: a placed part is the size of the largest polygon, so moving a probe that
+/// held one would copy that many bytes a query.
 pub(crate) struct Probe<'a> {
-    shape: &'a Shape,
-    angle: f64,
-    /// A one-part shape placed (the usual query: a box, a circle), with no allocation.
-    one: Option<[PlacedPrimitive; 1]>,
-    /// Every part placed, for any other shape.
-    many: Vec<PlacedPrimitive>,
-}
-
-impl<'a> Probe<'a> {
-    pub(crate) fn new(shape: &'a Shape, angle: f64) -> Probe<'a> {
-        let rot = shape.rotation(angle);
-        let place = |p| place_rotated(p, Vec2::ZERO, rot, angle);
-        match shape.primitives() {
-            [p] => Probe {
-                shape,
-                angle,
-                one: Some([place(p)]),
-                many: Vec::new(),
-            },
-            parts => Probe {
-                shape,
-                angle,
-                one: None,
-                many: parts.iter().map(place).collect(),
-            },
-        }
-    }
-
+    pub(crate) shape: &'a Shape,
+    pub(crate) angle: f64,
     /// Its parts placed, with its rotation.
-    fn placed(&self) -> &[PlacedPrimitive] {
-        self.one.as_ref().map_or(&self.many, |one| one)
-    }
+    pub(crate) placed: &'a [PlacedPrimitive],
 }
 
 /// The two tree sets, built lazily (see the module docs).
@@ -311,8 +285,10 @@ impl QueryCache {
         }
     }
 
-    /// The static trees and the moving trees of `world`, built if needed.
-    pub(crate) fn trees(&self, world: &World) -> [Arc<Trees>; 2] {
+    /// The static trees and the moving trees of `world`, built if needed, lent: no `Arc`
+    /// count is touched (two atomic increments and decrements a query of a few hundred
+    /// nanoseconds).
+    pub(crate) fn trees(&self, world: &World) -> [Lent<'_>; 2] {
         let generation = world.static_generation();
         let build_statics = || {
             Arc::new(Trees::build(
@@ -321,11 +297,13 @@ impl QueryCache {
                 (0..world.len()).filter(|&i| world.kind[i] == BodyKind::Static),
             ))
         };
-        let mut statics = Arc::clone(self.statics.get_or_init(build_statics));
-        if statics.generation != generation {
+        let kept = self.statics.get_or_init(build_statics);
+        let statics = if kept.generation == generation {
+            Lent::Kept(kept)
+        } else {
             // A change that did not go through `invalidate`: answer from fresh trees.
-            statics = build_statics();
-        }
+            Lent::Fresh(build_statics())
+        };
         let movers = self.movers.get_or_init(|| {
             Arc::new(Trees::build(
                 world,
@@ -333,7 +311,35 @@ impl QueryCache {
                 world.movers().iter().map(|&i| i as usize),
             ))
         });
-        [statics, Arc::clone(movers)]
+        [statics, Lent::Kept(movers)]
+    }
+}
+
+/// A tree set as a query holds it: lent by the cache, or built for this query alone.
+pub(crate) enum Lent<'a> {
+    Kept(&'a Trees),
+    Fresh(Arc<Trees>),
+}
+
+impl std::ops::Deref for Lent<'_> {
+    type Target = Trees;
+
+    #[inline]
+    fn deref(&self) -> &Trees {
+        match self {
+            Lent::Kept(t) => t,
+            Lent::Fresh(t) => t,
+        }
+    }
+}
+
+/// The box around the members of both sets (`None` when both are empty): an image of a
+/// query that misses it is not walked at all (`wrap::images`).
+#[inline]
+pub(crate) fn hull(trees: &[&Trees; 2]) -> Option<Bounds> {
+    match (trees[0].bounds, trees[1].bounds) {
+        (Some(a), Some(b)) => Some(a.union(b)),
+        (a, b) => a.or(b),
     }
 }
 
@@ -342,12 +348,12 @@ impl QueryCache {
 #[inline]
 pub(crate) fn each_in_box(
     entity: &[Entity],
-    trees: &[Arc<Trees>; 2],
+    trees: &[&Trees; 2],
     accepts_layer: impl Fn(LayerId) -> bool,
     q: &Bounds,
     f: &mut impl FnMut(&Trees, usize, usize),
 ) {
-    for set in trees {
+    for &set in trees {
         if !set.may_meet(q) {
             continue;
         }

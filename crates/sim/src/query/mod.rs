@@ -39,12 +39,13 @@
 mod filter;
 mod hits;
 pub(crate) mod index;
+mod slab;
 mod tree;
 mod wrap;
 
-use std::sync::Arc;
-
-use ricochet_geom::{Aabb, Bounds, Pose, Primitive, Ray, Shape, Sweep, Vec2};
+use ricochet_geom::{
+    Aabb, Bounds, PlacedAabb, PlacedPrimitive, Pose, Primitive, Ray, Shape, Sweep, Vec2,
+};
 
 pub use filter::QueryFilter;
 pub use hits::{RayHit, ShapeHit};
@@ -67,8 +68,9 @@ pub(crate) trait Bodies {
     fn shape(&self, i: usize) -> &Shape;
     /// Body `i`'s pose.
     fn pose(&self, i: usize) -> Pose;
-    /// The static trees and the moving trees over the bodies (`index.rs`), built if needed.
-    fn trees(&self) -> [Arc<index::Trees>; 2];
+    /// The static trees and the moving trees over the bodies (`index.rs`), built if needed,
+    /// lent for the query.
+    fn trees(&self) -> [index::Lent<'_>; 2];
 }
 
 /// The world now, with the simulation's cached trees.
@@ -96,7 +98,7 @@ impl Bodies for Now<'_> {
         self.world.pose(i)
     }
 
-    fn trees(&self) -> [Arc<index::Trees>; 2] {
+    fn trees(&self) -> [index::Lent<'_>; 2] {
         self.cache.trees(self.world)
     }
 }
@@ -264,7 +266,8 @@ impl<B: Bodies> Scene<'_, B> {
         } else {
             Vec2::ZERO
         };
-        let trees = bodies.trees();
+        let lent = bodies.trees();
+        let trees = [&*lent[0], &*lent[1]];
         let (offsets, images) = wrap::offsets(wrap);
         let mut best: Option<ShapeHit> = None;
         let mut segment = |from: Vec2, travelled: f64, len: f64| {
@@ -363,7 +366,21 @@ impl<B: Bodies> Scene<'_, B> {
             center: Vec2::ZERO,
             half_extents: half,
         }));
-        self.overlap_shape(&shape, Pose::new(bounds.center(), 0.0), filter)
+        let center = bounds.center();
+        // `shape.bounds` at `center`, angle 0, and the box placed about its centre: a box
+        // turns with no rotation, so its centre moves by exactly zero (the same bits as
+        // `Shape::bounds` and `overlap_shape`'s placement, without the general placing).
+        let q = Bounds::around(center, half);
+        let one = [PlacedPrimitive::Aabb(PlacedAabb {
+            center: Vec2::ZERO,
+            half,
+        })];
+        let probe = index::Probe {
+            shape: &shape,
+            angle: 0.0,
+            placed: &one,
+        };
+        self.overlap_probe(q, &probe, center, filter)
     }
 
     /// The bodies `shape` at `pose` overlaps (touching not counted), in id order.
@@ -377,10 +394,36 @@ impl<B: Bodies> Scene<'_, B> {
         if !(pose.position.is_finite() && pose.angle.is_finite()) {
             return Vec::new();
         }
-        let q = shape.bounds(&pose);
-        let probe = index::Probe::new(shape, pose.angle);
+        // Placed about its own position (the frame of `ricochet_geom::overlaps`): one part
+        // (the usual query: a box, a circle) on the stack, more in a `Vec`.
+        let rot = shape.rotation(pose.angle);
+        let place = |p| ricochet_geom::place_rotated(p, Vec2::ZERO, rot, pose.angle);
+        let (one, many);
+        let placed: &[PlacedPrimitive] = if let [p] = shape.primitives() {
+            one = [place(p)];
+            &one
+        } else {
+            many = shape.primitives().iter().map(place).collect::<Vec<_>>();
+            &many
+        };
+        let probe = index::Probe {
+            shape,
+            angle: pose.angle,
+            placed,
+        };
+        self.overlap_probe(shape.bounds(&pose), &probe, pose.position, filter)
+    }
+
+    /// The bodies `probe` at `at` overlaps, `q` its bounds there, in id order.
+    fn overlap_probe(
+        &self,
+        q: Bounds,
+        probe: &index::Probe<'_>,
+        at: Vec2,
+        filter: &QueryFilter,
+    ) -> Vec<Entity> {
         self.overlapping(q, filter, &mut |set, k, i, o| {
-            set.overlaps(k, self.bodies.shape(i), &probe, pose.position - o)
+            set.overlaps(k, self.bodies.shape(i), probe, at - o)
         })
     }
 
@@ -395,10 +438,11 @@ impl<B: Bodies> Scene<'_, B> {
         let (entity, layer) = (self.bodies.entity(), self.bodies.layer());
         let wrap = self.wrap;
         let shift = wrap.map_or(Vec2::ZERO, |b| wrap::wrap_point(b, q.center()) - q.center());
-        let trees = self.bodies.trees();
+        let lent = self.bodies.trees();
+        let trees = [&*lent[0], &*lent[1]];
         let mut found = Vec::new();
-        let (offsets, images) = wrap::offsets(wrap);
-        for &o in &offsets[..images] {
+        let images = wrap::images(wrap, Some(&q), shift, index::hull(&trees));
+        for o in images.iter() {
             // The query moved by `shift - o`: the body's image at `o` against the query.
             let d = shift - o;
             let qo = q.translated(d);
@@ -442,18 +486,23 @@ impl<B: Bodies> Scene<'_, B> {
         let wrap = self.wrap;
         let start = wrap.map_or(origin, |b| wrap::wrap_point(b, origin));
         let dir = ray.direction();
-        let trees = bodies.trees();
-        let (offsets, images) = wrap::offsets(wrap);
+        let lent = bodies.trees();
+        let trees = [&*lent[0], &*lent[1]];
+        let hull = index::hull(&trees);
         let mut limit = f64::INFINITY;
         let mut segment = |from: Vec2, travelled: f64, len: f64| {
             let mut hit_here = false;
             let room = len.min(limit - travelled);
             // The segment's box (none for an endless ray): an image whose box misses a tree
             // set's skips that set.
-            let reach = room
-                .is_finite()
-                .then(|| Bounds::of_points(&[from, from + dir * room.max(0.0)]));
-            for &o in &offsets[..images] {
+            let reach = room.is_finite().then(|| {
+                let to = from + dir * room.max(0.0);
+                Bounds {
+                    min: from.min(to),
+                    max: from.max(to),
+                }
+            });
+            for o in wrap::images(wrap, reach.as_ref(), Vec2::ZERO, hull).iter() {
                 let seen = reach.map(|r| r.translated(-o));
                 let meets = |set: &index::Trees| seen.is_none_or(|q| set.may_meet(&q));
                 if !trees.iter().any(|set| meets(set)) {
@@ -462,7 +511,7 @@ impl<B: Bodies> Scene<'_, B> {
                 let Some(seg) = Ray::new(from - o, dir) else {
                     continue;
                 };
-                for set in &trees {
+                for set in trees {
                     if !meets(set) {
                         continue;
                     }

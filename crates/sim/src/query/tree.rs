@@ -6,14 +6,33 @@
 //! Leaves of [`LEAF`] = 4 members (each member of a visited leaf costs a box test, and a
 //! query's answer is a handful of bodies) and nodes of 4 children, each node's four boxes
 //! stored by coordinate ([`Quad`]) and tested together with no branch per child; half the
-//! levels of a binary tree, so fewer dependent loads. The walk's stack is on the thread's
-//! stack (no allocation a query), and the ray's slab test has the direction inverted and
-//! the rounding margin taken once a walk.
+//! levels of a binary tree, so fewer dependent loads. A box walk keeps, per level, a mask
+//! of the children still to walk (no stack); a ray walk's stack is kept per thread (no
+//! allocation and nothing zeroed a query), and its slab test (`slab.rs`) has the direction
+//! inverted and the rounding margin taken once a walk.
+
+use std::cell::RefCell;
 
 use ricochet_geom::{Bounds, Vec2};
 
+use super::slab::{Slab, larger};
+
 /// Members per leaf, and children per node.
 const LEAF: usize = 4;
+
+/// A ray walk's node put off: its level, its index there, and where the segment enters it.
+type Pending = (u32, u32, f64);
+
+thread_local! {
+    /// The ray walk's stack, one per thread: as an array on the thread's stack it was
+    /// 1 KiB zeroed every walk (a `memset` call, two walks a ray where static bodies and
+    /// moving ones are both met).
+    static RAY_STACK: RefCell<[Pending; STACK]> = const { RefCell::new([(0, 0, 0.0); STACK]) };
+}
+
+/// Levels a tree has at most: a member's handle is a `u32`, so at most `2^30` leaves, 16
+/// levels above them.
+const LEVELS: usize = 17;
 
 /// Entries a walk's stack holds: up to three pending siblings per level (a tree over 2^32
 /// members has < 16 levels of four), plus the four children of the node being expanded.
@@ -22,31 +41,39 @@ const STACK: usize = 64;
 /// Four boxes side by side, one array per coordinate, so that a walk tests a node's four
 /// children in one pass with no branch per child. A missing child is the empty box
 /// ([`Quad::EMPTY`]'s lanes), which nothing meets.
+///
+/// The coordinates are indexed ([`MIN_X`], [`MIN_Y`], [`MAX_X`], [`MAX_Y`]) so that a ray's
+/// walk picks each axis' near face by an index set once a walk, not a branch per node.
 #[derive(Clone, Copy, Debug)]
-struct Quad {
-    min_x: [f64; 4],
-    min_y: [f64; 4],
-    max_x: [f64; 4],
-    max_y: [f64; 4],
+pub(super) struct Quad {
+    pub(super) c: [[f64; 4]; 4],
 }
+
+/// [`Quad::c`]'s rows: min x, min y, max x, max y (a max row is its min row + 2).
+pub(super) const MIN_X: usize = 0;
+pub(super) const MIN_Y: usize = 1;
+pub(super) const MAX_X: usize = 2;
+pub(super) const MAX_Y: usize = 3;
 
 impl Quad {
     /// Min at `+inf`, max at `-inf`: no box or segment meets it, and a hull ignores it.
     const EMPTY: Quad = Quad {
-        min_x: [f64::INFINITY; 4],
-        min_y: [f64::INFINITY; 4],
-        max_x: [f64::NEG_INFINITY; 4],
-        max_y: [f64::NEG_INFINITY; 4],
+        c: [
+            [f64::INFINITY; 4],
+            [f64::INFINITY; 4],
+            [f64::NEG_INFINITY; 4],
+            [f64::NEG_INFINITY; 4],
+        ],
     };
 
     /// Up to four boxes, the rest empty.
     fn of(boxes: &[Bounds]) -> Quad {
         let mut q = Quad::EMPTY;
         for (j, b) in boxes.iter().enumerate() {
-            q.min_x[j] = b.min.x;
-            q.min_y[j] = b.min.y;
-            q.max_x[j] = b.max.x;
-            q.max_y[j] = b.max.y;
+            q.c[MIN_X][j] = b.min.x;
+            q.c[MIN_Y][j] = b.min.y;
+            q.c[MAX_X][j] = b.max.x;
+            q.c[MAX_Y][j] = b.max.y;
         }
         q
     }
@@ -56,23 +83,42 @@ impl Quad {
         (1..4).fold(self.lane(0), |u, j| hull(u, self.lane(j)))
     }
 
-    fn lane(&self, j: usize) -> Bounds {
+    pub(super) fn lane(&self, j: usize) -> Bounds {
         Bounds {
-            min: Vec2::new(self.min_x[j], self.min_y[j]),
-            max: Vec2::new(self.max_x[j], self.max_y[j]),
+            min: Vec2::new(self.c[MIN_X][j], self.c[MIN_Y][j]),
+            max: Vec2::new(self.c[MAX_X][j], self.c[MAX_Y][j]),
         }
     }
 
     /// Bit `j` set when lane `j` overlaps `q` (touching counts), as [`meets`].
     #[inline]
     fn meets(&self, q: &Bounds) -> u32 {
+        let [min_x, min_y, max_x, max_y] = &self.c;
         let mut mask = 0;
         for j in 0..4 {
-            let m = (self.min_x[j] <= q.max.x)
-                & (q.min.x <= self.max_x[j])
-                & (self.min_y[j] <= q.max.y)
-                & (q.min.y <= self.max_y[j]);
+            let m = (min_x[j] <= q.max.x)
+                & (q.min.x <= max_x[j])
+                & (min_y[j] <= q.max.y)
+                & (q.min.y <= max_y[j]);
             mask |= u32::from(m) << j;
+        }
+        mask
+    }
+
+    /// [`Quad::meets`] for a finite `q`, as differences: `a <= b` is `a - b <= 0` (a
+    /// difference is zero only between equal numbers, and keeps its sign when it overflows;
+    /// `+inf - q` of an empty lane is `+inf`), and the largest of four differences is
+    /// positive when any is. Written so, the four lanes compile to two-wide subtractions and
+    /// maxima (about 30 instructions against 60 for the comparisons one by one). No lane is
+    /// NaN: [`QueryTree::new`] stores a box with a NaN coordinate as the empty box.
+    #[inline]
+    fn meets_finite(&self, q: &Bounds) -> u32 {
+        let [min_x, min_y, max_x, max_y] = &self.c;
+        let mut mask = 0;
+        for j in 0..4 {
+            let below = larger(min_x[j] - q.max.x, min_y[j] - q.max.y);
+            let above = larger(q.min.x - max_x[j], q.min.y - max_y[j]);
+            mask |= u32::from(larger(below, above) <= 0.0) << j;
         }
         mask
     }
@@ -81,10 +127,16 @@ impl Quad {
 /// A packed tree over boxes, its members in tree order.
 #[derive(Debug, Default)]
 pub(crate) struct QueryTree {
-    /// `levels[0][k]` holds the boxes of members `4k .. 4k + 4` (in tree order);
-    /// `levels[j + 1][k]` holds the boxes around the members of `levels[j][4k .. 4k + 4]`.
+    /// Every level's nodes, one level after another (one allocation: a node is one load
+    /// from here, not two): node `k` of level `j` is `quads[start[j] + k]`. Level 0's node
+    /// `k` holds the boxes of members `4k .. 4k + 4` (in tree order); level `j + 1`'s node
+    /// `k` holds the boxes around level `j`'s nodes `4k .. 4k + 4`.
     /// The last level is one node, the root.
-    levels: Vec<Vec<Quad>>,
+    quads: Vec<Quad>,
+    /// Where each level starts in `quads`.
+    start: [usize; LEVELS],
+    /// The root's level (the last).
+    top: usize,
     /// The box around every member.
     all: Option<Bounds>,
 }
@@ -111,20 +163,50 @@ impl QueryTree {
             &centers,
             LEAF << leaves.next_power_of_two().trailing_zeros(),
         );
-        let sorted: Vec<Bounds> = order.iter().map(|&k| boxes[k as usize]).collect();
+        // A box with a NaN coordinate (a member whose pose is not a number) overlaps nothing
+        // and no ray hits its member: stored empty, so that no lane is NaN.
+        let sorted: Vec<Bounds> = order
+            .iter()
+            .map(|&k| boxes[k as usize])
+            .map(|b| {
+                if [b.min.x, b.min.y, b.max.x, b.max.y]
+                    .iter()
+                    .any(|v| v.is_nan())
+                {
+                    Quad::EMPTY.lane(0)
+                } else {
+                    b
+                }
+            })
+            .collect();
         let mut levels = vec![sorted.chunks(LEAF).map(Quad::of).collect::<Vec<Quad>>()];
         while levels[levels.len() - 1].len() > 1 {
             let hulls: Vec<Bounds> = levels[levels.len() - 1].iter().map(Quad::hull).collect();
             levels.push(hulls.chunks(LEAF).map(Quad::of).collect());
         }
         let all = levels[levels.len() - 1][0].hull();
+        let top = levels.len() - 1;
+        let mut start = [0; LEVELS];
+        let mut quads = Vec::with_capacity(levels.iter().map(Vec::len).sum());
+        for (j, level) in levels.iter().enumerate() {
+            start[j] = quads.len();
+            quads.extend_from_slice(level);
+        }
         (
             QueryTree {
-                levels,
+                quads,
+                start,
+                top,
                 all: Some(all),
             },
             order,
         )
+    }
+
+    /// Node `i` of level `level`.
+    #[inline(always)]
+    fn node(&self, level: usize, i: usize) -> &Quad {
+        &self.quads[self.start[level] + i]
     }
 
     /// Calls `f` with every member whose box overlaps `q` (touching counts).
@@ -136,32 +218,40 @@ impl QueryTree {
         if !meets(&all, q) {
             return;
         }
-        let top = self.levels.len() - 1;
-        let mut stack = [(0u32, 0u32); STACK];
-        let mut len = 0;
+        if q.min.is_finite() && q.max.is_finite() {
+            self.walk(q, f, Quad::meets_finite);
+        } else {
+            self.walk(q, f, Quad::meets);
+        }
+    }
+
+    /// [`QueryTree::query`]'s walk, depth first, lowest child first, with `meets` the box
+    /// test of a node's four children. No stack of nodes: the children still to walk of
+    /// the node being walked at each level are a mask, and a node's parent is its index
+    /// divided by four.
+    #[inline(always)]
+    fn walk(&self, q: &Bounds, f: &mut impl FnMut(usize), meets: impl Fn(&Quad, &Bounds) -> u32) {
+        let top = self.top;
+        let mut pending = [0u32; LEVELS];
         let (mut level, mut i) = (top, 0);
+        pending[top] = meets(self.node(top, 0), q);
         loop {
-            let mut mask = self.levels[level][i].meets(q);
+            let mask = pending[level];
+            if mask == 0 {
+                if level == top {
+                    return;
+                }
+                (level, i) = (level + 1, i / LEAF);
+                continue;
+            }
+            pending[level] = mask & (mask - 1);
+            let c = i * LEAF + mask.trailing_zeros() as usize;
             if level == 0 {
-                while mask != 0 {
-                    f(i * LEAF + mask.trailing_zeros() as usize);
-                    mask &= mask - 1;
-                }
+                f(c);
             } else {
-                // Pushed highest first, so the lowest is walked first.
-                let below = (level - 1) as u32;
-                while mask != 0 {
-                    let j = 31 - mask.leading_zeros();
-                    stack[len] = (below, (i * LEAF) as u32 + j);
-                    len += 1;
-                    mask &= !(1 << j);
-                }
+                (level, i) = (level - 1, c);
+                pending[level] = meets(self.node(level, i), q);
             }
-            if len == 0 {
-                return;
-            }
-            len -= 1;
-            (level, i) = (stack[len].0 as usize, stack[len].1 as usize);
         }
     }
 
@@ -174,7 +264,7 @@ impl QueryTree {
         &self,
         origin: Vec2,
         dir: Vec2,
-        mut max: f64,
+        max: f64,
         f: &mut impl FnMut(usize, f64) -> f64,
     ) {
         let Some(all) = self.all else {
@@ -184,17 +274,44 @@ impl QueryTree {
         if slab.enter(&all, max).is_none() {
             return;
         }
-        let top = self.levels.len() - 1;
-        // (level, index, entry distance) of the nodes put off.
-        let mut stack = [(0u32, 0u32, 0.0f64); STACK];
+        RAY_STACK.with(|cell| match cell.try_borrow_mut() {
+            Ok(mut stack) => self.ray_walk(&slab, max, f, &mut stack),
+            // A walk from within a walk's `f` (none today): a stack of its own.
+            Err(_) => self.ray_walk(&slab, max, f, &mut [(0, 0, 0.0); STACK]),
+        });
+    }
+
+    /// [`QueryTree::ray`]'s walk from the root, `stack` its scratch.
+    #[inline(always)]
+    fn ray_walk(
+        &self,
+        slab: &Slab,
+        mut max: f64,
+        f: &mut impl FnMut(usize, f64) -> f64,
+        stack: &mut [Pending; STACK],
+    ) {
+        let top = self.top;
         let mut len = 0;
         let (mut level, mut i) = (top, 0);
         loop {
-            let (t, mut mask) = slab.enter4(&self.levels[level][i], max);
+            let (t, mut mask) = slab.enter4(self.node(level, i), max);
             if level == 0 {
+                // The members met, nearest entry first (ties: the lower first), so that a
+                // first hit prunes the farther ones of the leaf before their exact test.
+                let mut near = [0usize; LEAF];
+                let mut n = 0;
                 while mask != 0 {
                     let j = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
+                    let mut at = n;
+                    while at > 0 && t[near[at - 1]] > t[j] {
+                        near[at] = near[at - 1];
+                        at -= 1;
+                    }
+                    near[at] = j;
+                    n += 1;
+                }
+                for &j in &near[..n] {
                     // `max` may have shrunk since the four were tested.
                     if t[j] <= max {
                         max = f(i * LEAF + j, max);
@@ -262,137 +379,6 @@ fn split(ids: &mut [u32], centers: &[Vec2], cap: usize) {
     split(right, centers, half);
 }
 
-/// A segment's slab test, set up once a walk.
-struct Slab {
-    origin: Vec2,
-    /// `1 / dir` per axis (infinite along an axis the segment is parallel to).
-    inv: Vec2,
-    /// Whether the segment is parallel to the faces of either axis.
-    flat: bool,
-    /// Per axis, whether the segment runs towards smaller coordinates (it meets a box's
-    /// `max` face first).
-    back: [bool; 2],
-    /// One rounding margin for the whole walk: the root's, which is at least any box's.
-    pad: Vec2,
-    /// `origin + pad` and `origin - pad`: `min - pad - origin` is `min - from_min`.
-    from_min: Vec2,
-    from_max: Vec2,
-}
-
-impl Slab {
-    fn new(origin: Vec2, dir: Vec2, root: &Bounds) -> Slab {
-        let inv = Vec2::new(1.0 / dir.x, 1.0 / dir.y);
-        let pad = root.max.abs().max(root.min.abs()).max(origin.abs()) * 1e-12;
-        Slab {
-            origin,
-            inv,
-            flat: inv.x.is_infinite() || inv.y.is_infinite(),
-            back: [dir.x < 0.0, dir.y < 0.0],
-            pad,
-            from_min: origin + pad,
-            from_max: origin - pad,
-        }
-    }
-
-    /// Where the segment, `t` in `[0, max]`, enters `b` widened by the margin (touching
-    /// counts), or `None` if it misses. The margin covers rounding, so a segment that only
-    /// grazes a box is never lost (the exact test follows).
-    #[inline]
-    fn enter(&self, b: &Bounds, max: f64) -> Option<f64> {
-        if self.flat {
-            return self.enter_flat(b, max);
-        }
-        let to_min = (b.min - self.from_min) * self.inv;
-        let to_max = (b.max - self.from_max) * self.inv;
-        let (near_x, far_x) = if self.back[0] {
-            (to_max.x, to_min.x)
-        } else {
-            (to_min.x, to_max.x)
-        };
-        let (near_y, far_y) = if self.back[1] {
-            (to_max.y, to_min.y)
-        } else {
-            (to_min.y, to_max.y)
-        };
-        let enter = near_x.max(near_y).max(0.0);
-        let exit = far_x.min(far_y).min(max);
-        (enter <= exit).then_some(enter)
-    }
-
-    /// [`Slab::enter`] of the four lanes of `q` at once: each lane's entry distance, and
-    /// bit `j` set when lane `j` is met.
-    #[inline]
-    fn enter4(&self, q: &Quad, max: f64) -> ([f64; 4], u32) {
-        let mut t = [0.0; 4];
-        let mut mask = 0;
-        if self.flat {
-            for (j, tj) in t.iter_mut().enumerate() {
-                if let Some(e) = self.enter_flat(&q.lane(j), max) {
-                    *tj = e;
-                    mask |= 1 << j;
-                }
-            }
-            return (t, mask);
-        }
-        let (near_x, far_x) = if self.back[0] {
-            (&q.max_x, &q.min_x)
-        } else {
-            (&q.min_x, &q.max_x)
-        };
-        let (near_y, far_y) = if self.back[1] {
-            (&q.max_y, &q.min_y)
-        } else {
-            (&q.min_y, &q.max_y)
-        };
-        // The near face is padded against the origin by the one the direction meets first
-        // (`from_min` for a min face), as `enter` pads each face.
-        let (nx, fx) = if self.back[0] {
-            (self.from_max.x, self.from_min.x)
-        } else {
-            (self.from_min.x, self.from_max.x)
-        };
-        let (ny, fy) = if self.back[1] {
-            (self.from_max.y, self.from_min.y)
-        } else {
-            (self.from_min.y, self.from_max.y)
-        };
-        for j in 0..4 {
-            let enter = ((near_x[j] - nx) * self.inv.x)
-                .max((near_y[j] - ny) * self.inv.y)
-                .max(0.0);
-            let exit = ((far_x[j] - fx) * self.inv.x)
-                .min((far_y[j] - fy) * self.inv.y)
-                .min(max);
-            t[j] = enter;
-            mask |= u32::from(enter <= exit) << j;
-        }
-        (t, mask)
-    }
-
-    /// [`Slab::enter`] for a segment parallel to an axis' faces (`inv` infinite there).
-    #[cold]
-    fn enter_flat(&self, b: &Bounds, max: f64) -> Option<f64> {
-        let (lo, hi) = (b.min - self.pad, b.max + self.pad);
-        let (mut enter, mut exit) = (0.0_f64, max);
-        for axis in 0..2 {
-            let (o, inv) = (self.origin[axis], self.inv[axis]);
-            if inv.is_infinite() {
-                // Inside the slab or never.
-                if o < lo[axis] || o > hi[axis] {
-                    return None;
-                }
-                continue;
-            }
-            let t1 = (lo[axis] - o) * inv;
-            let t2 = (hi[axis] - o) * inv;
-            let (near, far) = if t1 < t2 { (t1, t2) } else { (t2, t1) };
-            enter = enter.max(near);
-            exit = exit.min(far);
-        }
-        (enter <= exit).then_some(enter)
-    }
-}
-
 /// Whether `a` and `b` overlap, touching counted ([`Bounds::overlaps`]), with one branch
 /// for the caller instead of four.
 #[inline]
@@ -448,6 +434,76 @@ mod tests {
                 .collect();
             assert_eq!(got, want, "{q:?}");
         }
+    }
+
+    #[test]
+    fn the_box_test_by_differences_agrees_with_the_comparisons() {
+        // Lanes touching the query on each face, overlapping, apart by an ulp, empty,
+        // huge and tiny, against queries on and off the lattice.
+        let v = [
+            -1e300,
+            -3.0,
+            -1.0,
+            -0.0,
+            0.0,
+            1e-300,
+            0.5,
+            1.0,
+            1.0 + f64::EPSILON,
+            3.0,
+        ];
+        let mut lanes = Vec::new();
+        for &a in &v {
+            for &b in &v {
+                if a <= b {
+                    lanes.push((a, b));
+                }
+            }
+        }
+        let mut quads = Vec::new();
+        for (k, &(x0, x1)) in lanes.iter().enumerate() {
+            let (y0, y1) = lanes[(k * 7) % lanes.len()];
+            let b = Bounds {
+                min: Vec2::new(x0, y0),
+                max: Vec2::new(x1, y1),
+            };
+            let c = Bounds {
+                min: Vec2::new(y0, x0),
+                max: Vec2::new(y1, x1),
+            };
+            quads.push(Quad::of(&[b, c, b.translated(Vec2::splat(0.5))]));
+        }
+        let mut met = 0;
+        for &(qx0, qx1) in &lanes {
+            for &(qy0, qy1) in lanes.iter().step_by(3) {
+                let q = Bounds {
+                    min: Vec2::new(qx0, qy0),
+                    max: Vec2::new(qx1, qy1),
+                };
+                for quad in &quads {
+                    let m = quad.meets(&q);
+                    assert_eq!(quad.meets_finite(&q), m, "{quad:?} {q:?}");
+                    met += m.count_ones();
+                }
+            }
+        }
+        assert!(met > 1000, "{met}");
+    }
+
+    #[test]
+    fn a_member_box_with_a_nan_is_stored_empty_and_met_by_nothing() {
+        let mut boxes = boxes();
+        boxes[3].max.x = f64::NAN;
+        let (tree, order) = QueryTree::new(&boxes);
+        // Over every member but the far one; member 3's box, but for its NaN, is in it.
+        let q = Bounds::around(Vec2::splat(10.0), Vec2::splat(100.0));
+        let mut got = Vec::new();
+        tree.query(&q, &mut |k| got.push(order[k]));
+        got.sort_unstable();
+        let want: Vec<u32> = (0..boxes.len() as u32)
+            .filter(|&k| k != 3 && boxes[k as usize].overlaps(&q))
+            .collect();
+        assert_eq!(got, want);
     }
 
     #[test]

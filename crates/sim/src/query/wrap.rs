@@ -14,7 +14,7 @@
 //! one running along an edge forever) stops there. In a world without wrap a query is one
 //! segment, the direct image only.
 
-use ricochet_geom::Vec2;
+use ricochet_geom::{Bounds, Vec2};
 
 use crate::def::WorldBounds;
 
@@ -33,6 +33,87 @@ pub(crate) fn offsets(wrap: Option<&WorldBounds>) -> ([Vec2; 9], usize) {
         Some(b) => (b.image_offsets(), 9),
         None => ([Vec2::ZERO; 9], 1),
     }
+}
+
+/// The images of the bodies a query looks at: which of [`offsets`]' nine (a bit each, in
+/// that order), with no array built or copied a query.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Images {
+    size: Vec2,
+    mask: u16,
+}
+
+/// Each of [`WorldBounds::image_offsets`]' nine, as world sizes per axis, in its order.
+const STEPS: [(f64, f64); 9] = [
+    (0.0, 0.0),
+    (-1.0, -1.0),
+    (-1.0, 0.0),
+    (-1.0, 1.0),
+    (0.0, -1.0),
+    (0.0, 1.0),
+    (1.0, -1.0),
+    (1.0, 0.0),
+    (1.0, 1.0),
+];
+
+impl Images {
+    /// The offsets of the images looked at, in [`offsets`]' order (the same arithmetic,
+    /// so the same bits, as [`WorldBounds::image_offsets`]).
+    pub(crate) fn iter(self) -> impl Iterator<Item = Vec2> {
+        (0..9)
+            .filter(move |k| self.mask & (1 << k) != 0)
+            .map(move |k| {
+                let (sx, sy) = STEPS[k];
+                Vec2::new(sx * self.size.x, sy * self.size.y)
+            })
+    }
+}
+
+/// The images among [`offsets`]' at which the query box `q`, moved by `shift - offset`,
+/// meets `hull` (touching counts; the box around every member, [`super::index::hull`]);
+/// every image when `q` is `None` (an endless ray). The same arithmetic, axis by axis, as
+/// [`Bounds::translated`] and [`Bounds::overlaps`] in the per-set test that follows, so no
+/// image that test would walk is dropped: a query well inside the world looks at the
+/// direct image only, for six comparisons per axis instead of nine box tests per set.
+pub(crate) fn images(
+    wrap: Option<&WorldBounds>,
+    q: Option<&Bounds>,
+    shift: Vec2,
+    hull: Option<Bounds>,
+) -> Images {
+    let size = wrap.map_or(Vec2::ZERO, WorldBounds::size);
+    let all = if wrap.is_some() { 0x1ff } else { 1 };
+    let Some(hull) = hull else {
+        return Images { size, mask: 0 };
+    };
+    let Some(q) = q else {
+        return Images { size, mask: all };
+    };
+    // Whether the query meets the hull with the bodies moved by `s` world sizes on `axis`.
+    let meets = |axis: usize, s: f64| {
+        let d = shift[axis] - s * size[axis];
+        (q.min[axis] + d <= hull.max[axis]) & (hull.min[axis] <= q.max[axis] + d)
+    };
+    let direct = meets(0, 0.0) & meets(1, 0.0);
+    if wrap.is_none() {
+        return Images {
+            size,
+            mask: u16::from(direct),
+        };
+    }
+    let x = [meets(0, -1.0), meets(0, 0.0), meets(0, 1.0)];
+    let y = [meets(1, -1.0), meets(1, 0.0), meets(1, 1.0)];
+    if x == [false, true, false] && y == [false, true, false] {
+        // Well inside the world: the direct image only.
+        return Images { size, mask: 1 };
+    }
+    let mut mask = 0;
+    for (k, &(sx, sy)) in STEPS.iter().enumerate() {
+        // `s + 1`: the lane of -1, 0 or +1 world sizes.
+        let (i, j) = ((sx + 1.0) as usize, (sy + 1.0) as usize);
+        mask |= u16::from(x[i] & y[j]) << k;
+    }
+    Images { size, mask }
 }
 
 /// `p` moved by whole world sizes into `[min, max)` on each axis.
@@ -102,5 +183,82 @@ pub(crate) fn segments(
             }
         }
         p = next;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The images the per-set test would walk: every one of the nine whose moved query box
+    /// meets the hull, by `Bounds::overlaps`.
+    fn brute(b: &WorldBounds, q: &Bounds, shift: Vec2, hull: &Bounds) -> Vec<Vec2> {
+        b.image_offsets()
+            .into_iter()
+            .filter(|&o| q.translated(shift - o).overlaps(hull))
+            .collect()
+    }
+
+    #[test]
+    fn the_images_kept_are_those_whose_query_box_meets_the_hull_in_order() {
+        let b = WorldBounds {
+            min: Vec2::new(-10.0, 0.0),
+            max: Vec2::new(30.0, 20.0),
+            wrap: true,
+        };
+        // The hull sticks out of the world by 1.5 on the left and 0.5 at the top.
+        let hull = Bounds {
+            min: Vec2::new(-11.5, 0.0),
+            max: Vec2::new(30.0, 20.5),
+        };
+        let mut cases = 0;
+        let mut several = 0;
+        // Boxes along both axes across the world and past its edges, some touching the
+        // hull's images exactly (the grid's steps of 0.5 land on its faces).
+        for ix in -4..=84 {
+            for iy in -4..=44 {
+                let c = Vec2::new(-10.0 + f64::from(ix) * 0.5, f64::from(iy) * 0.5);
+                for h in [Vec2::new(0.25, 0.5), Vec2::new(1.0, 0.25), Vec2::splat(6.0)] {
+                    let q = Bounds::around(c, h);
+                    let shift = wrap_point(&b, c) - c;
+                    let got: Vec<Vec2> = images(Some(&b), Some(&q), shift, Some(hull))
+                        .iter()
+                        .collect();
+                    let want = brute(&b, &q, shift, &hull);
+                    assert_eq!(got, want, "{q:?}");
+                    cases += 1;
+                    several += usize::from(want.len() > 1);
+                }
+            }
+        }
+        assert!(
+            several > cases / 20,
+            "{several} of {cases}: too few near the edges"
+        );
+        // No hull: nothing; an endless ray: all nine; no wrap: the direct image if met.
+        let q = Bounds::around(Vec2::new(5.0, 5.0), Vec2::ONE);
+        assert_eq!(
+            images(Some(&b), Some(&q), Vec2::ZERO, None).iter().count(),
+            0
+        );
+        assert_eq!(
+            images(Some(&b), None, Vec2::ZERO, Some(hull))
+                .iter()
+                .count(),
+            9
+        );
+        let far = Bounds::around(Vec2::new(500.0, 5.0), Vec2::ONE);
+        assert_eq!(
+            images(None, Some(&q), Vec2::ZERO, Some(hull))
+                .iter()
+                .count(),
+            1
+        );
+        assert_eq!(
+            images(None, Some(&far), Vec2::ZERO, Some(hull))
+                .iter()
+                .count(),
+            0
+        );
     }
 }
