@@ -1,6 +1,9 @@
 """Reads Ricochet logs with the official readers and checks every message of every channel.
 
-Usage: python tests/python/check_mcap.py LOG.mcap [LOG.mcap ...]
+Usage: python tests/python/check_mcap.py [--draw-every-frame] LOG.mcap [LOG.mcap ...]
+
+(`--draw-every-frame`: the logs were recorded with `ricochet run --draw-every-frame`, so every
+frame may draw, whatever the scene's size.)
 
 Each log is read with the official Python `mcap` reader, every CRC checked (the data
 section's, each chunk's, the summary's), and every message is decoded with
@@ -38,7 +41,7 @@ section's, each chunk's, the summary's), and every message is decoded with
   seek (the last message of each TOPIC at or before the time: so each message is whole):
   every message is a delete-all stamped at its time, then the entities of its topic, each
   in `world`, not `frame_locked`, stamped then, with no lifetime, only cubes, cylinders,
-  one triangle list and one line list (a terrain chain's segments), every number an f32. Both are sent at frame 0. With at most 1000
+  one triangle list and one line list (a terrain chain's segments), every number an f32. Both are sent at frame 0. With at most 256
   bodies at frame 0, each live body is one entity `body/ID:GENERATION` on the topic of its
   kind, with metadata `name`, `id`, `layer`, `kind` (`static`, or `dynamic`/`kinematic`)
   and, moving, `velocity` and `angular_velocity` equal to `/bodies`' to the bit; with more,
@@ -49,9 +52,15 @@ section's, each chunk's, the summary's), and every message is decoded with
   `/bodies` pose, within f32 rounding (4 f32 epsilons of max(1, |value|)): a circle a
   cylinder at its centre, an AABB an upright cube, an OBB a cube turned by the body's angle
   plus its own, a capsule a cube along its segment and a cylinder at each end, polygons
-  fans in the one triangle list in world coordinates. A frame without a message of a topic
-  has exactly the bodies of the topic's last message, none moved or turned (to the bit;
-  per body, none with another velocity): what a seek shows then is that frame.
+  fans in the one triangle list in world coordinates. A frame that may draw (below) without
+  a message of a topic has exactly the bodies of the topic's last message, none moved or
+  turned (to the bit; per body, none with another velocity): what a seek shows then is that
+  frame.
+- The drawing's pace (README, "Drawing a big scene"): with at most 256 bodies at frame 0
+  every frame may draw; with more, frame 0 draws, and a frame that drew `n` bytes of
+  `/scene`, `/scene/static`, `/tf` and `/scene/contacts` (as the file holds them) lets the
+  next draw no sooner than `ceil(n / 32768)` frames later: a frame before that sends none of
+  the four, and what a seek shows there is the last drawing.
 - `/tf`: one transform a message, the camera's frame `view` in `world`, upright, at f32
   precision, stamped at its time; sent at frame 0, then only when it moves.
 - `/scene/contacts`: one entity `contacts` in `world`, with one `LINE_LIST` of 2 points per
@@ -93,8 +102,11 @@ PER_FRAME = ("/bodies", "/contacts", "/stats")
 WORLD = "world"
 # The recorder's scene styles: an entity per body up to this many bodies at frame 0, above
 # that per-layer batches of at most CHUNK_PARTS body parts.
-PER_BODY_LIMIT = 1000
+PER_BODY_LIMIT = 256
 CHUNK_PARTS = 1024
+# A batched scene's drawing of n bytes waits ceil(n / DRAW_BYTES_PER_FRAME) frames.
+DRAW_BYTES_PER_FRAME = 32 * 1024
+SCENE_TOPICS = ("/scene", "/scene/static", "/tf", "/scene/contacts")
 # Drawings are at f32 precision: within a few f32 roundings of max(1, |value|).
 F32_TOLERANCE = 4 * 2.0**-23
 
@@ -506,8 +518,9 @@ def round_ns(seconds):
 
 
 class Log:
-    def __init__(self, path):
+    def __init__(self, path, every_frame=False):
         self.path = path
+        self.every_frame = every_frame  # recorded with --draw-every-frame
         self.counts = Counter()
         self.dt_ns = None
         self.frames = 0
@@ -519,6 +532,8 @@ class Log:
         self.views = 0  # /tf messages
         self.view = None  # the last one's (x, y)
         self.contacts_shown = False  # the last /scene/contacts drew some
+        self.next_drawing = 0  # the first frame that may draw again (a batched scene)
+        self.drawn_bytes = 0  # this frame's scene-topic bytes
         self.validation = False
         self.validation_mismatches = 0
 
@@ -566,7 +581,10 @@ class Log:
                 if message.log_time != group_time:
                     self.frame(group_time, group)
                     group, group_time = {}, message.log_time
+                    self.drawn_bytes = 0
                 group.setdefault(topic, []).append(decoded)
+                if topic in SCENE_TOPICS:
+                    self.drawn_bytes += len(message.data)
             if not group:
                 raise Problem("no message")
             self.frame(group_time, group)
@@ -612,6 +630,13 @@ class Log:
             raise Problem(f"/stats frame {frame}: {stats.contacts} contacts, /contacts lists {contacts}")
         if frame == 0:
             self.batched = len(live) > PER_BODY_LIMIT
+        if self.batched and not self.every_frame and frame < self.next_drawing:
+            early = [t for t in SCENE_TOPICS if t in msgs]
+            if early:
+                raise Problem(f"frame {frame}: {early} drawn before the pace allows (frame {self.next_drawing})")
+            return self.check_events(frame, t, msgs)
+        if self.batched and self.drawn_bytes:
+            self.next_drawing = frame + max(1, -(-self.drawn_bytes // DRAW_BYTES_PER_FRAME))
         for topic in ("/scene", "/scene/static"):
             sent = msgs.get(topic, [])
             if len(sent) > 1 or (frame == 0 and not sent):
@@ -625,6 +650,9 @@ class Log:
         if frame == 0 and self.views == 0:
             raise Problem("/tf frame 0: no view frame")
         self.check_contacts(frame, t, msgs["/contacts"][0].contacts, msgs.get("/scene/contacts", []))
+        self.check_events(frame, t, msgs)
+
+    def check_events(self, frame, t, msgs):
         for e in msgs.get("/events", []):
             if ts_ns(e.timestamp) != t:
                 raise Problem(f"/events frame {frame}: stamped {ts_ns(e.timestamp)} ns at {t} ns")
@@ -780,9 +808,9 @@ class Log:
                 raise Problem(f"{where}: contact {k // 2}'s {end} drawn at ({p.x!r}, {p.y!r}, {p.z!r}), /contacts has ({x!r}, {y!r})")
 
 
-def check(path):
+def check(path, every_frame=False):
     try:
-        print(f"{path}: {Log(path).check()}")
+        print(f"{path}: {Log(path, every_frame).check()}")
         return 0
     except Problem as e:
         print(f"{path}: FAILED: {e}")
@@ -792,8 +820,11 @@ def check(path):
 
 
 if __name__ == "__main__":
-    if len(sys.argv) < 2:
+    args = sys.argv[1:]
+    every_frame = "--draw-every-frame" in args
+    logs = [a for a in args if a != "--draw-every-frame"]
+    if not logs:
         sys.exit(__doc__)
-    failed = sum(check(p) for p in sys.argv[1:])
-    print(f"check_mcap: {len(sys.argv) - 1 - failed} passed, {failed} failed")
+    failed = sum(check(p, every_frame) for p in logs)
+    print(f"check_mcap: {len(logs) - failed} passed, {failed} failed")
     sys.exit(1 if failed else 0)
