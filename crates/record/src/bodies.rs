@@ -199,31 +199,6 @@ impl Tracker {
             let (position, angle) = (world.position[i], world.angle[i]);
             let (velocity, angular_velocity) = (world.velocity(i), world.angular_velocity(i));
             let slot = e.index as usize;
-            // Most bodies of a big scene go on as the integrator predicts, velocities
-            // unchanged: nothing to write, only whether the drawing changed. This is the
-            // general path below for that case, taken first because it is most of the cost
-            // of recording 10,000 drifting bodies (issue #37).
-            if !keyframe
-                && let Some(Some(k)) = self.known.get_mut(slot)
-                && k.generation == e.generation
-                && !k.falling
-                && same2(velocity, k.velocity)
-                && same(angular_velocity, k.angular_velocity)
-                && same2(position, k.position + velocity * dt)
-                && same(angle, k.angle + angular_velocity * dt)
-            {
-                if !same2(position, k.position) || !same(angle, k.angle) {
-                    *if k.is_static {
-                        &mut static_changed
-                    } else {
-                        &mut scene_changed
-                    } = true;
-                }
-                k.seen = frame;
-                k.position = position;
-                k.angle = angle;
-                continue;
-            }
             if self.known.len() <= slot {
                 self.known.resize_with(slot + 1, || None);
             }

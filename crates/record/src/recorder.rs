@@ -318,6 +318,8 @@ impl<S: MessageSink> Recorder<S> {
             let due = style == scene::Style::PerBody || self.pace.due(out.frame);
             if self.wanted.scene && due {
                 let whole = std::mem::take(&mut self.scene_skipped);
+                // Only a batched drawing is paced, so only its bytes are counted.
+                let counted = style == scene::Style::Batched;
                 let mut bytes = 0;
                 for (channel, statics, changed) in [
                     (
@@ -334,7 +336,9 @@ impl<S: MessageSink> Recorder<S> {
                     let redraw = !statics && std::mem::take(&mut self.moving_skipped);
                     if let (Some(ch), true) = (channel, changed || whole || redraw) {
                         let message = scene::snapshot(w, layers, statics, style, ts);
-                        bytes += message.encoded_len();
+                        if counted {
+                            bytes += message.encoded_len();
+                        }
                         self.writer.write(ch, t, message)?;
                         self.built += 1;
                     }
@@ -346,7 +350,9 @@ impl<S: MessageSink> Recorder<S> {
                         let transforms = FrameTransforms {
                             transforms: vec![scene::view_transform(ts, at)],
                         };
-                        bytes += transforms.encoded_len();
+                        if counted {
+                            bytes += transforms.encoded_len();
+                        }
                         self.writer.write(ch, t, transforms)?;
                         self.built += 1;
                     }
@@ -355,7 +361,9 @@ impl<S: MessageSink> Recorder<S> {
                     && (!out.contacts.is_empty() || self.normals_shown)
                 {
                     let normals = scene::contact_normals(&out.contacts, ts);
-                    bytes += normals.encoded_len();
+                    if counted {
+                        bytes += normals.encoded_len();
+                    }
                     self.writer.write(ch, t, normals)?;
                     self.normals_shown = !out.contacts.is_empty();
                     self.built += 1;

@@ -167,13 +167,18 @@ impl Shared {
     /// Whether some client subscribes to `topic` (a room nobody records builds only what
     /// is watched).
     pub fn watched(&self, topic: &str) -> bool {
+        self.any_subscriber(topic, |_, _| true)
+    }
+
+    /// Whether some client subscribed to `topic` passes `test` (given with the channel).
+    fn any_subscriber(&self, topic: &str, test: impl Fn(&Client, u32) -> bool) -> bool {
         self.channels
             .iter()
             .find(|c| c.topic == topic)
             .is_some_and(|c| {
                 self.clients
                     .values()
-                    .any(|k| k.subscriptions.contains_key(&c.id))
+                    .any(|k| k.subscriptions.contains_key(&c.id) && test(k, c.id))
             })
     }
 
@@ -182,14 +187,7 @@ impl Shared {
     /// draws `/scene` only then.
     pub fn state_wanted(&self, topic: &str, by: std::time::Instant) -> bool {
         let by = tokio::time::Instant::from_std(by);
-        self.channels
-            .iter()
-            .find(|c| c.topic == topic)
-            .is_some_and(|c| {
-                self.clients
-                    .values()
-                    .any(|k| k.subscriptions.contains_key(&c.id) && k.queue.wants_latest(c.id, by))
-            })
+        self.any_subscriber(topic, |k, channel| k.queue.wants_latest(channel, by))
     }
 
     /// How many clients are connected.
