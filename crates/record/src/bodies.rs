@@ -8,7 +8,7 @@
 
 use ricochet_geom::{ShapeDef, Vec2};
 use ricochet_log::messages::ricochet as pb;
-use ricochet_sim::{BodyKind, Entity, FrameOutput, Layers, RemovedBody, World, WorldDef};
+use ricochet_sim::{BodyKind, FrameOutput, Layers, RemovedBody, World, WorldDef};
 
 /// `/bodies` lists every moving body in full at frame 0 and then at multiples of this many
 /// frames (a big scene's less often: see [`KEYFRAME_BYTES_PER_FRAME`]).
@@ -38,6 +38,31 @@ struct Known {
     is_static: bool,
     /// The frame it was last seen in the world.
     seen: u64,
+}
+
+impl Known {
+    /// Whether a reader predicts this frame's state from this one: the velocity unchanged
+    /// (or one step of falling, `fall` = `gravity * dt`, when falling), the spin unchanged, and
+    /// the pose one integrator step on. Then `/bodies` has nothing to say of the body.
+    fn as_predicted(
+        &self,
+        position: Vec2,
+        angle: f64,
+        velocity: Vec2,
+        spin: f64,
+        fall: Vec2,
+        dt: f64,
+    ) -> bool {
+        let expected = if self.falling {
+            self.velocity + fall
+        } else {
+            self.velocity
+        };
+        same2(velocity, expected)
+            && same(spin, self.angular_velocity)
+            && same2(position, self.position + velocity * dt)
+            && same(angle, self.angle + spin * dt)
+    }
 }
 
 fn same(a: f64, b: f64) -> bool {
@@ -154,12 +179,68 @@ pub struct Tracker {
     frame: u64,
     /// The first frame that may be a keyframe again (see [`KEYFRAME_BYTES_PER_FRAME`]).
     next_keyframe: u64,
+    /// Scratch: the dense indices [`Tracker::settle`] left to the general case.
+    unsettled: Vec<usize>,
+}
+
+/// What [`Tracker::settle`] saw move.
+#[derive(Default)]
+struct Settled {
+    scene_changed: bool,
+    static_changed: bool,
 }
 
 impl Tracker {
     /// The keyframe of frame `frame` was `bytes` encoded bytes: the next waits for them.
     pub fn keyframe_written(&mut self, frame: u64, bytes: u64) {
         self.next_keyframe = frame.saturating_add(bytes.div_ceil(KEYFRAME_BYTES_PER_FRAME));
+    }
+
+    /// Settles every known body that did only what a reader predicts (see
+    /// [`Known::as_predicted`]): its state is taken as the new last one, and `/bodies` says
+    /// nothing of it. The indices of the others go to `unsettled`, ascending. Not for a
+    /// keyframe (which lists every moving body). `fall` is `gravity * dt`.
+    fn settle(
+        &mut self,
+        world: &World,
+        frame: u64,
+        fall: Vec2,
+        dt: f64,
+        velocities_drawn: bool,
+    ) -> Settled {
+        let mut out = Settled::default();
+        self.unsettled.clear();
+        for (i, m) in world.motions().enumerate() {
+            let e = m.entity;
+            if let Some(Some(k)) = self.known.get_mut(e.index as usize)
+                && k.generation == e.generation
+                && k.as_predicted(
+                    m.position,
+                    m.angle,
+                    m.velocity,
+                    m.angular_velocity,
+                    fall,
+                    dt,
+                )
+            {
+                let moved = !same2(m.position, k.position) || !same(m.angle, k.angle);
+                let sped = !same2(k.velocity, m.velocity);
+                if moved || (velocities_drawn && !k.is_static && sped) {
+                    *if k.is_static {
+                        &mut out.static_changed
+                    } else {
+                        &mut out.scene_changed
+                    } = true;
+                }
+                k.seen = frame;
+                k.position = m.position;
+                k.angle = m.angle;
+                k.velocity = m.velocity;
+            } else {
+                self.unsettled.push(i);
+            }
+        }
+        out
     }
 
     /// The changes of frame `out.frame` (its world is `world`, its settings `def`).
@@ -194,8 +275,19 @@ impl Tracker {
         } else {
             0
         });
-        for i in 0..world.len() {
-            let e: Entity = world.entity[i];
+        // Most bodies of a big scene did only what a reader predicts: settled first, in a
+        // loop of their own; the others take the general case below, in world order.
+        if keyframe {
+            self.unsettled.clear();
+            self.unsettled.extend(0..world.len());
+        } else {
+            let settled = self.settle(world, frame, gravity * dt, dt, velocities_drawn);
+            scene_changed |= settled.scene_changed;
+            static_changed |= settled.static_changed;
+        }
+        let unsettled = std::mem::take(&mut self.unsettled);
+        for &i in &unsettled {
+            let e = world.entity[i];
             let (position, angle) = (world.position[i], world.angle[i]);
             let (velocity, angular_velocity) = (world.velocity(i), world.angular_velocity(i));
             let slot = e.index as usize;
@@ -297,6 +389,7 @@ impl Tracker {
             k.velocity = velocity;
             k.angular_velocity = angular_velocity;
         }
+        self.unsettled = unsettled;
         if self.alive != world.len() {
             // Some bodies went (removed, or despawned between frames): forget them.
             for slot in &mut self.known {

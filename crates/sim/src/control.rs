@@ -323,6 +323,9 @@ impl Simulation {
 
     fn first_non_finite_state(&self) -> Option<NonFinite> {
         let w = &self.world;
+        if w.moving_state_finite() {
+            return None;
+        }
         w.movers().iter().find_map(|&i| {
             let i = i as usize;
             let (p, v) = (w.position[i], w.velocity(i));

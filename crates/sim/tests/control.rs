@@ -281,6 +281,22 @@ fn an_overflowing_body_is_named() {
     assert!(sim.position(calm).unwrap().is_finite());
 }
 
+/// Finite values whose sum overflows are finite still: `first_non_finite`'s quick pass adds
+/// each body's values up, so a kinematic body moving at `(f64::MAX, f64::MAX)` (no kinetic
+/// energy is counted for it) sends it to the value-by-value check, which finds nothing.
+#[test]
+fn finite_values_summing_past_the_largest_f64_are_not_named() {
+    let mut sim = Simulation::from_def(world(BroadPhaseKind::Auto, Response::Ignore)).unwrap();
+    let fast = sim.spawn(&circle(0, BodyKind::Kinematic, 0.0));
+    sim.set_velocity(fast, Vec2::new(f64::MAX, f64::MAX))
+        .unwrap();
+    assert!(
+        (f64::MAX + f64::MAX).is_infinite(),
+        "the sum the quick pass sees"
+    );
+    assert_eq!(sim.first_non_finite(), None);
+}
+
 /// A clone is a snapshot: stepped on, it gives the same states as the original, bit for bit
 /// (`ricochet serve` seeks back from such snapshots). Every kind of broad phase and the
 /// per-axis grids are exercised: asteroids (sort and sweep), rain (the grid for a crowd),

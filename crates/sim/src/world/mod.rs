@@ -43,6 +43,7 @@ mod sleep;
 mod state;
 
 pub(crate) use bounds::placed;
+pub use rows::Motion;
 pub(crate) use state::{Bodies, PackedWorld};
 
 use bounds::LocalBounds;

@@ -124,6 +124,50 @@ row_writers! {
     user_data, user_data_mut: u128;
 }
 
+/// One body's motion, as [`World::motions`] reads it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Motion {
+    /// The body.
+    pub entity: Entity,
+    /// Position.
+    pub position: Vec2,
+    /// Angle, radians.
+    pub angle: f64,
+    /// Velocity ([`Vec2::ZERO`] for scenery).
+    pub velocity: Vec2,
+    /// Angular velocity (0 for scenery).
+    pub angular_velocity: f64,
+}
+
+impl World {
+    /// Every body's motion, by dense index: what [`World::velocity`] and the columns give
+    /// one by one, read in one pass over borrowed columns (a recorder comparing 10,000
+    /// bodies a frame spent a third of its time in the per-body bounds checks).
+    pub fn motions(&self) -> impl ExactSizeIterator<Item = Motion> + '_ {
+        let n = self.entity.len();
+        let m = self.rows.velocity.len();
+        let (velocity, spin) = (&self.rows.velocity[..m], &self.rows.angular_velocity[..m]);
+        self.entity[..n]
+            .iter()
+            .zip(&self.position[..n])
+            .zip(&self.angle[..n])
+            .zip(&self.row[..n])
+            .map(move |(((&entity, &position), &angle), &r)| {
+                let (velocity, angular_velocity) = match r {
+                    NO_ROW => (Vec2::ZERO, 0.0),
+                    r => (velocity[r as usize], spin[r as usize]),
+                };
+                Motion {
+                    entity,
+                    position,
+                    angle,
+                    velocity,
+                    angular_velocity,
+                }
+            })
+    }
+}
+
 impl Rows {
     /// Appends a row for `def`'s body `e`.
     pub(super) fn push(&mut self, e: Entity, def: &BodyDef) {
