@@ -305,22 +305,36 @@ impl<G: Game> Room<G> {
                 ricochet_sim::MAX_FRAMES
             )));
         }
+        // The next frame's start; so far off that no `Instant` holds it, whatever is due
+        // comes before it.
+        let by = Instant::now().checked_add(self.dt);
         let wanted = {
             let mut s = self.hub.lock();
             s.broadcast(&Message::binary(protocol::time(t)));
             // A room nobody records builds only the messages some client subscribes to:
             // building every channel's for nobody was most of a room's frame
-            // (BENCHMARKS.md, "Rooms"). A recorded room builds them all, as before.
-            self.recording.is_none().then(|| Channels {
-                scene: LATEST.iter().any(|topic| s.watched(topic)),
-                bodies: s.watched("/bodies"),
-                contacts: s.watched("/contacts"),
-                stats: s.watched("/stats"),
-                events: s.watched("/events"),
+            // (BENCHMARKS.md, "Rooms"). A recorded room builds them all, as before. And it
+            // draws `/scene` only in the frames some client is due one, as `serve` does
+            // (`serving/drawing.rs`): a client paced by its bytes, or one that stopped
+            // reading, makes no drawing it would not be sent.
+            self.recording.is_none().then(|| {
+                let channels = Channels {
+                    scene: LATEST.iter().any(|topic| s.watched(topic)),
+                    bodies: s.watched("/bodies"),
+                    contacts: s.watched("/contacts"),
+                    stats: s.watched("/stats"),
+                    events: s.watched("/events"),
+                };
+                let draw = match by {
+                    Some(by) => s.state_wanted("/scene", by),
+                    None => s.watched("/scene"),
+                };
+                (channels, draw)
             })
         };
-        if let (Some(wanted), Some(session)) = (wanted, self.session.as_mut()) {
+        if let (Some((wanted, draw)), Some(session)) = (wanted, self.session.as_mut()) {
             session.recorder().build_only(wanted);
+            session.recorder().draw_moving(draw);
         }
         match self.guarded("a frame", GameSession::step)? {
             Ok(_) => {}
@@ -472,6 +486,44 @@ mod tests {
         let dt_ns = room.session.as_ref().unwrap().dt_ns();
         let game: Vec<(u32, u64)> = (0..10).map(|n| (7, n * dt_ns)).collect();
         assert_eq!(received(&mut rx), game);
+    }
+
+    /// Messages the room's recorder built in `n` frames; `read` drains the receiver after
+    /// each frame, as a connection writing at once does.
+    fn built_in(room: &mut Room<Frames>, n: u64, read: Option<&mut ClientQueueReceiver>) -> u64 {
+        let before = room.session.as_mut().unwrap().recorder().built();
+        let mut read = read;
+        for _ in 0..n {
+            room.step().map_err(|_| "a step failed").unwrap();
+            if let Some(rx) = read.as_deref_mut() {
+                while rx.ready().is_some() {}
+            }
+        }
+        room.session.as_mut().unwrap().recorder().built() - before
+    }
+
+    /// Unrecorded, a room draws `/scene` only in the frames its client is due one: every
+    /// frame for a client that reads each (the balls move every frame; a scene this small is
+    /// due again well within a frame), and once in ten frames for one that never reads (its
+    /// queue holds that one, which a newer one would only replace). The first frame after
+    /// subscribing sends the scene's channels whole: `/scene`, `/scene/static` and `/tf`
+    /// (the wall and the camera's frame do not change after it).
+    #[test]
+    fn an_unrecorded_room_draws_the_scene_only_when_a_client_is_due_one() {
+        let (mut read, client, mut rx) = room();
+        subscribe(&read, client, "/scene", 2);
+        assert_eq!(
+            built_in(&mut read, 10, Some(&mut rx)),
+            3 + 9,
+            "a client reading each"
+        );
+        let (mut stuck, client, _rx) = room();
+        subscribe(&stuck, client, "/scene", 2);
+        assert_eq!(
+            built_in(&mut stuck, 10, None),
+            3,
+            "a client that never reads"
+        );
     }
 
     #[test]
