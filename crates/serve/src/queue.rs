@@ -45,6 +45,12 @@ const MESSAGE_OVERHEAD: usize = 64;
 /// (BENCHMARKS.md, "Live at 10,000 bodies").
 pub const STATE_RATE: f64 = 2e6;
 
+/// A state held back by its channel's pace ([`STATE_RATE`]) that was due this long ago and
+/// is still not taken: the connection is not draining (one that drains takes it when it is
+/// due), so it counts as waiting to be written, and the server stops drawing newer states
+/// for that client (it only replaced them, unsent). A second: far longer than any frame.
+pub const STALLED: Duration = Duration::from_secs(1);
+
 /// A queued message whose content a newer one may replace until it is written: the
 /// latest state of one channel.
 type Slot = Arc<Mutex<Held>>;
@@ -208,16 +214,26 @@ impl ClientQueue {
     /// none is waiting to be written in its queue (one is, behind other messages or a
     /// socket that does not drain: it goes first, and whatever is built meanwhile would only
     /// replace it), and its pace ([`STATE_RATE`]) lets the channel's next state go by then.
-    /// A state held back by the pace counts as none waiting: a newer one replaces it. The
-    /// server builds a costly whole state (`/scene`) only when some client wants it.
+    /// A state held back by the pace counts as none waiting: a newer one replaces it;
+    /// unless it has been due for [`STALLED`] and is still not taken. The server builds a
+    /// costly whole state (`/scene`) only when some client wants it.
     pub fn wants_latest(&self, channel: u32, by: Instant) -> bool {
+        self.wants_latest_at(channel, Instant::now(), by)
+    }
+
+    /// [`ClientQueue::wants_latest`] asked at `now`.
+    fn wants_latest_at(&self, channel: u32, now: Instant, by: Instant) -> bool {
+        let due = lock(&self.due).get(&channel).copied();
         if let Some(slot) = lock(&self.latest).get(&channel) {
             let held = lock(slot);
-            if held.message.is_some() && !held.paced {
+            let stalled = due
+                .and_then(|at| at.checked_add(STALLED))
+                .is_some_and(|late| late <= now);
+            if held.message.is_some() && (!held.paced || stalled) {
                 return false;
             }
         }
-        lock(&self.due).get(&channel).is_none_or(|&at| at <= by)
+        due.is_none_or(|at| at <= by)
     }
 
     /// Bytes queued now.
@@ -477,6 +493,41 @@ mod tests {
         assert!(
             queue.wants_latest(2, now),
             "another channel has its own pace"
+        );
+    }
+
+    /// A state held back by the pace and not taken long after it was due (the connection
+    /// stopped draining, say blocked in a write) counts as waiting: the server stops
+    /// drawing for that client.
+    #[tokio::test]
+    async fn a_held_state_not_taken_long_after_it_was_due_is_waiting() {
+        let (queue, mut receiver) = client_queue();
+        assert_eq!(
+            queue.offer_latest(1, Message::binary(vec![0u8; 4_000_000])),
+            Latest::Queued
+        );
+        assert_eq!(receiver.recv().await.unwrap().len(), 4_000_000);
+        assert_eq!(queue.offer_latest(1, text("scene 2")), Latest::Queued);
+        assert!(
+            receiver.ready().is_none(),
+            "scene 2 is held back: due in 2 s"
+        );
+        let now = Instant::now();
+        let frame = Duration::from_millis(16);
+        // Due 2 s after it was written (4 MB at 2 MB/s); this test runs well within 1 s.
+        let due = now + Duration::from_secs(2);
+        assert!(
+            !queue.wants_latest_at(1, now, now + frame),
+            "not due by then"
+        );
+        assert!(
+            queue.wants_latest_at(1, due, due + frame),
+            "due: a newer one would be written in its place"
+        );
+        let late = due + STALLED + Duration::from_millis(100);
+        assert!(
+            !queue.wants_latest_at(1, late, late + frame),
+            "due over a second ago and not taken: the connection is not draining"
         );
     }
 
