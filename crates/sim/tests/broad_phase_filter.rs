@@ -3,7 +3,7 @@
 //! bodies of the layers it meets): the pairs are exactly a plain all-pairs loop's, on scenes
 //! with touching boxes on a lattice, bodies of very different sizes (the filter tests one
 //! corner cell of each big body), tiny boxes near 1e6 (rounding), and the odd NaN or
-//! infinite box, across frames of motion.
+//! infinite box, across frames of motion in which bodies grow past the sizes of the last.
 
 use proptest::prelude::*;
 use ricochet_geom::{Bounds, Vec2};
@@ -28,8 +28,9 @@ fn reference(bodies: &[BodyEntry], interactions: &Interactions) -> Vec<(u32, u32
     pairs
 }
 
-/// A box of family `family` at lattice point `(cx, cy)` with half extents from `hx`, `hy`.
-fn make_bounds(family: u8, cx: i32, cy: i32, hx: u8, hy: u8) -> Bounds {
+/// A box of family `family` at lattice point `(cx, cy)` with half extents from `hx`, `hy`;
+/// `spread` scales the lattice (1: crowded, touching common; 16: as sparse as asteroids).
+fn make_bounds(family: u8, (cx, cy): (i32, i32), hx: u8, hy: u8, spread: f64) -> Bounds {
     let (cx, cy) = (f64::from(cx), f64::from(cy));
     let (hx, hy) = (f64::from(hx % 9), f64::from(hy % 9));
     let lattice = |offset: f64, unit: f64, size: f64| {
@@ -40,11 +41,11 @@ fn make_bounds(family: u8, cx: i32, cy: i32, hx: u8, hy: u8) -> Bounds {
     };
     match family {
         // Small boxes on a half-unit lattice: touching is common.
-        0..=5 => lattice(0.0, 0.5, 0.25),
+        0..=5 => lattice(0.0, 0.5 * spread, 0.25),
         // Degenerate.
-        6 => lattice(0.0, 0.5, 0.0),
+        6 => lattice(0.0, 0.5 * spread, 0.0),
         // Long: a body whose lower-left corner is far from where it meets a small one.
-        7 => lattice(0.0, 0.5, 3.0),
+        7 => lattice(0.0, 0.5 * spread, 3.0),
         // Tiny near 1e6.
         8 => lattice(1e6, 1e-7, 0.5e-7),
         // Inverted, infinite, NaN.
@@ -76,7 +77,13 @@ fn kind_of(k: u64) -> BodyKind {
 
 /// A scene: `big` bodies of the big layer and `small` of layers 0 and 2, interleaved in key
 /// order, with families drawn from `families` (`odd`: the NaN and infinite ones too).
-fn scene(seed: u64, big: usize, small: usize, near_1e6: bool, odd: bool) -> Vec<BodyEntry> {
+fn scene(
+    seed: u64,
+    (big, small): (usize, usize),
+    near_1e6: bool,
+    odd: bool,
+    spread: f64,
+) -> Vec<BodyEntry> {
     let mut rng = Rng::new(seed);
     let n = big + small;
     let mut smalls_left = small;
@@ -97,7 +104,8 @@ fn scene(seed: u64, big: usize, small: usize, near_1e6: bool, odd: bool) -> Vec<
             };
             // The small layers' bodies span the whole lattice too (bullets all over).
             let (cx, cy) = (rng.below(160) as i32 - 80, rng.below(160) as i32 - 80);
-            let bounds = make_bounds(family, cx, cy, rng.below(256) as u8, rng.below(256) as u8);
+            let (hx, hy) = (rng.below(256) as u8, rng.below(256) as u8);
+            let bounds = make_bounds(family, (cx, cy), hx, hy, spread);
             BodyEntry {
                 key: (k as u64 + 1) * 4,
                 bounds,
@@ -121,7 +129,8 @@ proptest! {
         near_1e6 in any::<bool>(),
         odd in any::<bool>(),
         bits in 0u8..8,
-        frames in 1usize..4,
+        frames in 1usize..5,
+        sparse in any::<bool>(),
     ) {
         // Layers 0 and 2 meet the big layer; among themselves, as `bits` says; the big layer
         // never meets itself.
@@ -132,7 +141,8 @@ proptest! {
             (0, 2) => bits & 4 != 0,
             _ => false,
         });
-        let mut bodies = scene(seed, big, small, near_1e6, odd);
+        let spread = if sparse { 16.0 } else { 1.0 };
+        let mut bodies = scene(seed, (big, small), near_1e6, odd, spread);
         let kinds = [BroadPhaseKind::SortAndSweep, BroadPhaseKind::Auto];
         let mut whole: Vec<BroadPhase> = kinds.iter().map(|&k| BroadPhase::new(k)).collect();
         let mut split: Vec<BroadPhase> = kinds.iter().map(|&k| BroadPhase::new(k)).collect();
@@ -153,6 +163,11 @@ proptest! {
                 let offset = if rng.below(3) == 0 { (offset * 2.0).round() * 0.5 } else { offset };
                 b.bounds = b.bounds.translated(offset);
             }
+            // A body grows down and left, wider and taller than any before it: its
+            // lower-left corner moves far from the small bodies it now reaches.
+            let grows = rng.below(bodies.len());
+            let by = Vec2::new(20.0 + rng.unit() * 60.0, 20.0 + rng.unit() * 60.0) * spread;
+            bodies[grows].bounds.min -= by;
         }
     }
 }

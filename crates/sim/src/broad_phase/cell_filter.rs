@@ -31,6 +31,8 @@ pub(super) struct CellFilter {
     bits: Vec<u64>,
     /// The small layers met by the layer being filtered.
     partners: Vec<u8>,
+    /// Per layer, the widest and tallest body of its last filtered call.
+    reach: Vec<Vec2>,
 }
 
 /// The monotone map from a coordinate to a cell along one axis (clamped to the grid): two
@@ -175,84 +177,109 @@ impl BroadPhase {
         for &m in &partners {
             resorted += self.ensure_sweep(m, bodies);
         }
-        let big_handles = of_layer(&self.movers, &self.layer_start, big);
-        // The big layer's widest and tallest body (NaN ignored: it overlaps nothing): a big
-        // body that overlaps a small one has its lower-left corner within the small one's
-        // bounds widened down and left by these, so one cell a big body is enough.
-        let mut reach = Vec2::ZERO;
-        for &h in big_handles {
-            let b = &bodies[h as usize].bounds;
-            let size = b.max - b.min;
-            // Branches, not `f64::max`: rarely taken, and no dependency chain.
-            if size.x > reach.x {
-                reach.x = size.x;
-            }
-            if size.y > reach.y {
-                reach.y = size.y;
-            }
+        let f = &mut self.filter;
+        if f.reach.is_empty() {
+            f.reach.resize(256, Vec2::ZERO);
         }
-        // The union of the small bodies' widened bounds (NaN bounds, which overlap nothing,
-        // left out).
-        let mut union: Option<Bounds> = None;
-        for &m in &partners {
-            for &h in of_layer(&self.movers, &self.layer_start, m) {
-                let b = widened(&bodies[h as usize].bounds, reach);
-                if [b.min.x, b.min.y, b.max.x, b.max.y]
-                    .iter()
-                    .any(|v| v.is_nan())
-                {
+        // The big layer's widest and tallest body, as of the last call: a big body that
+        // overlaps a small one has its lower-left corner within the small one's bounds
+        // widened down and left by these, so one cell a big body is enough. The pass measures
+        // them again; if a body outgrew them, it is done again with this call's.
+        let mut reach = f.reach[usize::from(big)];
+        let (start, mut tested) = (out.len(), 0);
+        let smalls = |m: u8| of_layer(&self.movers, &self.layer_start, m);
+        let big_handles = smalls(big);
+        while let Some((ax, ay)) = mark(&mut f.bits, &partners, smalls, bodies, reach) {
+            let bits = &f.bits;
+            let mut seen = Vec2::ZERO;
+            tested = 0;
+            for &h in big_handles {
+                let e = &bodies[h as usize];
+                let b = &e.bounds;
+                let size = b.max - b.min;
+                // Branches, not `f64::max`: rarely taken, no dependency chain, NaN ignored
+                // (a NaN box overlaps nothing).
+                if size.x > seen.x {
+                    seen.x = size.x;
+                }
+                if size.y > seen.y {
+                    seen.y = size.y;
+                }
+                let (x, y) = (ax.cell(b.min.x), ay.cell(b.min.y));
+                if bits[y * WORDS + x / 64] & (1 << (x % 64)) == 0 {
                     continue;
                 }
-                union = Some(union.map_or(b, |u| u.union(b)));
-            }
-        }
-        let Some(u) = union else {
-            self.filter.partners = partners;
-            return (0, resorted);
-        };
-        let (ax, ay) = (Axis::new(u.min.x, u.max.x), Axis::new(u.min.y, u.max.y));
-        let bits = &mut self.filter.bits;
-        bits.clear();
-        // Past finite values (which the world's limits keep out) every body is tested.
-        let finite = reach.is_finite() && u.min.is_finite() && u.max.is_finite();
-        bits.resize(CELLS * WORDS, if finite { 0 } else { u64::MAX });
-        for &m in &partners {
-            for &h in of_layer(&self.movers, &self.layer_start, m) {
-                let b = widened(&bodies[h as usize].bounds, reach);
-                let (x0, x1) = (ax.cell(b.min.x), ax.cell(b.max.x));
-                for y in ay.cell(b.min.y)..=ay.cell(b.max.y) {
-                    set(&mut bits[y * WORDS..(y + 1) * WORDS], x0, x1);
+                let q = member(e, h);
+                for &m in &partners {
+                    let view = SweepView {
+                        list: &self.sweeps[usize::from(m)],
+                        handles: smalls(m),
+                        bodies,
+                    };
+                    view.each_along_x(e, |s| {
+                        if q.dynamic || s.dynamic {
+                            tested += 1;
+                            if q.bounds.overlaps(&s.bounds) {
+                                out.push((s.handle, q.handle));
+                            }
+                        }
+                    });
                 }
             }
-        }
-        let mut tested = 0;
-        let bits = &self.filter.bits;
-        for &h in big_handles {
-            let e = &bodies[h as usize];
-            let (x, y) = (ax.cell(e.bounds.min.x), ay.cell(e.bounds.min.y));
-            if bits[y * WORDS + x / 64] & (1 << (x % 64)) == 0 {
-                continue;
+            if seen.x <= reach.x && seen.y <= reach.y {
+                reach = seen;
+                break;
             }
-            let q = member(e, h);
-            for &m in &partners {
-                let view = SweepView {
-                    list: &self.sweeps[usize::from(m)],
-                    handles: of_layer(&self.movers, &self.layer_start, m),
-                    bodies,
-                };
-                view.each_along_x(e, |s| {
-                    if q.dynamic || s.dynamic {
-                        tested += 1;
-                        if q.bounds.overlaps(&s.bounds) {
-                            out.push((s.handle, q.handle));
-                        }
-                    }
-                });
-            }
+            out.truncate(start);
+            reach = seen;
         }
-        self.filter.partners = partners;
+        f.reach[usize::from(big)] = reach;
+        f.partners = partners;
         (tested, resorted)
     }
+}
+
+/// Marks in `bits` the cells of the small layers' bodies (`partners`, each layer's handles
+/// from `of`) widened by `reach`; returns the map of each axis, or `None` when no small body
+/// has bounds without NaN (nothing to pair).
+fn mark<'a>(
+    bits: &mut Vec<u64>,
+    partners: &[u8],
+    of: impl Fn(u8) -> &'a [u32],
+    bodies: &[BodyEntry],
+    reach: Vec2,
+) -> Option<(Axis, Axis)> {
+    // The union of the small bodies' widened bounds (NaN bounds, which overlap nothing, left
+    // out).
+    let mut union: Option<Bounds> = None;
+    for &m in partners {
+        for &h in of(m) {
+            let b = widened(&bodies[h as usize].bounds, reach);
+            if [b.min.x, b.min.y, b.max.x, b.max.y]
+                .iter()
+                .any(|v| v.is_nan())
+            {
+                continue;
+            }
+            union = Some(union.map_or(b, |u| u.union(b)));
+        }
+    }
+    let u = union?;
+    let (ax, ay) = (Axis::new(u.min.x, u.max.x), Axis::new(u.min.y, u.max.y));
+    bits.clear();
+    // Past finite values (which the world's limits keep out) every body is tested.
+    let finite = reach.is_finite() && u.min.is_finite() && u.max.is_finite();
+    bits.resize(CELLS * WORDS, if finite { 0 } else { u64::MAX });
+    for &m in partners {
+        for &h in of(m) {
+            let b = widened(&bodies[h as usize].bounds, reach);
+            let (x0, x1) = (ax.cell(b.min.x), ax.cell(b.max.x));
+            for y in ay.cell(b.min.y)..=ay.cell(b.max.y) {
+                set(&mut bits[y * WORDS..(y + 1) * WORDS], x0, x1);
+            }
+        }
+    }
+    Some((ax, ay))
 }
 
 #[cfg(test)]
