@@ -43,14 +43,22 @@ impl BroadPhase {
         }
         let layers = std::mem::take(&mut self.mover_layers);
         let static_layers = std::mem::take(&mut self.statics.layers);
+        self.plan_filters(kind, &layers, interactions);
         for (k, &a) in layers.iter().enumerate() {
+            if self.filter.filtered(a) {
+                // Every pair of `a` with the moving layers it meets (`cell_filter.rs`).
+                let (tested, resorted) = self.filtered_pairs(a, &layers, interactions, bodies, out);
+                stats.tested += tested;
+                stats.resorted += resorted;
+            }
             for &b in &layers[k..] {
                 if !interactions.interacts(a, b) {
                     stats.layer_pairs_skipped += 1;
                     continue;
                 }
                 let (da, db) = (self.dynamic[usize::from(a)], self.dynamic[usize::from(b)]);
-                if da != 0 || db != 0 {
+                let filtered = self.filter.filtered(a) || self.filter.filtered(b);
+                if (da != 0 || db != 0) && !filtered {
                     self.moving_pairs(kind, (a, b), bodies, out, stats);
                 }
             }
@@ -139,7 +147,7 @@ impl BroadPhase {
 
     /// Brings layer `l`'s sorted list up to this call, once per call. Returns the re-sort's
     /// moves.
-    fn ensure_sweep(&mut self, l: u8, bodies: &[BodyEntry]) -> u64 {
+    pub(super) fn ensure_sweep(&mut self, l: u8, bodies: &[BodyEntry]) -> u64 {
         let list = &mut self.sweeps[usize::from(l)];
         if list.frame == self.frame {
             return 0;

@@ -25,7 +25,11 @@
 //!   kept from the previous call and re-sorted by insertion sort (nearly sorted: about
 //!   `O(n)`). A self-interacting layer is swept against itself; two interacting layers never
 //!   look at pairs within one layer. Static bodies go into a packed tree per layer
-//!   (`static_tree.rs`), which each dynamic body queries in `O(log n + k)`.
+//!   (`static_tree.rs`), which each dynamic body queries in `O(log n + k)`. A layer of at
+//!   least 1,024 moving bodies that does not meet itself, met only by layers with a
+//!   sixteenth of its bodies or fewer (asteroids met by bullets), is not kept sorted: the
+//!   small layers mark a 256 × 256 bitmap of cells, and a big body is tested only when the
+//!   cell of its lower-left corner is marked (`cell_filter.rs`).
 //! - `Grid` (`hash_grid.rs`): a uniform grid per layer, dense over the occupied cells or
 //!   hashed; two interacting layers: the grid of the larger is queried with the bodies of the
 //!   smaller. Static bodies have their own grid per layer, with its own cell size. What every
@@ -121,6 +125,7 @@ pub const STRIPS_ENTER: f64 = 4.0;
 mod auto;
 mod brute_force;
 mod by_layers;
+mod cell_filter;
 mod dynamic_tree;
 mod fixed_grid;
 mod grid;
@@ -140,6 +145,7 @@ mod tile_map;
 use ricochet_geom::Bounds;
 
 use crate::def::BodyKind;
+use cell_filter::CellFilter;
 
 pub(crate) use fixed_grid::FixedGrid;
 use hash_grid::HashGrid;
@@ -229,6 +235,8 @@ pub struct BroadPhase {
     inv_h: f64,
     static_extent: (f64, f64),
     scratch: Scratch,
+    /// Sort and sweep's filter of a big layer met only by far smaller ones (`cell_filter.rs`).
+    filter: CellFilter,
 }
 
 /// Buffers reused across calls.
@@ -284,6 +292,7 @@ impl BroadPhase {
             inv_h: 0.0,
             static_extent: (0.0, 0.0),
             scratch: Scratch::default(),
+            filter: CellFilter::default(),
         }
     }
 

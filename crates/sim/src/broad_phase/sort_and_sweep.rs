@@ -79,6 +79,17 @@ impl SweepView<'_> {
         let h = self.handles[local as usize];
         member(&self.bodies[h as usize], h)
     }
+
+    /// Hands `f` every body of the layer that can overlap `q` along x (a binary search of
+    /// the sorted list, as [`sweep_cross`] does).
+    #[inline]
+    pub(super) fn each_along_x(&self, q: &BodyEntry, mut f: impl FnMut(&Member)) {
+        let order = &self.list.order;
+        let (lo, hi) = x_range(order, self.list.width, q);
+        for s in &order[lo..hi] {
+            f(&self.member(s.local));
+        }
+    }
 }
 
 impl SweepList {
