@@ -17,6 +17,8 @@
 
 use ricochet_geom::{Bounds, Vec2};
 
+use super::slab::Slab;
+
 /// Cells per member at most.
 const CELLS_PER_MEMBER: f64 = 2.0;
 
@@ -45,6 +47,22 @@ impl Entry {
     }
 }
 
+impl Entry {
+    /// `f(handle, max)` if the segment crosses the entry's box within `max` (as the tree's
+    /// walk tests it), else `max`.
+    #[inline(always)]
+    fn cross(&self, slab: &Slab, max: f64, f: &mut impl FnMut(usize, f64) -> f64) -> f64 {
+        let b = Bounds {
+            min: self.min,
+            max: self.max,
+        };
+        match slab.enter(&b, max) {
+            Some(t) if t <= max => f(self.handle as usize, max),
+            _ => max,
+        }
+    }
+}
+
 /// A uniform grid over a set's member boxes, cells in rows (see the module docs).
 #[derive(Debug)]
 pub(crate) struct Grid {
@@ -52,6 +70,10 @@ pub(crate) struct Grid {
     origin: Vec2,
     /// Cells per length unit (one over the cell's side).
     inv: f64,
+    /// The cell's side.
+    side: f64,
+    /// The box around every member listed or kept apart.
+    hull: Bounds,
     /// Cells along x and y.
     nx: u32,
     ny: u32,
@@ -110,6 +132,8 @@ impl Grid {
         let mut grid = Grid {
             origin: hull.min,
             inv,
+            side,
+            hull,
             nx: nx as u32,
             ny: ny as u32,
             start: vec![0; cells as usize + 1],
@@ -216,6 +240,93 @@ impl Grid {
     }
 }
 
+impl Grid {
+    /// Calls `f` on every member whose box the segment `origin + t * dir`, `t` in
+    /// `[0, max]`, may cross ([`Slab::enter`], as the tree's walk tests it), possibly more
+    /// than once; `f` returns the new `max`. Rows of cells are visited in the order the
+    /// segment crosses them, and the walk stops at the first row it enters beyond `max`.
+    /// `false` (nothing called) when the segment is not finite or lies so far from the
+    /// grid that its rounding nears [`Grid::ray`]'s margin: the tree answers then.
+    ///
+    /// The cells visited are those within a margin of the segment (a millionth of a cell,
+    /// ten times the slab test's rounding pad, a `1e-12` of the coordinates, at the farthest
+    /// the grid is walked: `1e5` cells from the origin), so every
+    /// member whose padded box the segment enters is in a cell visited.
+    pub(crate) fn ray(
+        &self,
+        origin: Vec2,
+        dir: Vec2,
+        max: f64,
+        f: &mut impl FnMut(usize, f64) -> f64,
+    ) -> bool {
+        let far = origin
+            .abs()
+            .max(self.hull.min.abs())
+            .max(self.hull.max.abs());
+        let end = origin + dir * max;
+        let usable = origin.is_finite()
+            && end.is_finite()
+            && max.is_finite()
+            && far.x.max(far.y) < self.side * 1e5;
+        if !usable {
+            return false;
+        }
+        let slab = Slab::new(origin, dir, &self.hull);
+        let mut max = max;
+        for e in &self.big {
+            max = e.cross(&slab, max, f);
+        }
+        let m = self.side * 1e-6;
+        // The rows the segment's box covers, widened by the margin, in the order it
+        // crosses them.
+        let (lo, hi) = (origin.min(end), origin.max(end));
+        let r0 = self.column(lo.y - m, self.origin.y, self.ny);
+        let r1 = self.column(hi.y + m, self.origin.y, self.ny);
+        let up = dir.y >= 0.0;
+        let inv_y = 1.0 / dir.y;
+        // Handles tested last (a member listed in the cells a segment crosses next to
+        // each other is tested once, not once a cell; a repeat is harmless, only slower).
+        let mut recent = [u32::MAX; 4];
+        let mut slot = 0;
+        for n in 0..=(r1 - r0) {
+            let r = if up { r0 + n } else { r1 - n };
+            // Where the segment is within the row (widened): its `t` range, then its x.
+            let y_lo = self.origin.y + f64::from(r) * self.side - m;
+            let y_hi = self.origin.y + f64::from(r + 1) * self.side + m;
+            let (t0, t1) = if inv_y.is_finite() {
+                let (a, b) = ((y_lo - origin.y) * inv_y, (y_hi - origin.y) * inv_y);
+                (a.min(b).max(0.0), a.max(b).min(max))
+            } else {
+                (0.0, max)
+            };
+            if t0 > max {
+                // This row, and every row after it, lies beyond the nearest hit.
+                break;
+            }
+            if t0 > t1 {
+                continue;
+            }
+            let (xa, xb) = (origin.x + dir.x * t0, origin.x + dir.x * t1);
+            let c0 = self.column(xa.min(xb) - m, self.origin.x, self.nx);
+            let c1 = self.column(xa.max(xb) + m, self.origin.x, self.nx);
+            let row = r as usize * self.nx as usize;
+            for k in 0..=(c1 - c0) {
+                let c = row + if dir.x >= 0.0 { c0 + k } else { c1 - k } as usize;
+                let (from, to) = (self.start[c] as usize, self.start[c + 1] as usize);
+                for e in &self.entries[from..to] {
+                    if recent.contains(&e.handle) {
+                        continue;
+                    }
+                    max = e.cross(&slab, max, f);
+                    recent[slot & 3] = e.handle;
+                    slot += 1;
+                }
+            }
+        }
+        true
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -276,6 +387,76 @@ mod tests {
             };
             let q = Bounds::around(c, h);
             assert_eq!(grid_answer(&grid, &q), brute(&boxes, &q), "query {q:?}");
+        }
+    }
+
+    #[test]
+    fn a_grid_ray_meets_every_box_the_slab_test_meets_and_finds_the_same_first() {
+        let mut s = 0x2545_f491_4f6c_dd1d;
+        let mut boxes: Vec<Bounds> = (0..400)
+            .map(|k| {
+                let c = Vec2::new((k % 20) as f64, (k / 20) as f64);
+                Bounds::around(c, Vec2::splat(0.5))
+            })
+            .collect();
+        for k in 0..300 {
+            let c = Vec2::new(uniform(&mut s) * 40.0 - 10.0, uniform(&mut s) * 40.0 - 10.0);
+            let big = if k % 60 == 0 { 8.0 } else { 1.0 };
+            let h = Vec2::new(uniform(&mut s) * big, uniform(&mut s) * big);
+            boxes.push(Bounds::around(c, h));
+        }
+        let grid = Grid::new(&boxes).expect("a grid");
+        let hull = boxes.iter().copied().reduce(Bounds::union).expect("boxes");
+        for k in 0..3000 {
+            let o = if k % 4 == 0 {
+                // On tile edges and corners, along the axes and the diagonals.
+                Vec2::new(
+                    (uniform(&mut s) * 44.0).floor() - 12.5,
+                    (uniform(&mut s) * 44.0).floor() - 12.0,
+                )
+            } else {
+                Vec2::new(uniform(&mut s) * 60.0 - 20.0, uniform(&mut s) * 60.0 - 20.0)
+            };
+            let a = if k % 4 == 0 {
+                std::f64::consts::FRAC_PI_4 * (k / 4 % 8) as f64
+            } else {
+                uniform(&mut s) * std::f64::consts::TAU
+            };
+            let dir = Vec2::new(libm::cos(a), libm::sin(a));
+            let max = if k % 8 == 1 {
+                60.0
+            } else {
+                uniform(&mut s) * 20.0
+            };
+            let slab = Slab::new(o, dir, &hull);
+            let want: Vec<usize> = (0..boxes.len())
+                .filter(|&j| slab.enter(&boxes[j], max).is_some())
+                .collect();
+            // Every candidate, `max` kept.
+            let mut got = Vec::new();
+            assert!(grid.ray(o, dir, max, &mut |j, m| {
+                got.push(j);
+                m
+            }));
+            got.sort_unstable();
+            got.dedup();
+            assert_eq!(got, want, "ray from {o:?} along {dir:?} for {max}");
+            // A first-hit search (a member hit where the segment enters its box): the
+            // same first as over every box.
+            let first = want
+                .iter()
+                .filter_map(|&j| slab.enter(&boxes[j], max).map(|t| (t, j)))
+                .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            let mut best: Option<(f64, usize)> = None;
+            grid.ray(o, dir, max, &mut |j, m| {
+                if let Some(t) = slab.enter(&boxes[j], m)
+                    && best.is_none_or(|b| (t, j) < b)
+                {
+                    best = Some((t, j));
+                }
+                best.map_or(m, |b| b.0)
+            });
+            assert_eq!(best, first, "ray from {o:?} along {dir:?} for {max}");
         }
     }
 

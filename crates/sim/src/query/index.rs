@@ -162,15 +162,39 @@ impl Trees {
         }
     }
 
+    /// [`QueryTree::ray`] by the grid where it can walk the segment (`grid.rs`), else by
+    /// the tree: `f` may see a member more than once, and in another order, with the same
+    /// first hit and the same hits (its test is exact and `max` only shrinks).
+    #[inline]
+    pub(crate) fn ray(
+        &self,
+        origin: Vec2,
+        dir: Vec2,
+        max: f64,
+        f: &mut impl FnMut(usize, f64) -> f64,
+    ) {
+        if let Some(g) = self.grid()
+            && g.ray(origin, dir, max, f)
+        {
+            return;
+        }
+        self.tree.ray(origin, dir, max, f);
+    }
+
+    /// The grid over the members, built if needed (`None` when they do not suit one).
+    #[inline]
+    fn grid(&self) -> Option<&Grid> {
+        self.grid
+            .get_or_init(|| Grid::new(&self.tree.member_boxes(self.entities.len())))
+            .as_ref()
+    }
+
     /// Calls `f` with every member whose box overlaps `q` (touching counts), once each, in
     /// no order: by the grid for a finite `q` (built here if needed), else by the tree.
     #[inline]
     pub(crate) fn each_overlapping(&self, q: &Bounds, f: &mut impl FnMut(usize)) {
         let finite = q.min.is_finite() && q.max.is_finite();
-        let grid = self
-            .grid
-            .get_or_init(|| Grid::new(&self.tree.member_boxes(self.entities.len())));
-        match grid {
+        match self.grid() {
             Some(g) if finite => g.query(q, f),
             _ => self.tree.query(q, f),
         }

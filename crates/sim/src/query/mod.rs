@@ -522,7 +522,7 @@ impl<B: Bodies> Scene<'_, B> {
                     if room < 0.0 {
                         continue;
                     }
-                    set.tree.ray(seg.origin(), dir, room, &mut |k, max| {
+                    set.ray(seg.origin(), dir, room, &mut |k, max| {
                         if !filter.accepts_layer(set.layers[k]) {
                             return max;
                         }
