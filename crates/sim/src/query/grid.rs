@@ -428,7 +428,13 @@ mod tests {
             } else {
                 uniform(&mut s) * std::f64::consts::TAU
             };
-            let dir = Vec2::new(libm::cos(a), libm::sin(a));
+            // Exactly along each axis too (`cos` of a right angle is not zero).
+            let axes = [Vec2::X, Vec2::Y, -Vec2::X, -Vec2::Y];
+            let dir = if k % 16 == 4 {
+                axes[k / 16 % 4]
+            } else {
+                Vec2::new(libm::cos(a), libm::sin(a))
+            };
             let max = if k % 8 == 1 {
                 60.0
             } else {
