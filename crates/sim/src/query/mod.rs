@@ -29,9 +29,9 @@
 //! generation stays) and one over the moving bodies (built on the first query after the
 //! world changed), walked along the ray or by the query's bounds (`index.rs`, `tree.rs`),
 //! each member's pose and rotation kept with it. The overlap queries (point, box, shape)
-//! look a finite box up in a uniform grid over each set instead (`grid.rs`, built beside
-//! the tree by the first such query): a few cells, not the tree's levels. A candidate of a
-//! layer the filter refuses is dropped before its exact test.
+//! and the rays ask a uniform grid over each set instead where it can answer (`grid.rs`,
+//! built beside the tree by the set's first query): a few cells, not the tree's levels.
+//! A candidate of a layer the filter refuses is dropped before its exact test.
 //!
 //! # Now and then
 //! Every query is written once, over a [`Bodies`] view: the world now, or a frame kept for
