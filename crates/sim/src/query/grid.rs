@@ -113,11 +113,13 @@ impl Grid {
             .iter()
             .map(|(_, b)| (b.max.x - b.min.x).max(b.max.y - b.min.y))
             .collect();
-        sizes.sort_unstable_by(f64::total_cmp);
+        // The median's value, whatever the selection's order (linear, not a sort).
+        let mid = sizes.len() / 2;
+        sizes.select_nth_unstable_by(mid, f64::total_cmp);
         let (w, h) = (hull.max.x - hull.min.x, hull.max.y - hull.min.y);
         // At least twice the median member, and big enough for the cell count's bound.
         let most = CELLS_PER_MEMBER * members.len() as f64;
-        let side = (MEDIANS * sizes[sizes.len() / 2])
+        let side = (MEDIANS * sizes[mid])
             .max((w * h / most).sqrt())
             .max(w.max(h) / most)
             .max(f64::MIN_POSITIVE);

@@ -65,7 +65,7 @@ pub(crate) struct Trees {
     /// skips this set without walking its tree. In a wrap world most of the nine images of
     /// a query lie outside the world, so this is what keeps a query near one tree walk.
     pub(crate) bounds: Option<Bounds>,
-    /// The grid over the members' boxes (`grid.rs`), built by the first overlap query;
+    /// The grid over the members' boxes (`grid.rs`), built by the set's first query;
     /// `None` inside when the members' boxes do not suit one (the tree answers then).
     grid: OnceLock<Option<Grid>>,
 }
