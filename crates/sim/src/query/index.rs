@@ -25,6 +25,7 @@ use ricochet_geom::{
     Bounds, PlacedPrimitive, Pose, Ray, RayIntersection, Rot, Shape, Vec2, place_rotated,
 };
 
+use super::grid::Grid;
 use super::tree::QueryTree;
 use crate::def::{BodyKind, LayerId};
 use crate::entity::Entity;
@@ -64,6 +65,9 @@ pub(crate) struct Trees {
     /// skips this set without walking its tree. In a wrap world most of the nine images of
     /// a query lie outside the world, so this is what keeps a query near one tree walk.
     pub(crate) bounds: Option<Bounds>,
+    /// The grid over the members' boxes (`grid.rs`), built by the set's first query;
+    /// `None` inside when the members' boxes do not suit one (the tree answers then).
+    grid: OnceLock<Option<Grid>>,
 }
 
 /// A member's pose as the tree was built, with what placing it needs.
@@ -154,6 +158,45 @@ impl Trees {
             ready: order.iter().map(|&k| ready[k as usize]).collect(),
             dense: order.iter().map(|&k| dense[k as usize]).collect(),
             bounds: all,
+            grid: OnceLock::new(),
+        }
+    }
+
+    /// [`QueryTree::ray`] by the grid where it can walk the segment (`grid.rs`), else by
+    /// the tree: `f` may see a member more than once, and in another order, with the same
+    /// first hit and the same hits (its test is exact and `max` only shrinks).
+    #[inline]
+    pub(crate) fn ray(
+        &self,
+        origin: Vec2,
+        dir: Vec2,
+        max: f64,
+        f: &mut impl FnMut(usize, f64) -> f64,
+    ) {
+        if let Some(g) = self.grid()
+            && g.ray(origin, dir, max, f)
+        {
+            return;
+        }
+        self.tree.ray(origin, dir, max, f);
+    }
+
+    /// The grid over the members, built if needed (`None` when they do not suit one).
+    #[inline]
+    fn grid(&self) -> Option<&Grid> {
+        self.grid
+            .get_or_init(|| Grid::new(&self.tree.member_boxes(self.entities.len())))
+            .as_ref()
+    }
+
+    /// Calls `f` with every member whose box overlaps `q` (touching counts), once each, in
+    /// no order: by the grid for a finite `q` (built here if needed), else by the tree.
+    #[inline]
+    pub(crate) fn each_overlapping(&self, q: &Bounds, f: &mut impl FnMut(usize)) {
+        let finite = q.min.is_finite() && q.max.is_finite();
+        match self.grid() {
+            Some(g) if finite => g.query(q, f),
+            _ => self.tree.query(q, f),
         }
     }
 
@@ -340,6 +383,30 @@ pub(crate) fn hull(trees: &[&Trees; 2]) -> Option<Bounds> {
     match (trees[0].bounds, trees[1].bounds) {
         (Some(a), Some(b)) => Some(a.union(b)),
         (a, b) => a.or(b),
+    }
+}
+
+/// [`each_in_box`] for the overlap queries, by each set's grid ([`Trees::each_overlapping`]):
+/// the same bodies, once each, in another order.
+#[inline]
+pub(crate) fn each_overlapping(
+    entity: &[Entity],
+    trees: &[&Trees; 2],
+    accepts_layer: impl Fn(LayerId) -> bool,
+    q: &Bounds,
+    f: &mut impl FnMut(&Trees, usize, usize),
+) {
+    for &set in trees {
+        if !set.may_meet(q) {
+            continue;
+        }
+        set.each_overlapping(q, &mut |k| {
+            if accepts_layer(set.layers[k])
+                && let Some(i) = set.index(entity, k)
+            {
+                f(set, k, i);
+            }
+        });
     }
 }
 

@@ -28,8 +28,10 @@
 //! Never a loop over every body: a tree over the static bodies (kept while the static
 //! generation stays) and one over the moving bodies (built on the first query after the
 //! world changed), walked along the ray or by the query's bounds (`index.rs`, `tree.rs`),
-//! each member's pose and rotation kept with it. A candidate of a layer the filter
-//! refuses is dropped before its exact test.
+//! each member's pose and rotation kept with it. The overlap queries (point, box, shape)
+//! and the rays ask a uniform grid over each set instead where it can answer (`grid.rs`,
+//! built beside the tree by the set's first query): a few cells, not the tree's levels.
+//! A candidate of a layer the filter refuses is dropped before its exact test.
 //!
 //! # Now and then
 //! Every query is written once, over a [`Bodies`] view: the world now, or a frame kept for
@@ -37,6 +39,7 @@
 //! built by its first query. So a past frame answers exactly as the world restored there.
 
 mod filter;
+mod grid;
 mod hits;
 pub(crate) mod index;
 mod slab;
@@ -446,7 +449,7 @@ impl<B: Bodies> Scene<'_, B> {
             // The query moved by `shift - o`: the body's image at `o` against the query.
             let d = shift - o;
             let qo = q.translated(d);
-            index::each_in_box(
+            index::each_overlapping(
                 entity,
                 &trees,
                 |l| filter.accepts_layer(l),
@@ -519,7 +522,7 @@ impl<B: Bodies> Scene<'_, B> {
                     if room < 0.0 {
                         continue;
                     }
-                    set.tree.ray(seg.origin(), dir, room, &mut |k, max| {
+                    set.ray(seg.origin(), dir, room, &mut |k, max| {
                         if !filter.accepts_layer(set.layers[k]) {
                             return max;
                         }

@@ -203,6 +203,14 @@ impl QueryTree {
         )
     }
 
+    /// The boxes of the tree's first `n` members, by handle, as stored (a box with a NaN
+    /// coordinate stored empty).
+    pub(crate) fn member_boxes(&self, n: usize) -> Vec<Bounds> {
+        (0..n)
+            .map(|k| self.quads[k / LEAF].lane(k % LEAF))
+            .collect()
+    }
+
     /// Node `i` of level `level`.
     #[inline(always)]
     fn node(&self, level: usize, i: usize) -> &Quad {
