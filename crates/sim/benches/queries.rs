@@ -5,7 +5,8 @@
 //! bench draws them. Prints each scene's queries per second (the median pass) and a sum of
 //! the answers, so nothing is optimised away. `QUERY_PASSES=0` measures the set-up alone,
 //! to subtract from an instruction count; `QUERY_SCENE=rain` runs only the scenes whose
-//! name holds `rain`.
+//! name holds `rain`. Then, per scene, the first box query after each of 21 steps against
+//! the one after it: the first builds the moving bodies' tree and grid, once a frame.
 //!
 //! Run: `cargo bench -p ricochet-sim --bench queries` (or the built binary under `perf`).
 
@@ -122,5 +123,29 @@ fn main() {
             rate(ray_times),
             rate(box_times)
         );
+        // What a game pays once a frame: the first query after a step builds the moving
+        // bodies' tree and grid (after the passes, so the sums above stay as they were).
+        let (mut first, mut next) = (Vec::new(), Vec::new());
+        for _ in 0..FIRST_QUERY_FRAMES {
+            sim.step();
+            let t = Instant::now();
+            sum += sim.overlap_aabb(boxes[0], &all).len() as f64;
+            first.push(t.elapsed().as_secs_f64());
+            let t = Instant::now();
+            sum += sim.overlap_aabb(boxes[1], &all).len() as f64;
+            next.push(t.elapsed().as_secs_f64());
+        }
+        let median = |mut t: Vec<f64>| {
+            t.sort_by(f64::total_cmp);
+            t.get(t.len() / 2).copied().unwrap_or(0.0) * 1e6
+        };
+        println!(
+            "{name}: a frame's first box query {:.1} µs, the next {:.1} µs (medians of {FIRST_QUERY_FRAMES} frames; {sum})",
+            median(first),
+            median(next)
+        );
     }
 }
+
+/// Frames stepped to time the first query after a step.
+const FIRST_QUERY_FRAMES: usize = 21;
