@@ -3,6 +3,8 @@
 //! scenes and across frames with bodies moving, spawning and despawning; static bodies are
 //! indexed once.
 
+mod common;
+
 use proptest::prelude::*;
 use ricochet_geom::{Bounds, Vec2};
 use ricochet_scenes::Rng;
@@ -22,20 +24,6 @@ const KINDS: [BroadPhaseKind; 7] = [
 ];
 
 const LAYERS: usize = 4;
-
-/// The definition, written as plainly as possible.
-fn reference(bodies: &[BodyEntry], interactions: &Interactions) -> Vec<(u32, u32)> {
-    let mut pairs = Vec::new();
-    for (i, a) in bodies.iter().enumerate() {
-        for (j, b) in bodies.iter().enumerate().skip(i + 1) {
-            let dynamic = a.kind == BodyKind::Dynamic || b.kind == BodyKind::Dynamic;
-            if dynamic && interactions.interacts(a.layer, b.layer) && a.bounds.overlaps(&b.bounds) {
-                pairs.push((i as u32, j as u32));
-            }
-        }
-    }
-    pairs
-}
 
 fn split(bodies: &[BodyEntry]) -> (Vec<BodyEntry>, Vec<BodyEntry>) {
     bodies.iter().partition(|b| b.kind == BodyKind::Static)
@@ -159,7 +147,7 @@ impl Checker {
         bodies: &[BodyEntry],
         interactions: &Interactions,
     ) -> Result<Vec<BroadPhaseStats>, TestCaseError> {
-        let expected = reference(bodies, interactions);
+        let expected = common::all_pairs(bodies, interactions);
         let (statics, movers) = split(bodies);
         if statics != self.statics {
             self.generation += 1;
@@ -381,14 +369,14 @@ fn static_bodies_are_indexed_once_while_they_do_not_change() {
             let mut bodies = statics.clone();
             bodies.extend_from_slice(&movers);
             let s = whole.pairs(&bodies, &interactions, &mut out);
-            assert_eq!(out, reference(&bodies, &interactions), "{kind:?}");
+            assert_eq!(out, common::all_pairs(&bodies, &interactions), "{kind:?}");
             assert_eq!(s.static_rebuilds, 1, "{kind:?} frame {frame}");
             assert_eq!((s.statics, s.movers), (400, 30));
             // Past the first call, the static bodies are not even read while the generation
             // stays the same.
             let given: &[BodyEntry] = if frame == 0 { &statics } else { &[] };
             let s = apart.pairs_split(given, 0, &movers, &interactions, &mut out);
-            assert_eq!(out, reference(&bodies, &interactions), "{kind:?}");
+            assert_eq!(out, common::all_pairs(&bodies, &interactions), "{kind:?}");
             assert_eq!(s.static_rebuilds, 1, "{kind:?} frame {frame}");
         }
         // A tile goes: rebuilt once, then left alone again.
@@ -398,10 +386,10 @@ fn static_bodies_are_indexed_once_while_they_do_not_change() {
             let mut bodies = statics.to_vec();
             bodies.extend_from_slice(&movers);
             let s = whole.pairs(&bodies, &interactions, &mut out);
-            assert_eq!(out, reference(&bodies, &interactions), "{kind:?}");
+            assert_eq!(out, common::all_pairs(&bodies, &interactions), "{kind:?}");
             assert_eq!(s.static_rebuilds, 2, "{kind:?}");
             let s = apart.pairs_split(statics, 1, &movers, &interactions, &mut out);
-            assert_eq!(out, reference(&bodies, &interactions), "{kind:?}");
+            assert_eq!(out, common::all_pairs(&bodies, &interactions), "{kind:?}");
             assert_eq!(s.static_rebuilds, 2, "{kind:?}");
         }
     }
@@ -430,7 +418,7 @@ fn a_layer_that_ignores_itself_is_never_tested_against_itself() {
         body(3000 + u64::from(i), (f, 10.0), 0.05, 1, BodyKind::Dynamic)
     }));
     bodies.push(body(4000, (10.0, 10.0), 1.0, 2, BodyKind::Dynamic));
-    let expected = reference(&bodies, &interactions);
+    let expected = common::all_pairs(&bodies, &interactions);
     let mut out = Vec::new();
     // Brute force counts the skipped layer combinations too (its tests are all pairs).
     let s = BroadPhase::new(BroadPhaseKind::BruteForce).pairs(&bodies, &interactions, &mut out);

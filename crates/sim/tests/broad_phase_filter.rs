@@ -5,6 +5,8 @@
 //! corner cell of each big body), tiny boxes near 1e6 (rounding), and the odd NaN or
 //! infinite box, across frames of motion in which bodies grow past the sizes of the last.
 
+mod common;
+
 use proptest::prelude::*;
 use ricochet_geom::{Bounds, Vec2};
 use ricochet_scenes::Rng;
@@ -13,20 +15,6 @@ use ricochet_sim::broad_phase::{BodyEntry, BroadPhase, BroadPhaseKind, Interacti
 
 /// The big layer; layers 0 and 2 are the small ones.
 const BIG: u8 = 1;
-
-/// The definition, written as plainly as possible.
-fn reference(bodies: &[BodyEntry], interactions: &Interactions) -> Vec<(u32, u32)> {
-    let mut pairs = Vec::new();
-    for (i, a) in bodies.iter().enumerate() {
-        for (j, b) in bodies.iter().enumerate().skip(i + 1) {
-            let dynamic = a.kind == BodyKind::Dynamic || b.kind == BodyKind::Dynamic;
-            if dynamic && interactions.interacts(a.layer, b.layer) && a.bounds.overlaps(&b.bounds) {
-                pairs.push((i as u32, j as u32));
-            }
-        }
-    }
-    pairs
-}
 
 /// A box of family `family` at lattice point `(cx, cy)` with half extents from `hx`, `hy`;
 /// `spread` scales the lattice (1: crowded, touching common; 16: as sparse as asteroids).
@@ -149,7 +137,7 @@ proptest! {
         let mut rng = Rng::new(seed ^ 0x5eed);
         let mut out = Vec::new();
         for frame in 0..frames {
-            let expected = reference(&bodies, &interactions);
+            let expected = common::all_pairs(&bodies, &interactions);
             for (k, kind) in kinds.iter().enumerate() {
                 whole[k].pairs(&bodies, &interactions, &mut out);
                 prop_assert_eq!(&out, &expected, "{:?} (pairs), frame {}", kind, frame);
@@ -197,7 +185,7 @@ fn a_long_big_body_touching_a_small_one_at_its_far_end_pairs() {
     bodies.push(body(2001, (500.0, 3.5), (500.2, 3.7), 0));
     bodies.push(body(2002, (-2000.0, 900.0), (-1999.0, 901.0), 0));
     let interactions = Interactions::from_fn(3, |a, b| a != b && (a == BIG || b == BIG));
-    let expected = reference(&bodies, &interactions);
+    let expected = common::all_pairs(&bodies, &interactions);
     assert_eq!(expected, vec![(1100, 1101)]);
     let mut out = Vec::new();
     BroadPhase::new(BroadPhaseKind::SortAndSweep).pairs(&bodies, &interactions, &mut out);

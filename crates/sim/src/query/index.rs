@@ -386,50 +386,34 @@ pub(crate) fn hull(trees: &[&Trees; 2]) -> Option<Bounds> {
     }
 }
 
-/// [`each_in_box`] for the overlap queries, by each set's grid ([`Trees::each_overlapping`]):
-/// the same bodies, once each, in another order.
-#[inline]
-pub(crate) fn each_overlapping(
-    entity: &[Entity],
-    trees: &[&Trees; 2],
-    accepts_layer: impl Fn(LayerId) -> bool,
-    q: &Bounds,
-    f: &mut impl FnMut(&Trees, usize, usize),
-) {
-    for &set in trees {
-        if !set.may_meet(q) {
-            continue;
-        }
-        set.each_overlapping(q, &mut |k| {
-            if accepts_layer(set.layers[k])
-                && let Some(i) = set.index(entity, k)
-            {
-                f(set, k, i);
-            }
-        });
-    }
-}
-
 /// Calls `f` with the set, handle and dense index of every body of an accepted layer whose
-/// box overlaps `q` (touching counts), in no set order.
+/// box overlaps `q` (touching counts), in no set order: by each set's grid when `by_grid`
+/// ([`Trees::each_overlapping`]: the overlap queries), else by its tree (the same bodies,
+/// once each, in another order).
 #[inline]
 pub(crate) fn each_in_box(
     entity: &[Entity],
     trees: &[&Trees; 2],
     accepts_layer: impl Fn(LayerId) -> bool,
     q: &Bounds,
+    by_grid: bool,
     f: &mut impl FnMut(&Trees, usize, usize),
 ) {
     for &set in trees {
         if !set.may_meet(q) {
             continue;
         }
-        set.tree.query(q, &mut |k| {
+        let mut accepted = |k| {
             if accepts_layer(set.layers[k])
                 && let Some(i) = set.index(entity, k)
             {
                 f(set, k, i);
             }
-        });
+        };
+        if by_grid {
+            set.each_overlapping(q, &mut accepted);
+        } else {
+            set.tree.query(q, &mut accepted);
+        }
     }
 }

@@ -289,6 +289,7 @@ impl<B: Bodies> Scene<'_, B> {
                     &trees,
                     |l| filter.accepts_layer(l),
                     &q,
+                    false,
                     &mut |_, _, i| {
                         if !filter.accepts(layer[i], entity[i]) {
                             return;
@@ -449,11 +450,12 @@ impl<B: Bodies> Scene<'_, B> {
             // The query moved by `shift - o`: the body's image at `o` against the query.
             let d = shift - o;
             let qo = q.translated(d);
-            index::each_overlapping(
+            index::each_in_box(
                 entity,
                 &trees,
                 |l| filter.accepts_layer(l),
                 &qo,
+                true,
                 &mut |set, k, i| {
                     if filter.accepts(layer[i], entity[i]) && test(set, k, i, o - shift) {
                         found.push(entity[i]);

@@ -7,8 +7,9 @@
 //! the stages do (semi-implicit Euler: `x += v * dt`, frame 0 does not move).
 #![allow(dead_code, reason = "each test file uses its own part of the helpers")]
 
+use ricochet_sim::broad_phase::{BodyEntry, Interactions};
 use ricochet_sim::{
-    FrameOutput, GameEvent, Phase, Response, Simulation, StageSet, Stats, load_scenario,
+    BodyKind, FrameOutput, GameEvent, Phase, Response, Simulation, StageSet, Stats, load_scenario,
 };
 
 pub fn sim(text: &str) -> Simulation {
@@ -243,4 +244,20 @@ pub fn index(sim: &Simulation, name: &str) -> usize {
     sim.world()
         .find(name)
         .unwrap_or_else(|| panic!("no body named {name}"))
+}
+
+/// Every pair a broad phase owes, by its definition written as plainly as possible: each
+/// two bodies (by index, `a < b`) of which one is dynamic, of layers that interact, whose
+/// boxes overlap (the `broad_phase` and `broad_phase_filter` tests' reference).
+pub fn all_pairs(bodies: &[BodyEntry], interactions: &Interactions) -> Vec<(u32, u32)> {
+    let mut pairs = Vec::new();
+    for (i, a) in bodies.iter().enumerate() {
+        for (j, b) in bodies.iter().enumerate().skip(i + 1) {
+            let dynamic = a.kind == BodyKind::Dynamic || b.kind == BodyKind::Dynamic;
+            if dynamic && interactions.interacts(a.layer, b.layer) && a.bounds.overlaps(&b.bounds) {
+                pairs.push((i as u32, j as u32));
+            }
+        }
+    }
+    pairs
 }
