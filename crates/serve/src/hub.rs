@@ -183,11 +183,23 @@ impl Shared {
     }
 
     /// Whether some client subscribed to the whole-state `topic` wants a newer state by
-    /// `by` (the next frame's start; see [`ClientQueue::wants_latest`]): the plain server
-    /// draws `/scene` only then.
+    /// `by` (the next frame's start; see [`ClientQueue::wants_latest`]).
     pub fn state_wanted(&self, topic: &str, by: std::time::Instant) -> bool {
         let by = tokio::time::Instant::from_std(by);
         self.any_subscriber(topic, |k, channel| k.queue.wants_latest(channel, by))
+    }
+
+    /// Whether the frame about to be stepped, which ends `period` from now, must draw
+    /// `/scene`: some subscriber is due a newer state by then ([`Self::state_wanted`]); a
+    /// client paced by its bytes, or one that stopped reading, makes no drawing it would not
+    /// be sent. A `period` so long that no `Instant` holds its end: whether any client
+    /// watches `/scene` (whatever is due comes before it). `serve` and unrecorded rooms
+    /// draw by this.
+    pub fn scene_due(&self, period: std::time::Duration) -> bool {
+        match std::time::Instant::now().checked_add(period) {
+            Some(by) => self.state_wanted("/scene", by),
+            None => self.watched("/scene"),
+        }
     }
 
     /// How many clients are connected.

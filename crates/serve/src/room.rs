@@ -305,9 +305,6 @@ impl<G: Game> Room<G> {
                 ricochet_sim::MAX_FRAMES
             )));
         }
-        // The next frame's start; so far off that no `Instant` holds it, whatever is due
-        // comes before it.
-        let by = Instant::now().checked_add(self.dt);
         let wanted = {
             let mut s = self.hub.lock();
             s.broadcast(&Message::binary(protocol::time(t)));
@@ -315,8 +312,7 @@ impl<G: Game> Room<G> {
             // building every channel's for nobody was most of a room's frame
             // (BENCHMARKS.md, "Rooms"). A recorded room builds them all, as before. And it
             // draws `/scene` only in the frames some client is due one, as `serve` does
-            // (`serving/drawing.rs`): a client paced by its bytes, or one that stopped
-            // reading, makes no drawing it would not be sent.
+            // (`Hub::scene_due`).
             self.recording.is_none().then(|| {
                 let channels = Channels {
                     scene: LATEST.iter().any(|topic| s.watched(topic)),
@@ -325,10 +321,7 @@ impl<G: Game> Room<G> {
                     stats: s.watched("/stats"),
                     events: s.watched("/events"),
                 };
-                let draw = match by {
-                    Some(by) => s.state_wanted("/scene", by),
-                    None => s.watched("/scene"),
-                };
+                let draw = s.scene_due(self.dt);
                 (channels, draw)
             })
         };

@@ -3,7 +3,7 @@
 //! (1.5 MB) goes to a viewer about once a second; drawing and encoding it in every frame
 //! for that was most of the frame's time (BENCHMARKS.md, "Live at 10,000 bodies").
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use super::Serving;
 use crate::common::ServeError;
@@ -22,14 +22,7 @@ impl Serving {
         let muted = self.session.recorder().sink_mut().muted;
         let period = Duration::try_from_secs_f64(self.scenario.world.dt / self.speed)
             .unwrap_or(Duration::MAX);
-        // The next frame's start; so far off that no `Instant` holds it, whatever is due
-        // comes before it.
-        let by = Instant::now().checked_add(period);
-        let draw = !muted
-            && match by {
-                Some(by) => hub.lock().state_wanted("/scene", by),
-                None => hub.lock().watched("/scene"),
-            };
+        let draw = !muted && hub.lock().scene_due(period);
         self.session.recorder().draw_moving(draw);
     }
 
