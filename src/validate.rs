@@ -114,7 +114,7 @@ pub fn run(path: &Path, frames: Option<u64>) -> anyhow::Result<ExitCode> {
     let mut v = Validation::new(&scenario);
     for _ in 0..=frames {
         let out = sim.step();
-        if let Some(bad) = sim.first_non_finite() {
+        if let Some(bad) = sim.first_non_finite_after(&out) {
             // No comparison with a NaN or an infinity can pass: say so and fail.
             crate::out::error(&format!(
                 "error: frame {}: {}; the simulation overflowed, nothing after it can be \

@@ -269,7 +269,7 @@ fn judge(
             return Ok((Verdict::Interrupted, "interrupted".to_owned()));
         }
         let out = sim.step();
-        if let Some(bad) = sim.first_non_finite() {
+        if let Some(bad) = sim.first_non_finite_after(&out) {
             let _ = recorder.finish();
             return Err(format!(
                 "frame {}: {}; the simulation overflowed",

@@ -167,7 +167,7 @@ impl Stepper {
     pub fn step(&mut self, sampled: bool) -> Result<Frame, Overflow> {
         let out = self.sim.step();
         self.next += 1;
-        if let Some(bad) = self.sim.first_non_finite() {
+        if let Some(bad) = self.sim.first_non_finite_after(&out) {
             return Err(Overflow {
                 frame: out.frame,
                 what: crate::validate::describe(&self.sim, &bad),

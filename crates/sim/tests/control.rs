@@ -4,8 +4,8 @@
 use ricochet_geom::{Shape, Vec2};
 use ricochet_sim::broad_phase::BroadPhaseKind;
 use ricochet_sim::{
-    Action, BodyDef, BodyKind, ControlError, Event, GameEvent, Layers, Response, Scenario,
-    ScriptAction, ScriptInput, Simulation, WorldBounds, WorldDef,
+    Action, BodyDef, BodyKind, ControlError, Event, GameEvent, Layers, NonFinite, Response,
+    Scenario, ScriptAction, ScriptInput, Simulation, WorldBounds, WorldDef,
 };
 
 const KINDS: [BroadPhaseKind; 6] = [
@@ -279,6 +279,39 @@ fn an_overflowing_body_is_named() {
     assert_eq!(bad.field, "position");
     assert_eq!(bad.value, [5.0, f64::NEG_INFINITY]);
     assert!(sim.position(calm).unwrap().is_finite());
+}
+
+/// Two bodies whose `m v² / 2` are each finite but sum past `f64::MAX` overflow the
+/// kinetic energy: both checks name the second, by the step's reported sum
+/// (`first_non_finite_after`) or by summing again. An `out` of an earlier step is not
+/// trusted: after a frame that made the energy overflow, the stale `out` (whose reported sum
+/// was finite) still finds it.
+#[test]
+fn an_overflowing_kinetic_energy_is_named_by_the_steps_sum_or_a_new_one() {
+    let mut sim = Simulation::from_def(world(BroadPhaseKind::Auto, Response::Ignore)).unwrap();
+    let heavy = |x| BodyDef {
+        mass: 2.0,
+        ..circle(0, BodyKind::Dynamic, x)
+    };
+    let (a, b) = (sim.spawn(&heavy(0.0)), sim.spawn(&heavy(10.0)));
+    let calm = sim.step();
+    assert!(calm.stats.kinetic_energy.is_finite());
+    assert_eq!(sim.first_non_finite_after(&calm), None);
+    // v² = 0.9 MAX and m = 2: each body's m v² / 2 is 0.9 MAX, their sum 1.8 MAX.
+    let v = (f64::MAX * 0.9).sqrt();
+    for e in [a, b] {
+        sim.set_velocity(e, Vec2::new(v, 0.0)).unwrap();
+    }
+    let out = sim.step();
+    assert!(out.stats.kinetic_energy.is_infinite());
+    let want = NonFinite {
+        body: b,
+        field: "kinetic_energy",
+        value: [f64::INFINITY, 0.0],
+    };
+    assert_eq!(sim.first_non_finite(), Some(want));
+    assert_eq!(sim.first_non_finite_after(&out), Some(want));
+    assert_eq!(sim.first_non_finite_after(&calm), Some(want), "a stale out");
 }
 
 /// Finite values whose sum overflows are finite still: `first_non_finite`'s quick pass adds

@@ -208,7 +208,7 @@ impl<G: Game> GameLoop<G> {
     pub fn step(&mut self) -> Result<FrameOutput, Overflowed> {
         self.game.before_step(&mut self.sim);
         let out = self.sim.step();
-        if let Some(bad) = self.sim.first_non_finite() {
+        if let Some(bad) = self.sim.first_non_finite_after(&out) {
             return Err(Overflowed {
                 frame: out.frame,
                 bad,

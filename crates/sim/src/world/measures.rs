@@ -71,13 +71,14 @@ impl World {
 
     /// The first dynamic body (world index, in [`World::kinetic_energy`]'s order) at which
     /// that sum stops being finite, if it does: every velocity can be finite while `m v²`
-    /// overflows (a velocity past 1e154, or two bodies near `f64::MAX` each).
+    /// overflows (a velocity past 1e154, or two bodies near `f64::MAX` each). `total` is
+    /// [`World::kinetic_energy`] now (the step's reported sum, or summed again).
     #[must_use]
-    pub(crate) fn kinetic_energy_overflow(&self) -> Option<usize> {
+    pub(crate) fn kinetic_energy_overflow(&self, total: f64) -> Option<usize> {
         // Once a running sum is not finite, adding finite or infinite terms never makes it
         // finite again: a finite total means no prefix overflowed (the common answer, in
         // one pass without the per-body test).
-        if self.kinetic_energy().is_finite() {
+        if total.is_finite() {
             return None;
         }
         let mut sum = 0.0;
