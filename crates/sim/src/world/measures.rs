@@ -3,7 +3,7 @@
 
 use ricochet_geom::{Shape, Vec2};
 
-use super::{NO_ROW, World};
+use super::World;
 use crate::def::BodyKind;
 
 impl World {
@@ -38,29 +38,23 @@ impl World {
     }
 
     /// True when every moving body's position, angle, velocity and angular velocity are
-    /// finite, in one pass without an early exit or a branch a body; false when one is not,
-    /// or (rarely) when they all are but a body's sum of them overflows. The caller looks
-    /// value by value for the first that is not finite only when this says false.
+    /// finite; false when one is not, or (rarely) when they all are but a sum of them
+    /// overflows. The caller looks value by value for the first that is not finite only when
+    /// this says false.
+    ///
+    /// It sums whole columns (every body's, not only the movers'), four lanes at a time:
+    /// contiguous and branch-free, so the compiler vectorises it (through `movers` and `row`
+    /// it cost as much as integrating). A NaN or an infinity anywhere makes a lane's sum not
+    /// finite; a static body's or a row's values are finite (checked when set, never
+    /// integrated), so looking at them too changes no answer, only an overflow of finite
+    /// values can raise a false alarm, which the exact search then clears.
     #[must_use]
     pub(crate) fn moving_state_finite(&self) -> bool {
-        let n = self.entity.len();
-        let (position, angle, row) = (&self.position[..n], &self.angle[..n], &self.row[..n]);
-        let m = self.rows.velocity.len();
-        let (velocity, spin) = (&self.rows.velocity[..m], &self.rows.angular_velocity[..m]);
-        let mut finite = true;
-        for &i in &self.movers {
-            let i = i as usize;
-            let (p, a) = (position[i], angle[i]);
-            let (v, w) = match row[i] {
-                NO_ROW => (Vec2::ZERO, 0.0),
-                r => (velocity[r as usize], spin[r as usize]),
-            };
-            // A NaN or an infinity among the six makes their sum not finite; six finite
-            // values make it finite unless it overflows (a false alarm: the caller's exact
-            // test then decides).
-            finite &= ((p.x + p.y) + (v.x + v.y) + (a + w)).is_finite();
-        }
-        finite
+        let rows = &self.rows;
+        lanes_finite(&self.angle)
+            && lanes_finite(&rows.angular_velocity)
+            && pairs_finite(&self.position)
+            && pairs_finite(&rows.velocity)
     }
 
     /// Kinetic energy of the dynamic bodies, `sum(m v² / 2)` (translation only).
@@ -138,5 +132,85 @@ impl World {
             + cap(&self.non_boxes)
             + cap(&self.key)
             + self.ids.heap_bytes()
+    }
+}
+
+/// Whether the sum of `xs` in four lanes is finite: false when one is not finite (or, rarely,
+/// when finite values overflow a lane's sum).
+fn lanes_finite(xs: &[f64]) -> bool {
+    let mut acc = [0.0f64; 4];
+    let chunks = xs.chunks_exact(4);
+    let rest: f64 = chunks.remainder().iter().sum();
+    for c in chunks {
+        for (a, x) in acc.iter_mut().zip(c) {
+            *a += x;
+        }
+    }
+    ((acc[0] + acc[1]) + (acc[2] + acc[3]) + rest).is_finite()
+}
+
+/// [`lanes_finite`] over both coordinates of `xs`.
+fn pairs_finite(xs: &[Vec2]) -> bool {
+    let mut acc = [0.0f64; 4];
+    let chunks = xs.chunks_exact(2);
+    let rest = chunks.remainder().iter().fold(0.0, |s, v| s + (v.x + v.y));
+    for c in chunks {
+        acc[0] += c[0].x;
+        acc[1] += c[0].y;
+        acc[2] += c[1].x;
+        acc[3] += c[1].y;
+    }
+    ((acc[0] + acc[1]) + (acc[2] + acc[3]) + rest).is_finite()
+}
+
+#[cfg(test)]
+mod tests {
+    use ricochet_geom::{Shape, Vec2};
+
+    use super::World;
+    use crate::def::{BodyDef, BodyKind};
+
+    /// Worlds of four to eight moving bodies and a static one (every remainder of the lanes
+    /// is read). Each of the six values a moving body has, made a NaN or an infinity, in
+    /// each body in turn, is seen; a world of finite values is finite.
+    #[test]
+    fn a_non_finite_value_in_any_column_of_any_body_is_seen() {
+        for n in 5..=9 {
+            let mut w = World::new();
+            for k in 0..n {
+                w.spawn(&BodyDef {
+                    kind: if k == 3 {
+                        BodyKind::Static
+                    } else {
+                        BodyKind::Dynamic
+                    },
+                    shape: Shape::circle(1.0).unwrap(),
+                    position: Vec2::new(f64::from(k) * 3.0, 0.0),
+                    velocity: Vec2::new(1.0, -1.0),
+                    ..BodyDef::default()
+                });
+            }
+            assert!(w.moving_state_finite());
+            let movers: Vec<usize> = w.movers().iter().map(|&i| i as usize).collect();
+            assert_eq!(movers.len(), n as usize - 1);
+            for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+                for &i in &movers {
+                    let r = w.row[i] as usize;
+                    for field in 0..6 {
+                        let mut v = w.clone();
+                        match field {
+                            0 => v.position[i].x = bad,
+                            1 => v.position[i].y = bad,
+                            2 => v.angle[i] = bad,
+                            3 => v.rows.velocity[r].x = bad,
+                            4 => v.rows.velocity[r].y = bad,
+                            _ => v.rows.angular_velocity[r] = bad,
+                        }
+                        let what = format!("{n} bodies, body {i}, value {field}: {bad}");
+                        assert!(!v.moving_state_finite(), "{what}");
+                    }
+                }
+            }
+        }
     }
 }
