@@ -15,7 +15,6 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::sync::{Arc, Mutex, MutexGuard};
 
-use ricochet_log::{ChannelId, LogError, MessageSink, Schema};
 use tokio_tungstenite::tungstenite::Message;
 
 use crate::protocol::{self, Channel};
@@ -387,7 +386,19 @@ impl Shared {
     }
 
     /// Publishes a message on `channel` to its subscribers.
-    fn publish(&mut self, channel: u32, time_ns: u64, payload: Vec<u8>) {
+    /// The id of the channel on `topic`, added (as `make` builds it from its id) if there is
+    /// none: a new session (after a reset) adds the same topics, and they keep their ids,
+    /// and the clients their subscriptions.
+    pub(crate) fn channel(&mut self, topic: &str, make: impl FnOnce(u32) -> Channel) -> u32 {
+        if let Some(c) = self.channels.iter().find(|c| c.topic == topic) {
+            return c.id;
+        }
+        let id = self.channels.len() as u32 + 1;
+        self.channels.push(make(id));
+        id
+    }
+
+    pub(crate) fn publish(&mut self, channel: u32, time_ns: u64, payload: Vec<u8>) {
         let mut dropped = 0;
         let topic = self.channels.iter().find(|c| c.id == channel);
         let latched = topic.is_some_and(|c| LATCHED.contains(&c.topic.as_str()));
@@ -460,100 +471,6 @@ impl Shared {
         if latched {
             self.latched.insert(channel, (time_ns, payload));
         }
-    }
-}
-
-/// The recorder's [`MessageSink`] for a live stream: each message encoded once and
-/// published to the clients subscribed to its channel.
-pub struct LiveSink {
-    hub: Hub,
-}
-
-/// The topic a session (a room's, or the plain server's) advertises its recorded commands
-/// on: `/input` is what its clients publish (the game's input, JSON), so the server's
-/// record of them is told apart (the recording keeps `/input`, which replays read).
-pub const RECORDED_INPUT: &str = "/input/recorded";
-
-impl LiveSink {
-    /// A sink publishing through `hub`; the session's recorded `/input` is advertised as
-    /// [`RECORDED_INPUT`].
-    pub fn new(hub: Hub) -> LiveSink {
-        LiveSink { hub }
-    }
-
-    fn topic<'a>(&self, topic: &'a str) -> &'a str {
-        if topic == "/input" {
-            RECORDED_INPUT
-        } else {
-            topic
-        }
-    }
-}
-
-impl MessageSink for LiveSink {
-    fn add_protobuf_channel(&mut self, topic: &str, schema: Schema) -> Result<ChannelId, LogError> {
-        let topic = self.topic(topic);
-        let mut s = self.hub.lock();
-        // A new session (after a reset) adds the same topics: they keep their ids, and the
-        // clients their subscriptions.
-        if let Some(c) = s.channels.iter().find(|c| c.topic == topic) {
-            return Ok(ChannelId::from_index(c.id as u16));
-        }
-        let id = s.channels.len() as u32 + 1;
-        s.channels
-            .push(Channel::protobuf(id, topic, &schema.name, &schema.data));
-        Ok(ChannelId::from_index(id as u16))
-    }
-
-    fn write<M: prost::Message + Clone + Send + 'static>(
-        &mut self,
-        channel: ChannelId,
-        time_ns: u64,
-        message: M,
-    ) -> Result<(), LogError> {
-        let payload = message.encode_to_vec();
-        self.hub
-            .lock()
-            .publish(u32::from(channel.index()), time_ns, payload);
-        Ok(())
-    }
-
-    fn add_json_channel(
-        &mut self,
-        topic: &str,
-        schema_name: &str,
-        schema_json: &str,
-    ) -> Result<ChannelId, LogError> {
-        let topic = self.topic(topic);
-        let mut s = self.hub.lock();
-        if let Some(c) = s.channels.iter().find(|c| c.topic == topic) {
-            return Ok(ChannelId::from_index(c.id as u16));
-        }
-        let id = s.channels.len() as u32 + 1;
-        s.channels
-            .push(Channel::json(id, topic, schema_name, schema_json));
-        Ok(ChannelId::from_index(id as u16))
-    }
-
-    fn write_json_bytes(
-        &mut self,
-        channel: ChannelId,
-        time_ns: u64,
-        json: Vec<u8>,
-    ) -> Result<(), LogError> {
-        self.hub
-            .lock()
-            .publish(u32::from(channel.index()), time_ns, json);
-        Ok(())
-    }
-
-    fn write_live<M: prost::Message + Clone + Send + 'static>(
-        &mut self,
-        channel: ChannelId,
-        time_ns: u64,
-        message: M,
-    ) -> Result<(), LogError> {
-        self.write(channel, time_ns, message)
     }
 }
 

@@ -54,8 +54,9 @@ mod sink;
 
 pub use common::{DEFAULT_BIND, Listener, MAX_CLIENTS, Note, SPEEDS, ServeError};
 pub use door::MAX_ROOM_NAME;
-pub use hub::{CLIENT_BUDGET, RECORDED_INPUT, STATE_RATE};
+pub use hub::{CLIENT_BUDGET, STATE_RATE};
 pub use load_path::MAX_SCENARIO_BYTES;
 pub use realtime::{Options, Served, cpu_seconds, serve, serve_rooms};
 pub use rooms::{MAX_ROOM_INPUTS, MAX_THREADS, RoomMaker, RoomOptions, ServedRooms};
 pub use scenario_rooms::ScenarioRooms;
+pub use sink::RECORDED_INPUT;

@@ -381,8 +381,9 @@ mod tests {
     use ricochet_sim::prelude::*;
 
     use super::*;
-    use crate::hub::{LiveSink, client_queue};
+    use crate::hub::client_queue;
     use crate::queue::ClientQueueReceiver;
+    use crate::sink::LiveSink;
 
     /// A game whose state (on `/game`) counts the frames stepped.
     struct Frames(u64);

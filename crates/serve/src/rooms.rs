@@ -28,9 +28,10 @@ use ricochet_sim::Simulation;
 
 use crate::common::{Lateness, MAX_CLIENTS, Note, ServeError, metadata};
 use crate::door::{Door, Entered, check_room_name};
-use crate::hub::{ClientQueue, Hub, LiveSink};
+use crate::hub::{ClientQueue, Hub};
 use crate::protocol::{self, ServerMessage};
 use crate::room::{self, Closing, Room, RoomsRequest, Stats};
+use crate::sink::LiveSink;
 use crate::sink::ServeSink;
 
 /// What a server hosts: each new room's simulation and game.

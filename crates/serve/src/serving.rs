@@ -20,9 +20,10 @@ use ricochet_sim::{Scenario, Simulation};
 use tokio_tungstenite::tungstenite::Message;
 
 use crate::common::{Note, ServeError};
-use crate::hub::{Hub, LiveSink};
+use crate::hub::Hub;
 use crate::protocol;
 use crate::services;
+use crate::sink::LiveSink;
 use crate::sink::{ServeSink, finish, segment, start};
 use ricochet_record::session::{Session, StepError};
 

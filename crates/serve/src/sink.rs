@@ -1,5 +1,5 @@
-//! Where a served session's messages go: the live stream (the room's hub) and its
-//! recording, if any; and a session's start and finish on them.
+//! Where a served session's messages go: the live stream ([`LiveSink`], publishing into the
+//! room's hub) and its recording, if any; and a session's start and finish on them.
 
 use std::path::{Path, PathBuf};
 
@@ -8,7 +8,92 @@ use ricochet_record::session::{SCENARIO_ATTACHMENT, Session};
 use ricochet_sim::Scenario;
 
 use crate::common::ServeError;
-use crate::hub::{Hub, LiveSink};
+use crate::hub::Hub;
+use crate::protocol::Channel;
+
+/// The recorder's [`MessageSink`] for a live stream: each message encoded once and
+/// published to the clients subscribed to its channel.
+pub struct LiveSink {
+    hub: Hub,
+}
+
+/// The topic a session (a room's, or the plain server's) advertises its recorded commands
+/// on: `/input` is what its clients publish (the game's input, JSON), so the server's
+/// record of them is told apart (the recording keeps `/input`, which replays read).
+pub const RECORDED_INPUT: &str = "/input/recorded";
+
+impl LiveSink {
+    /// A sink publishing through `hub`; the session's recorded `/input` is advertised as
+    /// [`RECORDED_INPUT`].
+    pub fn new(hub: Hub) -> LiveSink {
+        LiveSink { hub }
+    }
+
+    fn topic<'a>(&self, topic: &'a str) -> &'a str {
+        if topic == "/input" {
+            RECORDED_INPUT
+        } else {
+            topic
+        }
+    }
+}
+
+impl MessageSink for LiveSink {
+    fn add_protobuf_channel(&mut self, topic: &str, schema: Schema) -> Result<ChannelId, LogError> {
+        let topic = self.topic(topic);
+        let id = self.hub.lock().channel(topic, |id| {
+            Channel::protobuf(id, topic, &schema.name, &schema.data)
+        });
+        Ok(ChannelId::from_index(id as u16))
+    }
+
+    fn write<M: prost::Message + Clone + Send + 'static>(
+        &mut self,
+        channel: ChannelId,
+        time_ns: u64,
+        message: M,
+    ) -> Result<(), LogError> {
+        let payload = message.encode_to_vec();
+        self.hub
+            .lock()
+            .publish(u32::from(channel.index()), time_ns, payload);
+        Ok(())
+    }
+
+    fn add_json_channel(
+        &mut self,
+        topic: &str,
+        schema_name: &str,
+        schema_json: &str,
+    ) -> Result<ChannelId, LogError> {
+        let topic = self.topic(topic);
+        let id = self.hub.lock().channel(topic, |id| {
+            Channel::json(id, topic, schema_name, schema_json)
+        });
+        Ok(ChannelId::from_index(id as u16))
+    }
+
+    fn write_json_bytes(
+        &mut self,
+        channel: ChannelId,
+        time_ns: u64,
+        json: Vec<u8>,
+    ) -> Result<(), LogError> {
+        self.hub
+            .lock()
+            .publish(u32::from(channel.index()), time_ns, json);
+        Ok(())
+    }
+
+    fn write_live<M: prost::Message + Clone + Send + 'static>(
+        &mut self,
+        channel: ChannelId,
+        time_ns: u64,
+        message: M,
+    ) -> Result<(), LogError> {
+        self.write(channel, time_ns, message)
+    }
+}
 
 /// Where a served session's messages go: the live stream, and the recording if any.
 pub(crate) struct ServeSink {
