@@ -42,12 +42,12 @@ impl World {
     /// overflows. The caller looks value by value for the first that is not finite only when
     /// this says false.
     ///
-    /// It sums whole columns (every body's, not only the movers'), four lanes at a time:
-    /// contiguous and branch-free, so the compiler vectorises it (through `movers` and `row`
-    /// it cost as much as integrating). A NaN or an infinity anywhere makes a lane's sum not
-    /// finite; a static body's or a row's values are finite (checked when set, never
-    /// integrated), so looking at them too changes no answer, only an overflow of finite
-    /// values can raise a false alarm, which the exact search then clears.
+    /// It sums whole columns, four lanes at a time: contiguous and branch-free, so the
+    /// compiler vectorises it (through `movers` and `row` it cost as much as integrating). A
+    /// NaN or an infinity anywhere makes a lane's sum not finite. The columns hold the static
+    /// bodies' values too, which are finite (checked when set, never integrated), so reading
+    /// them changes no answer; only an overflow of finite values can raise a false alarm,
+    /// which the exact search then clears.
     #[must_use]
     pub(crate) fn moving_state_finite(&self) -> bool {
         let rows = &self.rows;
