@@ -6,10 +6,18 @@
 //!   the same (statics never move without bumping it), so a scene of 10,000 tiles is
 //!   indexed once, not once a frame.
 //! - **Moving tree**: every moving body as it is now. Every `&mut self` method of
-//!   `Simulation` that can move, add, remove or reshape a body drops it
-//!   ([`QueryCache::invalidate`]); the next query rebuilds it, in `O(m log m)` for `m`
-//!   moving bodies (and one sine and cosine a body). A step costs nothing more when no
-//!   query is made: dropping an empty cell is a branch.
+//!   `Simulation` that can move, add, remove or reshape a body makes it stale
+//!   ([`QueryCache::invalidate`] keeps it aside); the next query refits it
+//!   ([`Trees::refit`]: each member's pose and box recomputed, a sine and cosine only for
+//!   a member that turned, the nodes' boxes recomputed bottom up, in `O(m)` for `m` moving
+//!   bodies, with no allocation), or rebuilds it in `O(m log m)` when the bodies changed
+//!   (another [`World::layout`]) or the refit tree walks worse than a fresh one would
+//!   ([`REFIT_COST`]). The tree's shape so depends on which frames asked a query; the
+//!   answers do not (they are exact and ordered by id). A step costs nothing more when no
+//!   query is made: moving an empty cell aside is a branch.
+//!
+//! Each set's grid (`grid.rs`) is built after the set's first [`GRID_AFTER`] queries (the
+//! tree answers those), and the moving set's is dropped by each refit.
 //!
 //! Each member keeps its pose and rotation as the tree was built, and its box is its
 //! shape's exact box there: a candidate is tested with no sine or cosine, with the same
@@ -528,5 +536,85 @@ pub(crate) fn each_in_box(
         } else {
             set.tree.query(q, &mut accepted);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::pipeline::Simulation;
+    use crate::{BodyDef, QueryFilter, Scenario};
+
+    /// 300 balls on a lattice, each with its own slow velocity, in an unbounded world.
+    fn scene() -> Simulation {
+        let bodies = (0..300)
+            .map(|k| BodyDef {
+                shape: Shape::circle(1.0).expect("radius"),
+                position: Vec2::new((k % 20) as f64 * 5.0, (k / 20) as f64 * 5.0),
+                // Apart by under a unit a second: they drift, the tree stays good.
+                velocity: Vec2::new(
+                    (k * 37 % 11) as f64 * 0.08 - 0.4,
+                    (k * 53 % 7) as f64 * 0.12 - 0.36,
+                ),
+                ..BodyDef::default()
+            })
+            .collect();
+        Simulation::new(&Scenario {
+            bodies,
+            ..Scenario::default()
+        })
+    }
+
+    fn movers(sim: &Simulation) -> &Trees {
+        sim.queries.movers.get().expect("built by a query")
+    }
+
+    fn ask(sim: &Simulation) -> usize {
+        let q = Bounds::around(Vec2::splat(50.0), Vec2::splat(5.0));
+        sim.overlap_aabb(q, &QueryFilter::all()).len()
+    }
+
+    /// Steps while the bodies stay the same are refits: the members keep the order of the
+    /// build (a fresh build orders them otherwise by then); a spawn rebuilds.
+    #[test]
+    fn the_moving_tree_is_refit_while_the_bodies_stay_and_rebuilt_when_they_change() {
+        let mut sim = scene();
+        sim.step();
+        ask(&sim);
+        let built = movers(&sim).entities.clone();
+        for _ in 0..20 {
+            sim.step();
+            ask(&sim);
+        }
+        assert!(movers(&sim).entities == built, "rebuilt");
+        let w = sim.world();
+        let fresh = Trees::build(w, 0, w.movers().iter().map(|&i| i as usize));
+        assert_ne!(
+            fresh.entities, built,
+            "a fresh build would be the same tree"
+        );
+        sim.spawn(&BodyDef {
+            shape: Shape::circle(1.0).expect("radius"),
+            ..BodyDef::default()
+        });
+        ask(&sim);
+        assert_eq!(movers(&sim).entities.len(), built.len() + 1);
+    }
+
+    /// A set's first [`GRID_AFTER`] queries are answered by its tree: a frame that asks a
+    /// few builds no grid.
+    #[test]
+    fn the_grid_is_built_only_after_many_queries_of_a_frame() {
+        let mut sim = scene();
+        sim.step();
+        for _ in 0..GRID_AFTER {
+            ask(&sim);
+        }
+        assert!(movers(&sim).grid.get().is_none());
+        ask(&sim);
+        assert!(movers(&sim).grid.get().is_some());
+        sim.step();
+        ask(&sim);
+        assert!(movers(&sim).grid.get().is_none(), "a new frame starts over");
     }
 }
