@@ -83,7 +83,8 @@ pub(crate) struct Trees {
     /// Each member's pose and rotation when the tree was built, by handle.
     ready: Vec<Ready>,
     /// Each member's box about its position at its kept angle (before `placed`), by handle:
-    /// a refit of a member that did not turn places it again, with no sine or cosine.
+    /// a refit of a member that did not turn places it again, with no sine or cosine. Kept
+    /// by the moving trees only (empty in the others, which are never refit).
     local: Vec<Bounds>,
     /// The world's layout ([`World::layout`]) the moving trees were built at: a refit
     /// needs the same bodies, layers and shapes.
@@ -150,13 +151,19 @@ impl Ready {
 }
 
 impl Trees {
-    /// The trees over the bodies `which` picks.
-    fn build(world: &World, generation: u64, which: impl Iterator<Item = usize>) -> Trees {
-        Trees::over(
+    /// The trees over the bodies `which` picks, ready to refit if `refit`.
+    fn build(
+        world: &World,
+        generation: u64,
+        which: impl Iterator<Item = usize>,
+        refit: bool,
+    ) -> Trees {
+        Trees::gather(
             generation,
             &world.entity,
             &world.layer,
             which.map(|i| (i, world.shape(i), world.pose(i))),
+            refit,
         )
     }
 
@@ -168,6 +175,18 @@ impl Trees {
         entity: &[Entity],
         layer: &[LayerId],
         members: impl Iterator<Item = (usize, &'s Shape, Pose)>,
+    ) -> Trees {
+        Trees::gather(generation, entity, layer, members, false)
+    }
+
+    /// [`Trees::over`], keeping each member's box about its position ([`Trees::local`]:
+    /// 32 bytes a member) if the trees are to be refit.
+    fn gather<'s>(
+        generation: u64,
+        entity: &[Entity],
+        layer: &[LayerId],
+        members: impl Iterator<Item = (usize, &'s Shape, Pose)>,
+        refit: bool,
     ) -> Trees {
         let n = members.size_hint().0;
         let (mut boxes, mut dense, mut ready, mut local) = (
@@ -194,7 +213,11 @@ impl Trees {
             entities: order.iter().map(|k| entity[by(k)]).collect(),
             layers: order.iter().map(|k| layer[by(k)]).collect(),
             ready: order.iter().map(|&k| ready[k as usize]).collect(),
-            local: order.iter().map(|&k| local[k as usize]).collect(),
+            local: if refit {
+                order.iter().map(|&k| local[k as usize]).collect()
+            } else {
+                Vec::new()
+            },
             dense: order.iter().map(|&k| dense[k as usize]).collect(),
             layout: 0,
             bounds: all,
@@ -209,6 +232,7 @@ impl Trees {
             world,
             generation,
             world.movers().iter().map(|&i| i as usize),
+            true,
         );
         t.layout = world.layout();
         t
@@ -222,7 +246,7 @@ impl Trees {
     /// costs more than [`REFIT_COST`] times a fresh one (a fresh build walks faster).
     fn refit(&mut self, world: &World) -> bool {
         let n = self.entities.len();
-        if self.layout != world.layout() || world.movers().len() != n {
+        if self.layout != world.layout() || world.movers().len() != n || self.local.len() != n {
             return false;
         }
         let mut all: Option<Bounds> = None;
@@ -453,6 +477,7 @@ impl QueryCache {
                 world,
                 generation,
                 (0..world.len()).filter(|&i| world.kind[i] == BodyKind::Static),
+                false,
             ))
         };
         let kept = self.statics.get_or_init(build_statics);
@@ -588,7 +613,7 @@ mod tests {
         }
         assert!(movers(&sim).entities == built, "rebuilt");
         let w = sim.world();
-        let fresh = Trees::build(w, 0, w.movers().iter().map(|&i| i as usize));
+        let fresh = Trees::build(w, 0, w.movers().iter().map(|&i| i as usize), true);
         assert_ne!(
             fresh.entities, built,
             "a fresh build would be the same tree"
