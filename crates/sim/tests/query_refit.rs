@@ -368,3 +368,33 @@ fn answers_do_not_depend_on_earlier_queries() {
         same_answers(&quiet, &fresh, &mut b, size).unwrap();
     }
 }
+
+/// A clone shares the trees until one of the two moves on: each then answers as its own
+/// fresh restore (neither refits a tree the other still holds).
+#[test]
+fn a_clone_and_its_original_answer_each_for_itself() {
+    for seed in [5, 41, 977] {
+        let mut rng = Rng(seed);
+        let scene = scenario(&mut rng, 120);
+        let size = scene
+            .world
+            .bounds
+            .map_or(Vec2::new(40.0, 40.0), |b| b.size());
+        let mut sim = Simulation::new(&scene);
+        let mut fresh = Simulation::new(&scene);
+        sim.step();
+        let _ = sim.overlap_aabb(Bounds::around(size * 0.5, size), &QueryFilter::all());
+        let mut twin = sim.clone();
+        for frame in 0..6 {
+            sim.step();
+            if frame % 2 == 0 {
+                edit(&mut twin, &mut rng, size);
+            }
+            twin.step();
+            for s in [&sim, &twin] {
+                fresh.restore(&s.snapshot()).unwrap();
+                same_answers(s, &fresh, &mut rng, size).unwrap();
+            }
+        }
+    }
+}
