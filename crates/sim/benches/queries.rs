@@ -5,8 +5,10 @@
 //! bench draws them. Prints each scene's queries per second (the median pass) and a sum of
 //! the answers, so nothing is optimised away. `QUERY_PASSES=0` measures the set-up alone,
 //! to subtract from an instruction count; `QUERY_SCENE=rain` runs only the scenes whose
-//! name holds `rain`. Then, per scene, the first box query after each of 21 steps against
-//! the one after it: the first builds the moving bodies' tree and grid, once a frame.
+//! name holds `rain`. Then, per scene, the first box query after each of `QUERY_FRAMES`
+//! (default 21) steps against the one after it: the first brings the moving bodies' tree up
+//! to date (a refit, or a rebuild when it has grown too costly), once a frame; the median,
+//! the mean and how many frames took over twice the median (the rebuilds).
 //!
 //! Run: `cargo bench -p ricochet-sim --bench queries` (or the built binary under `perf`).
 
@@ -38,6 +40,10 @@ fn main() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(200);
+    let frames: usize = std::env::var("QUERY_FRAMES")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(FIRST_QUERY_FRAMES);
     let scenes = [
         (
             "asteroids-10000",
@@ -126,7 +132,7 @@ fn main() {
         // What a game pays once a frame: the first query after a step builds the moving
         // bodies' tree and grid (after the passes, so the sums above stay as they were).
         let (mut first, mut next) = (Vec::new(), Vec::new());
-        for _ in 0..FIRST_QUERY_FRAMES {
+        for _ in 0..frames {
             sim.step();
             let t = Instant::now();
             sum += sim.overlap_aabb(boxes[0], &all).len() as f64;
@@ -135,17 +141,21 @@ fn main() {
             sum += sim.overlap_aabb(boxes[1], &all).len() as f64;
             next.push(t.elapsed().as_secs_f64());
         }
-        let median = |mut t: Vec<f64>| {
+        let median = |t: &[f64]| {
+            let mut t = t.to_vec();
             t.sort_by(f64::total_cmp);
             t.get(t.len() / 2).copied().unwrap_or(0.0) * 1e6
         };
+        let m = median(&first);
+        // The frames that rebuilt the tree (a fresh build costs several refits).
+        let slow = first.iter().filter(|&&t| t * 1e6 > 2.0 * m).count();
+        let mean = first.iter().sum::<f64>() / first.len().max(1) as f64 * 1e6;
         println!(
-            "{name}: a frame's first box query {:.1} µs, the next {:.1} µs (medians of {FIRST_QUERY_FRAMES} frames; {sum})",
-            median(first),
-            median(next)
+            "{name}: a frame's first box query {m:.1} µs (mean {mean:.1}, {slow} frames over twice the median), the next {:.1} µs (medians of {frames} frames; {sum})",
+            median(&next)
         );
     }
 }
 
-/// Frames stepped to time the first query after a step.
+/// Frames stepped to time the first query after a step (`QUERY_FRAMES` overrides).
 const FIRST_QUERY_FRAMES: usize = 21;

@@ -1,7 +1,7 @@
 //! The queries' grid: a uniform grid over one set of bodies (`index.rs`), built beside its
-//! tree by the set's first query, so that a small box is a few cell lookups and a short
-//! ray a few rows of cells, instead of a walk down the tree's levels (seven on 10,000
-//! members).
+//! tree once the set has answered 1,024 queries by the tree (`index.rs`), so that a small
+//! box is a few cell lookups and a short ray a few rows of cells, instead of a walk down
+//! the tree's levels (seven on 10,000 members).
 //!
 //! A member is listed in every cell its box covers (touching counts). A box query visits
 //! the cells its box covers and reports a member only from the cell holding the lower

@@ -6,10 +6,18 @@
 //!   the same (statics never move without bumping it), so a scene of 10,000 tiles is
 //!   indexed once, not once a frame.
 //! - **Moving tree**: every moving body as it is now. Every `&mut self` method of
-//!   `Simulation` that can move, add, remove or reshape a body drops it
-//!   ([`QueryCache::invalidate`]); the next query rebuilds it, in `O(m log m)` for `m`
-//!   moving bodies (and one sine and cosine a body). A step costs nothing more when no
-//!   query is made: dropping an empty cell is a branch.
+//!   `Simulation` that can move, add, remove or reshape a body makes it stale
+//!   ([`QueryCache::invalidate`] keeps it aside); the next query refits it
+//!   ([`Trees::refit`]: each member's pose and box recomputed, a sine and cosine only for
+//!   a member that turned, the nodes' boxes recomputed bottom up, in `O(m)` for `m` moving
+//!   bodies, with no allocation), or rebuilds it in `O(m log m)` when the bodies changed
+//!   (another [`World::layout`]) or the refit tree walks worse than a fresh one would
+//!   ([`REFIT_COST`]). The tree's shape so depends on which frames asked a query; the
+//!   answers do not (they are exact and ordered by id). A step costs nothing more when no
+//!   query is made: moving an empty cell aside is a branch.
+//!
+//! Each set's grid (`grid.rs`) is built after the set's first [`GRID_AFTER`] queries (the
+//! tree answers those), and the moving set's is dropped by each refit.
 //!
 //! Each member keeps its pose and rotation as the tree was built, and its box is its
 //! shape's exact box there: a candidate is tested with no sine or cosine, with the same
@@ -19,7 +27,8 @@
 //! removed since: dense indices shift, entities never do). Both sets sit behind an `Arc`,
 //! so cloning a `Simulation` shares them instead of copying trees.
 
-use std::sync::{Arc, OnceLock};
+use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::{Arc, Mutex, OnceLock, PoisonError};
 
 use ricochet_geom::{
     Bounds, PlacedPrimitive, Pose, Ray, RayIntersection, Rot, Shape, Vec2, place_rotated,
@@ -35,6 +44,18 @@ use crate::world::{World, placed};
 /// with the kept rotation (the bodies of a game have one part or a few); beyond, the pair
 /// goes to [`ricochet_geom::overlaps`], which culls the parts (the same answer).
 const ALL_PAIRS: usize = 64;
+
+/// How much costlier than a fresh build ([`QueryTree::cost`]: the summed perimeters of its
+/// nodes) a refit moving tree may grow before the next frame's query rebuilds it: bodies
+/// that drift apart from their leaf-mates (or wrap to the far edge) stretch their nodes.
+const REFIT_COST: f64 = 1.5;
+
+/// Queries a set answers by its tree alone before it builds its grid: building the grid
+/// costs about what it saves over a few thousand queries (a grid query takes some 300
+/// instructions fewer than a tree walk; the grid over 10,000 members, about half a
+/// millisecond), so a frame that asks a few queries of the moving set (a game's usual
+/// frame) never pays for one, and a frame that asks thousands does.
+const GRID_AFTER: u32 = 1024;
 
 /// One tree over one set of bodies (the static ones or the moving ones), every layer in it.
 ///
@@ -61,13 +82,27 @@ pub(crate) struct Trees {
     dense: Vec<u32>,
     /// Each member's pose and rotation when the tree was built, by handle.
     ready: Vec<Ready>,
+    /// Each member's box about its position at its kept angle (before `placed`), by handle:
+    /// a refit of a member that did not turn places it again, with no sine or cosine. Kept
+    /// by the moving trees only (empty in the others, which are never refit).
+    local: Vec<Bounds>,
+    /// The world's layout ([`World::layout`]) the moving trees were built at: a refit
+    /// needs the same bodies, layers and shapes.
+    layout: u64,
+    /// The tree's [`QueryTree::cost`] when built fresh: a refit that makes it costlier
+    /// than [`REFIT_COST`] times this rebuilds instead.
+    fresh_cost: f64,
     /// The box around every member (`None` when empty): an image of a query that misses it
     /// skips this set without walking its tree. In a wrap world most of the nine images of
     /// a query lie outside the world, so this is what keeps a query near one tree walk.
     pub(crate) bounds: Option<Bounds>,
-    /// The grid over the members' boxes (`grid.rs`), built by the set's first query;
-    /// `None` inside when the members' boxes do not suit one (the tree answers then).
+    /// The grid over the members' boxes (`grid.rs`), built by the set's query after the
+    /// first [`GRID_AFTER`] ones; `None` inside when the members' boxes do not suit one
+    /// (the tree answers then).
     grid: OnceLock<Option<Grid>>,
+    /// Queries that asked for the grid before it was built (at most a few past
+    /// [`GRID_AFTER`]: counted only until then).
+    asked: AtomicU32,
 }
 
 /// A member's pose as the tree was built, with what placing it needs.
@@ -98,31 +133,37 @@ impl Ready {
         if self.turns { self.rot } else { Rot::IDENTITY }
     }
 
-    /// The shape's box at this pose: its parts placed about the body, padded for the
-    /// translation (`world::placed`, as the world's own bounds).
-    fn bounds(&self, shape: &Shape) -> Bounds {
+    /// The shape's box at this angle about the body's position: its parts placed about the
+    /// body; [`world::placed`](placed) at the position pads it for the translation, as the
+    /// world's own bounds.
+    fn local_bounds(&self, shape: &Shape) -> Bounds {
         let rot = self.shape_rot();
         let mut parts = shape
             .primitives()
             .iter()
             .map(|p| place_rotated(p, Vec2::ZERO, rot, self.angle).bounds());
-        let local = parts
+        parts
             .next()
             .map_or(Bounds::around(Vec2::ZERO, Vec2::ZERO), |b| {
                 parts.fold(b, Bounds::union)
-            });
-        placed(local, self.position)
+            })
     }
 }
 
 impl Trees {
-    /// The trees over the bodies `which` picks.
-    fn build(world: &World, generation: u64, which: impl Iterator<Item = usize>) -> Trees {
-        Trees::over(
+    /// The trees over the bodies `which` picks, ready to refit if `refit`.
+    fn build(
+        world: &World,
+        generation: u64,
+        which: impl Iterator<Item = usize>,
+        refit: bool,
+    ) -> Trees {
+        Trees::gather(
             generation,
             &world.entity,
             &world.layer,
             which.map(|i| (i, world.shape(i), world.pose(i))),
+            refit,
         )
     }
 
@@ -135,15 +176,30 @@ impl Trees {
         layer: &[LayerId],
         members: impl Iterator<Item = (usize, &'s Shape, Pose)>,
     ) -> Trees {
+        Trees::gather(generation, entity, layer, members, false)
+    }
+
+    /// [`Trees::over`], keeping each member's box about its position ([`Trees::local`]:
+    /// 32 bytes a member) if the trees are to be refit.
+    fn gather<'s>(
+        generation: u64,
+        entity: &[Entity],
+        layer: &[LayerId],
+        members: impl Iterator<Item = (usize, &'s Shape, Pose)>,
+        refit: bool,
+    ) -> Trees {
         let n = members.size_hint().0;
-        let (mut boxes, mut dense, mut ready) = (
+        let (mut boxes, mut dense, mut ready, mut local) = (
+            Vec::with_capacity(n),
             Vec::with_capacity(n),
             Vec::with_capacity(n),
             Vec::with_capacity(n),
         );
         for (i, shape, pose) in members {
             let r = Ready::new(shape, pose);
-            boxes.push(r.bounds(shape));
+            let l = r.local_bounds(shape);
+            boxes.push(placed(l, r.position));
+            local.push(l);
             dense.push(i as u32);
             ready.push(r);
         }
@@ -152,14 +208,70 @@ impl Trees {
         let by = |k: &u32| dense[*k as usize] as usize;
         Trees {
             generation,
+            fresh_cost: tree.cost(),
             tree,
             entities: order.iter().map(|k| entity[by(k)]).collect(),
             layers: order.iter().map(|k| layer[by(k)]).collect(),
             ready: order.iter().map(|&k| ready[k as usize]).collect(),
+            local: if refit {
+                order.iter().map(|&k| local[k as usize]).collect()
+            } else {
+                Vec::new()
+            },
             dense: order.iter().map(|&k| dense[k as usize]).collect(),
+            layout: 0,
             bounds: all,
             grid: OnceLock::new(),
+            asked: AtomicU32::new(0),
         }
+    }
+
+    /// The trees over the world's moving bodies as they are now, built fresh.
+    fn movers(world: &World, generation: u64) -> Trees {
+        let mut t = Trees::build(
+            world,
+            generation,
+            world.movers().iter().map(|&i| i as usize),
+            true,
+        );
+        t.layout = world.layout();
+        t
+    }
+
+    /// Moves these moving trees to the world's moving bodies as they are now, keeping the
+    /// members' order and the tree's shape (`QueryTree::refit`): each member's pose and
+    /// box recomputed as [`Trees::over`] computes them (its sine and cosine only if it
+    /// turned), so a query answers exactly as over a fresh build. False when the bodies
+    /// are not the same ones (then `self` is half moved: rebuild), or when the refit tree
+    /// costs more than [`REFIT_COST`] times a fresh one (a fresh build walks faster).
+    fn refit(&mut self, world: &World) -> bool {
+        let n = self.entities.len();
+        if self.layout != world.layout() || world.movers().len() != n || self.local.len() != n {
+            return false;
+        }
+        let mut all: Option<Bounds> = None;
+        for k in 0..n {
+            let i = self.dense[k] as usize;
+            if world.entity.get(i) != Some(&self.entities[k]) {
+                return false;
+            }
+            let pose = world.pose(i);
+            let r = &mut self.ready[k];
+            if pose.angle.to_bits() == r.angle.to_bits() {
+                r.position = pose.position;
+            } else {
+                let shape = world.shape(i);
+                *r = Ready::new(shape, pose);
+                self.local[k] = r.local_bounds(shape);
+            }
+            let b = placed(self.local[k], pose.position);
+            self.tree.set_member(k, b);
+            all = Some(all.map_or(b, |a| a.union(b)));
+        }
+        self.bounds = all;
+        self.grid = OnceLock::new();
+        *self.asked.get_mut() = 0;
+        self.tree.refit() <= REFIT_COST * self.fresh_cost
     }
 
     /// [`QueryTree::ray`] by the grid where it can walk the segment (`grid.rs`), else by
@@ -181,9 +293,18 @@ impl Trees {
         self.tree.ray(origin, dir, max, f);
     }
 
-    /// The grid over the members, built if needed (`None` when they do not suit one).
+    /// The grid over the members, built if needed after the set's first [`GRID_AFTER`]
+    /// queries (`None` before, and when the members do not suit one). The tree and the
+    /// grid give the same answers, so which one answers depends on nothing an answer
+    /// shows.
     #[inline]
     fn grid(&self) -> Option<&Grid> {
+        if let Some(g) = self.grid.get() {
+            return g.as_ref();
+        }
+        if self.asked.fetch_add(1, Ordering::Relaxed) < GRID_AFTER {
+            return None;
+        }
         self.grid
             .get_or_init(|| Grid::new(&self.tree.member_boxes(self.entities.len())))
             .as_ref()
@@ -308,17 +429,35 @@ pub(crate) struct Probe<'a> {
 }
 
 /// The two tree sets, built lazily (see the module docs).
-#[derive(Clone, Debug, Default)]
+#[derive(Debug, Default)]
 pub(crate) struct QueryCache {
     statics: OnceLock<Arc<Trees>>,
     movers: OnceLock<Arc<Trees>>,
+    /// The moving trees of the last frame that asked a query, stale: the next frame's
+    /// first query refits them ([`Trees::refit`]) instead of building new ones. A lock
+    /// only because a query holds the cache shared; it is taken once a frame, never held.
+    stale: Mutex<Option<Arc<Trees>>>,
+}
+
+impl Clone for QueryCache {
+    /// The trees shared; the stale moving trees left to the original, which refits them
+    /// in place (shared, neither could).
+    fn clone(&self) -> QueryCache {
+        QueryCache {
+            statics: self.statics.clone(),
+            movers: self.movers.clone(),
+            stale: Mutex::default(),
+        }
+    }
 }
 
 impl QueryCache {
-    /// Forgets what the world's last change made stale: the moving trees always, the
-    /// static trees when the static generation moved on.
+    /// Forgets what the world's last change made stale: the moving trees always (kept
+    /// aside to refit), the static trees when the static generation moved on.
     pub(crate) fn invalidate(&mut self, world: &World) {
-        self.movers = OnceLock::new();
+        if let Some(movers) = self.movers.take() {
+            *self.stale.get_mut().unwrap_or_else(PoisonError::into_inner) = Some(movers);
+        }
         if self
             .statics
             .get()
@@ -338,6 +477,7 @@ impl QueryCache {
                 world,
                 generation,
                 (0..world.len()).filter(|&i| world.kind[i] == BodyKind::Static),
+                false,
             ))
         };
         let kept = self.statics.get_or_init(build_statics);
@@ -348,11 +488,17 @@ impl QueryCache {
             Lent::Fresh(build_statics())
         };
         let movers = self.movers.get_or_init(|| {
-            Arc::new(Trees::build(
-                world,
-                generation,
-                world.movers().iter().map(|&i| i as usize),
-            ))
+            let stale = self
+                .stale
+                .lock()
+                .unwrap_or_else(PoisonError::into_inner)
+                .take();
+            if let Some(mut kept) = stale
+                && Arc::get_mut(&mut kept).is_some_and(|t| t.refit(world))
+            {
+                return kept;
+            }
+            Arc::new(Trees::movers(world, generation))
         });
         [statics, Lent::Kept(movers)]
     }
@@ -415,5 +561,85 @@ pub(crate) fn each_in_box(
         } else {
             set.tree.query(q, &mut accepted);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::pipeline::Simulation;
+    use crate::{BodyDef, QueryFilter, Scenario};
+
+    /// 300 balls on a lattice, each with its own slow velocity, in an unbounded world.
+    fn scene() -> Simulation {
+        let bodies = (0..300)
+            .map(|k| BodyDef {
+                shape: Shape::circle(1.0).expect("radius"),
+                position: Vec2::new((k % 20) as f64 * 5.0, (k / 20) as f64 * 5.0),
+                // Apart by under a unit a second: they drift, the tree stays good.
+                velocity: Vec2::new(
+                    (k * 37 % 11) as f64 * 0.08 - 0.4,
+                    (k * 53 % 7) as f64 * 0.12 - 0.36,
+                ),
+                ..BodyDef::default()
+            })
+            .collect();
+        Simulation::new(&Scenario {
+            bodies,
+            ..Scenario::default()
+        })
+    }
+
+    fn movers(sim: &Simulation) -> &Trees {
+        sim.queries.movers.get().expect("built by a query")
+    }
+
+    fn ask(sim: &Simulation) -> usize {
+        let q = Bounds::around(Vec2::splat(50.0), Vec2::splat(5.0));
+        sim.overlap_aabb(q, &QueryFilter::all()).len()
+    }
+
+    /// Steps while the bodies stay the same are refits: the members keep the order of the
+    /// build (a fresh build orders them otherwise by then); a spawn rebuilds.
+    #[test]
+    fn the_moving_tree_is_refit_while_the_bodies_stay_and_rebuilt_when_they_change() {
+        let mut sim = scene();
+        sim.step();
+        ask(&sim);
+        let built = movers(&sim).entities.clone();
+        for _ in 0..20 {
+            sim.step();
+            ask(&sim);
+        }
+        assert!(movers(&sim).entities == built, "rebuilt");
+        let w = sim.world();
+        let fresh = Trees::build(w, 0, w.movers().iter().map(|&i| i as usize), true);
+        assert_ne!(
+            fresh.entities, built,
+            "a fresh build would be the same tree"
+        );
+        sim.spawn(&BodyDef {
+            shape: Shape::circle(1.0).expect("radius"),
+            ..BodyDef::default()
+        });
+        ask(&sim);
+        assert_eq!(movers(&sim).entities.len(), built.len() + 1);
+    }
+
+    /// A set's first [`GRID_AFTER`] queries are answered by its tree: a frame that asks a
+    /// few builds no grid.
+    #[test]
+    fn the_grid_is_built_only_after_many_queries_of_a_frame() {
+        let mut sim = scene();
+        sim.step();
+        for _ in 0..GRID_AFTER {
+            ask(&sim);
+        }
+        assert!(movers(&sim).grid.get().is_none());
+        ask(&sim);
+        assert!(movers(&sim).grid.get().is_some());
+        sim.step();
+        ask(&sim);
+        assert!(movers(&sim).grid.get().is_none(), "a new frame starts over");
     }
 }

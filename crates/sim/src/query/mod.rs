@@ -26,11 +26,12 @@
 //!
 //! # Candidates
 //! Never a loop over every body: a tree over the static bodies (kept while the static
-//! generation stays) and one over the moving bodies (built on the first query after the
-//! world changed), walked along the ray or by the query's bounds (`index.rs`, `tree.rs`),
-//! each member's pose and rotation kept with it. The overlap queries (point, box, shape)
-//! and the rays ask a uniform grid over each set instead where it can answer (`grid.rs`,
-//! built beside the tree by the set's first query): a few cells, not the tree's levels.
+//! generation stays) and one over the moving bodies (refit by the first query after the
+//! world changed, rebuilt when the bodies did), walked along the ray or by the query's
+//! bounds (`index.rs`, `tree.rs`), each member's pose and rotation kept with it. The
+//! overlap queries (point, box, shape) and the rays ask a uniform grid over each set
+//! instead where it can answer (`grid.rs`, built beside the tree once the set has answered
+//! 1,024 queries): a few cells, not the tree's levels.
 //! A candidate of a layer the filter refuses is dropped before its exact test.
 //!
 //! # Now and then

@@ -1,0 +1,400 @@
+//! The moving bodies' tree is kept from frame to frame and refit (issue #37): every query
+//! answers, bit for bit, as the same query on a fresh simulation of the scene restored from
+//! a snapshot of this frame (its trees built new: the independent source), over random
+//! scenes of up to 150 bodies moving, turning, wrapping, leaving the world, spawned,
+//! despawned, reshaped and teleported between steps, asked in some frames and not others.
+//! And the answers after a run do not depend on which frames asked.
+
+use proptest::prelude::*;
+use ricochet_sim::Doomed;
+use ricochet_sim::prelude::*;
+
+/// A small deterministic generator (xorshift64*): the scene and its edits follow from the
+/// proptest's seed.
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
+    }
+
+    /// Uniform in `[a, b)`.
+    fn range(&mut self, a: f64, b: f64) -> f64 {
+        a + (b - a) * ((self.next() >> 11) as f64 / (1u64 << 53) as f64)
+    }
+
+    fn below(&mut self, n: usize) -> usize {
+        (self.next() % n as u64) as usize
+    }
+
+    fn chance(&mut self, p: f64) -> bool {
+        self.range(0.0, 1.0) < p
+    }
+
+    fn vec(&mut self, a: f64, b: f64) -> Vec2 {
+        Vec2::new(self.range(a, b), self.range(a, b))
+    }
+}
+
+fn shape(rng: &mut Rng) -> Shape {
+    let r = rng.range(0.3, 3.0);
+    match rng.below(5) {
+        0 => Shape::circle(r).unwrap(),
+        1 => Shape::aabb(Vec2::new(r, rng.range(0.3, 3.0))).unwrap(),
+        2 => {
+            let v = [
+                (1.0, 0.1),
+                (0.3, 0.95),
+                (-0.8, 0.6),
+                (-0.9, -0.5),
+                (0.2, -1.0),
+            ];
+            Shape::polygon(&v.map(|(x, y)| Vec2::new(x * r, y * r))).unwrap()
+        }
+        3 => Shape::capsule(Vec2::new(-r, 0.0), Vec2::new(r, 0.5), r * 0.4).unwrap(),
+        _ => Shape::compound(vec![
+            Primitive::circle(Vec2::new(r, 0.0), r * 0.5).unwrap(),
+            Primitive::aabb(Vec2::new(-r, 0.0), Vec2::splat(r * 0.5)).unwrap(),
+        ])
+        .unwrap(),
+    }
+}
+
+fn body(rng: &mut Rng, size: Vec2) -> BodyDef {
+    let kind = match rng.below(10) {
+        0..5 => BodyKind::Dynamic,
+        5..7 => BodyKind::Kinematic,
+        _ => BodyKind::Static,
+    };
+    let moving = kind != BodyKind::Static;
+    BodyDef {
+        layer: rng.below(3) as LayerId,
+        kind,
+        shape: shape(rng),
+        position: Vec2::new(rng.range(0.0, size.x), rng.range(0.0, size.y)),
+        angle: rng.range(-3.0, 3.0),
+        velocity: if moving {
+            rng.vec(-30.0, 30.0)
+        } else {
+            Vec2::ZERO
+        },
+        // Some bodies never turn: a refit moves them with no sine or cosine.
+        angular_velocity: if moving && rng.chance(0.6) {
+            rng.range(-4.0, 4.0)
+        } else {
+            0.0
+        },
+        lifetime: rng.chance(0.2).then(|| 3 + rng.below(30) as u32),
+        ..BodyDef::default()
+    }
+}
+
+fn scenario(rng: &mut Rng, count: usize) -> Scenario {
+    let size = rng.vec(20.0, 60.0);
+    let mut layers = Layers::new(vec!["a".into(), "b".into(), "c".into()]);
+    layers.set(0, 1, Response::Report);
+    layers.set(1, 2, Response::Destroy(Doomed::Second));
+    let bounds = match rng.below(3) {
+        0 => None,
+        k => Some(WorldBounds {
+            min: Vec2::ZERO,
+            max: size,
+            // Not wrapping: a body leaving the world is removed.
+            wrap: k == 1,
+        }),
+    };
+    let bodies = (0..3 + rng.below(count)).map(|_| body(rng, size)).collect();
+    Scenario {
+        name: "refit".into(),
+        world: WorldDef {
+            layers,
+            bounds,
+            gravity: Vec2::new(0.0, rng.range(-10.0, 0.0)),
+            ..WorldDef::default()
+        },
+        frames: 100,
+        templates: Default::default(),
+        tiles: Vec::new(),
+        bodies,
+        script: Vec::new(),
+    }
+}
+
+/// Spawns, despawns, reshapes or moves a few bodies between two steps. Half the new shapes
+/// are a live body's (the world's shape table then gains nothing: only the bodies change).
+fn edit(sim: &mut Simulation, rng: &mut Rng, size: Vec2) {
+    for _ in 0..rng.below(4) {
+        let live = sim.world().entity.clone();
+        let pick = |rng: &mut Rng| live.get(rng.below(live.len().max(1))).copied();
+        let reuse = |sim: &Simulation, rng: &mut Rng| match pick(rng) {
+            Some(e) if rng.chance(0.5) => {
+                let i = sim.world().index_of(e).unwrap();
+                sim.world().shape(i).clone()
+            }
+            _ => shape(rng),
+        };
+        match rng.below(4) {
+            0 => {
+                let b = BodyDef {
+                    shape: reuse(sim, rng),
+                    ..body(rng, size)
+                };
+                sim.spawn(&b);
+            }
+            1 => {
+                if let Some(e) = pick(rng) {
+                    sim.despawn(e).unwrap();
+                }
+            }
+            2 => {
+                if let Some(e) = pick(rng) {
+                    let s = reuse(sim, rng);
+                    sim.set_shape(e, s).unwrap();
+                }
+            }
+            _ => {
+                if let Some(e) = pick(rng) {
+                    let p = Vec2::new(rng.range(0.0, size.x), rng.range(0.0, size.y));
+                    sim.set_position(e, p).unwrap();
+                }
+            }
+        }
+    }
+}
+
+fn filter(rng: &mut Rng, live: &[Entity]) -> QueryFilter {
+    let f = match rng.below(3) {
+        0 => QueryFilter::all(),
+        1 => QueryFilter::layers(&[rng.below(3) as LayerId]),
+        _ => QueryFilter::layers(&[0, 2]),
+    };
+    match live.get(rng.below(live.len().max(1) * 2)) {
+        Some(&e) => f.exclude(e),
+        None => f,
+    }
+}
+
+/// A ray hit as bits: equal exactly when every field is the same bits.
+fn ray_bits(h: &RayHit) -> (Entity, [u64; 5]) {
+    let b = |x: f64| x.to_bits();
+    (
+        h.entity,
+        [
+            b(h.point.x),
+            b(h.point.y),
+            b(h.normal.x),
+            b(h.normal.y),
+            b(h.distance),
+        ],
+    )
+}
+
+fn shape_bits(h: &ShapeHit) -> (Entity, [u64; 5]) {
+    let b = |x: f64| x.to_bits();
+    (
+        h.entity,
+        [
+            b(h.fraction),
+            b(h.point.x),
+            b(h.point.y),
+            b(h.normal.x),
+            b(h.normal.y),
+        ],
+    )
+}
+
+/// Asks `now` (its moving tree kept and refit) and `fresh` (the scene restored at the same
+/// frame: every tree built new) the same random queries; how many found something.
+fn same_answers(
+    now: &Simulation,
+    fresh: &Simulation,
+    rng: &mut Rng,
+    size: Vec2,
+) -> Result<usize, TestCaseError> {
+    let live = fresh.world().entity.clone();
+    let everywhere = Bounds {
+        min: Vec2::splat(-1e6),
+        max: Vec2::splat(1e6),
+    };
+    prop_assert_eq!(
+        now.overlap_aabb(everywhere, &QueryFilter::all()),
+        fresh.overlap_aabb(everywhere, &QueryFilter::all())
+    );
+    let mut hits = 0;
+    for _ in 0..8 {
+        let f = filter(rng, &live);
+        let origin = rng.vec(-0.2, 1.2) * size;
+        let dir = rng.vec(-1.0, 1.0);
+        let max = if rng.chance(0.1) {
+            f64::INFINITY
+        } else {
+            rng.range(0.0, 3.0) * size.max_element()
+        };
+        let (a, b) = (
+            now.cast_ray(origin, dir, max, &f),
+            fresh.cast_ray(origin, dir, max, &f),
+        );
+        prop_assert_eq!(a.as_ref().map(ray_bits), b.as_ref().map(ray_bits));
+        hits += usize::from(b.is_some());
+        let (a, b) = (
+            now.cast_ray_all(origin, dir, max, &f),
+            fresh.cast_ray_all(origin, dir, max, &f),
+        );
+        prop_assert_eq!(
+            a.iter().map(ray_bits).collect::<Vec<_>>(),
+            b.iter().map(ray_bits).collect::<Vec<_>>()
+        );
+        let s = shape(rng);
+        let pose = Pose::new(rng.vec(-0.2, 1.2) * size, rng.range(-3.0, 3.0));
+        let t = rng.vec(-1.0, 1.0) * size * 0.5;
+        let (a, b) = (
+            now.cast_shape(&s, pose, t, &f),
+            fresh.cast_shape(&s, pose, t, &f),
+        );
+        prop_assert_eq!(a.as_ref().map(shape_bits), b.as_ref().map(shape_bits));
+        hits += usize::from(b.is_some());
+        let point = rng.vec(0.0, 1.0) * size;
+        let b = fresh.overlap_point(point, &f);
+        hits += usize::from(!b.is_empty());
+        prop_assert_eq!(now.overlap_point(point, &f), b);
+        let c = rng.vec(-0.1, 1.1) * size;
+        let h = rng.vec(0.1, 8.0);
+        let q = Bounds {
+            min: c - h,
+            max: c + h,
+        };
+        let b = fresh.overlap_aabb(q, &f);
+        hits += usize::from(!b.is_empty());
+        prop_assert_eq!(now.overlap_aabb(q, &f), b);
+        let b = fresh.overlap_shape(&s, pose, &f);
+        hits += usize::from(!b.is_empty());
+        prop_assert_eq!(now.overlap_shape(&s, pose, &f), b);
+    }
+    Ok(hits)
+}
+
+/// One case: a random scene stepped `steps` frames, asked random queries in about half of
+/// them (with edits between some steps), each answer checked against a fresh simulation
+/// restored at that frame; how many queries found something.
+fn check(seed: u64, count: usize, steps: u64) -> Result<usize, TestCaseError> {
+    let mut rng = Rng(seed);
+    let scene = scenario(&mut rng, count);
+    let size = scene
+        .world
+        .bounds
+        .map_or(Vec2::new(40.0, 40.0), |b| b.size());
+    let mut sim = Simulation::new(&scene);
+    let mut fresh = Simulation::new(&scene);
+    let mut hits = 0;
+    for _ in 0..steps {
+        sim.step();
+        if rng.chance(0.5) {
+            fresh.restore(&sim.snapshot()).unwrap();
+            hits += same_answers(&sim, &fresh, &mut rng, size)?;
+        }
+        // Mostly motion alone (the tree refit), sometimes the bodies change (rebuilt).
+        if rng.chance(0.15) {
+            edit(&mut sim, &mut rng, size);
+        }
+    }
+    Ok(hits)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+
+    #[test]
+    fn a_refit_tree_answers_as_a_fresh_one(
+        seed in 1..u64::MAX,
+        count in 1..150usize,
+        steps in 1..40u64,
+    ) {
+        check(seed, count, steps)?;
+    }
+}
+
+/// The proptest's cases find things: a check that finds nothing checks nothing.
+#[test]
+fn the_cases_find_something() {
+    let hits: usize = (1..=6)
+        .map(|seed| check(seed * 7919, 120, 30).unwrap())
+        .sum();
+    assert!(hits > 200, "{hits}");
+}
+
+/// The answers after a run are the same whether the frames before asked queries (the
+/// moving tree kept and refit in those frames) or not (built once, at the end): what a
+/// query answers depends on the simulation's history, never on the queries asked.
+#[test]
+fn answers_do_not_depend_on_earlier_queries() {
+    for seed in [3, 17, 2024] {
+        let mut rng = Rng(seed);
+        let scene = scenario(&mut rng, 140);
+        let size = scene
+            .world
+            .bounds
+            .map_or(Vec2::new(40.0, 40.0), |b| b.size());
+        let (mut asked, mut quiet) = (Simulation::new(&scene), Simulation::new(&scene));
+        let mut probe = Rng(seed ^ 0x5eed);
+        let mut found = 0;
+        for frame in 0..60 {
+            asked.step();
+            quiet.step();
+            // A few queries a frame; every tenth frame past the grid's threshold, so that
+            // the grid answers too.
+            for _ in 0..if frame % 10 == 0 { 1100 } else { 3 } {
+                let c = probe.vec(0.0, 1.0) * size;
+                found += asked
+                    .overlap_aabb(Bounds::around(c, Vec2::splat(2.0)), &QueryFilter::all())
+                    .len();
+            }
+            let o = probe.vec(0.0, 1.0) * size;
+            found += usize::from(
+                asked
+                    .cast_ray(o, Vec2::X, 50.0, &QueryFilter::all())
+                    .is_some(),
+            );
+        }
+        assert!(found > 100, "{found}");
+        let mut a = Rng(seed);
+        let mut b = Rng(seed);
+        same_answers(&asked, &quiet, &mut a, size).unwrap();
+        // And both against a fresh restore, from the same queries.
+        let mut fresh = Simulation::new(&scene);
+        fresh.restore(&quiet.snapshot()).unwrap();
+        same_answers(&quiet, &fresh, &mut b, size).unwrap();
+    }
+}
+
+/// A clone shares the trees until one of the two moves on: each then answers as its own
+/// fresh restore (neither refits a tree the other still holds).
+#[test]
+fn a_clone_and_its_original_answer_each_for_itself() {
+    for seed in [5, 41, 977] {
+        let mut rng = Rng(seed);
+        let scene = scenario(&mut rng, 120);
+        let size = scene
+            .world
+            .bounds
+            .map_or(Vec2::new(40.0, 40.0), |b| b.size());
+        let mut sim = Simulation::new(&scene);
+        let mut fresh = Simulation::new(&scene);
+        sim.step();
+        let _ = sim.overlap_aabb(Bounds::around(size * 0.5, size), &QueryFilter::all());
+        let mut twin = sim.clone();
+        for frame in 0..6 {
+            sim.step();
+            if frame % 2 == 0 {
+                edit(&mut twin, &mut rng, size);
+            }
+            twin.step();
+            for s in [&sim, &twin] {
+                fresh.restore(&s.snapshot()).unwrap();
+                same_answers(s, &fresh, &mut rng, size).unwrap();
+            }
+        }
+    }
+}
