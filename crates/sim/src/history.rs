@@ -27,7 +27,8 @@ use crate::entity::Entity;
 use crate::interned::ShapeTable;
 use crate::limits::MAX_HISTORY;
 use crate::pipeline::Simulation;
-use crate::query::index::{Lent, Trees};
+use crate::query::cache::Lent;
+use crate::query::index::Trees;
 use crate::query::{Bodies, QueryFilter, RayHit, Scene, ShapeHit};
 use crate::world::World;
 

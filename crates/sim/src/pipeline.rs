@@ -113,7 +113,7 @@ pub struct Simulation {
     pub(crate) workers: Workers,
     /// The scene queries' trees (`query/index.rs`): built by the first query after a
     /// change, dropped by every method that moves, adds, removes or reshapes a body.
-    pub(crate) queries: crate::query::index::QueryCache,
+    pub(crate) queries: crate::query::cache::QueryCache,
     /// The world before the first step, that snapshots are written against (`snapshot/`).
     pub(crate) baseline: std::sync::Arc<crate::snapshot::Baseline>,
     /// The last frames kept for [`Simulation::past`] (`history.rs`); off by default.
@@ -226,7 +226,7 @@ impl Simulation {
             targeted: Vec::new(),
             focus: None,
             workers: Workers::default(),
-            queries: crate::query::index::QueryCache::default(),
+            queries: crate::query::cache::QueryCache::default(),
             baseline,
             history: crate::history::History::default(),
         }

@@ -7,7 +7,7 @@
 //!   indexed once, not once a frame.
 //! - **Moving tree**: every moving body as it is now. Every `&mut self` method of
 //!   `Simulation` that can move, add, remove or reshape a body makes it stale
-//!   ([`QueryCache::invalidate`] keeps it aside); the next query refits it
+//!   ([`QueryCache::invalidate`](super::cache::QueryCache::invalidate) keeps it aside); the next query refits it
 //!   ([`Trees::refit`]: each member's pose and box recomputed, a sine and cosine only for
 //!   a member that turned, the nodes' boxes recomputed bottom up, in `O(m)` for `m` moving
 //!   bodies, with no allocation), or rebuilds it in `O(m log m)` when the bodies changed
@@ -27,8 +27,8 @@
 //! removed since: dense indices shift, entities never do). Both sets sit behind an `Arc`,
 //! so cloning a `Simulation` shares them instead of copying trees.
 
+use std::sync::OnceLock;
 use std::sync::atomic::{AtomicU32, Ordering};
-use std::sync::{Arc, Mutex, OnceLock, PoisonError};
 
 use ricochet_geom::{
     Bounds, PlacedPrimitive, Pose, Ray, RayIntersection, Rot, Shape, Vec2, place_rotated,
@@ -36,7 +36,7 @@ use ricochet_geom::{
 
 use super::grid::Grid;
 use super::tree::QueryTree;
-use crate::def::{BodyKind, LayerId};
+use crate::def::LayerId;
 use crate::entity::Entity;
 use crate::world::{World, placed};
 
@@ -70,7 +70,7 @@ const GRID_AFTER: u32 = 1024;
 #[derive(Debug, Default)]
 pub(crate) struct Trees {
     /// The static generation they were built at (static trees only).
-    generation: u64,
+    pub(super) generation: u64,
     /// The tree; a member's handle indexes the vectors below.
     pub(crate) tree: QueryTree,
     /// Each member's entity, by handle.
@@ -152,7 +152,7 @@ impl Ready {
 
 impl Trees {
     /// The trees over the bodies `which` picks, ready to refit if `refit`.
-    fn build(
+    pub(super) fn build(
         world: &World,
         generation: u64,
         which: impl Iterator<Item = usize>,
@@ -227,7 +227,7 @@ impl Trees {
     }
 
     /// The trees over the world's moving bodies as they are now, built fresh.
-    fn movers(world: &World, generation: u64) -> Trees {
+    pub(super) fn movers(world: &World, generation: u64) -> Trees {
         let mut t = Trees::build(
             world,
             generation,
@@ -244,7 +244,7 @@ impl Trees {
     /// turned), so a query answers exactly as over a fresh build. False when the bodies
     /// are not the same ones (then `self` is half moved: rebuild), or when the refit tree
     /// costs more than [`REFIT_COST`] times a fresh one (a fresh build walks faster).
-    fn refit(&mut self, world: &World) -> bool {
+    pub(super) fn refit(&mut self, world: &World) -> bool {
         let n = self.entities.len();
         if self.layout != world.layout() || world.movers().len() != n || self.local.len() != n {
             return false;
@@ -426,100 +426,6 @@ pub(crate) struct Probe<'a> {
     pub(crate) angle: f64,
     /// Its parts placed, with its rotation.
     pub(crate) placed: &'a [PlacedPrimitive],
-}
-
-/// The two tree sets, built lazily (see the module docs).
-#[derive(Debug, Default)]
-pub(crate) struct QueryCache {
-    statics: OnceLock<Arc<Trees>>,
-    movers: OnceLock<Arc<Trees>>,
-    /// The moving trees of the last frame that asked a query, stale: the next frame's
-    /// first query refits them ([`Trees::refit`]) instead of building new ones. A lock
-    /// only because a query holds the cache shared; it is taken once a frame, never held.
-    stale: Mutex<Option<Arc<Trees>>>,
-}
-
-impl Clone for QueryCache {
-    /// The trees shared; the stale moving trees left to the original, which refits them
-    /// in place (shared, neither could).
-    fn clone(&self) -> QueryCache {
-        QueryCache {
-            statics: self.statics.clone(),
-            movers: self.movers.clone(),
-            stale: Mutex::default(),
-        }
-    }
-}
-
-impl QueryCache {
-    /// Forgets what the world's last change made stale: the moving trees always (kept
-    /// aside to refit), the static trees when the static generation moved on.
-    pub(crate) fn invalidate(&mut self, world: &World) {
-        if let Some(movers) = self.movers.take() {
-            *self.stale.get_mut().unwrap_or_else(PoisonError::into_inner) = Some(movers);
-        }
-        if self
-            .statics
-            .get()
-            .is_some_and(|t| t.generation != world.static_generation())
-        {
-            self.statics = OnceLock::new();
-        }
-    }
-
-    /// The static trees and the moving trees of `world`, built if needed, lent: no `Arc`
-    /// count is touched (two atomic increments and decrements a query of a few hundred
-    /// nanoseconds).
-    pub(crate) fn trees(&self, world: &World) -> [Lent<'_>; 2] {
-        let generation = world.static_generation();
-        let build_statics = || {
-            Arc::new(Trees::build(
-                world,
-                generation,
-                (0..world.len()).filter(|&i| world.kind[i] == BodyKind::Static),
-                false,
-            ))
-        };
-        let kept = self.statics.get_or_init(build_statics);
-        let statics = if kept.generation == generation {
-            Lent::Kept(kept)
-        } else {
-            // A change that did not go through `invalidate`: answer from fresh trees.
-            Lent::Fresh(build_statics())
-        };
-        let movers = self.movers.get_or_init(|| {
-            let stale = self
-                .stale
-                .lock()
-                .unwrap_or_else(PoisonError::into_inner)
-                .take();
-            if let Some(mut kept) = stale
-                && Arc::get_mut(&mut kept).is_some_and(|t| t.refit(world))
-            {
-                return kept;
-            }
-            Arc::new(Trees::movers(world, generation))
-        });
-        [statics, Lent::Kept(movers)]
-    }
-}
-
-/// A tree set as a query holds it: lent by the cache, or built for this query alone.
-pub(crate) enum Lent<'a> {
-    Kept(&'a Trees),
-    Fresh(Arc<Trees>),
-}
-
-impl std::ops::Deref for Lent<'_> {
-    type Target = Trees;
-
-    #[inline]
-    fn deref(&self) -> &Trees {
-        match self {
-            Lent::Kept(t) => t,
-            Lent::Fresh(t) => t,
-        }
-    }
 }
 
 /// The box around the members of both sets (`None` when both are empty): an image of a

@@ -39,6 +39,7 @@
 //! lag compensation (`history.rs`, [`crate::Past`]), whose one tree over all its bodies is
 //! built by its first query. So a past frame answers exactly as the world restored there.
 
+pub(crate) mod cache;
 mod filter;
 mod grid;
 mod hits;
@@ -54,6 +55,8 @@ use ricochet_geom::{
 pub use filter::QueryFilter;
 pub use hits::{RayHit, ShapeHit};
 pub(crate) use wrap::wrapping;
+
+use cache::{Lent, QueryCache};
 
 use crate::def::{LayerId, WorldBounds};
 use crate::entity::Entity;
@@ -74,13 +77,13 @@ pub(crate) trait Bodies {
     fn pose(&self, i: usize) -> Pose;
     /// The static trees and the moving trees over the bodies (`index.rs`), built if needed,
     /// lent for the query.
-    fn trees(&self) -> [index::Lent<'_>; 2];
+    fn trees(&self) -> [Lent<'_>; 2];
 }
 
 /// The world now, with the simulation's cached trees.
 pub(crate) struct Now<'a> {
     world: &'a World,
-    cache: &'a index::QueryCache,
+    cache: &'a QueryCache,
 }
 
 impl Bodies for Now<'_> {
@@ -102,7 +105,7 @@ impl Bodies for Now<'_> {
         self.world.pose(i)
     }
 
-    fn trees(&self) -> [index::Lent<'_>; 2] {
+    fn trees(&self) -> [Lent<'_>; 2] {
         self.cache.trees(self.world)
     }
 }

@@ -372,7 +372,7 @@ impl Simulation {
         self.touch = TouchState::restored(layers, st.touching, seen);
         // Another world: neither tree set of the scene queries may be kept (a static
         // generation can repeat with other static bodies).
-        self.queries = crate::query::index::QueryCache::default();
+        self.queries = crate::query::cache::QueryCache::default();
         // The frames kept belong to the timeline left (`history.rs`); the length stays.
         self.history.clear();
         self.frame = s.frame;
