@@ -70,7 +70,7 @@ pub use math::{Pose, Rot, Vec2};
 pub use number::{Number, Numbers};
 pub use placed::{
     PlacedAabb, PlacedCapsule, PlacedCircle, PlacedObb, PlacedPolygon, PlacedPrimitive,
-    PlacedSegment, place, place_rotated,
+    PlacedSegment, place, place_rotated, placed_bounds,
 };
 pub use ray::{Ray, RayIntersection, cast_placed, cast_ray, contains_placed, contains_point};
 pub use shape::{

@@ -4,8 +4,8 @@
 use proptest::prelude::*;
 use ricochet_geom::pairs::collide_cores;
 use ricochet_geom::{
-    Bounds, Contact, Pose, Primitive, Shape, Vec2, contact, contact_deeper_than, contact_placed,
-    overlaps, place,
+    Bounds, Contact, Pose, Primitive, Rot, Shape, Vec2, contact, contact_deeper_than,
+    contact_placed, overlaps, place, place_rotated, placed_bounds,
 };
 
 const TAU: f64 = std::f64::consts::TAU;
@@ -87,6 +87,28 @@ fn assert_unit(c: &Contact) {
         "{c:?}"
     );
     assert!((c.normal.length() - 1.0).abs() < 1e-12, "{c:?}");
+}
+
+/// A box's four coordinates as bits: `-0.0` and `0.0` differ, a NaN is its own bits.
+fn box_bits(b: Bounds) -> [u64; 4] {
+    [b.min.x, b.min.y, b.max.x, b.max.y].map(f64::to_bits)
+}
+
+proptest! {
+    /// `placed_bounds` is the box of the part `place_rotated` places, bit for bit, for every
+    /// kind of part, angle and position (far ones too, where rounding shows).
+    #[test]
+    fn placed_bounds_is_the_placed_parts_box_bit_for_bit(
+        p in primitive(),
+        pose in pose(),
+        far in prop_oneof![Just(1.0), Just(1e6), Just(1e-9)],
+    ) {
+        let (at, rot) = (pose.position * far, Rot::from_angle(pose.angle));
+        prop_assert_eq!(
+            box_bits(placed_bounds(&p, at, rot, pose.angle)),
+            box_bits(place_rotated(&p, at, rot, pose.angle).bounds())
+        );
+    }
 }
 
 proptest! {

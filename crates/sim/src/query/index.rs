@@ -32,6 +32,7 @@ use std::sync::atomic::{AtomicU32, Ordering};
 
 use ricochet_geom::{
     Bounds, PlacedPrimitive, Pose, Ray, RayIntersection, Rot, Shape, Vec2, place_rotated,
+    placed_bounds,
 };
 
 use super::grid::Grid;
@@ -141,7 +142,7 @@ impl Ready {
         let mut parts = shape
             .primitives()
             .iter()
-            .map(|p| place_rotated(p, Vec2::ZERO, rot, self.angle).bounds());
+            .map(|p| placed_bounds(p, Vec2::ZERO, rot, self.angle));
         parts
             .next()
             .map_or(Bounds::around(Vec2::ZERO, Vec2::ZERO), |b| {
