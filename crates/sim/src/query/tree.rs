@@ -18,6 +18,8 @@ use ricochet_geom::{Bounds, Vec2};
 use super::slab::{Slab, larger};
 
 /// Members per leaf, and children per node.
+mod refit;
+
 const LEAF: usize = 4;
 
 /// A ray walk's node put off: its level, its index there, and where the segment enters it.
@@ -186,73 +188,6 @@ impl QueryTree {
             },
             order,
         )
-    }
-
-    /// Sets member `k`'s box (by handle) to `b` for [`QueryTree::refit`]: until then the
-    /// nodes above it are stale.
-    #[inline]
-    pub(crate) fn set_member(&mut self, k: usize, b: Bounds) {
-        let b = stored(b);
-        let q = &mut self.quads[k / LEAF];
-        let j = k % LEAF;
-        q.c[MIN_X][j] = b.min.x;
-        q.c[MIN_Y][j] = b.min.y;
-        q.c[MAX_X][j] = b.max.x;
-        q.c[MAX_Y][j] = b.max.y;
-    }
-
-    /// Recomputes every node above the members from the members' boxes as they are now
-    /// ([`QueryTree::set_member`]), keeping the members' order and the tree's shape: the
-    /// same nodes [`QueryTree::new`] builds over the members in this order, bit for bit.
-    /// Returns the tree's [`QueryTree::cost`].
-    pub(crate) fn refit(&mut self) -> f64 {
-        if self.quads.is_empty() {
-            return 0.0;
-        }
-        for level in 1..=self.top {
-            let (below, this) = (self.start[level - 1], self.start[level]);
-            let end = if level < self.top {
-                self.start[level + 1]
-            } else {
-                self.quads.len()
-            };
-            for n in 0..end - this {
-                let first = below + n * LEAF;
-                let last = (first + LEAF).min(this);
-                let mut q = Quad::EMPTY;
-                for (j, c) in (first..last).enumerate() {
-                    let h = self.quads[c].hull();
-                    q.c[MIN_X][j] = h.min.x;
-                    q.c[MIN_Y][j] = h.min.y;
-                    q.c[MAX_X][j] = h.max.x;
-                    q.c[MAX_Y][j] = h.max.y;
-                }
-                self.quads[this + n] = q;
-            }
-        }
-        self.all = Some(self.quads[self.start[self.top]].hull());
-        self.cost()
-    }
-
-    /// The summed half perimeter of every node's box above the members: how much a walk
-    /// pays, the measure a refit tree is compared by against a fresh build (`index.rs`).
-    /// Empty lanes count nothing.
-    pub(crate) fn cost(&self) -> f64 {
-        if self.top == 0 {
-            return 0.0;
-        }
-        let mut sum = 0.0;
-        for q in &self.quads[self.start[1]..] {
-            for j in 0..LEAF {
-                let w = q.c[MAX_X][j] - q.c[MIN_X][j];
-                let h = q.c[MAX_Y][j] - q.c[MIN_Y][j];
-                // Also false for an empty lane (`-inf`) and a NaN.
-                if w >= 0.0 && h >= 0.0 {
-                    sum += w + h;
-                }
-            }
-        }
-        sum
     }
 
     /// The boxes of the tree's first `n` members, by handle, as stored (a box with a NaN
