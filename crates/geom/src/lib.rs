@@ -4,7 +4,7 @@
 //! polygon, a compound of those, and a terrain chain of segments: [`Shape::chain`]), the [`Pose`] that places a shape in the world, the
 //! bounding box of any shape at any pose ([`Bounds`]), the scenario/case-file description of a
 //! shape ([`ShapeDef`]) with its validation, and the narrow phase: a cheap boolean
-//! [`overlaps`] and a full [`contact`] (signed depth, unit normal from `a` to `b`, a contact
+//! [`overlaps`] and a full [`contact()`] (signed depth, unit normal from `a` to `b`, a contact
 //! point) for every pairing, and rays against every shape ([`cast_ray`], [`contains_point`]).
 //!
 //! **Never:** does I/O (a case file is read from a reader its caller opened, through
@@ -21,7 +21,7 @@
 //! tolerances near `1e-11`. An `f32` cannot even store a position at `1.7e6` closer than
 //! `0.125`. `f64` has a unit roundoff of `1.1e-16`, so a position at `1e6` is stored to
 //! `1.2e-10`. On top of that, every pair is computed in a frame centred on body `a`
-//! ([`contact`] subtracts the two positions first, which is exact for nearby bodies), so a pair
+//! ([`contact()`] subtracts the two positions first, which is exact for nearby bodies), so a pair
 //! far from the origin is exactly as accurate as the same pair at the origin.
 //!
 //! # Conventions

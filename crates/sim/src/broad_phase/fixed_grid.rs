@@ -13,7 +13,7 @@ use super::grid::{CellRange, Cells, MAX_CELLS};
 /// the cell of its lower-left corner: a box overlapping a query has its corner in the
 /// query's cells or one cell below or left of them, so a lookup reaches one cell further
 /// down and left and meets each such box once (40 bytes a tile). A larger box (up to
-/// [`MAX_CELLS`](super::grid::MAX_CELLS) cells) is entered in every cell it covers and
+/// [`MAX_CELLS`] cells) is entered in every cell it covers and
 /// reported from the cell holding the lower-left corner of the overlap; a box covering more,
 /// or with irregular bounds, is kept in a list every lookup scans.
 #[derive(Debug, Default, Clone)]
