@@ -41,9 +41,40 @@ struct Known {
 }
 
 impl Known {
-    /// Whether a reader predicts this frame's state from this one: the velocity unchanged
-    /// (or one step of falling, `fall` = `gravity * dt`, when falling), the spin unchanged, and
-    /// the pose one integrator step on. Then `/bodies` has nothing to say of the body.
+    /// What a reader predicts of the velocity (the one place this is written; the settling
+    /// pass and the general case both ask here): one step of falling, `fall` = `gravity *
+    /// dt`, when falling, else unchanged.
+    #[inline(always)]
+    fn expected_velocity(&self, fall: Vec2) -> Vec2 {
+        if self.falling {
+            self.fallen(fall)
+        } else {
+            self.velocity
+        }
+    }
+
+    /// The velocity after one step of falling.
+    #[inline(always)]
+    fn fallen(&self, fall: Vec2) -> Vec2 {
+        self.velocity + fall
+    }
+
+    /// Whether `position` is one integrator step on from this one at `velocity` (this
+    /// frame's).
+    #[inline(always)]
+    fn moved_as_predicted(&self, position: Vec2, velocity: Vec2, dt: f64) -> bool {
+        same2(position, self.position + velocity * dt)
+    }
+
+    /// Whether `angle` is one integrator step on from this one at `spin` (this frame's).
+    #[inline(always)]
+    fn turned_as_predicted(&self, angle: f64, spin: f64, dt: f64) -> bool {
+        same(angle, self.angle + spin * dt)
+    }
+
+    /// Whether a reader predicts this frame's state from this one: the velocity as
+    /// [`Known::expected_velocity`] says, the spin unchanged, and the pose one integrator
+    /// step on. Then `/bodies` has nothing to say of the body.
     fn as_predicted(
         &self,
         position: Vec2,
@@ -53,15 +84,10 @@ impl Known {
         fall: Vec2,
         dt: f64,
     ) -> bool {
-        let expected = if self.falling {
-            self.velocity + fall
-        } else {
-            self.velocity
-        };
-        same2(velocity, expected)
+        same2(velocity, self.expected_velocity(fall))
             && same(spin, self.angular_velocity)
-            && same2(position, self.position + velocity * dt)
-            && same(angle, self.angle + spin * dt)
+            && self.moved_as_predicted(position, velocity, dt)
+            && self.turned_as_predicted(angle, spin, dt)
     }
 }
 
@@ -324,9 +350,9 @@ impl Tracker {
             let sped = !same2(k.velocity, velocity);
             // What a reader predicts of the velocity: unchanged, or one step of falling. A
             // velocity that is neither is written; one that is the other switches the mode.
-            let fell = k.velocity + gravity * dt;
-            let falls = gravity != Vec2::ZERO && same2(velocity, fell);
-            let as_predicted = same2(velocity, if k.falling { fell } else { k.velocity });
+            let fall = gravity * dt;
+            let falls = gravity != Vec2::ZERO && same2(velocity, k.fallen(fall));
+            let as_predicted = same2(velocity, k.expected_velocity(fall));
             let mode = if as_predicted {
                 None
             } else if falls {
@@ -347,8 +373,8 @@ impl Tracker {
                 } = true;
             }
             // What a reader predicts: the integrator's step with this frame's velocities.
-            let moved_as_predicted = same2(position, k.position + velocity * dt);
-            let turned_as_predicted = same(angle, k.angle + angular_velocity * dt);
+            let moved_as_predicted = k.moved_as_predicted(position, velocity, dt);
+            let turned_as_predicted = k.turned_as_predicted(angle, angular_velocity, dt);
             let still = same2(position, k.position) && same(angle, k.angle);
             let full = fresh || (keyframe && !k.is_static);
             let predicted = moved_as_predicted && turned_as_predicted;
