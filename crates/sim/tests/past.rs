@@ -10,7 +10,7 @@ use ricochet_sim::{HistoryError, MAX_HISTORY};
 
 mod random_scene;
 
-use random_scene::{Rng, edit, filter, ray_bits, scenario, shape, shape_bits};
+use random_scene::{Rng, edit, scenario};
 
 /// Asks `past` and `then` (the scene restored at the same frame) the same random queries.
 fn same_answers(
@@ -19,68 +19,8 @@ fn same_answers(
     rng: &mut Rng,
     size: Vec2,
 ) -> Result<usize, TestCaseError> {
-    let live = then.world().entity.clone();
-    prop_assert_eq!(past.len(), live.len());
-    let all = Bounds {
-        min: Vec2::splat(-1e6),
-        max: Vec2::splat(1e6),
-    };
-    prop_assert_eq!(
-        past.overlap_aabb(all, &QueryFilter::all()),
-        then.overlap_aabb(all, &QueryFilter::all())
-    );
-    let mut hits = 0;
-    for _ in 0..12 {
-        let f = filter(rng, &live);
-        // Inside the world and out of it (wrapped in first in a wrap world).
-        let origin = rng.vec(-0.2, 1.2) * size;
-        let dir = rng.vec(-1.0, 1.0);
-        let max = if rng.chance(0.1) {
-            f64::INFINITY
-        } else {
-            rng.range(0.0, 3.0) * size.max_element()
-        };
-        let (a, b) = (
-            past.cast_ray(origin, dir, max, &f),
-            then.cast_ray(origin, dir, max, &f),
-        );
-        prop_assert_eq!(a.as_ref().map(ray_bits), b.as_ref().map(ray_bits));
-        hits += usize::from(b.is_some());
-        let (a, b) = (
-            past.cast_ray_all(origin, dir, max, &f),
-            then.cast_ray_all(origin, dir, max, &f),
-        );
-        prop_assert_eq!(
-            a.iter().map(ray_bits).collect::<Vec<_>>(),
-            b.iter().map(ray_bits).collect::<Vec<_>>()
-        );
-        let s = shape(rng);
-        let pose = Pose::new(rng.vec(-0.2, 1.2) * size, rng.range(-3.0, 3.0));
-        let t = rng.vec(-1.0, 1.0) * size * 0.5;
-        let (a, b) = (
-            past.cast_shape(&s, pose, t, &f),
-            then.cast_shape(&s, pose, t, &f),
-        );
-        prop_assert_eq!(a.as_ref().map(shape_bits), b.as_ref().map(shape_bits));
-        hits += usize::from(b.is_some());
-        let point = rng.vec(0.0, 1.0) * size;
-        let b = then.overlap_point(point, &f);
-        hits += usize::from(!b.is_empty());
-        prop_assert_eq!(past.overlap_point(point, &f), b);
-        let c = rng.vec(-0.1, 1.1) * size;
-        let h = rng.vec(0.1, 8.0);
-        let q = Bounds {
-            min: c - h,
-            max: c + h,
-        };
-        let b = then.overlap_aabb(q, &f);
-        hits += usize::from(!b.is_empty());
-        prop_assert_eq!(past.overlap_aabb(q, &f), b);
-        let b = then.overlap_shape(&s, pose, &f);
-        hits += usize::from(!b.is_empty());
-        prop_assert_eq!(past.overlap_shape(&s, pose, &f), b);
-    }
-    Ok(hits)
+    prop_assert_eq!(past.len(), then.world().len());
+    random_scene::same_answers(past, then, rng, size, 12)
 }
 
 /// One case: a random scene stepped `steps` frames keeping `keep`, every kept frame asked

@@ -10,7 +10,7 @@ use ricochet_sim::prelude::*;
 
 mod random_scene;
 
-use random_scene::{Rng, edit, filter, ray_bits, scenario, shape, shape_bits};
+use random_scene::{Rng, edit, scenario};
 
 /// Some moving bodies never turn: a refit moves them with no sine or cosine.
 const TURNING: f64 = 0.6;
@@ -23,66 +23,7 @@ fn same_answers(
     rng: &mut Rng,
     size: Vec2,
 ) -> Result<usize, TestCaseError> {
-    let live = fresh.world().entity.clone();
-    let everywhere = Bounds {
-        min: Vec2::splat(-1e6),
-        max: Vec2::splat(1e6),
-    };
-    prop_assert_eq!(
-        now.overlap_aabb(everywhere, &QueryFilter::all()),
-        fresh.overlap_aabb(everywhere, &QueryFilter::all())
-    );
-    let mut hits = 0;
-    for _ in 0..8 {
-        let f = filter(rng, &live);
-        let origin = rng.vec(-0.2, 1.2) * size;
-        let dir = rng.vec(-1.0, 1.0);
-        let max = if rng.chance(0.1) {
-            f64::INFINITY
-        } else {
-            rng.range(0.0, 3.0) * size.max_element()
-        };
-        let (a, b) = (
-            now.cast_ray(origin, dir, max, &f),
-            fresh.cast_ray(origin, dir, max, &f),
-        );
-        prop_assert_eq!(a.as_ref().map(ray_bits), b.as_ref().map(ray_bits));
-        hits += usize::from(b.is_some());
-        let (a, b) = (
-            now.cast_ray_all(origin, dir, max, &f),
-            fresh.cast_ray_all(origin, dir, max, &f),
-        );
-        prop_assert_eq!(
-            a.iter().map(ray_bits).collect::<Vec<_>>(),
-            b.iter().map(ray_bits).collect::<Vec<_>>()
-        );
-        let s = shape(rng);
-        let pose = Pose::new(rng.vec(-0.2, 1.2) * size, rng.range(-3.0, 3.0));
-        let t = rng.vec(-1.0, 1.0) * size * 0.5;
-        let (a, b) = (
-            now.cast_shape(&s, pose, t, &f),
-            fresh.cast_shape(&s, pose, t, &f),
-        );
-        prop_assert_eq!(a.as_ref().map(shape_bits), b.as_ref().map(shape_bits));
-        hits += usize::from(b.is_some());
-        let point = rng.vec(0.0, 1.0) * size;
-        let b = fresh.overlap_point(point, &f);
-        hits += usize::from(!b.is_empty());
-        prop_assert_eq!(now.overlap_point(point, &f), b);
-        let c = rng.vec(-0.1, 1.1) * size;
-        let h = rng.vec(0.1, 8.0);
-        let q = Bounds {
-            min: c - h,
-            max: c + h,
-        };
-        let b = fresh.overlap_aabb(q, &f);
-        hits += usize::from(!b.is_empty());
-        prop_assert_eq!(now.overlap_aabb(q, &f), b);
-        let b = fresh.overlap_shape(&s, pose, &f);
-        hits += usize::from(!b.is_empty());
-        prop_assert_eq!(now.overlap_shape(&s, pose, &f), b);
-    }
-    Ok(hits)
+    random_scene::same_answers(now, fresh, rng, size, 8)
 }
 
 /// One case: a random scene stepped `steps` frames, asked random queries in about half of

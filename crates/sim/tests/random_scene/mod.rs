@@ -3,6 +3,7 @@
 //! random query filters, and query answers as bits.
 #![allow(dead_code, reason = "each test file uses its own part of the helpers")]
 
+use proptest::prelude::*;
 use ricochet_sim::Doomed;
 use ricochet_sim::prelude::*;
 
@@ -206,4 +207,124 @@ pub fn shape_bits(h: &ShapeHit) -> (Entity, [u64; 5]) {
             b(h.normal.y),
         ],
     )
+}
+
+/// The scene queries, as a `Simulation` answers them now and a `Past` answers them then: the
+/// two tests ask both the same way.
+pub trait Queries {
+    fn cast_ray(&self, o: Vec2, d: Vec2, max: f64, f: &QueryFilter) -> Option<RayHit>;
+    fn cast_ray_all(&self, o: Vec2, d: Vec2, max: f64, f: &QueryFilter) -> Vec<RayHit>;
+    fn cast_shape(&self, s: &Shape, pose: Pose, t: Vec2, f: &QueryFilter) -> Option<ShapeHit>;
+    fn overlap_point(&self, p: Vec2, f: &QueryFilter) -> Vec<Entity>;
+    fn overlap_aabb(&self, b: Bounds, f: &QueryFilter) -> Vec<Entity>;
+    fn overlap_shape(&self, s: &Shape, pose: Pose, f: &QueryFilter) -> Vec<Entity>;
+}
+
+/// Implements [`Queries`] by the type's own methods of the same names.
+macro_rules! queries_by_own_methods {
+    ($t:ty) => {
+        impl Queries for $t {
+            fn cast_ray(&self, o: Vec2, d: Vec2, max: f64, f: &QueryFilter) -> Option<RayHit> {
+                <$t>::cast_ray(self, o, d, max, f)
+            }
+            fn cast_ray_all(&self, o: Vec2, d: Vec2, max: f64, f: &QueryFilter) -> Vec<RayHit> {
+                <$t>::cast_ray_all(self, o, d, max, f)
+            }
+            fn cast_shape(
+                &self,
+                s: &Shape,
+                pose: Pose,
+                t: Vec2,
+                f: &QueryFilter,
+            ) -> Option<ShapeHit> {
+                <$t>::cast_shape(self, s, pose, t, f)
+            }
+            fn overlap_point(&self, p: Vec2, f: &QueryFilter) -> Vec<Entity> {
+                <$t>::overlap_point(self, p, f)
+            }
+            fn overlap_aabb(&self, b: Bounds, f: &QueryFilter) -> Vec<Entity> {
+                <$t>::overlap_aabb(self, b, f)
+            }
+            fn overlap_shape(&self, s: &Shape, pose: Pose, f: &QueryFilter) -> Vec<Entity> {
+                <$t>::overlap_shape(self, s, pose, f)
+            }
+        }
+    };
+}
+
+queries_by_own_methods!(Simulation);
+queries_by_own_methods!(Past<'_>);
+
+/// Asks `ours` and `theirs` (the independent source: a scene restored at the same frame)
+/// `rounds` rounds of random queries (rays, all hits of a ray, a cast shape, a point, a
+/// box, a shape; filters drawn from `theirs`' bodies), and one box around everything;
+/// every answer must be the same bits. How many of `theirs`' answers found something.
+pub fn same_answers(
+    ours: &impl Queries,
+    theirs: &Simulation,
+    rng: &mut Rng,
+    size: Vec2,
+    rounds: usize,
+) -> Result<usize, TestCaseError> {
+    let live = theirs.world().entity.clone();
+    let everywhere = Bounds {
+        min: Vec2::splat(-1e6),
+        max: Vec2::splat(1e6),
+    };
+    prop_assert_eq!(
+        ours.overlap_aabb(everywhere, &QueryFilter::all()),
+        theirs.overlap_aabb(everywhere, &QueryFilter::all())
+    );
+    let mut hits = 0;
+    for _ in 0..rounds {
+        let f = filter(rng, &live);
+        // Inside the world and out of it (wrapped in first in a wrap world).
+        let origin = rng.vec(-0.2, 1.2) * size;
+        let dir = rng.vec(-1.0, 1.0);
+        let max = if rng.chance(0.1) {
+            f64::INFINITY
+        } else {
+            rng.range(0.0, 3.0) * size.max_element()
+        };
+        let (a, b) = (
+            ours.cast_ray(origin, dir, max, &f),
+            theirs.cast_ray(origin, dir, max, &f),
+        );
+        prop_assert_eq!(a.as_ref().map(ray_bits), b.as_ref().map(ray_bits));
+        hits += usize::from(b.is_some());
+        let (a, b) = (
+            ours.cast_ray_all(origin, dir, max, &f),
+            theirs.cast_ray_all(origin, dir, max, &f),
+        );
+        prop_assert_eq!(
+            a.iter().map(ray_bits).collect::<Vec<_>>(),
+            b.iter().map(ray_bits).collect::<Vec<_>>()
+        );
+        let s = shape(rng);
+        let pose = Pose::new(rng.vec(-0.2, 1.2) * size, rng.range(-3.0, 3.0));
+        let t = rng.vec(-1.0, 1.0) * size * 0.5;
+        let (a, b) = (
+            ours.cast_shape(&s, pose, t, &f),
+            theirs.cast_shape(&s, pose, t, &f),
+        );
+        prop_assert_eq!(a.as_ref().map(shape_bits), b.as_ref().map(shape_bits));
+        hits += usize::from(b.is_some());
+        let point = rng.vec(0.0, 1.0) * size;
+        let b = theirs.overlap_point(point, &f);
+        hits += usize::from(!b.is_empty());
+        prop_assert_eq!(ours.overlap_point(point, &f), b);
+        let c = rng.vec(-0.1, 1.1) * size;
+        let h = rng.vec(0.1, 8.0);
+        let q = Bounds {
+            min: c - h,
+            max: c + h,
+        };
+        let b = theirs.overlap_aabb(q, &f);
+        hits += usize::from(!b.is_empty());
+        prop_assert_eq!(ours.overlap_aabb(q, &f), b);
+        let b = theirs.overlap_shape(&s, pose, &f);
+        hits += usize::from(!b.is_empty());
+        prop_assert_eq!(ours.overlap_shape(&s, pose, &f), b);
+    }
+    Ok(hits)
 }
