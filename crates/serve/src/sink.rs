@@ -29,6 +29,13 @@ impl LiveSink {
         LiveSink { hub }
     }
 
+    /// Publishes `payload` (an encoded message) on `channel` to its subscribers.
+    fn publish(&self, channel: ChannelId, time_ns: u64, payload: Vec<u8>) {
+        self.hub
+            .lock()
+            .publish(u32::from(channel.index()), time_ns, payload);
+    }
+
     fn topic<'a>(&self, topic: &'a str) -> &'a str {
         if topic == "/input" {
             RECORDED_INPUT
@@ -53,10 +60,7 @@ impl MessageSink for LiveSink {
         time_ns: u64,
         message: M,
     ) -> Result<(), LogError> {
-        let payload = message.encode_to_vec();
-        self.hub
-            .lock()
-            .publish(u32::from(channel.index()), time_ns, payload);
+        self.publish(channel, time_ns, message.encode_to_vec());
         Ok(())
     }
 
@@ -79,9 +83,7 @@ impl MessageSink for LiveSink {
         time_ns: u64,
         json: Vec<u8>,
     ) -> Result<(), LogError> {
-        self.hub
-            .lock()
-            .publish(u32::from(channel.index()), time_ns, json);
+        self.publish(channel, time_ns, json);
         Ok(())
     }
 

@@ -72,12 +72,18 @@ impl Quad {
     fn of(boxes: &[Bounds]) -> Quad {
         let mut q = Quad::EMPTY;
         for (j, b) in boxes.iter().enumerate() {
-            q.c[MIN_X][j] = b.min.x;
-            q.c[MIN_Y][j] = b.min.y;
-            q.c[MAX_X][j] = b.max.x;
-            q.c[MAX_Y][j] = b.max.y;
+            q.set_lane(j, b);
         }
         q
+    }
+
+    /// Sets lane `j` to `b` (what [`Quad::lane`] reads back).
+    #[inline]
+    pub(super) fn set_lane(&mut self, j: usize, b: &Bounds) {
+        self.c[MIN_X][j] = b.min.x;
+        self.c[MIN_Y][j] = b.min.y;
+        self.c[MAX_X][j] = b.max.x;
+        self.c[MAX_Y][j] = b.max.y;
     }
 
     /// The box around the four (ignoring empty and NaN lanes, as [`hull`]).

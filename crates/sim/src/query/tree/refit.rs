@@ -11,13 +11,7 @@ impl QueryTree {
     /// nodes above it are stale.
     #[inline]
     pub(crate) fn set_member(&mut self, k: usize, b: Bounds) {
-        let b = stored(b);
-        let q = &mut self.quads[k / LEAF];
-        let j = k % LEAF;
-        q.c[MIN_X][j] = b.min.x;
-        q.c[MIN_Y][j] = b.min.y;
-        q.c[MAX_X][j] = b.max.x;
-        q.c[MAX_Y][j] = b.max.y;
+        self.quads[k / LEAF].set_lane(k % LEAF, &stored(b));
     }
 
     /// Recomputes every node above the members from the members' boxes as they are now
@@ -40,11 +34,7 @@ impl QueryTree {
                 let last = (first + LEAF).min(this);
                 let mut q = Quad::EMPTY;
                 for (j, c) in (first..last).enumerate() {
-                    let h = self.quads[c].hull();
-                    q.c[MIN_X][j] = h.min.x;
-                    q.c[MIN_Y][j] = h.min.y;
-                    q.c[MAX_X][j] = h.max.x;
-                    q.c[MAX_Y][j] = h.max.y;
+                    q.set_lane(j, &self.quads[c].hull());
                 }
                 self.quads[this + n] = q;
             }
