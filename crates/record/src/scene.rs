@@ -126,6 +126,15 @@ fn vec3(x: f64, y: f64, z: f64) -> Option<Vector3> {
 
 /// A rotation by `yaw` about z.
 fn yaw(angle: f64) -> Option<Quaternion> {
+    if angle == 0.0 {
+        // What `sincos` gives, but for a zero's sign, which proto3 never encodes.
+        return Some(Quaternion {
+            x: 0.0,
+            y: 0.0,
+            z: 0.0,
+            w: 1.0,
+        });
+    }
     let (s, c) = libm::sincos(angle / 2.0);
     Some(Quaternion {
         x: 0.0,
@@ -172,8 +181,17 @@ fn fill(entity: &mut SceneEntity, outline: impl Iterator<Item = Vec2>, color: Co
 /// world coordinates. An AABB part does not turn: only its centre turns with the body.
 /// Polygons and capsules join the entity's one triangle list (one batch for the viewer).
 fn draw(entity: &mut SceneEntity, prim: &Primitive, at: Vec2, angle: f64, color: Color) {
-    let rot = Rot::from_angle(angle);
-    let place = |v: Vec2| at + rot.apply(v);
+    // The turn is found only for a part off the body's centre: a centred circle is at `at`
+    // whatever the angle (but for a zero's sign, which proto3 never encodes), and a sine and
+    // cosine per body were a quarter of a big scene's drawing.
+    let rot = || Rot::from_angle(angle);
+    let place = |v: Vec2| {
+        if v == Vec2::ZERO {
+            at
+        } else {
+            at + rot().apply(v)
+        }
+    };
     match prim {
         Primitive::Circle(c) => entity.cylinders.push(CylinderPrimitive {
             // Foxglove cylinders stand along z: lying in the XY plane needs no turn.
@@ -196,7 +214,8 @@ fn draw(entity: &mut SceneEntity, prim: &Primitive, at: Vec2, angle: f64, color:
         // A capsule is its segment's rectangle and a disc at each end: primitives that the
         // viewer draws as instanced batches, in fewer numbers than an outline.
         Primitive::Capsule(c) => {
-            let (a, b) = (place(c.a), place(c.b));
+            let rot = rot();
+            let (a, b) = (at + rot.apply(c.a), at + rot.apply(c.b));
             let d = b - a;
             let turn = if d == Vec2::ZERO {
                 0.0
@@ -218,7 +237,14 @@ fn draw(entity: &mut SceneEntity, prim: &Primitive, at: Vec2, angle: f64, color:
                 });
             }
         }
-        Primitive::Polygon(p) => fill(entity, p.vertices().iter().map(|v| place(*v)), color),
+        Primitive::Polygon(p) => {
+            let rot = rot();
+            fill(
+                entity,
+                p.vertices().iter().map(|v| at + rot.apply(*v)),
+                color,
+            );
+        }
         // A chain segment (zero thickness) is drawn as a line of the entity's one line list.
         Primitive::Segment(s) => {
             if entity.lines.is_empty() {
@@ -233,9 +259,10 @@ fn draw(entity: &mut SceneEntity, prim: &Primitive, at: Vec2, angle: f64, color:
                     indices: Vec::new(),
                 });
             }
+            let rot = rot();
             entity.lines[0]
                 .points
-                .extend([place(s.a), place(s.b)].map(p3));
+                .extend([at + rot.apply(s.a), at + rot.apply(s.b)].map(p3));
         }
     }
 }
