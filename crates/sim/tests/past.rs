@@ -10,7 +10,7 @@ use ricochet_sim::{HistoryError, MAX_HISTORY};
 
 mod random_scene;
 
-use random_scene::{Rng, edit, scenario};
+use random_scene::{Rng, edit, probed_size, scenario};
 
 /// Asks `past` and `then` (the scene restored at the same frame) the same random queries.
 fn same_answers(
@@ -28,10 +28,7 @@ fn same_answers(
 fn check(seed: u64, keep: usize, steps: u64) -> Result<usize, TestCaseError> {
     let mut rng = Rng(seed);
     let scene = scenario(&mut rng, "past", 20, 1.0);
-    let size = scene
-        .world
-        .bounds
-        .map_or(Vec2::new(40.0, 40.0), |b| b.size());
+    let size = probed_size(&scene);
     let mut sim = Simulation::new(&scene);
     sim.keep_history(keep).unwrap();
     // The snapshot right after each frame's step: what `past` must answer as.

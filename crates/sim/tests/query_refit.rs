@@ -10,7 +10,7 @@ use ricochet_sim::prelude::*;
 
 mod random_scene;
 
-use random_scene::{Rng, edit, scenario};
+use random_scene::{Rng, edit, probed_size, scenario};
 
 /// Some moving bodies never turn: a refit moves them with no sine or cosine.
 const TURNING: f64 = 0.6;
@@ -32,10 +32,7 @@ fn same_answers(
 fn check(seed: u64, count: usize, steps: u64) -> Result<usize, TestCaseError> {
     let mut rng = Rng(seed);
     let scene = scenario(&mut rng, "refit", count, TURNING);
-    let size = scene
-        .world
-        .bounds
-        .map_or(Vec2::new(40.0, 40.0), |b| b.size());
+    let size = probed_size(&scene);
     let mut sim = Simulation::new(&scene);
     let mut fresh = Simulation::new(&scene);
     let mut hits = 0;
@@ -83,10 +80,7 @@ fn answers_do_not_depend_on_earlier_queries() {
     for seed in [3, 17, 2024] {
         let mut rng = Rng(seed);
         let scene = scenario(&mut rng, "refit", 140, TURNING);
-        let size = scene
-            .world
-            .bounds
-            .map_or(Vec2::new(40.0, 40.0), |b| b.size());
+        let size = probed_size(&scene);
         let (mut asked, mut quiet) = (Simulation::new(&scene), Simulation::new(&scene));
         let mut probe = Rng(seed ^ 0x5eed);
         let mut found = 0;
@@ -126,10 +120,7 @@ fn a_clone_and_its_original_answer_each_for_itself() {
     for seed in [5, 41, 977] {
         let mut rng = Rng(seed);
         let scene = scenario(&mut rng, "refit", 120, TURNING);
-        let size = scene
-            .world
-            .bounds
-            .map_or(Vec2::new(40.0, 40.0), |b| b.size());
+        let size = probed_size(&scene);
         let mut sim = Simulation::new(&scene);
         let mut fresh = Simulation::new(&scene);
         sim.step();

@@ -126,6 +126,15 @@ pub fn scenario(rng: &mut Rng, name: &str, count: usize, turning: f64) -> Scenar
     }
 }
 
+/// The area a test probes `scene` in with queries, from the origin: its world's bounds, or
+/// 40 x 40 when it has none (its bodies were spawned within 20 to 60 a side).
+pub fn probed_size(scene: &Scenario) -> Vec2 {
+    scene
+        .world
+        .bounds
+        .map_or(Vec2::new(40.0, 40.0), |b| b.size())
+}
+
 /// Spawns, despawns, reshapes or moves a few bodies between two steps. Half the new shapes
 /// are a live body's (the world's shape table then gains nothing: only the bodies change).
 pub fn edit(sim: &mut Simulation, rng: &mut Rng, size: Vec2) {
