@@ -23,7 +23,11 @@ pub const KEYFRAME_INTERVAL: u64 = 60;
 /// (issue #37). Bytes, never time: the same log on every machine.
 pub const KEYFRAME_BYTES_PER_FRAME: u64 = 8 * 1024;
 
-/// What was last recorded of a body alive at the end of the previous frame.
+mod undisturbed;
+
+/// What was last recorded of a body alive at the end of the previous frame (or, for a body
+/// nothing disturbed since, of frame `seen`: see `bodies/undisturbed.rs`).
+#[derive(Clone, Debug, PartialEq)]
 struct Known {
     generation: u32,
     position: Vec2,
@@ -36,7 +40,7 @@ struct Known {
     /// A static body: drawn on `/scene/static`, and listed in `/bodies` only when it appears
     /// or changes (keyframes list the moving bodies).
     is_static: bool,
-    /// The frame it was last seen in the world.
+    /// The frame it was last seen in the world, which its state is of.
     seen: u64,
 }
 
@@ -196,7 +200,7 @@ pub struct Changes {
 }
 
 /// The last recorded state of every body, by slot.
-#[derive(Default)]
+#[derive(Clone, Default)]
 pub struct Tracker {
     known: Vec<Option<Known>>,
     alive: usize,
@@ -207,6 +211,22 @@ pub struct Tracker {
     next_keyframe: u64,
     /// Scratch: the dense indices [`Tracker::settle`] left to the general case.
     unsettled: Vec<usize>,
+    /// The world's [`ricochet_sim::Disturbed`] serial and step count at the last frame.
+    world: (u64, u64),
+    /// Some bodies' state is of an earlier frame than the last (`bodies/undisturbed.rs`).
+    lagging: bool,
+}
+
+/// Which bodies a frame compares with their records.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Pass {
+    /// Every body, each moving one listed in full.
+    Keyframe,
+    /// Every body: the ones that did what a reader predicts settled first.
+    Every,
+    /// Only the ones the world names as disturbed, and those the usual integration does
+    /// not move (`bodies/undisturbed.rs`).
+    Disturbed,
 }
 
 /// What [`Tracker::settle`] saw move.
@@ -280,10 +300,43 @@ impl Tracker {
         want_bodies: bool,
         velocities_drawn: bool,
     ) -> Changes {
+        let pass = if !self.started
+            || (out.frame.is_multiple_of(KEYFRAME_INTERVAL) && out.frame >= self.next_keyframe)
+        {
+            Pass::Keyframe
+        } else if self.may_skip(world, out.frame, def.gravity) {
+            Pass::Disturbed
+        } else {
+            Pass::Every
+        };
+        #[cfg(debug_assertions)]
+        let oracle = (pass == Pass::Disturbed).then(|| self.clone());
+        let changes = self.changes(world, out, def, (want_bodies, velocities_drawn), pass);
+        #[cfg(debug_assertions)]
+        if let Some(oracle) = oracle {
+            let args = (out, def, want_bodies, velocities_drawn);
+            undisturbed::check(oracle, self, world, args, &changes);
+        }
+        let d = world.disturbed();
+        self.world = (d.serial(), d.steps());
+        changes
+    }
+
+    /// [`Tracker::frame`]'s changes, taking its `want_bodies` and `velocities_drawn`, in a
+    /// [`Pass`].
+    fn changes(
+        &mut self,
+        world: &World,
+        out: &FrameOutput,
+        def: &WorldDef,
+        (want_bodies, velocities_drawn): (bool, bool),
+        pass: Pass,
+    ) -> Changes {
+        let keyframe = pass == Pass::Keyframe;
+        let skip = pass == Pass::Disturbed;
         let (layers, dt, gravity) = (&def.layers, def.dt, def.gravity);
         let frame = out.frame;
-        let keyframe = !self.started
-            || (frame.is_multiple_of(KEYFRAME_INTERVAL) && frame >= self.next_keyframe);
+        let previous = self.frame;
         let (mut scene_changed, mut static_changed) = (!self.started, !self.started);
         for r in &out.removed {
             *if r.kind == BodyKind::Static {
@@ -302,14 +355,22 @@ impl Tracker {
             0
         });
         // Most bodies of a big scene did only what a reader predicts: settled first, in a
-        // loop of their own; the others take the general case below, in world order.
-        if keyframe {
-            self.unsettled.clear();
-            self.unsettled.extend(0..world.len());
+        // loop of their own (or, `skip`, not looked at); the others take the general case
+        // below, in world order.
+        if skip {
+            self.gather_disturbed(world, previous, dt);
         } else {
-            let settled = self.settle(world, frame, gravity * dt, dt, velocities_drawn);
-            scene_changed |= settled.scene_changed;
-            static_changed |= settled.static_changed;
+            if self.lagging {
+                self.catch_up(previous, dt);
+            }
+            if keyframe {
+                self.unsettled.clear();
+                self.unsettled.extend(0..world.len());
+            } else {
+                let settled = self.settle(world, frame, gravity * dt, dt, velocities_drawn);
+                scene_changed |= settled.scene_changed;
+                static_changed |= settled.static_changed;
+            }
         }
         let unsettled = std::mem::take(&mut self.unsettled);
         for &i in &unsettled {
@@ -416,7 +477,11 @@ impl Tracker {
             k.angular_velocity = angular_velocity;
         }
         self.unsettled = unsettled;
-        if self.alive != world.len() {
+        if skip {
+            let (scene, statics) = self.after_skip(world, out, scene_changed, dt);
+            scene_changed |= scene;
+            static_changed |= statics;
+        } else if self.alive != world.len() {
             // Some bodies went (removed, or despawned between frames): forget them.
             for slot in &mut self.known {
                 if let Some(k) = slot.as_ref()

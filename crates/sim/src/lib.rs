@@ -219,7 +219,7 @@ pub use scenario::{Scenario, TileRows, TiledDef};
 pub use snapshot::{SNAPSHOT_VERSION, Snapshot, SnapshotError};
 pub use stage_set::{Stage, StageSet};
 pub use stages::SLOP;
-pub use world::{Inputs, Motion, World};
+pub use world::{Disturbed, Inputs, Motion, World};
 
 /// The geometry crate, for what the prelude does not re-export (the narrow phase, ...).
 pub use ricochet_geom as geom;

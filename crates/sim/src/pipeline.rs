@@ -369,8 +369,9 @@ impl Simulation {
     /// three motion stages in one pass over the active bodies ([`World::integrate`]), each
     /// part run, and counted as run or skipped, exactly when its own stage would be.
     /// Moving changes no velocity and no body's activity, so each stage's `has_work` gives
-    /// the same answer here as in its turn.
-    fn run_motion(&mut self, out: &mut FrameOutput) {
+    /// the same answer here as in its turn. True when all three parts ran: the usual pass,
+    /// which moves every active body as a reader predicts ([`crate::Disturbed`]).
+    fn run_motion(&mut self, out: &mut FrameOutput) -> bool {
         let mut run = [false; MOTION.len()];
         for (r, &stage) in run.iter_mut().zip(&MOTION) {
             *r = self.has_work(stage, out);
@@ -385,6 +386,7 @@ impl Simulation {
         if x || y || turn {
             self.world.integrate(self.scenario.world.dt, x, y, turn);
         }
+        x && y && turn
     }
 
     /// Whether a body may ride a carrier: a per-axis (`separate`) pair of boxes, or a
@@ -395,6 +397,7 @@ impl Simulation {
 
     /// Runs one frame and reports what happened.
     pub fn step(&mut self) -> FrameOutput {
+        self.world.begin_step();
         self.queries.invalidate(&self.world);
         let mut out = FrameOutput {
             frame: self.frame,
@@ -405,6 +408,9 @@ impl Simulation {
         let w = &mut self.world;
         w.start_frame();
         let mut fused = false;
+        // Whether the usual integration ran (see [`crate::Disturbed`]): if not, every body
+        // is named as disturbed.
+        let mut usual = false;
         for stage in Stage::ALL {
             let allowed = self.frame > 0 || FRAME_ZERO.contains(&stage);
             if fused && MOTION.contains(&stage) {
@@ -432,7 +438,7 @@ impl Simulation {
             }
             if allowed && stage == Stage::MoveX && !self.carries() {
                 fused = true;
-                self.run_motion(&mut out);
+                usual = self.run_motion(&mut out);
                 continue;
             }
             if allowed && self.has_work(stage, &out) {
@@ -447,6 +453,10 @@ impl Simulation {
                 self.slopes.snap(&mut self.world, &self.scenario.world);
             }
         }
+        if !usual {
+            self.world.disturb_all();
+        }
+        self.world.end_step();
         out.stats.bodies = self.world.len();
         out.stats.contacts = out.contacts.len() as u64;
         out.stats.kinetic_energy = self.world.kinetic_energy();

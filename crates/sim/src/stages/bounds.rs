@@ -26,6 +26,7 @@ pub(crate) fn run(ctx: &mut StageCtx) {
     w.active_not_inside(b.min, b.max, &mut outside);
     for i in outside {
         let i = i as usize;
+        w.disturb(i);
         let p = &mut w.position[i];
         for axis in 0..2 {
             if p[axis] < b.min[axis] || p[axis] >= b.max[axis] {

@@ -36,6 +36,9 @@ pub(crate) fn run(ctx: &mut StageCtx, focus: &mut Option<Entity>) {
     for k in 0..w.movers().len() {
         let i = w.movers()[k] as usize;
         let outside = area.is_some_and(|a| Some(i) != found && !w.bounds(i).overlaps(&a));
+        if w.frozen(i) != outside {
+            w.disturb(i);
+        }
         *w.frozen_mut(i) = outside;
         if outside {
             // Thawed, it finds what it stands on again: the lift it rode has moved on.

@@ -195,7 +195,7 @@ pub(crate) fn run(ctx: &mut StageCtx, st: &mut OneWayState) {
         };
         let moved = Vec2::new(0.0, y - w.position[i].y);
         let pose_before = w.pose(i);
-        w.position[i].y = y;
+        w.position_mut(i).y = y;
         // As a `separate` push up: the velocity into the platform stops (a kinematic
         // platform carries the body by its own motion).
         let v = w.velocity_mut(i);

@@ -241,7 +241,7 @@ pub(crate) fn separate_along_normal(
     }
     let mut pushed = Vec2::ZERO;
     if di {
-        w.position[i] += pi;
+        *w.position_mut(i) += pi;
         let vn = w.velocity(i).dot(normal);
         if vn > 0.0 {
             *w.velocity_mut(i) -= normal * vn;
@@ -253,7 +253,7 @@ pub(crate) fn separate_along_normal(
         pushed = pi;
     }
     if dj {
-        w.position[j] += pj;
+        *w.position_mut(j) += pj;
         let vn = w.velocity(j).dot(normal);
         if vn < 0.0 {
             *w.velocity_mut(j) -= normal * vn;

@@ -416,7 +416,7 @@ fn flush(w: &World, i: usize, bi: &Bounds, axis: usize, stop: sweep_axis::Stop) 
 /// Moves body `i` to `to` along `axis` (a push by `push`), stops its motion into the obstacle, and notes
 /// landing (pushed up) and walkers turning round (pushed along x).
 fn apply_push(w: &mut crate::World, i: usize, axis: usize, to: f64, push: f64) {
-    w.position[i][axis] = to;
+    w.position_mut(i)[axis] = to;
     let v = &mut w.velocity_mut(i)[axis];
     if (push < 0.0 && *v > 0.0) || (push > 0.0 && *v < 0.0) {
         *v = 0.0;

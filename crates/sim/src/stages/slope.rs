@@ -124,7 +124,7 @@ pub(crate) fn stand(
     match surface {
         Surface::Ground => {
             let lift = Vec2::new(0.0, depth / up.y);
-            w.position[i].y += lift.y;
+            w.position_mut(i).y += lift.y;
             let v = w.velocity_mut(i);
             if v.y < 0.0 {
                 v.y = 0.0;
@@ -135,7 +135,7 @@ pub(crate) fn stand(
         }
         Surface::Wall => {
             let push = Vec2::new(depth / up.x, 0.0);
-            w.position[i].x += push.x;
+            w.position_mut(i).x += push.x;
             let v = w.velocity_mut(i);
             if v.x * up.x < 0.0 {
                 v.x = 0.0;
@@ -266,7 +266,7 @@ impl SlopeState {
                 }
             }
             if let Some((_, at)) = best {
-                w.position[i].y = at.y;
+                w.position_mut(i).y = at.y;
                 let v = w.velocity_mut(i);
                 if v.y < 0.0 {
                     v.y = 0.0;

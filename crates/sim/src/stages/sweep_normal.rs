@@ -77,7 +77,7 @@ pub(crate) fn apply(ctx: &mut StageCtx, (i, j): (usize, usize), impact: &Impact)
         (j, impact.pose_b.position)
     };
     let end = w.position[d];
-    w.position[d] = at;
+    *w.position_mut(d) = at;
     let c = contact(w.shape(i), &w.pose(i), w.shape(j), &w.pose(j));
     let (normal, depth) = if c.depth > SLOP {
         (c.normal, c.depth)

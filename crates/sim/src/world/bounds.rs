@@ -126,7 +126,7 @@ impl World {
     /// back in before `detect`, its motion over the frame unchanged.
     pub(crate) fn wrap_to(&mut self, i: usize, position: Vec2) {
         let shift = position - self.position[i];
-        self.position[i] = position;
+        *self.position_mut(i) = position;
         let r = self.row[i];
         if r != NO_ROW {
             self.rows.start_position[r as usize] += shift;

@@ -36,6 +36,7 @@ use crate::scenario::TileRows;
 mod bounds;
 #[cfg(test)]
 mod checksum_fields;
+mod disturbed;
 mod measures;
 mod motion;
 mod rows;
@@ -43,6 +44,7 @@ mod sleep;
 mod state;
 
 pub(crate) use bounds::placed;
+pub use disturbed::Disturbed;
 pub use rows::Motion;
 pub(crate) use state::{Bodies, PackedWorld};
 
@@ -68,7 +70,9 @@ pub struct Inputs {
 const NO_ROW: u32 = u32::MAX;
 
 /// The body columns. The every-body columns are public for reading; change bodies through
-/// the methods so the columns stay in step.
+/// the methods so the columns stay in step and the world names what it disturbed
+/// ([`World::disturbed`]: inside the crate, `position_mut`, `angle_mut`, `velocity_mut`
+/// and `angular_velocity_mut`, never the columns themselves, outside the integrator).
 #[derive(Clone, Debug, Default)]
 pub struct World {
     ids: EntityAllocator,
@@ -117,6 +121,8 @@ pub struct World {
     /// them (`history.rs`). A world a restore builds or patches takes a number never used
     /// before ([`crate::interned::next_serial`]): it is another world.
     layout: u64,
+    /// The bodies touched other than by the usual integration ([`World::disturbed`]).
+    disturbed: Disturbed,
 }
 
 impl World {
@@ -313,6 +319,7 @@ impl World {
         self.layout += 1;
         let i = self.entity.partition_point(|x| *x < e);
         self.entity.insert(i, e);
+        self.disturb(i);
         let name = self.names.acquire(def.name.as_str(), || ());
         self.layer.insert(i, def.layer);
         shape_key(&def.shape, &mut self.key);
@@ -381,6 +388,7 @@ impl World {
     /// Removes the body at dense index `i`, keeping the order of the rest.
     pub fn despawn(&mut self, i: usize) {
         self.layout += 1;
+        self.disturb(i);
         let e = self.entity.remove(i);
         self.ids.free(e);
         let layer = self.layer.remove(i);
@@ -434,8 +442,8 @@ impl World {
     /// moving body wakes and no longer rides what it stood on. The frame's swept tests start
     /// from the new position.
     pub fn teleport(&mut self, i: usize, position: Vec2, angle: f64) {
-        self.position[i] = position;
-        self.angle[i] = angle;
+        *self.position_mut(i) = position;
+        *self.angle_mut(i) = angle;
         let r = self.row[i];
         if r != NO_ROW {
             let r = r as usize;

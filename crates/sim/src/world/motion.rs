@@ -32,7 +32,8 @@ impl World {
     /// The `forces` stage's `v += (force + thrust + g * (m * gravity_scale)) / m * dt` for
     /// every active dynamic body, `thrust` giving a controlled body's engine force from its
     /// controller, inputs and angle (zero for a body without a controller). The columns
-    /// are read by row directly: one pass, no per-column check for scenery.
+    /// are read by row directly: one pass, no per-column check for scenery. A body whose
+    /// velocity's bits changed is named as disturbed ([`World::disturbed`]).
     pub(crate) fn accelerate(
         &mut self,
         dt: f64,
@@ -40,6 +41,7 @@ impl World {
         thrust: impl Fn(&Controller, &Inputs, f64) -> Vec2,
     ) {
         let (row, rows, kind, angle) = (&self.row, &mut self.rows, &self.kind, &self.angle);
+        let (entity, disturbed) = (&self.entity, &mut self.disturbed);
         for &i in &self.active {
             let i = i as usize;
             if kind[i] != BodyKind::Dynamic {
@@ -53,7 +55,12 @@ impl World {
             };
             let sum = rows.force[r] + push + g * (m * rows.gravity_scale[r]);
             let a = sum / m;
-            rows.velocity[r] += a * dt;
+            let v = rows.velocity[r];
+            let changed = v + a * dt;
+            if changed.x.to_bits() != v.x.to_bits() || changed.y.to_bits() != v.y.to_bits() {
+                disturbed.name(entity[i], entity.len());
+            }
+            rows.velocity[r] = changed;
         }
     }
 

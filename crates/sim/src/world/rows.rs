@@ -111,8 +111,6 @@ row_readers! {
 }
 
 row_writers! {
-    velocity, velocity_mut: Vec2;
-    angular_velocity, angular_velocity_mut: f64;
     force, force_mut: Vec2;
     inputs, inputs_mut: Inputs;
     grounded, grounded_mut: bool;
@@ -122,6 +120,39 @@ row_writers! {
     frozen, frozen_mut: bool;
     rest_frames, rest_frames_mut: u32;
     user_data, user_data_mut: u128;
+}
+
+impl World {
+    /// [`World::velocity`] of body `i`, to change: the body is named as disturbed
+    /// ([`World::disturbed`]).
+    #[inline]
+    pub(crate) fn velocity_mut(&mut self, i: usize) -> &mut Vec2 {
+        self.disturb(i);
+        let r = self.row_of(i);
+        &mut self.rows.velocity[r]
+    }
+
+    /// [`World::angular_velocity`] of body `i`, to change: the body is named as disturbed.
+    #[inline]
+    pub(crate) fn angular_velocity_mut(&mut self, i: usize) -> &mut f64 {
+        self.disturb(i);
+        let r = self.row_of(i);
+        &mut self.rows.angular_velocity[r]
+    }
+
+    /// Body `i`'s position, to change: the body is named as disturbed.
+    #[inline]
+    pub(crate) fn position_mut(&mut self, i: usize) -> &mut Vec2 {
+        self.disturb(i);
+        &mut self.position[i]
+    }
+
+    /// Body `i`'s angle, to change: the body is named as disturbed.
+    #[inline]
+    pub(crate) fn angle_mut(&mut self, i: usize) -> &mut f64 {
+        self.disturb(i);
+        &mut self.angle[i]
+    }
 }
 
 /// One body's motion, as [`World::motions`] reads it.

@@ -13,6 +13,7 @@ impl World {
         let r = r as usize;
         if self.rows.asleep[r] {
             self.sleeping -= 1;
+            self.disturb(i);
         }
         self.rows.asleep[r] = false;
         self.rows.rest_frames[r] = 0;
@@ -24,6 +25,7 @@ impl World {
         let r = self.row_of(i);
         if !self.rows.asleep[r] {
             self.sleeping += 1;
+            self.disturb(i);
         }
         self.rows.asleep[r] = true;
         self.rows.carrier[r] = None;
@@ -38,6 +40,7 @@ impl World {
     /// Wakes every sleeping body, now: the active list is recomputed.
     pub fn wake_all(&mut self) {
         if self.sleeping > 0 {
+            self.disturb_all();
             self.sleeping = 0;
             self.rows.asleep.fill(false);
             self.rows.rest_frames.fill(0);

@@ -190,6 +190,7 @@ impl World {
             key,
             reshaped,
             layout: _,
+            disturbed,
         } = self;
         World {
             ids: EntityAllocator::default(),
@@ -214,6 +215,8 @@ impl World {
             reshaped: *reshaped,
             // Another world: its own serial.
             layout: crate::interned::next_serial(),
+            // Another world: its own serial, every body named.
+            disturbed: disturbed.clone(),
         }
     }
 

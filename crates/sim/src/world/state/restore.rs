@@ -13,6 +13,7 @@ impl World {
             *self = World::rebuilt(base, b);
         }
         self.layout = crate::interned::next_serial();
+        self.disturb_all();
     }
 
     /// Patches the columns in place; false (nothing changed) when this world's bodies are
