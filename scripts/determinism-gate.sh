@@ -9,7 +9,7 @@
 #    wasi-libc (apt, once; skipped when present);
 # 2. builds crates/portable (ricochet-portable: ricochet-sim + the built-in scenes) natively
 #    with the workspace's toolchain, and with Debian's rustc and -Zbuild-std for
-#    aarch64-unknown-linux-gnu (with the recorder: zstd's C source through the cross gcc),
+#    aarch64-unknown-linux-gnu (with the recorder: liblz4's C source through the cross gcc),
 #    wasm32-wasip1 (no threads: ricochet-sim without `parallel`) and, for the browser
 #    example, wasm32-unknown-unknown;
 # 3. runs every shipped scenario, scenarios/stress/ and the built-in scenes natively, under

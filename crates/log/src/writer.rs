@@ -249,10 +249,10 @@ enum Engine {
 ///
 /// The file is a pure function of the calls made: no wall-clock time, host
 /// name or thread count reaches it. Messages are encoded and chunks
-/// zstd-compressed on one writer thread (or inline, see [`Threading`]), in the
-/// order the calls were made, so the bytes are the same either way; zstd
-/// itself runs single-threaded (multithreaded zstd output differs). The
-/// summary lists schemas and channels in id order.
+/// LZ4-compressed on one writer thread (or inline, see [`Threading`]), in the
+/// order the calls were made, so the bytes are the same either way; the
+/// compressor itself runs single-threaded. The summary lists schemas and
+/// channels in id order.
 ///
 /// The log is written to a temporary file next to `path` (`.NAME.XXXXXX.tmp`,
 /// in the same directory) and renamed onto `path` only by
@@ -344,9 +344,12 @@ impl LogWriter {
             .profile("")
             .use_chunks(true)
             .chunk_size(Some(CHUNK_SIZE))
-            .compression(Some(mcap::Compression::Zstd))
-            // zstd level 1: on these logs (mostly f64s) about as small as the default level
-            // 3, and half again as fast (rain-10000 recorded: 64 -> 94 frames/s).
+            // LZ4 (the MCAP format's other compression; Foxglove and the official
+            // readers take both): on the 10,000-asteroid level the log is 13.2 MB
+            // against zstd level 1's 9.0 MB, and the writer thread spends about half as
+            // long a byte, which recording at half the simulation's rate needs (issue
+            // #37, BENCHMARKS.md "LZ4 chunks"). Levels below 3 are LZ4's fast mode.
+            .compression(Some(mcap::Compression::Lz4))
             .compression_level(1)
             .compression_threads(0);
         let mcap = options
