@@ -37,7 +37,7 @@
 //! and `move_y`, before its own motion, so it keeps its place on a moving platform; a
 //! kinematic box moving into a dynamic one pushes it in the per-axis passes.
 
-use ricochet_geom::Pose;
+use ricochet_geom::{Pose, Vec2};
 
 use crate::action::{Action, Event};
 use crate::entity::Entity;
@@ -398,6 +398,12 @@ impl Simulation {
     /// Runs one frame and reports what happened.
     pub fn step(&mut self) -> FrameOutput {
         self.world.begin_step();
+        if self.frame == 0 || self.carries() || self.scenario.world.gravity != Vec2::ZERO {
+            // No usual pass (frame 0 moves nothing; a per-axis scene moves box by box), or
+            // nearly every body's velocity changes: every body named now, so the stages'
+            // own names cost a branch.
+            self.world.disturb_all();
+        }
         self.queries.invalidate(&self.world);
         let mut out = FrameOutput {
             frame: self.frame,

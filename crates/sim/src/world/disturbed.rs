@@ -5,9 +5,11 @@
 //! active body exactly as a reader of `/bodies` predicts: `position + velocity * dt`,
 //! `angle + angular_velocity * dt`, the velocities unchanged. Every other write of a body's
 //! position, angle, velocity or spin, of whether it is active (asleep, frozen), and every
-//! spawn and removal, names the body here ([`World::disturb`]); a write that cannot say
-//! which bodies (a restore, a frame without the usual pass) names them all
-//! ([`World::disturb_all`]).
+//! spawn and removal, names the body here ([`World::disturb`]). Every body is named at
+//! once ([`World::disturb_all`]) by a restore or a copy, by a frame without the usual pass
+//! (frame 0, a scene with per-axis pairs, a motion stage skipped) or with gravity (nearly
+//! every velocity changes: named before the stages run, so their names cost a branch), and
+//! past a quarter of the bodies' names.
 //!
 //! The list holds what was named since the end of the step before the last one: a reader
 //! that looks after every step (and only then) sees every body named since it last looked,
@@ -34,6 +36,8 @@ pub struct Disturbed {
     /// Where the last step's end is in `bodies`: the names before it are dropped when the
     /// next step begins.
     last_end: usize,
+    /// `bodies` holds [`ALL`]: a name adds nothing.
+    full: bool,
 }
 
 impl Default for Disturbed {
@@ -43,6 +47,7 @@ impl Default for Disturbed {
             steps: 0,
             bodies: Vec::new(),
             last_end: 0,
+            full: false,
         }
     }
 }
@@ -51,7 +56,7 @@ impl Clone for Disturbed {
     /// A copy is another world: its own serial, every body named.
     fn clone(&self) -> Disturbed {
         let mut copy = Disturbed::default();
-        copy.bodies.push(ALL);
+        copy.name_all();
         copy
     }
 }
@@ -72,7 +77,7 @@ impl Disturbed {
     /// Whether every body may have been touched (the list then says nothing).
     #[must_use]
     pub fn all(&self) -> bool {
-        self.bodies.contains(&ALL)
+        self.full
     }
 
     /// The bodies named since the step before last ended, repeats and gone bodies included
@@ -84,11 +89,21 @@ impl Disturbed {
 
     /// Names `e`, in a world of `len` bodies: more names than a quarter of them (and 64)
     /// become "all" (a reader would compare every body anyway).
+    #[inline]
     pub(super) fn name(&mut self, e: Entity, len: usize) {
-        if self.bodies.len() < len / 4 + 64 {
+        if self.full {
+        } else if self.bodies.len() < len / 4 + 64 {
             self.bodies.push(e);
-        } else if self.bodies.last() != Some(&ALL) {
+        } else {
+            self.name_all();
+        }
+    }
+
+    /// Names every body.
+    fn name_all(&mut self) {
+        if !self.full {
             self.bodies.push(ALL);
+            self.full = true;
         }
     }
 
@@ -96,6 +111,7 @@ impl Disturbed {
     fn begin_step(&mut self) {
         self.bodies.drain(..self.last_end);
         self.last_end = 0;
+        self.full = self.bodies.contains(&ALL);
     }
 
     /// A step ended.
@@ -115,13 +131,15 @@ impl World {
     /// Names body `i` as touched by something other than the usual integration.
     #[inline]
     pub(crate) fn disturb(&mut self, i: usize) {
-        let e = self.entity[i];
-        self.disturbed.name(e, self.entity.len());
+        if !self.disturbed.full {
+            let e = self.entity[i];
+            self.disturbed.name(e, self.entity.len());
+        }
     }
 
     /// Names every body: what was touched cannot be said body by body.
     pub(crate) fn disturb_all(&mut self) {
-        self.disturbed.bodies.push(ALL);
+        self.disturbed.name_all();
     }
 
     /// A step begins ([`Disturbed::begin_step`]).

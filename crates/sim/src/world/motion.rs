@@ -33,8 +33,27 @@ impl World {
     /// every active dynamic body, `thrust` giving a controlled body's engine force from its
     /// controller, inputs and angle (zero for a body without a controller). The columns
     /// are read by row directly: one pass, no per-column check for scenery. A body whose
-    /// velocity's bits changed is named as disturbed ([`World::disturbed`]).
+    /// velocity's bits changed is named as disturbed ([`World::disturbed`]); under gravity,
+    /// where nearly every one does, all are named at once.
     pub(crate) fn accelerate(
+        &mut self,
+        dt: f64,
+        g: Vec2,
+        thrust: impl Fn(&Controller, &Inputs, f64) -> Vec2,
+    ) {
+        if g != Vec2::ZERO {
+            self.disturb_all();
+        }
+        if self.disturbed.all() {
+            self.accelerate_naming::<false>(dt, g, thrust);
+        } else {
+            self.accelerate_naming::<true>(dt, g, thrust);
+        }
+    }
+
+    /// [`World::accelerate`]'s pass, naming each body whose velocity changed when `NAME`
+    /// (two copies of the loop: the one that names nothing is the loop as it was).
+    fn accelerate_naming<const NAME: bool>(
         &mut self,
         dt: f64,
         g: Vec2,
@@ -55,12 +74,16 @@ impl World {
             };
             let sum = rows.force[r] + push + g * (m * rows.gravity_scale[r]);
             let a = sum / m;
-            let v = rows.velocity[r];
-            let changed = v + a * dt;
-            if changed.x.to_bits() != v.x.to_bits() || changed.y.to_bits() != v.y.to_bits() {
-                disturbed.name(entity[i], entity.len());
+            if NAME {
+                let v = rows.velocity[r];
+                let changed = v + a * dt;
+                if changed.x.to_bits() != v.x.to_bits() || changed.y.to_bits() != v.y.to_bits() {
+                    disturbed.name(entity[i], entity.len());
+                }
+                rows.velocity[r] = changed;
+            } else {
+                rows.velocity[r] += a * dt;
             }
-            rows.velocity[r] = changed;
         }
     }
 
