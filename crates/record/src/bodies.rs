@@ -27,7 +27,7 @@ mod undisturbed;
 
 /// What was last recorded of a body alive at the end of the previous frame (or, for a body
 /// nothing disturbed since, of frame `seen`: see `bodies/undisturbed.rs`).
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 struct Known {
     generation: u32,
     position: Vec2,

@@ -92,7 +92,9 @@ impl Disturbed {
     #[inline]
     pub(super) fn name(&mut self, e: Entity, len: usize) {
         if self.full {
-        } else if self.bodies.len() < len / 4 + 64 {
+            return;
+        }
+        if self.bodies.len() < len / 4 + 64 {
             self.bodies.push(e);
         } else {
             self.name_all();
