@@ -59,12 +59,14 @@ impl Tracker {
 
     /// The bodies to compare, into `unsettled` (ascending dense indices): the disturbed
     /// ones still in the world and every one the usual pass does not move. Their records
-    /// are brought forward to `previous`.
+    /// are brought forward to `previous`. The named ones gone go to `gone`.
     pub(super) fn gather_disturbed(&mut self, world: &World, previous: u64, dt: f64) {
         self.unsettled.clear();
+        self.gone.clear();
         for &e in world.disturbed().bodies() {
-            if let Some(i) = world.index_of(e) {
-                self.unsettled.push(i);
+            match world.index_of(e) {
+                Some(i) => self.unsettled.push(i),
+                None => self.gone.push(e),
             }
         }
         let active = world.active();
@@ -110,13 +112,16 @@ impl Tracker {
     ) -> (bool, bool) {
         let (frame, mut changed) = (out.frame, (false, false));
         self.lagging = true;
-        let gone = out.removed.iter().map(|r| r.entity);
-        let named = world.disturbed().bodies().iter().copied();
-        for e in gone.chain(named) {
-            if world.index_of(e).is_none() {
-                self.forget(e, &mut changed);
-            }
+        let gone = std::mem::take(&mut self.gone);
+        for e in out
+            .removed
+            .iter()
+            .map(|r| r.entity)
+            .chain(gone.iter().copied())
+        {
+            self.forget(e, &mut changed);
         }
+        self.gone = gone;
         if self.alive != world.len() {
             // Something went unnamed: look at every record.
             let slots = (0..self.known.len()).filter_map(|slot| {
