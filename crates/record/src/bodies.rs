@@ -224,6 +224,10 @@ pub struct Tracker {
 enum Pass {
     /// Every body, each moving one listed in full.
     Keyframe,
+    /// [`Pass::Keyframe`] where [`Tracker::may_skip`] holds: the records the world did not
+    /// disturb are not brought forward, since a keyframe writes each moving body whole from
+    /// the world (`bodies/undisturbed.rs`).
+    KeyframeNamed,
     /// Every body: the ones that did what a reader predicts settled first.
     Every,
     /// Only the ones the world names as disturbed, and those the usual integration does
@@ -302,22 +306,21 @@ impl Tracker {
         want_bodies: bool,
         velocities_drawn: bool,
     ) -> Changes {
-        let pass = if !self.started
-            || (out.frame.is_multiple_of(KEYFRAME_INTERVAL) && out.frame >= self.next_keyframe)
-        {
-            Pass::Keyframe
-        } else if self.may_skip(world, out.frame, def.gravity) {
-            Pass::Disturbed
-        } else {
-            Pass::Every
+        let keyframe = !self.started
+            || (out.frame.is_multiple_of(KEYFRAME_INTERVAL) && out.frame >= self.next_keyframe);
+        let pass = match (keyframe, self.may_skip(world, out.frame, def.gravity)) {
+            (true, false) => Pass::Keyframe,
+            (true, true) => Pass::KeyframeNamed,
+            (false, true) => Pass::Disturbed,
+            (false, false) => Pass::Every,
         };
         #[cfg(debug_assertions)]
-        let oracle = (pass == Pass::Disturbed).then(|| self.clone());
+        let oracle = matches!(pass, Pass::Disturbed | Pass::KeyframeNamed).then(|| self.clone());
         let changes = self.changes(world, out, def, (want_bodies, velocities_drawn), pass);
         #[cfg(debug_assertions)]
         if let Some(oracle) = oracle {
             let args = (out, def, want_bodies, velocities_drawn);
-            undisturbed::check(oracle, self, world, args, &changes);
+            undisturbed::check(oracle, self, world, args, &changes, pass);
         }
         let d = world.disturbed();
         self.world = (d.serial(), d.steps());
@@ -334,8 +337,9 @@ impl Tracker {
         (want_bodies, velocities_drawn): (bool, bool),
         pass: Pass,
     ) -> Changes {
-        let keyframe = pass == Pass::Keyframe;
+        let keyframe = matches!(pass, Pass::Keyframe | Pass::KeyframeNamed);
         let skip = pass == Pass::Disturbed;
+        let named = pass == Pass::KeyframeNamed;
         let (layers, dt, gravity) = (&def.layers, def.dt, def.gravity);
         let frame = out.frame;
         let previous = self.frame;
@@ -362,7 +366,11 @@ impl Tracker {
         if skip {
             self.gather_disturbed(world, previous, dt);
         } else {
-            if self.lagging {
+            if named {
+                // Only the records of the bodies compared in a skipping frame are brought
+                // forward: the others are left alone below.
+                self.gather_disturbed(world, previous, dt);
+            } else if self.lagging {
                 self.catch_up(previous, dt);
             }
             if keyframe {
@@ -409,7 +417,10 @@ impl Tracker {
             let Some(k) = self.known[slot].as_mut() else {
                 continue;
             };
-            k.seen = frame;
+            // A record the world left alone since `seen` (`named`): its velocities are this
+            // frame's, and the integrator moved it on from there.
+            let left_alone = named && !fresh && !k.is_static && k.seen < previous;
+            let seen = std::mem::replace(&mut k.seen, frame);
             let sped = !same2(k.velocity, velocity);
             // What a reader predicts of the velocity: unchanged, or one step of falling. A
             // velocity that is neither is written; one that is the other switches the mode.
@@ -427,7 +438,13 @@ impl Tracker {
             };
             k.falling = mode.unwrap_or(k.falling);
             let spun = !same(k.angular_velocity, angular_velocity);
-            let moved = !same2(position, k.position) || !same(angle, k.angle);
+            let moved = if left_alone {
+                // Written whole, so only whether it moved since the last frame is asked,
+                // and only while no other body has said so.
+                !scene_changed && k.moved_since(previous - seen, position, angle, dt)
+            } else {
+                !same2(position, k.position) || !same(angle, k.angle)
+            };
             if !fresh && (moved || (velocities_drawn && !k.is_static && (sped || spun))) {
                 *if k.is_static {
                     &mut static_changed
@@ -479,6 +496,10 @@ impl Tracker {
             k.angular_velocity = angular_velocity;
         }
         self.unsettled = unsettled;
+        if named {
+            // Every record still here is of this frame now (the gone ones go below).
+            self.lagging = false;
+        }
         if skip {
             let (scene, statics) = self.after_skip(world, out, scene_changed, dt);
             scene_changed |= scene;

@@ -34,6 +34,13 @@ impl Known {
         (p, a)
     }
 
+    /// Whether the body, `steps` integrator steps on from this record last frame, is not
+    /// at `position` and `angle` now.
+    pub(super) fn moved_since(&self, steps: u64, position: Vec2, angle: f64, dt: f64) -> bool {
+        let (p, a) = self.advanced(steps, dt);
+        !same2(p, position) || !same(a, angle)
+    }
+
     /// Brings the record forward to frame `to`.
     fn bring_to(&mut self, to: u64, dt: f64) {
         if self.seen < to {
@@ -198,10 +205,15 @@ pub(super) fn check(
     world: &World,
     (out, def, want_bodies, velocities_drawn): Args<'_>,
     got: &super::Changes,
+    pass: super::Pass,
 ) {
     use prost::Message;
     let wants = (want_bodies, velocities_drawn);
-    let want = oracle.changes(world, out, def, wants, super::Pass::Every);
+    let full = match pass {
+        super::Pass::KeyframeNamed => super::Pass::Keyframe,
+        _ => super::Pass::Every,
+    };
+    let want = oracle.changes(world, out, def, wants, full);
     let frame = out.frame;
     assert!(
         want.bodies.encode_to_vec() == got.bodies.encode_to_vec(),
@@ -247,36 +259,54 @@ mod tests {
     use ricochet_scenes::bench::Scene;
     use ricochet_sim::{Action, BodyDef, BodyKind, Shape, Simulation, load_scenario};
 
-    use super::super::Tracker;
+    use super::super::{Pass, Tracker};
 
-    /// Runs `sim` for `frames` frames through a tracker, comparing each frame that leaves
-    /// the undisturbed bodies alone with the full comparison ([`super::check`], in every
-    /// build), `between(sim, frame)` run after each frame is recorded. How many frames
-    /// left them alone, of how many that were not keyframes.
+    /// What [`run`] counted.
+    #[derive(Debug, Default)]
+    struct Counts {
+        /// Frames that left the undisturbed bodies alone.
+        skipped: u64,
+        /// Frames after the first that were not keyframes.
+        others: u64,
+        /// Keyframes that left the undisturbed records alone.
+        named_keyframes: u64,
+    }
+
+    /// Runs `sim` for `frames` frames through a tracker, comparing each frame (keyframes
+    /// too) that leaves the undisturbed bodies alone with the full comparison
+    /// ([`super::check`], in every build), `between(sim, frame)` run after each frame is
+    /// recorded.
     fn run(
         sim: &mut Simulation,
         frames: u64,
         mut between: impl FnMut(&mut Simulation, u64),
-    ) -> (u64, u64) {
+    ) -> Counts {
         let mut tracker = Tracker::default();
-        let (mut skipped, mut others) = (0, 0);
+        let mut counts = Counts::default();
         for frame in 0..=frames {
             let out = sim.step();
             let def = &sim.scenario().world;
             let before = tracker.clone();
             let changes = tracker.frame(sim.world(), &out, def, true, frame % 2 == 0);
             // What `frame` chose, asked again of the tracker as it was.
-            if before.started && !changes.bodies.keyframe {
-                others += 1;
-                if before.may_skip(sim.world(), out.frame, def.gravity) {
-                    skipped += 1;
-                    let args = (&out, def, true, frame % 2 == 0);
-                    super::check(before, &tracker, sim.world(), args, &changes);
-                }
+            let keyframe = changes.bodies.keyframe;
+            if before.started && !keyframe {
+                counts.others += 1;
+            }
+            if before.started && before.may_skip(sim.world(), out.frame, def.gravity) {
+                let pass = if keyframe {
+                    counts.named_keyframes += 1;
+                    Pass::KeyframeNamed
+                } else {
+                    counts.skipped += 1;
+                    Pass::Disturbed
+                };
+                let args = (&out, def, true, frame % 2 == 0);
+                super::check(before, &tracker, sim.world(), args, &changes, pass);
             }
             between(sim, frame);
         }
-        (skipped, others)
+        counts
     }
 
     /// A zero-gravity bench scene (asteroids, bullets fired and expiring, a ship turning
@@ -286,12 +316,63 @@ mod tests {
     fn asteroids_leave_the_undisturbed_alone_and_agree_with_the_full_comparison() {
         let scenario = Scene::parse("asteroids-300").unwrap().build(200);
         let mut sim = Simulation::new(&scenario);
-        let (skipped, others) = run(&mut sim, 200, |_, _| {});
-        assert!(others > 190, "{others} frames compared");
-        assert!(
-            skipped * 10 >= others * 9,
-            "{skipped} of {others} frames skipped"
-        );
+        let c = run(&mut sim, 200, |_, _| {});
+        assert!(c.others > 190, "{c:?}");
+        assert!(c.skipped * 10 >= c.others * 9, "{c:?}");
+        // Frames 60, 120 and 180.
+        assert_eq!(c.named_keyframes, 3, "{c:?}");
+    }
+
+    /// A keyframe in which the world named nobody: whether `/scene` is drawn again comes
+    /// from the records left alone, bodies drifting (moved) or too slow to leave their
+    /// floating-point place (not moved, though every motion stage ran). The frame before,
+    /// the one body that does not turn is put somewhere and stopped, so that the frame
+    /// before is known to redraw without a look at the others (whose records are then left
+    /// alone for two frames).
+    #[test]
+    fn a_keyframe_with_nobody_named_still_sees_the_drift() {
+        for (speed, moved) in [("0.25", true), ("1e-300", false)] {
+            let mut text = String::from(
+                "name = \"drift\"\nhz = 60\nframes = 130\nlayers = [\"rock\"]\n\
+                 [world]\ngravity = [0, 0]\n",
+            );
+            for k in 0..5 {
+                write!(
+                    text,
+                    "[[bodies]]\nname = \"r{k}\"\nlayer = \"rock\"\n\
+                     shape = {{ kind = \"circle\", radius = 0.5 }}\n\
+                     position = [{}, 1]\nangle = 1\nvelocity = [{speed}, {speed}]\n\
+                     angular_velocity = {}\n",
+                    3 + k * 3,
+                    // The last one does not turn: stopped, it stays put.
+                    if k < 4 { speed } else { "0" }
+                )
+                .unwrap();
+            }
+            let scenario = load_scenario(&text, "drift.toml").unwrap();
+            let mut sim = Simulation::new(&scenario);
+            let mut tracker = Tracker::default();
+            let last = sim.entity_named("r4").unwrap();
+            for frame in 0..=130 {
+                if frame == 59 || frame == 119 {
+                    sim.set_position(last, Vec2::new(20.0, 5.0)).unwrap();
+                    sim.set_velocity(last, Vec2::ZERO).unwrap();
+                }
+                let out = sim.step();
+                let def = &sim.scenario().world;
+                let before = tracker.clone();
+                let changes = tracker.frame(sim.world(), &out, def, true, false);
+                if frame == 60 || frame == 120 {
+                    assert!(changes.bodies.keyframe);
+                    assert!(before.may_skip(sim.world(), out.frame, def.gravity));
+                    assert!(sim.world().disturbed().bodies().is_empty());
+                    assert_eq!(changes.scene_changed, moved, "frame {frame}, speed {speed}");
+                    let args = (&out, def, true, false);
+                    let pass = Pass::KeyframeNamed;
+                    super::check(before, &tracker, sim.world(), args, &changes, pass);
+                }
+            }
+        }
     }
 
     /// The hard cases of a scene that may leave bodies alone (no gravity, no `separate`
@@ -386,7 +467,7 @@ lifetime = 30
         let mover = sim.entity_named("mover").unwrap();
         let ship = sim.entity_named("ship").unwrap();
         let streak = sim.entity_named("streak").unwrap();
-        let (skipped, others) = run(&mut sim, 300, |sim, frame| {
+        let c = run(&mut sim, 300, |sim, frame| {
             let ids: Vec<_> = (0..sim.world().len())
                 .map(|i| sim.world().entity[i])
                 .collect();
@@ -419,7 +500,8 @@ lifetime = 30
                 sim.apply(ship, Action::Fire).unwrap();
             }
         });
-        assert!(others > 290, "{others} frames compared");
-        assert!(skipped > 100, "{skipped} of {others} frames skipped");
+        assert!(c.others > 290, "{c:?}");
+        assert!(c.skipped > 100, "{c:?}");
+        assert!(c.named_keyframes > 0, "{c:?}");
     }
 }
