@@ -42,4 +42,4 @@ pub use log_file::{ChannelInfo, LogFile, RawMessage};
 pub use messages::Schema;
 pub use reader::{LogMessage, read_log, read_log_file};
 pub use stream::Messages;
-pub use writer::{ChannelId, LogWriter, MessageSink, Threading};
+pub use writer::{ChannelId, LogWriter, MessageSink, SHARE_ENCODING_FROM, Threading};

@@ -1,10 +1,12 @@
 //! Writing a deterministic, chunked, indexed MCAP log, encoding and compressing on a
-//! writer thread.
+//! writer thread (the caller sharing the encoding when that thread falls behind).
 
 use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::mpsc;
 use std::thread::JoinHandle;
 
@@ -21,6 +23,10 @@ const CHUNK_SIZE: u64 = 1024 * 1024;
 /// Messages queued for the writer thread before [`LogWriter::write`] waits: bounds the
 /// memory a fast simulation can fill while the thread compresses.
 const QUEUE: usize = 256;
+
+/// Jobs queued for the writer thread from which [`LogWriter::write`] encodes the message
+/// on the caller's thread by default (see [`LogWriter::share_encoding_from`]).
+pub const SHARE_ENCODING_FROM: usize = 32;
 
 /// A channel of a [`LogWriter`], returned when the channel is added.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -240,6 +246,10 @@ enum Engine {
     Thread {
         jobs: mpsc::SyncSender<Job>,
         thread: JoinHandle<Result<Sink, mcap::McapError>>,
+        /// Jobs sent and not yet run (the thread counts them down).
+        queued: Arc<AtomicUsize>,
+        /// From this many queued jobs, [`LogWriter::write`] encodes on the caller's thread.
+        share_from: usize,
     },
     /// Between a failure and the error's report.
     Failed,
@@ -250,8 +260,10 @@ enum Engine {
 /// The file is a pure function of the calls made: no wall-clock time, host
 /// name or thread count reaches it. Messages are encoded and chunks
 /// LZ4-compressed on one writer thread (or inline, see [`Threading`]), in the
-/// order the calls were made, so the bytes are the same either way; the
-/// compressor itself runs single-threaded. The summary lists schemas and
+/// order the calls were made, so the bytes are the same either way; when the
+/// writer thread falls behind, the caller encodes messages itself (see
+/// [`share_encoding_from`](Self::share_encoding_from)), with the same bytes
+/// again. The compressor itself runs single-threaded. The summary lists schemas and
 /// channels in id order.
 ///
 /// The log is written to a temporary file next to `path` (`.NAME.XXXXXX.tmp`,
@@ -366,12 +378,15 @@ impl LogWriter {
             Threading::Inline => Engine::Inline(Box::new(sink)),
             Threading::Thread => {
                 let (jobs, queue) = mpsc::sync_channel::<Job>(QUEUE);
+                let queued = Arc::new(AtomicUsize::new(0));
+                let ran = Arc::clone(&queued);
                 let thread = std::thread::Builder::new()
                     .name("log-writer".into())
                     .spawn(move || {
                         let mut sink = sink;
                         for job in queue {
                             sink.run(job)?;
+                            ran.fetch_sub(1, Ordering::Relaxed);
                         }
                         Ok(sink)
                     })
@@ -379,7 +394,12 @@ impl LogWriter {
                         path: path.clone(),
                         source: mcap::McapError::Io(e),
                     })?;
-                Engine::Thread { jobs, thread }
+                Engine::Thread {
+                    jobs,
+                    thread,
+                    queued,
+                    share_from: SHARE_ENCODING_FROM,
+                }
             }
         };
         Ok(Self {
@@ -453,14 +473,36 @@ impl LogWriter {
 
     /// Writes the protobuf `message` on `channel` at simulation time `time_ns` (both the
     /// log and publish time). Its sequence number is the count of messages written on
-    /// `channel` before it. The message is encoded on the writer thread.
+    /// `channel` before it. The message is encoded on the writer thread, or here when that
+    /// thread is behind (the same bytes either way).
     pub fn write<M: prost::Message + Send + 'static>(
         &mut self,
         channel: ChannelId,
         time_ns: u64,
         message: M,
     ) -> Result<(), LogError> {
-        self.write_payload(channel, time_ns, Payload::Proto(Box::new(message)))
+        let payload = match &self.engine {
+            Engine::Thread {
+                queued, share_from, ..
+            } if queued.load(Ordering::Relaxed) >= *share_from => {
+                Payload::Bytes(message.encode_to_vec())
+            }
+            _ => Payload::Proto(Box::new(message)),
+        };
+        self.write_payload(channel, time_ns, payload)
+    }
+
+    /// Encodes a message on the caller's thread, in [`write`](Self::write), once `jobs`
+    /// jobs are queued for the writer thread ([`SHARE_ENCODING_FROM`] by default; 0: every
+    /// message, `usize::MAX`: none). A queue that long means the writer is behind, and the
+    /// caller, which would soon wait for room, takes a share of its work instead: on the
+    /// 10,000-asteroid level the writer thread is the recording's bound (issue #37). Where a
+    /// message is encoded never changes the file's bytes, only which core spends the time.
+    /// Nothing changes with [`Threading::Inline`].
+    pub fn share_encoding_from(&mut self, jobs: usize) {
+        if let Engine::Thread { share_from, .. } = &mut self.engine {
+            *share_from = jobs;
+        }
     }
 
     /// Attaches a file to the log (an MCAP attachment, times 0): `ricochet serve` attaches
@@ -509,10 +551,13 @@ impl LogWriter {
     fn submit(&mut self, job: Job) -> Result<(), LogError> {
         match &mut self.engine {
             Engine::Inline(sink) => sink.run(job).map_err(|source| self.write_error(source)),
-            Engine::Thread { jobs, .. } => match jobs.send(job) {
-                Ok(()) => Ok(()),
-                Err(_) => Err(self.fail()),
-            },
+            Engine::Thread { jobs, queued, .. } => {
+                queued.fetch_add(1, Ordering::Relaxed);
+                match jobs.send(job) {
+                    Ok(()) => Ok(()),
+                    Err(_) => Err(self.fail()),
+                }
+            }
             Engine::Failed => Err(self.write_error(mcap::McapError::Io(std::io::Error::other(
                 "the log writer failed before",
             )))),
@@ -533,7 +578,7 @@ impl LogWriter {
     fn take_sink(&mut self) -> Result<Sink, LogError> {
         match std::mem::replace(&mut self.engine, Engine::Failed) {
             Engine::Inline(sink) => Ok(*sink),
-            Engine::Thread { jobs, thread } => {
+            Engine::Thread { jobs, thread, .. } => {
                 drop(jobs);
                 match thread.join() {
                     Ok(Ok(sink)) => Ok(sink),

@@ -44,6 +44,29 @@ fn the_writer_thread_and_inline_encoding_give_the_same_bytes() {
     assert!(t.len() > 1000 && t == i, "{} vs {} bytes", t.len(), i.len());
 }
 
+/// The caller encoding every message (from 0 jobs queued), or those written while one job
+/// or more waits (some here, some on the writer thread, as the threads' timing falls):
+/// the same bytes as inline.
+#[test]
+fn encoding_shared_with_the_caller_gives_the_same_bytes() {
+    use ricochet_log::Threading;
+    let dir = tempfile::tempdir().unwrap();
+    let inline = dir.path().join("i.mcap");
+    common::write_sample_log_with(&inline, Threading::Inline);
+    let want = std::fs::read(inline).unwrap();
+    for from in [0, 1, 2] {
+        let shared = dir.path().join(format!("s{from}.mcap"));
+        common::write_sample_log_sharing(&shared, Threading::Thread, from);
+        let got = std::fs::read(shared).unwrap();
+        assert!(
+            want.len() > 1000 && got == want,
+            "from {from}: {} vs {} bytes",
+            got.len(),
+            want.len()
+        );
+    }
+}
+
 #[test]
 fn written_log_reads_back_unchanged() {
     use prost::Message;

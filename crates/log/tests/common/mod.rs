@@ -167,7 +167,18 @@ pub fn write_sample_log(path: &Path) {
 
 /// [`write_sample_log`], encoding where `threading` says.
 pub fn write_sample_log_with(path: &Path, threading: ricochet_log::Threading) {
+    write_sample_log_sharing(path, threading, ricochet_log::SHARE_ENCODING_FROM);
+}
+
+/// [`write_sample_log_with`], the caller encoding once `share_from` jobs are queued
+/// (`LogWriter::share_encoding_from`).
+pub fn write_sample_log_sharing(
+    path: &Path,
+    threading: ricochet_log::Threading,
+    share_from: usize,
+) {
     let mut writer = LogWriter::create_with(path, "ricochet-log tests", threading).unwrap();
+    writer.share_encoding_from(share_from);
     let scene = writer
         .add_foxglove_channel::<SceneUpdate>("/scene")
         .unwrap();
