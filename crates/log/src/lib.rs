@@ -32,6 +32,7 @@ mod error;
 mod escape;
 mod log_file;
 mod reader;
+mod sink;
 mod stream;
 mod writer;
 
@@ -41,5 +42,6 @@ pub use escape::escape_controls;
 pub use log_file::{ChannelInfo, LogFile, RawMessage};
 pub use messages::Schema;
 pub use reader::{LogMessage, read_log, read_log_file};
+pub use sink::{ChannelId, MessageSink};
 pub use stream::Messages;
-pub use writer::{ChannelId, LogWriter, MessageSink, SHARE_ENCODING_FROM, Threading};
+pub use writer::{LogWriter, SHARE_ENCODING_FROM, Threading};
