@@ -16,12 +16,13 @@ pub const KEYFRAME_INTERVAL: u64 = 60;
 
 /// A keyframe of `n` encoded bytes is followed by the next at the first multiple of
 /// [`KEYFRAME_INTERVAL`] at least `ceil(n / KEYFRAME_BYTES_PER_FRAME)` frames later: up to
-/// 480 KiB (about 3,000 moving bodies) that is the next multiple, as it always was; 10,000
-/// asteroids' keyframe (1.5 MB) comes every 240 frames. A keyframe is where a reader may
+/// 240 KiB (about 1,500 moving bodies) that is the next multiple, as it always was; 10,000
+/// asteroids' keyframe (1.7 MB) comes every 420 frames. A keyframe is where a reader may
 /// start (every frame between is still exact from the one before); building and
-/// compressing 10,000 bodies every second was a third of the cost of recording them
-/// (issue #37). Bytes, never time: the same log on every machine.
-pub const KEYFRAME_BYTES_PER_FRAME: u64 = 8 * 1024;
+/// compressing 10,000 bodies every second was a third of the cost of recording them, and
+/// every four seconds still a tenth of the level's (issue #37). Bytes, never time: the same
+/// log on every machine.
+pub const KEYFRAME_BYTES_PER_FRAME: u64 = 4 * 1024;
 
 mod undisturbed;
 

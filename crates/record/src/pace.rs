@@ -6,8 +6,9 @@
 //! frames later. A scene drawn body by body (at most 256 bodies when recording starts:
 //! `scene::PER_BODY_LIMIT`; every shipped scenario) is drawn in every frame it changes, as
 //! before, and so is a bigger one whose drawing is at most [`DRAW_BYTES_PER_FRAME`] (about
-//! 200 moving bodies drawn in batches); 10,000 moving asteroids (1.5 MB a frame) are drawn every 46th frame (1.3 times
-//! a second of a 60 Hz game, about what the viewer redraws a live 10,000-body scene at).
+//! 160 moving bodies drawn in batches); 10,000 moving asteroids (1.5 MB a frame) are drawn
+//! every 63rd frame (about once a second of a 60 Hz game, about what the viewer redraws a
+//! live 10,000-body scene at).
 //! The rule depends only on the bytes, never on time, so a log stays the same bytes on any
 //! machine and with any thread count.
 //!
@@ -20,12 +21,13 @@
 //!
 //! Why bytes and not a fixed rate in log time: what costs is bytes. Measured on the 2-core
 //! machine (BENCHMARKS.md, "Recording at the simulation's speed"), 10,000 asteroids drawn
-//! every frame record at about 5% of the simulation's rate, at 64 KiB a frame the
-//! 10,000-asteroid level at about 40%, at 32 KiB about half; a scene of 200 bodies costs
-//! nothing to draw at 60 Hz.
+//! every frame record at about 5% of the simulation's rate; the 10,000-asteroid level,
+//! with its keyframes (`bodies.rs`) every 420 frames, at 50% with 32 KiB a frame and 56% with
+//! 24 KiB, the budget chosen (with keyframes every 240 frames: 47% and 52%; BENCHMARKS.md,
+//! "Then: the budgets chosen again"); a scene of 200 bodies costs nothing to draw at 60 Hz.
 
 /// Encoded drawing bytes a frame may average (see the module docs).
-pub const DRAW_BYTES_PER_FRAME: u64 = 32 * 1024;
+pub const DRAW_BYTES_PER_FRAME: u64 = 24 * 1024;
 
 /// Which frames draw the scene, and what changed since the last drawing.
 #[derive(Clone, Debug, Default)]
@@ -73,13 +75,13 @@ mod tests {
         assert!(p.due(0));
         p.drawn(0, DRAW_BYTES_PER_FRAME);
         assert!(p.due(1));
-        // 1.5 MB: 1_500_000 / 32_768 = 45.8, so 46 frames.
+        // 1.5 MB: 1_500_000 / 24_576 = 61.04, so 62 frames.
         p.drawn(1, 1_500_000);
-        assert!(!p.due(46));
-        assert!(p.due(47));
+        assert!(!p.due(62));
+        assert!(p.due(63));
         // Nothing to send: the next change draws at once.
-        p.drawn(47, 0);
-        assert!(p.due(48));
+        p.drawn(63, 0);
+        assert!(p.due(64));
     }
 
     #[test]
