@@ -20,8 +20,8 @@ pub const KEYFRAME_INTERVAL: u64 = 60;
 /// asteroids' keyframe (1.7 MB) comes every 420 frames. A keyframe is where a reader may
 /// start (every frame between is still exact from the one before); building and
 /// compressing 10,000 bodies every second was a third of the cost of recording them, and
-/// every four seconds still a tenth of the level's (issue #37). Bytes, never time: the same
-/// log on every machine.
+/// each such keyframe still costs the 10,000-asteroid level's 600-frame recording about 6%
+/// (issue #37, BENCHMARKS.md). Bytes, never time: the same log on every machine.
 pub const KEYFRAME_BYTES_PER_FRAME: u64 = 4 * 1024;
 
 mod undisturbed;

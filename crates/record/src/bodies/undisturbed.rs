@@ -7,11 +7,15 @@
 //! frame, the tracker compares only those and the bodies the usual pass does not move
 //! (static, asleep, frozen), and leaves every other body's record as it was, of an earlier
 //! frame (its `seen`). A record is brought forward, step by step with the integrator's own
-//! arithmetic, when it is next needed: the body is disturbed, a keyframe or a full pass
-//! comes, or the frame needs one moved body to know `/scene` must be drawn again.
+//! arithmetic, when it is next needed: the body is disturbed, a full pass comes, or the
+//! frame needs one moved body to know `/scene` must be drawn again. A keyframe in such a
+//! world writes every moving body whole from the world, so it takes each undisturbed
+//! body's state as it is, and brings a record forward only to ask whether the body moved,
+//! while no other body has said so.
 //!
-//! In a debug build every frame taken this way is checked against the full comparison
-//! ([`check`]): the same `/bodies` bytes, the same redraw flags and the same records.
+//! In a debug build every frame taken this way, keyframes too, is checked against the full
+//! comparison ([`check`]): the same `/bodies` bytes, the same redraw flags and the same
+//! records.
 
 use ricochet_geom::Vec2;
 use ricochet_sim::{Entity, FrameOutput, World};
