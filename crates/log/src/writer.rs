@@ -402,9 +402,10 @@ impl LogWriter {
         }
     }
 
-    /// Writes `bytes`, one message already encoded as `channel` says, like
-    /// [`write`](Self::write).
-    pub(crate) fn write_encoded(
+    /// Writes `bytes`, one message already encoded as `channel`'s schema says (protobuf, or
+    /// JSON on a JSON channel), like [`write`](Self::write): for a caller that encodes a
+    /// message once for the log and for something else (`ricochet serve`'s live stream).
+    pub fn write_encoded(
         &mut self,
         channel: ChannelId,
         time_ns: u64,

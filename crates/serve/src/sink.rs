@@ -121,14 +121,22 @@ impl MessageSink for ServeSink {
         time_ns: u64,
         message: M,
     ) -> Result<(), LogError> {
-        if let Some((file, ids)) = &mut self.file {
-            let id = ids[usize::from(channel.index()) - 1];
-            file.write(id, time_ns, message.clone())?;
+        match (&mut self.file, self.muted) {
+            (Some((file, ids)), true) => {
+                file.write(ids[usize::from(channel.index()) - 1], time_ns, message)
+            }
+            (None, true) => Ok(()),
+            (None, false) => self.live.write(channel, time_ns, message),
+            (Some((file, ids)), false) => {
+                // Encoded once, here, for both: the live stream needs the bytes now anyway
+                // (a copy of the message for the file's writer thread cost more).
+                let bytes = message.encode_to_vec();
+                let id = ids[usize::from(channel.index()) - 1];
+                file.write_encoded(id, time_ns, bytes.clone())?;
+                self.live.publish(channel, time_ns, bytes);
+                Ok(())
+            }
         }
-        if self.muted {
-            return Ok(());
-        }
-        self.live.write(channel, time_ns, message)
     }
 
     fn add_json_channel(
