@@ -33,17 +33,15 @@ impl World {
     /// every active dynamic body, `thrust` giving a controlled body's engine force from its
     /// controller, inputs and angle (zero for a body without a controller). The columns
     /// are read by row directly: one pass, no per-column check for scenery. A body whose
-    /// velocity's bits changed is named as disturbed ([`World::disturbed`]); under gravity,
-    /// where nearly every one does, all are named at once.
+    /// velocity's bits changed is named as disturbed ([`World::disturbed`]), unless every
+    /// body already is (the step names them all up front under gravity, where nearly every
+    /// velocity changes: `Simulation::step`).
     pub(crate) fn accelerate(
         &mut self,
         dt: f64,
         g: Vec2,
         thrust: impl Fn(&Controller, &Inputs, f64) -> Vec2,
     ) {
-        if g != Vec2::ZERO {
-            self.disturb_all();
-        }
         if self.disturbed.all() {
             self.accelerate_naming::<false>(dt, g, thrust);
         } else {

@@ -22,14 +22,8 @@ impl World {
                 self.rows.local_bounds[r] = LocalBounds::new(self.shape(i), angle);
             }
         }
-        if self.kind[i] == BodyKind::Static {
-            self.static_generation += 1;
-            self.wake_all();
-        } else {
-            // A turned body's bounds follow from the cache (it widens to the any-angle disc).
-            self.wake(i);
-            self.refresh_active();
-        }
+        // A turned body's bounds follow from the cache (it widens to the any-angle disc).
+        self.changed_in_place(i);
     }
 
     /// Gives body `i` another shape now, keeping the caches right as [`World::teleport`]
@@ -64,6 +58,14 @@ impl World {
         if r != NO_ROW {
             self.rows.local_bounds[r as usize] = LocalBounds::new(shape, self.angle[i]);
         }
+        self.changed_in_place(i);
+    }
+
+    /// Body `i` was moved or reshaped where it stands: a static body bumps
+    /// [`World::static_generation`] (the broad phase and the per-axis stages index it
+    /// again) and wakes every sleeper, which new static geometry may now touch; a moving
+    /// body wakes.
+    fn changed_in_place(&mut self, i: usize) {
         if self.kind[i] == BodyKind::Static {
             self.static_generation += 1;
             self.wake_all();
