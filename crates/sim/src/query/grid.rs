@@ -40,7 +40,15 @@ struct Entry {
     min: Vec2,
     max: Vec2,
     handle: u32,
+    /// Whether this cell is the member's first column ([`FIRST_COLUMN`]) and first row
+    /// ([`FIRST_ROW`]): in the padding, so the entry stays 40 bytes.
+    first: u8,
 }
+
+/// [`Entry::first`]'s bit: the cell is in the member's first column.
+const FIRST_COLUMN: u8 = 1;
+/// [`Entry::first`]'s bit: the cell is in the member's first row.
+const FIRST_ROW: u8 = 2;
 
 impl Entry {
     /// Whether the entry's box overlaps `q` (touching counts), as [`Bounds::overlaps`].
@@ -148,16 +156,17 @@ impl Grid {
             entries: Vec::new(),
             big: Vec::new(),
         };
-        let entry = |k: u32, b: &Bounds| Entry {
+        let entry = |k: u32, b: &Bounds, first: u8| Entry {
             min: b.min,
             max: b.max,
             handle: k,
+            first,
         };
         let mut listed = Vec::with_capacity(members.len());
         for &(k, b) in &members {
             let (x0, y0, x1, y1) = grid.span(b);
             if u64::from(x1 - x0 + 1) * u64::from(y1 - y0 + 1) > SPAN {
-                grid.big.push(entry(k, b));
+                grid.big.push(entry(k, b, 0));
                 if grid.big.len() > BIG {
                     return None;
                 }
@@ -176,13 +185,15 @@ impl Grid {
         }
         let total = grid.start[cells as usize] as usize;
         let mut next = grid.start.clone();
-        let mut entries = vec![entry(0, &hull); total];
+        let mut entries = vec![entry(0, &hull, 0); total];
         for &(k, b) in &listed {
             let (x0, y0, x1, y1) = grid.span(b);
             for y in y0..=y1 {
                 for x in x0..=x1 {
                     let c = grid.cell(x, y);
-                    entries[next[c] as usize] = entry(k, b);
+                    let first =
+                        (u8::from(x == x0) * FIRST_COLUMN) | (u8::from(y == y0) * FIRST_ROW);
+                    entries[next[c] as usize] = entry(k, b, first);
                     next[c] += 1;
                 }
             }
@@ -229,17 +240,17 @@ impl Grid {
         let (x0, y0, x1, y1) = self.span(q);
         for y in y0..=y1 {
             let row = y as usize * self.nx as usize;
+            // Reported from the cell of the intersection's lower corner only: its column
+            // is `max(x0, the member's first)` (`column` is monotone), so it is this cell's
+            // when this is the query's first column or the member's (both are at most
+            // `x`), and likewise its row.
+            let at_y0 = if y == y0 { FIRST_ROW } else { 0 };
             for x in x0..=x1 {
                 let c = row + x as usize;
                 let (from, to) = (self.start[c] as usize, self.start[c + 1] as usize);
+                let here = at_y0 | if x == x0 { FIRST_COLUMN } else { 0 };
                 for e in &self.entries[from..to] {
-                    if !e.meets(q) {
-                        continue;
-                    }
-                    // Reported from the cell of the intersection's lower corner only.
-                    let cx = self.column(q.min.x.max(e.min.x), self.origin.x, self.nx);
-                    let cy = self.column(q.min.y.max(e.min.y), self.origin.y, self.ny);
-                    if (cx == x) & (cy == y) {
+                    if ((e.first | here) == (FIRST_COLUMN | FIRST_ROW)) & e.meets(q) {
                         f(e.handle as usize);
                     }
                 }
@@ -292,10 +303,11 @@ impl Grid {
         let r1 = self.column(hi.y + m, self.origin.y, self.ny);
         let up = dir.y >= 0.0;
         let inv_y = 1.0 / dir.y;
-        // Handles tested last (a member listed in the cells a segment crosses next to
-        // each other is tested once, not once a cell; a repeat is harmless, only slower).
+        // Handles tested last, newest first (a member listed in the cells a segment
+        // crosses next to each other is tested once, not once a cell; a repeat is
+        // harmless, only slower). Shifted along rather than written at a rotating slot:
+        // a 4-byte store into the array the next check loads whole stalls the load.
         let mut recent = [u32::MAX; 4];
-        let mut slot = 0;
         for n in 0..=(r1 - r0) {
             let r = if up { r0 + n } else { r1 - n };
             // Where the segment is within the row (widened): its `t` range, then its x.
@@ -322,12 +334,12 @@ impl Grid {
                 let c = row + if dir.x >= 0.0 { c0 + k } else { c1 - k } as usize;
                 let (from, to) = (self.start[c] as usize, self.start[c + 1] as usize);
                 for e in &self.entries[from..to] {
-                    if recent.contains(&e.handle) {
+                    let h = e.handle;
+                    if (recent[0] == h) | (recent[1] == h) | (recent[2] == h) | (recent[3] == h) {
                         continue;
                     }
                     max = e.cross(&slab, max, f);
-                    recent[slot & 3] = e.handle;
-                    slot += 1;
+                    recent = [h, recent[0], recent[1], recent[2]];
                 }
             }
         }
