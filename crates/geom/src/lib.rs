@@ -62,7 +62,8 @@ pub use bounds::Bounds;
 pub use case::{Case, CaseBody, CaseError, MAX_ID_BYTES, MAX_QUOTED, parse_case, parse_case_file};
 pub use case_reader::{CaseReader, MAX_CASE_BYTES};
 pub use collide::{
-    contact, contact_deeper_than, contact_placed, overlaps, overlaps_placed, pair_name,
+    contact, contact_deeper_than, contact_placed, overlaps, overlaps_placed, overlaps_placing,
+    pair_name,
 };
 pub use contact::Contact;
 pub use def::ShapeDef;

@@ -3,7 +3,7 @@
 use crate::bounds::Bounds;
 use crate::cores::Core;
 use crate::math::{Pose, Rot, Vec2};
-use crate::shape::{MAX_POLYGON_VERTICES, Primitive, Shape};
+use crate::shape::{Aabb, MAX_POLYGON_VERTICES, Primitive, Shape};
 
 /// A circle in a frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -135,6 +135,16 @@ pub fn placed_bounds(primitive: &Primitive, position: Vec2, rot: Rot, angle: f64
     }
 }
 
+/// An axis-aligned box part placed as [`place_with`] places it (its centre turns, its
+/// sides stay on the axes).
+#[inline]
+pub(crate) fn place_aabb(b: &Aabb, position: Vec2, rot: Rot) -> PlacedAabb {
+    PlacedAabb {
+        center: position + rot.apply(b.center),
+        half: b.half_extents,
+    }
+}
+
 /// [`place`] with the body rotation already computed.
 #[must_use]
 pub(crate) fn place_with(
@@ -148,10 +158,7 @@ pub(crate) fn place_with(
             center: position + rot.apply(c.center),
             radius: c.radius,
         }),
-        Primitive::Aabb(b) => PlacedPrimitive::Aabb(PlacedAabb {
-            center: position + rot.apply(b.center),
-            half: b.half_extents,
-        }),
+        Primitive::Aabb(b) => PlacedPrimitive::Aabb(place_aabb(b, position, rot)),
         Primitive::Obb(b) => PlacedPrimitive::Obb(PlacedObb {
             center: position + rot.apply(b.center),
             rot: if b.angle == 0.0 {

@@ -5,7 +5,8 @@ use proptest::prelude::*;
 use ricochet_geom::pairs::collide_cores;
 use ricochet_geom::{
     Bounds, Contact, Pose, Primitive, Rot, Shape, Vec2, contact, contact_deeper_than,
-    contact_placed, overlaps, place, place_rotated, placed_bounds,
+    contact_placed, overlaps, overlaps_placed, overlaps_placing, place, place_rotated,
+    placed_bounds,
 };
 
 const TAU: f64 = std::f64::consts::TAU;
@@ -108,6 +109,39 @@ proptest! {
             box_bits(placed_bounds(&p, at, rot, pose.angle)),
             box_bits(place_rotated(&p, at, rot, pose.angle).bounds())
         );
+    }
+
+    /// `overlaps_placing` (a box against a box placed inline) answers as
+    /// `overlaps_placed` of the part `place_rotated` places, for every kind of part, and
+    /// for boxes on a half-unit lattice, edge to edge (touching: no overlap) often.
+    #[test]
+    fn overlaps_placing_is_overlaps_placed_of_the_placed_part(
+        (a, b) in prop_oneof![
+            (primitive(), primitive()),
+            ((-6i32..6, -6i32..6, 1i32..4, 1i32..4), (-6i32..6, -6i32..6, 1i32..4, 1i32..4))
+                .prop_map(|(a, b)| {
+                    let boxed = |(x, y, w, h): (i32, i32, i32, i32)| {
+                        let half = |k: i32| f64::from(k) * 0.5;
+                        Primitive::aabb(v(half(x), half(y)), v(half(w), half(h))).unwrap()
+                    };
+                    (boxed(a), boxed(b))
+                }),
+        ],
+        pa in pose(),
+        (x, y) in (-8i32..8, -8i32..8),
+        angle in prop_oneof![Just(0.0), -3.2f64..3.2],
+    ) {
+        let lattice = v(f64::from(x) * 0.5, f64::from(y) * 0.5);
+        for (placed_a, at) in [
+            (place(&a, &Pose::new(Vec2::ZERO, 0.0), Vec2::ZERO), lattice),
+            (place(&a, &pa, Vec2::ZERO), pa.position + lattice * 0.37),
+        ] {
+            let rot = Rot::from_angle(angle);
+            prop_assert_eq!(
+                overlaps_placing(&placed_a, &b, at, rot, angle),
+                overlaps_placed(&placed_a, &place_rotated(&b, at, rot, angle))
+            );
+        }
     }
 }
 

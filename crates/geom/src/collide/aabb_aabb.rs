@@ -50,6 +50,7 @@ pub fn collide_aabb_aabb(a: &PlacedAabb, b: &PlacedAabb) -> Contact {
 
 /// Whether two axis-aligned boxes overlap: the four separating tests.
 #[must_use]
+#[inline]
 pub fn overlaps_aabb_aabb(a: &PlacedAabb, b: &PlacedAabb) -> bool {
     let (amin, amax) = (a.center - a.half, a.center + a.half);
     let (bmin, bmax) = (b.center - b.half, b.center + b.half);

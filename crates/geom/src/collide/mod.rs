@@ -22,9 +22,9 @@ pub(crate) mod segment;
 
 use crate::contact::Contact;
 use crate::cores::collide_cores_unless;
-use crate::math::Pose;
-use crate::placed::PlacedPrimitive;
-use crate::shape::{Shape, ShapeKind};
+use crate::math::{Pose, Rot, Vec2};
+use crate::placed::{PlacedPrimitive, place_aabb, place_rotated};
+use crate::shape::{Primitive, Shape, ShapeKind};
 
 use aabb_aabb::*;
 use aabb_capsule::*;
@@ -110,6 +110,24 @@ pub(crate) fn contact_placed_unless(
             cores(b, a).map(Contact::flipped)
         }
     }
+}
+
+/// `overlaps_placed(a, &place_rotated(b, position, rot, angle))`, the same answer from the
+/// same arithmetic, with the commonest pair of a box query (two axis-aligned boxes: a
+/// query box against a tile) placed and tested inline.
+#[must_use]
+#[inline]
+pub fn overlaps_placing(
+    a: &PlacedPrimitive,
+    b: &Primitive,
+    position: Vec2,
+    rot: Rot,
+    angle: f64,
+) -> bool {
+    if let (PlacedPrimitive::Aabb(a), Primitive::Aabb(b)) = (a, b) {
+        return overlaps_aabb_aabb(a, &place_aabb(b, position, rot));
+    }
+    overlaps_placed(a, &place_rotated(b, position, rot, angle))
 }
 
 /// Whether two primitives placed in one frame overlap; the same answer as

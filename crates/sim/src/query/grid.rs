@@ -88,9 +88,11 @@ pub(crate) struct Grid {
     side: f64,
     /// The box around every member listed or kept apart.
     hull: Bounds,
-    /// Cells along x and y.
+    /// Cells along x (a row's length).
     nx: u32,
-    ny: u32,
+    /// The last column and row (cells along x and y, less one), as floats: the clamp of
+    /// [`Grid::column`].
+    last: Vec2,
     /// Cell `c`'s entries are `entries[start[c] .. start[c + 1]]`.
     start: Vec<u32>,
     entries: Vec<Entry>,
@@ -151,7 +153,7 @@ impl Grid {
             side,
             hull,
             nx: nx as u32,
-            ny: ny as u32,
+            last: Vec2::new((nx - 1) as f64, (ny - 1) as f64),
             start: vec![0; cells as usize + 1],
             entries: Vec::new(),
             big: Vec::new(),
@@ -202,24 +204,36 @@ impl Grid {
         Some(grid)
     }
 
-    /// The column (or row) of coordinate `v` on the axis starting at `o` with `n` cells:
-    /// monotone in `v`, clamped into the grid (a coordinate outside it counts as the edge
+    /// The column (or row) of coordinate `v` on the axis starting at `o` whose last cell is
+    /// `last`: monotone in `v`, clamped into the grid (a coordinate outside it counts as the edge
     /// cell, which keeps the module's argument: both boxes' cells are clamped alike).
     #[inline(always)]
-    fn column(&self, v: f64, o: f64, n: u32) -> u32 {
-        let t = (v - o) * self.inv;
-        // `t >= 0` truncated is its floor; `as` saturates, and `!(t >= 0)` takes NaN to 0.
-        if t >= 0.0 { (t as u32).min(n - 1) } else { 0 }
+    fn column(&self, v: f64, o: f64, last: f64) -> u32 {
+        // Clamped to `[0, n - 1]` first (`max` takes NaN to 0), so the conversion is in
+        // range: truncating the clamped `t` is its floor.
+        ((v - o) * self.inv).max(0.0).min(last) as u32
+    }
+
+    /// [`Grid::column`] on the x axis.
+    #[inline(always)]
+    fn column_x(&self, x: f64) -> u32 {
+        self.column(x, self.origin.x, self.last.x)
+    }
+
+    /// [`Grid::column`] on the y axis: the row.
+    #[inline(always)]
+    fn row_y(&self, y: f64) -> u32 {
+        self.column(y, self.origin.y, self.last.y)
     }
 
     /// The cells `b` covers: columns `x0..=x1`, rows `y0..=y1`.
     #[inline(always)]
     fn span(&self, b: &Bounds) -> (u32, u32, u32, u32) {
         (
-            self.column(b.min.x, self.origin.x, self.nx),
-            self.column(b.min.y, self.origin.y, self.ny),
-            self.column(b.max.x, self.origin.x, self.nx),
-            self.column(b.max.y, self.origin.y, self.ny),
+            self.column_x(b.min.x),
+            self.row_y(b.min.y),
+            self.column_x(b.max.x),
+            self.row_y(b.max.y),
         )
     }
 
@@ -299,8 +313,8 @@ impl Grid {
         // The rows the segment's box covers, widened by the margin, in the order it
         // crosses them.
         let (lo, hi) = (origin.min(end), origin.max(end));
-        let r0 = self.column(lo.y - m, self.origin.y, self.ny);
-        let r1 = self.column(hi.y + m, self.origin.y, self.ny);
+        let r0 = self.row_y(lo.y - m);
+        let r1 = self.row_y(hi.y + m);
         let up = dir.y >= 0.0;
         let inv_y = 1.0 / dir.y;
         // Handles tested last, newest first (a member listed in the cells a segment
@@ -327,8 +341,8 @@ impl Grid {
                 continue;
             }
             let (xa, xb) = (origin.x + dir.x * t0, origin.x + dir.x * t1);
-            let c0 = self.column(xa.min(xb) - m, self.origin.x, self.nx);
-            let c1 = self.column(xa.max(xb) + m, self.origin.x, self.nx);
+            let c0 = self.column_x(xa.min(xb) - m);
+            let c1 = self.column_x(xa.max(xb) + m);
             let row = r as usize * self.nx as usize;
             for k in 0..=(c1 - c0) {
                 let c = row + if dir.x >= 0.0 { c0 + k } else { c1 - k } as usize;

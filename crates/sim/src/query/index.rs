@@ -411,9 +411,9 @@ impl Trees {
         }
         let (position, rot) = (r.position - at, r.shape_rot());
         placed.iter().any(|a| {
-            parts.iter().any(|b| {
-                ricochet_geom::overlaps_placed(a, &place_rotated(b, position, rot, r.angle))
-            })
+            parts
+                .iter()
+                .any(|b| ricochet_geom::overlaps_placing(a, b, position, rot, r.angle))
         })
     }
 }

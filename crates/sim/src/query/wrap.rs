@@ -60,12 +60,17 @@ impl Images {
     /// The offsets of the images looked at, in [`offsets`]' order (the same arithmetic,
     /// so the same bits, as [`WorldBounds::image_offsets`]).
     pub(crate) fn iter(self) -> impl Iterator<Item = Vec2> {
-        (0..9)
-            .filter(move |k| self.mask & (1 << k) != 0)
-            .map(move |k| {
-                let (sx, sy) = STEPS[k];
-                Vec2::new(sx * self.size.x, sy * self.size.y)
-            })
+        // The set bits, lowest first: one step for the usual query, the direct image only.
+        let mut mask = self.mask;
+        std::iter::from_fn(move || {
+            if mask == 0 {
+                return None;
+            }
+            let k = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            let (sx, sy) = STEPS[k];
+            Some(Vec2::new(sx * self.size.x, sy * self.size.y))
+        })
     }
 }
 
@@ -89,20 +94,22 @@ pub(crate) fn images(
     let Some(q) = q else {
         return Images { size, mask: all };
     };
-    // Whether the query meets the hull with the bodies moved by `s` world sizes on `axis`.
-    let meets = |axis: usize, s: f64| {
-        let d = shift[axis] - s * size[axis];
-        (q.min[axis] + d <= hull.max[axis]) & (hull.min[axis] <= q.max[axis] + d)
+    // Whether the query meets the hull with the bodies moved by `s` world sizes, on one
+    // axis (each axis's fields named, not indexed: an index is a match a comparison).
+    let meets = |(q0, q1, h0, h1, shift, size): (f64, f64, f64, f64, f64, f64), s: f64| {
+        let d = shift - s * size;
+        (q0 + d <= h1) & (h0 <= q1 + d)
     };
-    let direct = meets(0, 0.0) & meets(1, 0.0);
+    let ax = (q.min.x, q.max.x, hull.min.x, hull.max.x, shift.x, size.x);
+    let ay = (q.min.y, q.max.y, hull.min.y, hull.max.y, shift.y, size.y);
     if wrap.is_none() {
         return Images {
             size,
-            mask: u16::from(direct),
+            mask: u16::from(meets(ax, 0.0) & meets(ay, 0.0)),
         };
     }
-    let x = [meets(0, -1.0), meets(0, 0.0), meets(0, 1.0)];
-    let y = [meets(1, -1.0), meets(1, 0.0), meets(1, 1.0)];
+    let x = [meets(ax, -1.0), meets(ax, 0.0), meets(ax, 1.0)];
+    let y = [meets(ay, -1.0), meets(ay, 0.0), meets(ay, 1.0)];
     if x == [false, true, false] && y == [false, true, false] {
         // Well inside the world: the direct image only.
         return Images { size, mask: 1 };
