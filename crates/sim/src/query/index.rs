@@ -433,9 +433,11 @@ pub(crate) struct Probe<'a> {
 /// query that misses it is not walked at all (`wrap::images`).
 #[inline]
 pub(crate) fn hull(trees: &[&Trees; 2]) -> Option<Bounds> {
-    match (trees[0].bounds, trees[1].bounds) {
-        (Some(a), Some(b)) => Some(a.union(b)),
-        (a, b) => a.or(b),
+    // Matched by reference: a copy of the pair through the stack, stored in one split and
+    // read back in another, stalled the loads (store forwarding fails).
+    match (&trees[0].bounds, &trees[1].bounds) {
+        (Some(a), Some(b)) => Some(a.union(*b)),
+        (a, b) => a.or(*b),
     }
 }
 

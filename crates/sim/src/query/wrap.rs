@@ -80,6 +80,9 @@ impl Images {
 /// [`Bounds::translated`] and [`Bounds::overlaps`] in the per-set test that follows, so no
 /// image that test would walk is dropped: a query well inside the world looks at the
 /// direct image only, for six comparisons per axis instead of nine box tests per set.
+/// Inline: passed through memory, the caller's hull was stored in one split and read back
+/// in another, which stalled the loads.
+#[inline(always)]
 pub(crate) fn images(
     wrap: Option<&WorldBounds>,
     q: Option<&Bounds>,
