@@ -191,3 +191,39 @@ fn a_long_big_body_touching_a_small_one_at_its_far_end_pairs() {
     BroadPhase::new(BroadPhaseKind::SortAndSweep).pairs(&bodies, &interactions, &mut out);
     assert_eq!(out, expected);
 }
+
+/// A small body whose bounds are inverted (min above max) by more than the big layer's
+/// widest body: no big body can overlap it, and the filter's bitmap, which marks the cells
+/// of each small body widened by that width, marked a reversed range and panicked (found by
+/// the proptest above, seed 14380036766739847613).
+#[test]
+fn a_small_body_inverted_past_the_big_layers_reach_pairs_nothing_and_does_not_panic() {
+    let body = |key: u64, min: (f64, f64), max: (f64, f64), layer: u8| BodyEntry {
+        key,
+        bounds: Bounds {
+            min: Vec2::new(min.0, min.1),
+            max: Vec2::new(max.0, max.1),
+        },
+        layer,
+        kind: BodyKind::Dynamic,
+    };
+    // 1,100 unit boxes of the big layer on a line, two small bodies among them, and one
+    // between those inverted by 60 units on x (and by 0.5 on y).
+    let mut bodies: Vec<BodyEntry> = (0..1100)
+        .map(|k| {
+            let x = k as f64 * 0.5;
+            body(k + 1, (x, 0.0), (x + 1.0, 1.0), BIG)
+        })
+        .collect();
+    bodies.push(body(2000, (200.0, 0.2), (200.3, 0.4), 0));
+    bodies.push(body(2001, (300.0, 0.5), (240.0, 0.0), 2));
+    bodies.push(body(2002, (400.0, 0.2), (400.3, 0.4), 0));
+    let interactions = Interactions::from_fn(3, |a, b| a != b && (a == BIG || b == BIG));
+    let expected = common::all_pairs(&bodies, &interactions);
+    assert!(!expected.is_empty());
+    for kind in [BroadPhaseKind::SortAndSweep, BroadPhaseKind::Auto] {
+        let mut out = Vec::new();
+        BroadPhase::new(kind).pairs(&bodies, &interactions, &mut out);
+        assert_eq!(out, expected, "{kind:?}");
+    }
+}

@@ -274,6 +274,12 @@ fn mark<'a>(
         for &h in of(m) {
             let b = widened(&bodies[h as usize].bounds, reach);
             let (x0, x1) = (ax.cell(b.min.x), ax.cell(b.max.x));
+            if x0 > x1 {
+                // Inverted past the reach (the map is monotone, so `min > max`): a big body
+                // overlapping it would span `[.. <= max, min <= ..]`, wider than the reach.
+                // None does; and an empty row range on y is no loop.
+                continue;
+            }
             for y in ay.cell(b.min.y)..=ay.cell(b.max.y) {
                 set(&mut bits[y * WORDS..(y + 1) * WORDS], x0, x1);
             }
