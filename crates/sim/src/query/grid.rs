@@ -210,12 +210,13 @@ impl Grid {
         Some(grid)
     }
 
-    /// The column (or row) of coordinate `v` on the axis starting at `o` whose last cell is
-    /// `last`: monotone in `v`, clamped into the grid (a coordinate outside it counts as the edge
-    /// cell, which keeps the module's argument: both boxes' cells are clamped alike).
+    /// The column (or row) of coordinate `v` on the axis starting at `o` whose last cell
+    /// is `last`: monotone in `v`, clamped into the grid (a coordinate outside it counts as
+    /// the edge cell, which keeps the module's argument: both boxes' cells are clamped
+    /// alike).
     #[inline(always)]
     fn column(&self, v: f64, o: f64, last: f64) -> u32 {
-        // Clamped to `[0, n - 1]` first (`max` takes NaN to 0), so the conversion is in
+        // Clamped to `[0, last]` first (`max` takes NaN to 0), so the conversion is in
         // range: truncating the clamped `t` is its floor.
         ((v - o) * self.inv).max(0.0).min(last) as u32
     }
@@ -270,8 +271,6 @@ impl Grid {
                 let (from, to) = (self.start[c] as usize, self.start[c + 1] as usize);
                 let here = at_y0 | if x == x0 { FIRST_COLUMN } else { 0 };
                 for e in &self.entries[from..to] {
-                    // Five conditions, one branch: each alone is a coin toss for the
-                    // predictor.
                     if ((e.first | here) == (FIRST_COLUMN | FIRST_ROW)) & e.meets(q) {
                         f(e.handle as usize);
                     }
