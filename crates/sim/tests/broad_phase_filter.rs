@@ -160,11 +160,9 @@ proptest! {
     }
 }
 
-/// Two boxes that only touch, the big one long and reaching the small one with its far end:
-/// its lower-left corner is far outside the small one's cell, and the pair is still found.
-#[test]
-fn a_long_big_body_touching_a_small_one_at_its_far_end_pairs() {
-    let body = |key: u64, min: (f64, f64), max: (f64, f64), layer: u8| BodyEntry {
+/// A dynamic body of `layer` with bounds `min` to `max`.
+fn body(key: u64, min: (f64, f64), max: (f64, f64), layer: u8) -> BodyEntry {
+    BodyEntry {
         key,
         bounds: Bounds {
             min: Vec2::new(min.0, min.1),
@@ -172,7 +170,13 @@ fn a_long_big_body_touching_a_small_one_at_its_far_end_pairs() {
         },
         layer,
         kind: BodyKind::Dynamic,
-    };
+    }
+}
+
+/// Two boxes that only touch, the big one long and reaching the small one with its far end:
+/// its lower-left corner is far outside the small one's cell, and the pair is still found.
+#[test]
+fn a_long_big_body_touching_a_small_one_at_its_far_end_pairs() {
     // 1,100 small bodies of the big layer in a row far from the small one, then one long
     // body whose right end touches it, and the small one (a bullet) at x = 500.
     let mut bodies: Vec<BodyEntry> = (0..1100)
@@ -198,15 +202,6 @@ fn a_long_big_body_touching_a_small_one_at_its_far_end_pairs() {
 /// the proptest above, seed 14380036766739847613).
 #[test]
 fn a_small_body_inverted_past_the_big_layers_reach_pairs_nothing_and_does_not_panic() {
-    let body = |key: u64, min: (f64, f64), max: (f64, f64), layer: u8| BodyEntry {
-        key,
-        bounds: Bounds {
-            min: Vec2::new(min.0, min.1),
-            max: Vec2::new(max.0, max.1),
-        },
-        layer,
-        kind: BodyKind::Dynamic,
-    };
     // 1,100 unit boxes of the big layer on a line, two small bodies among them, and one
     // between those inverted by 60 units on x (and by 0.5 on y).
     let mut bodies: Vec<BodyEntry> = (0..1100)
