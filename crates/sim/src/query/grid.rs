@@ -3,12 +3,19 @@
 //! box is a few cell lookups and a short ray a few rows of cells, instead of a walk down
 //! the tree's levels (seven on 10,000 members).
 //!
-//! A member is listed in every cell its box covers (touching counts). A box query visits
+//! A member is listed in every cell its box covers, but for a cell its box only touches
+//! from below: a box whose top (or right) side lies exactly on a cell's lower (or left)
+//! edge is not listed above (or right of) it. On a level of tiles the cells line up with
+//! the tiles, and each tile is listed once instead of up to four times. A box query visits
 //! the cells its box covers and reports a member only from the cell holding the lower
 //! corner of the two boxes' intersection, `(max(q.min.x, m.min.x), max(q.min.y, m.min.y))`.
-//! That point is in both boxes whenever they overlap, and the cell of a point is a monotone
-//! function of it on each axis, so the cell is among both boxes' cells: every member whose
-//! box meets the query is reported exactly once, with no list to dedup. A ray: [`Grid::ray`].
+//! Where the two boxes share more than a side (the intersection's lower corner is below
+//! the member's top and left of its right side), that point is in a cell the member is
+//! listed in and in one the query visits, since the cell of a point is a monotone function
+//! of it on each axis: every such member is reported exactly once, with no list to dedup.
+//! A member whose box only touches the query's may be reported or not, at most once: every
+//! caller's exact test (a shape overlapping a box, a point strictly inside a shape) fails
+//! for it anyway, as a shape lies within its box. A ray: [`Grid::ray`].
 //!
 //! **Bounds** (memory linear in the members whatever their boxes): the cell is
 //! [`MEDIANS`] times the median member's size, grown when needed to at most about
@@ -172,7 +179,7 @@ impl Grid {
         };
         let mut listed = Vec::with_capacity(members.len());
         for &(k, b) in &members {
-            let (x0, y0, x1, y1) = grid.span(b);
+            let (x0, y0, x1, y1) = grid.listed(b);
             if u64::from(x1 - x0 + 1) * u64::from(y1 - y0 + 1) > SPAN {
                 grid.big.push(entry(k, b, 0));
                 if grid.big.len() > BIG {
@@ -195,7 +202,7 @@ impl Grid {
         let mut next = grid.start.clone();
         let mut entries = vec![entry(0, &hull, 0); total];
         for &(k, b) in &listed {
-            let (x0, y0, x1, y1) = grid.span(b);
+            let (x0, y0, x1, y1) = grid.listed(b);
             for y in y0..=y1 {
                 for x in x0..=x1 {
                     let c = grid.cell(x, y);
@@ -231,6 +238,31 @@ impl Grid {
     #[inline(always)]
     fn row_y(&self, y: f64) -> u32 {
         self.column(y, self.origin.y, self.last.y)
+    }
+
+    /// The last column (or row) a member's box ending at `v` is listed in, its first being
+    /// `first`: [`Grid::column`]'s, less one when `v` lies exactly on that cell's lower
+    /// edge (the box only touches the cell).
+    #[inline(always)]
+    fn last_listed(&self, first: u32, v: f64, o: f64, last: f64) -> u32 {
+        let c = self.column(v, o, last);
+        if c > first && (v - o) * self.inv == f64::from(c) {
+            c - 1
+        } else {
+            c
+        }
+    }
+
+    /// The cells member box `b` is listed in (see the module docs): columns `x0..=x1`,
+    /// rows `y0..=y1`.
+    fn listed(&self, b: &Bounds) -> (u32, u32, u32, u32) {
+        let (x0, y0) = (self.column_x(b.min.x), self.row_y(b.min.y));
+        (
+            x0,
+            y0,
+            self.last_listed(x0, b.max.x, self.origin.x, self.last.x),
+            self.last_listed(y0, b.max.y, self.origin.y, self.last.y),
+        )
     }
 
     /// The cells `b` covers: columns `x0..=x1`, rows `y0..=y1`.
@@ -369,164 +401,4 @@ impl Grid {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A seeded xorshift in `[0, 1)`.
-    fn uniform(s: &mut u64) -> f64 {
-        *s ^= *s << 13;
-        *s ^= *s >> 7;
-        *s ^= *s << 17;
-        (*s >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    /// Every member whose box meets `q`, by a loop over all (the definition).
-    fn brute(boxes: &[Bounds], q: &Bounds) -> Vec<usize> {
-        (0..boxes.len()).filter(|&k| boxes[k].overlaps(q)).collect()
-    }
-
-    fn grid_answer(grid: &Grid, q: &Bounds) -> Vec<usize> {
-        let mut got = Vec::new();
-        grid.query(q, &mut |k| got.push(k));
-        got.sort_unstable();
-        got
-    }
-
-    #[test]
-    fn a_grid_reports_every_box_met_once_as_a_loop_over_all_does() {
-        let mut s = 0x9e37_79b9_7f4a_7c15;
-        // Unit tiles edge to edge (touching boxes, queries touching them at cell edges),
-        // and random boxes of mixed sizes, a few much larger than the rest.
-        let mut boxes: Vec<Bounds> = (0..400)
-            .map(|k| {
-                let c = Vec2::new((k % 20) as f64, (k / 20) as f64);
-                Bounds::around(c, Vec2::splat(0.5))
-            })
-            .collect();
-        for k in 0..300 {
-            let c = Vec2::new(uniform(&mut s) * 40.0 - 10.0, uniform(&mut s) * 40.0 - 10.0);
-            let big = if k % 60 == 0 { 8.0 } else { 1.0 };
-            let h = Vec2::new(uniform(&mut s) * big, uniform(&mut s) * big);
-            boxes.push(Bounds::around(c, h));
-        }
-        let grid = Grid::new(&boxes).expect("a grid");
-        assert!(!grid.big.is_empty(), "the large boxes are kept apart");
-        for k in 0..3000 {
-            let c = if k % 3 == 0 {
-                // On tile corners and edges exactly.
-                Vec2::new(
-                    (uniform(&mut s) * 44.0).floor() - 12.5,
-                    (uniform(&mut s) * 44.0).floor() - 12.5,
-                )
-            } else {
-                Vec2::new(uniform(&mut s) * 60.0 - 20.0, uniform(&mut s) * 60.0 - 20.0)
-            };
-            let h = if k % 3 == 0 {
-                Vec2::splat(0.5 * (1 + k % 4) as f64)
-            } else {
-                Vec2::new(uniform(&mut s) * 3.0, uniform(&mut s) * 3.0)
-            };
-            let q = Bounds::around(c, h);
-            assert_eq!(grid_answer(&grid, &q), brute(&boxes, &q), "query {q:?}");
-        }
-    }
-
-    #[test]
-    fn a_grid_ray_meets_every_box_the_slab_test_meets_and_finds_the_same_first() {
-        let mut s = 0x2545_f491_4f6c_dd1d;
-        let mut boxes: Vec<Bounds> = (0..400)
-            .map(|k| {
-                let c = Vec2::new((k % 20) as f64, (k / 20) as f64);
-                Bounds::around(c, Vec2::splat(0.5))
-            })
-            .collect();
-        for k in 0..300 {
-            let c = Vec2::new(uniform(&mut s) * 40.0 - 10.0, uniform(&mut s) * 40.0 - 10.0);
-            let big = if k % 60 == 0 { 8.0 } else { 1.0 };
-            let h = Vec2::new(uniform(&mut s) * big, uniform(&mut s) * big);
-            boxes.push(Bounds::around(c, h));
-        }
-        let grid = Grid::new(&boxes).expect("a grid");
-        let hull = boxes.iter().copied().reduce(Bounds::union).expect("boxes");
-        for k in 0..3000 {
-            let o = if k % 4 == 0 {
-                // On tile edges and corners, along the axes and the diagonals.
-                Vec2::new(
-                    (uniform(&mut s) * 44.0).floor() - 12.5,
-                    (uniform(&mut s) * 44.0).floor() - 12.0,
-                )
-            } else {
-                Vec2::new(uniform(&mut s) * 60.0 - 20.0, uniform(&mut s) * 60.0 - 20.0)
-            };
-            let a = if k % 4 == 0 {
-                std::f64::consts::FRAC_PI_4 * (k / 4 % 8) as f64
-            } else {
-                uniform(&mut s) * std::f64::consts::TAU
-            };
-            // Exactly along each axis too (`cos` of a right angle is not zero).
-            let axes = [Vec2::X, Vec2::Y, -Vec2::X, -Vec2::Y];
-            let dir = if k % 16 == 4 {
-                axes[k / 16 % 4]
-            } else {
-                Vec2::new(libm::cos(a), libm::sin(a))
-            };
-            let max = if k % 8 == 1 {
-                60.0
-            } else {
-                uniform(&mut s) * 20.0
-            };
-            let slab = Slab::new(o, dir, &hull);
-            let want: Vec<usize> = (0..boxes.len())
-                .filter(|&j| slab.enter(&boxes[j], max).is_some())
-                .collect();
-            // Every candidate, `max` kept.
-            let mut got = Vec::new();
-            assert!(grid.ray(o, dir, max, &mut |j, m| {
-                got.push(j);
-                m
-            }));
-            got.sort_unstable();
-            got.dedup();
-            assert_eq!(got, want, "ray from {o:?} along {dir:?} for {max}");
-            // A first-hit search (a member hit where the segment enters its box): the
-            // same first as over every box.
-            let first = want
-                .iter()
-                .filter_map(|&j| slab.enter(&boxes[j], max).map(|t| (t, j)))
-                .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-            let mut best: Option<(f64, usize)> = None;
-            grid.ray(o, dir, max, &mut |j, m| {
-                if let Some(t) = slab.enter(&boxes[j], m)
-                    && best.is_none_or(|b| (t, j) < b)
-                {
-                    best = Some((t, j));
-                }
-                best.map_or(m, |b| b.0)
-            });
-            assert_eq!(best, first, "ray from {o:?} along {dir:?} for {max}");
-        }
-    }
-
-    #[test]
-    fn no_grid_for_infinite_or_too_many_large_boxes_and_nan_boxes_meet_nothing() {
-        let unit = |x: f64| Bounds::around(Vec2::new(x, 0.0), Vec2::splat(0.5));
-        let mut boxes: Vec<Bounds> = (0..100).map(|k| unit(k as f64)).collect();
-        let mut inf = boxes.clone();
-        inf.push(Bounds {
-            min: Vec2::new(f64::NEG_INFINITY, 0.0),
-            max: Vec2::new(0.0, 1.0),
-        });
-        assert!(Grid::new(&inf).is_none());
-        let mut large = boxes.clone();
-        large.extend((0..=BIG).map(|_| Bounds::around(Vec2::ZERO, Vec2::splat(40.0))));
-        assert!(Grid::new(&large).is_none());
-        boxes.push(Bounds {
-            min: Vec2::new(f64::NAN, 0.0),
-            max: Vec2::new(1.0, 1.0),
-        });
-        let grid = Grid::new(&boxes).expect("a grid");
-        let q = Bounds::around(Vec2::new(0.5, 0.0), Vec2::splat(2.0));
-        assert_eq!(grid_answer(&grid, &q), vec![0, 1, 2, 3]);
-        assert!(Grid::new(&[]).is_none());
-    }
-}
+mod tests;
