@@ -48,11 +48,9 @@ fn check_answer(grid: &Grid, boxes: &[Bounds], q: &Bounds) {
     );
 }
 
-#[test]
-fn a_grid_reports_every_box_met_once_as_a_loop_over_all_does() {
-    let mut s = 0x9e37_79b9_7f4a_7c15;
-    // Unit tiles edge to edge (touching boxes, queries touching them at cell edges),
-    // and random boxes of mixed sizes, a few much larger than the rest.
+/// Unit tiles edge to edge (touching boxes, queries touching them at cell edges), and
+/// random boxes of mixed sizes, a few much larger than the rest.
+fn mixed(s: &mut u64) -> Vec<Bounds> {
     let mut boxes: Vec<Bounds> = (0..400)
         .map(|k| {
             let c = Vec2::new((k % 20) as f64, (k / 20) as f64);
@@ -60,11 +58,18 @@ fn a_grid_reports_every_box_met_once_as_a_loop_over_all_does() {
         })
         .collect();
     for k in 0..300 {
-        let c = Vec2::new(uniform(&mut s) * 40.0 - 10.0, uniform(&mut s) * 40.0 - 10.0);
+        let c = Vec2::new(uniform(s) * 40.0 - 10.0, uniform(s) * 40.0 - 10.0);
         let big = if k % 60 == 0 { 8.0 } else { 1.0 };
-        let h = Vec2::new(uniform(&mut s) * big, uniform(&mut s) * big);
+        let h = Vec2::new(uniform(s) * big, uniform(s) * big);
         boxes.push(Bounds::around(c, h));
     }
+    boxes
+}
+
+#[test]
+fn a_grid_reports_every_box_met_once_as_a_loop_over_all_does() {
+    let mut s = 0x9e37_79b9_7f4a_7c15;
+    let boxes = mixed(&mut s);
     let grid = Grid::new(&boxes).expect("a grid");
     assert!(!grid.big.is_empty(), "the large boxes are kept apart");
     for k in 0..3000 {
@@ -153,18 +158,7 @@ fn tiles_on_the_cells_edges_are_listed_once_and_still_found() {
 #[test]
 fn a_grid_ray_meets_every_box_the_slab_test_meets_and_finds_the_same_first() {
     let mut s = 0x2545_f491_4f6c_dd1d;
-    let mut boxes: Vec<Bounds> = (0..400)
-        .map(|k| {
-            let c = Vec2::new((k % 20) as f64, (k / 20) as f64);
-            Bounds::around(c, Vec2::splat(0.5))
-        })
-        .collect();
-    for k in 0..300 {
-        let c = Vec2::new(uniform(&mut s) * 40.0 - 10.0, uniform(&mut s) * 40.0 - 10.0);
-        let big = if k % 60 == 0 { 8.0 } else { 1.0 };
-        let h = Vec2::new(uniform(&mut s) * big, uniform(&mut s) * big);
-        boxes.push(Bounds::around(c, h));
-    }
+    let boxes = mixed(&mut s);
     let grid = Grid::new(&boxes).expect("a grid");
     let hull = boxes.iter().copied().reduce(Bounds::union).expect("boxes");
     for k in 0..3000 {
