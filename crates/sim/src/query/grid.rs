@@ -179,7 +179,8 @@ impl Grid {
         };
         let mut listed = Vec::with_capacity(members.len());
         for &(k, b) in &members {
-            let (x0, y0, x1, y1) = grid.listed(b);
+            let span = grid.listed(b);
+            let (x0, y0, x1, y1) = span;
             if u64::from(x1 - x0 + 1) * u64::from(y1 - y0 + 1) > SPAN {
                 grid.big.push(entry(k, b, 0));
                 if grid.big.len() > BIG {
@@ -193,7 +194,7 @@ impl Grid {
                     grid.start[c + 1] += 1;
                 }
             }
-            listed.push((k, b));
+            listed.push((k, b, span));
         }
         for c in 1..grid.start.len() {
             grid.start[c] += grid.start[c - 1];
@@ -201,8 +202,7 @@ impl Grid {
         let total = grid.start[cells as usize] as usize;
         let mut next = grid.start.clone();
         let mut entries = vec![entry(0, &hull, 0); total];
-        for &(k, b) in &listed {
-            let (x0, y0, x1, y1) = grid.listed(b);
+        for &(k, b, (x0, y0, x1, y1)) in &listed {
             for y in y0..=y1 {
                 for x in x0..=x1 {
                     let c = grid.cell(x, y);
