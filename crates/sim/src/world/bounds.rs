@@ -7,6 +7,7 @@ use super::{NO_ROW, World};
 use crate::broad_phase::BodyEntry;
 use crate::def::BodyKind;
 use crate::entity::Entity;
+use crate::interned::ShapeTable;
 
 /// A body's bounds relative to its position, kept from one frame to the next.
 #[derive(Clone, Copy, Debug)]
@@ -164,47 +165,91 @@ impl World {
     ) {
         out.clear();
         out.reserve(self.movers.len());
+        let run = self.row_run(&self.movers);
         // Every column sliced to its exact length first: the columns of one index then share
         // one bounds check (`i < n`, `r < m`) instead of one each.
         let n = self.row.len();
-        let (row, position, angle) = (&self.row[..n], &self.position[..n], &self.angle[..n]);
-        let (layers, kinds, entity) = (&self.layer[..n], &self.kind[..n], &self.entity[..n]);
-        let shape_id = &self.shape_id[..n];
         let rows = &mut self.rows;
         let m = rows.local_bounds.len();
-        let local_bounds = &mut rows.local_bounds[..m];
-        let (start_position, frozen) = (&rows.start_position[..m], &rows.frozen[..m]);
-        let shapes = &self.shapes;
-        for &i in &self.movers {
-            let i = i as usize;
-            let r = row[i] as usize;
-            let p = position[i];
-            // The shape table is read only when needed (a scene's shapes may all differ).
-            let id = shape_id[i];
-            let shape = || &shapes.get(id).0;
-            let mut bounds = local_bounds[r].at_with(shape, angle[i], p);
-            let layer = layers[i];
-            let moved = start_position[r] - p;
-            if moved != Vec2::ZERO
-                && (sweeping[usize::from(layer)]
-                    || (separate_swept[usize::from(layer)]
-                        && moved.length() > 0.5 * shape().min_width()))
-            {
-                bounds = bounds.union(bounds.translated(moved));
+        let mut columns = EntryColumns {
+            position: &self.position[..n],
+            angle: &self.angle[..n],
+            layers: &self.layer[..n],
+            kinds: &self.kind[..n],
+            entity: &self.entity[..n],
+            shape_id: &self.shape_id[..n],
+            local_bounds: &mut rows.local_bounds[..m],
+            start_position: &rows.start_position[..m],
+            frozen: &rows.frozen[..m],
+            shapes: &self.shapes,
+            sweeping,
+            separate_swept,
+        };
+        // Each body with its row: in place over one run (`runs.rs`), else through the list
+        // and the row column.
+        match run {
+            Some(run) => {
+                for (k, (i, r)) in run.indices().zip(run.rows()).enumerate() {
+                    out.push(columns.entry(i, r, |b| visit(k, b)));
+                }
             }
-            visit(out.len(), &bounds);
-            let e = entity[i];
-            out.push(BodyEntry {
-                // As [`World::key`].
-                key: (u64::from(e.index) << 32) | u64::from(e.generation),
-                bounds,
-                layer,
-                kind: if frozen[r] {
-                    BodyKind::Kinematic
-                } else {
-                    kinds[i]
-                },
-            });
+            None => {
+                let row = &self.row[..n];
+                for (k, &i) in self.movers.iter().enumerate() {
+                    let i = i as usize;
+                    out.push(columns.entry(i, row[i] as usize, |b| visit(k, b)));
+                }
+            }
+        }
+    }
+}
+
+/// What [`World::mover_entries`] reads of each body, and of its row.
+struct EntryColumns<'a> {
+    position: &'a [Vec2],
+    angle: &'a [f64],
+    layers: &'a [u8],
+    kinds: &'a [BodyKind],
+    entity: &'a [Entity],
+    shape_id: &'a [u32],
+    local_bounds: &'a mut [LocalBounds],
+    start_position: &'a [Vec2],
+    frozen: &'a [bool],
+    shapes: &'a ShapeTable,
+    sweeping: &'a [bool],
+    separate_swept: &'a [bool],
+}
+
+impl EntryColumns<'_> {
+    /// The entry of body `i`, of row `r`, its bounds shown to `visit` first.
+    #[inline(always)]
+    fn entry(&mut self, i: usize, r: usize, visit: impl FnOnce(&Bounds)) -> BodyEntry {
+        let p = self.position[i];
+        // The shape table is read only when needed (a scene's shapes may all differ).
+        let (shapes, id) = (self.shapes, self.shape_id[i]);
+        let shape = || &shapes.get(id).0;
+        let mut bounds = self.local_bounds[r].at_with(shape, self.angle[i], p);
+        let layer = self.layers[i];
+        let moved = self.start_position[r] - p;
+        if moved != Vec2::ZERO
+            && (self.sweeping[usize::from(layer)]
+                || (self.separate_swept[usize::from(layer)]
+                    && moved.length() > 0.5 * shape().min_width()))
+        {
+            bounds = bounds.union(bounds.translated(moved));
+        }
+        visit(&bounds);
+        let e = self.entity[i];
+        BodyEntry {
+            // As [`World::key`].
+            key: (u64::from(e.index) << 32) | u64::from(e.generation),
+            bounds,
+            layer,
+            kind: if self.frozen[r] {
+                BodyKind::Kinematic
+            } else {
+                self.kinds[i]
+            },
         }
     }
 }

@@ -40,6 +40,7 @@ mod disturbed;
 mod measures;
 mod motion;
 mod rows;
+mod runs;
 mod set;
 mod sleep;
 mod state;
@@ -124,6 +125,9 @@ pub struct World {
     layout: u64,
     /// The bodies touched other than by the usual integration ([`World::disturbed`]).
     disturbed: Disturbed,
+    /// Tests only: every pass goes body by body, as if no list were a run (`runs.rs`).
+    #[cfg(test)]
+    no_runs: bool,
 }
 
 impl World {
@@ -282,6 +286,11 @@ impl World {
     /// Copies every moving body's position to its start position: the frame's swept tests
     /// run from there (static bodies never move; their start is their position).
     pub fn start_frame(&mut self) {
+        if let Some(run) = self.row_run(&self.movers) {
+            // One run (`runs.rs`): one copy.
+            self.rows.start_position[run.rows()].copy_from_slice(&self.position[run.indices()]);
+            return;
+        }
         for &i in &self.movers {
             let r = self.row[i as usize] as usize;
             self.rows.start_position[r] = self.position[i as usize];

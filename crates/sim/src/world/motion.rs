@@ -121,6 +121,25 @@ impl World {
     /// body's arithmetic is the stages' own, and no body's depends on another's, so the
     /// result is the same bits as three passes.
     pub(crate) fn integrate(&mut self, dt: f64, x: bool, y: bool, turn: bool) {
+        if x && y
+            && turn
+            && let Some(run) = self.row_run(&self.active)
+        {
+            // The usual case over one run (`runs.rs`): each column a slice, in place.
+            let rows = &self.rows;
+            let bodies = self.position[run.indices()]
+                .iter_mut()
+                .zip(&mut self.angle[run.indices()]);
+            let motion = rows.velocity[run.rows()]
+                .iter()
+                .zip(&rows.angular_velocity[run.rows()]);
+            for ((p, angle), (v, w)) in bodies.zip(motion) {
+                p.x += v.x * dt;
+                p.y += v.y * dt;
+                *angle += w * dt;
+            }
+            return;
+        }
         // Sliced to their exact lengths: the columns of one index share one bounds check.
         let n = self.row.len();
         let (row, position, angle) = (

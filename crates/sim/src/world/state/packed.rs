@@ -191,6 +191,8 @@ impl World {
             reshaped,
             layout: _,
             disturbed,
+            #[cfg(test)]
+            no_runs,
         } = self;
         World {
             ids: EntityAllocator::default(),
@@ -217,6 +219,8 @@ impl World {
             layout: crate::interned::next_serial(),
             // Another world: its own serial, every body named.
             disturbed: disturbed.clone(),
+            #[cfg(test)]
+            no_runs: *no_runs,
         }
     }
 
