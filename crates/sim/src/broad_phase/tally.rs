@@ -57,7 +57,7 @@ impl BroadPhase {
 /// Counts moving bodies per layer (into `counts[layer + 1]`) and dynamic ones (into
 /// `dynamic[layer]`), a run of one layer in registers, and notes the runs of consecutive
 /// indices (up to [`MAX_RUNS`], and one more to say there were more).
-pub(super) struct Tally<'a> {
+pub(crate) struct Tally<'a> {
     counts: &'a mut [u32],
     dynamic: &'a mut [u32],
     runs: &'a mut Vec<(u32, u32, u8)>,
@@ -104,8 +104,20 @@ impl<'a> Tally<'a> {
         self.d += u32::from(b.kind == BodyKind::Dynamic);
     }
 
+    /// Counts `len` bodies of `layer` at indices `start..start + len`, `dynamic` of them
+    /// dynamic: what [`Tally::add`] of each would count.
+    pub(crate) fn add_run(&mut self, layer: u8, start: u32, len: u32, dynamic: u32) {
+        let l = usize::from(layer);
+        if l != self.layer || start != self.start + self.n {
+            self.flush();
+            (self.layer, self.start) = (l, start);
+        }
+        self.n += len;
+        self.d += dynamic;
+    }
+
     /// Adds the current run to the counts; call once after the last [`Tally::add`].
-    pub(super) fn flush(&mut self) {
+    pub(crate) fn flush(&mut self) {
         if self.n == 0 {
             return;
         }

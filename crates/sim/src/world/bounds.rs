@@ -4,7 +4,7 @@
 use ricochet_geom::{Bounds, Pose, Shape, Vec2};
 
 use super::{NO_ROW, World};
-use crate::broad_phase::BodyEntry;
+use crate::broad_phase::{BodyEntry, Tally};
 use crate::def::BodyKind;
 use crate::entity::Entity;
 use crate::interned::ShapeTable;
@@ -254,6 +254,46 @@ impl EntryColumns<'_> {
     }
 }
 
+impl World {
+    /// Counts the moving bodies by layer into `tally`, as the broad phase would count their
+    /// entries ([`World::mover_entries`], where a frozen body is kinematic), when they are
+    /// one run (`runs.rs`): the layer and kind columns are read in place, one layer's
+    /// stretch at a time, instead of every 48-byte entry. Returns whether it counted them
+    /// (nothing is counted when they are not one run).
+    pub(crate) fn count_movers(&self, tally: &mut Tally) -> bool {
+        let Some(run) = self.row_run(&self.movers) else {
+            return false;
+        };
+        let (layers, kinds) = (&self.layer[run.indices()], &self.kind[run.indices()]);
+        let frozen = &self.rows.frozen[run.rows()];
+        let mut start = 0;
+        while start < layers.len() {
+            let layer = layers[start];
+            let end = start + stretch(&layers[start..], layer);
+            let dynamic: u32 = (kinds[start..end].iter().zip(&frozen[start..end]))
+                .map(|(&k, &f)| u32::from(k == BodyKind::Dynamic && !f))
+                .sum();
+            tally.add_run(layer, start as u32, (end - start) as u32, dynamic);
+            start = end;
+        }
+        true
+    }
+}
+
+/// How many of `column`'s first values are `value` (in blocks without an early exit
+/// inside, which the compiler vectorises).
+fn stretch(column: &[u8], value: u8) -> usize {
+    let mut n = 0;
+    for block in column.chunks(32) {
+        if block.iter().fold(true, |all, &v| all & (v == value)) {
+            n += block.len();
+        } else {
+            return n + block.iter().take_while(|&&v| v == value).count();
+        }
+    }
+    n
+}
+
 /// Bounds `b`, relative to a body, placed at `p`.
 #[inline]
 pub(crate) fn placed(b: Bounds, p: Vec2) -> Bounds {
@@ -263,5 +303,21 @@ pub(crate) fn placed(b: Bounds, p: Vec2) -> Bounds {
     Bounds {
         min: b.min + p - pad,
         max: b.max + p + pad,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::stretch;
+
+    #[test]
+    fn a_stretch_ends_at_the_first_other_value_whatever_block_it_is_in() {
+        for len in [0, 1, 31, 32, 33, 64, 100] {
+            for end in 0..=len {
+                let column: Vec<u8> = (0..len).map(|k| if k < end { 7 } else { 8 }).collect();
+                assert_eq!(stretch(&column, 7), end, "{end} of {len}");
+            }
+        }
+        assert_eq!(stretch(&[7, 7, 8, 7, 7], 7), 2);
     }
 }
