@@ -104,7 +104,7 @@ pub(crate) fn bring_in(world: &WorldBounds, w: &mut World) {
     // others.
     let mut candidates = Vec::new();
     w.active_not_inside(world.min, world.max, &mut candidates);
-    for i in candidates {
+    for &i in &candidates {
         let i = i as usize;
         let p = w.position[i];
         let outside = |axis: usize| p[axis] < world.min[axis] || p[axis] >= world.max[axis];
@@ -122,6 +122,9 @@ pub(crate) fn bring_in(world: &WorldBounds, w: &mut World) {
             w.wrap_to(i, q);
         }
     }
+    // The `bounds` stage asks the same after `detect`: if nothing is touched in between, the
+    // bodies still outside are among these.
+    w.keep_not_inside(world.min, world.max, &candidates);
 }
 
 /// How far `b` sticks out of the world on each axis (`>= 0`).

@@ -80,6 +80,13 @@ impl Disturbed {
         self.full
     }
 
+    /// A mark that changes with every name and every step: while it is the same, no body
+    /// was touched but by the integrator, which runs once a step. `None` once every body
+    /// is named (nothing can be told apart then).
+    pub(super) fn mark(&self) -> Option<(u64, usize)> {
+        (!self.full).then_some((self.steps, self.bodies.len()))
+    }
+
     /// The bodies named since the step before last ended, repeats and gone bodies included
     /// (meaningful only when not [`Disturbed::all`]).
     #[must_use]

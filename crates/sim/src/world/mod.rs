@@ -51,7 +51,7 @@ pub use rows::Motion;
 pub(crate) use state::{Bodies, PackedWorld};
 
 use bounds::LocalBounds;
-use motion::any_in_blocks;
+use motion::{KeptOutside, any_in_blocks};
 use rows::Rows;
 
 /// What a controller's inputs currently are.
@@ -125,6 +125,8 @@ pub struct World {
     layout: u64,
     /// The bodies touched other than by the usual integration ([`World::disturbed`]).
     disturbed: Disturbed,
+    /// The last answer of [`World::active_not_inside`] kept for the same step's next ask.
+    kept_outside: KeptOutside,
     /// Tests only: every pass goes body by body, as if no list were a run (`runs.rs`).
     #[cfg(test)]
     no_runs: bool,

@@ -183,8 +183,48 @@ impl World {
     /// The active bodies whose position is not inside `[min, max)` on both axes (a NaN
     /// coordinate is not inside), in active order, into `out`: the wrap's and the `bounds`
     /// stage's one question about every active body, asked in one tight loop so that the
-    /// few answers go to their slower code.
+    /// few answers go to their slower code. Asked again in the same step with the same box
+    /// and nothing touched since the answer was kept ([`World::keep_not_inside`]), the kept
+    /// answer is given without the loop.
     pub(crate) fn active_not_inside(&self, min: Vec2, max: Vec2, out: &mut Vec<u32>) {
+        let kept = &self.kept_outside;
+        let bits = |v: Vec2| [v.x.to_bits(), v.y.to_bits()];
+        if kept.mark.is_some()
+            && kept.mark == self.disturbed.mark()
+            && bits(kept.min) == bits(min)
+            && bits(kept.max) == bits(max)
+        {
+            out.extend_from_slice(&kept.list);
+            #[cfg(debug_assertions)]
+            {
+                let mut scanned = Vec::new();
+                self.scan_not_inside(min, max, &mut scanned);
+                assert_eq!(kept.list, scanned, "nothing touched, the same answer");
+            }
+            return;
+        }
+        self.scan_not_inside(min, max, out);
+    }
+
+    /// Keeps the answer of [`World::active_not_inside`] for `[min, max)` now, from
+    /// `candidates`: its answer before the caller moved some of them (and nothing else).
+    /// A body outside now was outside then, or it did not move.
+    pub(crate) fn keep_not_inside(&mut self, min: Vec2, max: Vec2, candidates: &[u32]) {
+        let position = &self.position;
+        let outside = |p: &Vec2| !(p.x >= min.x && p.x < max.x && p.y >= min.y && p.y < max.y);
+        let kept = &mut self.kept_outside;
+        kept.list.clear();
+        kept.list.extend(
+            candidates
+                .iter()
+                .filter(|&&i| outside(&position[i as usize])),
+        );
+        (kept.min, kept.max) = (min, max);
+        kept.mark = self.disturbed.mark();
+    }
+
+    /// [`World::active_not_inside`]'s loop.
+    fn scan_not_inside(&self, min: Vec2, max: Vec2, out: &mut Vec<u32>) {
         let position = &self.position;
         let outside = |p: &Vec2| !(p.x >= min.x && p.x < max.x && p.y >= min.y && p.y < max.y);
         let active = &self.active;
@@ -222,4 +262,14 @@ pub(super) fn any_in_blocks<T>(column: &[T], on: impl Fn(&T) -> bool) -> bool {
     column
         .chunks(32)
         .any(|c| c.iter().fold(false, |any, x| any | on(x)))
+}
+
+/// An answer of [`World::active_not_inside`] kept for the next ask in the same step, with
+/// the mark of what the world had touched then ([`super::Disturbed`]).
+#[derive(Clone, Debug, Default)]
+pub(super) struct KeptOutside {
+    mark: Option<(u64, usize)>,
+    min: Vec2,
+    max: Vec2,
+    list: Vec<u32>,
 }

@@ -191,6 +191,7 @@ impl World {
             reshaped,
             layout: _,
             disturbed,
+            kept_outside: _,
             #[cfg(test)]
             no_runs,
         } = self;
@@ -219,6 +220,7 @@ impl World {
             layout: crate::interned::next_serial(),
             // Another world: its own serial, every body named.
             disturbed: disturbed.clone(),
+            kept_outside: Default::default(),
             #[cfg(test)]
             no_runs: *no_runs,
         }
