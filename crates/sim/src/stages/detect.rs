@@ -207,9 +207,7 @@ fn candidate_pairs(ctx: &mut StageCtx, st: &mut DetectState) -> Vec<(u32, u32)> 
             let seam = &mut st.seam;
             seam.begin(&b);
             let separate = &st.separate_swept;
-            w.mover_entries(&st.sweeping, separate, &mut st.movers, |m, b| {
-                seam.visit(m, b);
-            });
+            w.mover_entries(&st.sweeping, separate, &mut st.movers, seam.visitor());
         }
         None => w.mover_entries(&st.sweeping, &st.separate_swept, &mut st.movers, |_, _| {}),
     }

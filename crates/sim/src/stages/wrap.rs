@@ -182,7 +182,7 @@ impl Seam {
             .fold(Vec2::ZERO, |r, s| r.max(reach(world, &s.bounds)));
     }
 
-    /// Starts a frame: [`Seam::visit`] then sees every moving body's entry.
+    /// Starts a frame: [`Seam::visitor`] then sees every moving body's entry.
     pub(crate) fn begin(&mut self, world: &WorldBounds) {
         let slack = world.size() * SLACK;
         let r = self.guess.max(self.static_reach);
@@ -191,18 +191,22 @@ impl Seam {
         self.candidates.clear();
     }
 
-    /// Notes the moving body at place `m` of the entries if its bounds `b` are outside the
-    /// guessed edges (one pass, as the entries are made).
-    pub(crate) fn visit(&mut self, m: usize, b: &Bounds) {
+    /// What notes the moving body at place `m` of the entries if its bounds `b` are outside
+    /// the guessed edges (one pass, as the entries are made; the edges held in it, not read
+    /// again for each body).
+    pub(crate) fn visitor(&mut self) -> impl FnMut(usize, &Bounds) + '_ {
         let (lo, hi) = (self.guess_lo, self.guess_hi);
-        if !(b.min.x > lo.x && b.max.x < hi.x && b.min.y > lo.y && b.max.y < hi.y) {
-            self.candidates.push(m as u32);
+        let candidates = &mut self.candidates;
+        move |m, b| {
+            if !(b.min.x > lo.x && b.max.x < hi.x && b.min.y > lo.y && b.max.y < hi.y) {
+                candidates.push(m as u32);
+            }
         }
     }
 
     /// Adds to `pairs` (the main broad phase's: dense indices, sorted) the pairs that meet
     /// through the seam: the images of the moving bodies near an edge (`movers`, whose world
-    /// indices are [`World::movers`], each seen by [`Seam::visit`]) against the near moving
+    /// indices are [`World::movers`], each seen by [`Seam::visitor`]) against the near moving
     /// bodies and the static bodies (`statics`, read only when `static_generation`
     /// changes).
     ///

@@ -171,6 +171,13 @@ impl World {
         let n = self.row.len();
         let rows = &mut self.rows;
         let m = rows.local_bounds.len();
+        // Per layer, whether its bodies may be widened over their motion (a fixed-size table
+        // read by a `u8`: no bounds check).
+        let mut widen = [0u8; 256];
+        for (l, w) in widen.iter_mut().enumerate() {
+            let flag = |of: &[bool], bit: u8| if of.get(l) == Some(&true) { bit } else { 0 };
+            *w = flag(sweeping, SWEEPS) | flag(separate_swept, SEPARATE_SWEPT);
+        }
         let mut columns = EntryColumns {
             position: &self.position[..n],
             angle: &self.angle[..n],
@@ -182,8 +189,7 @@ impl World {
             start_position: &rows.start_position[..m],
             frozen: &rows.frozen[..m],
             shapes: &self.shapes,
-            sweeping,
-            separate_swept,
+            widen: &widen,
         };
         // Each body with its row: in place over one run (`runs.rs`), else through the list
         // and the row column.
@@ -216,9 +222,14 @@ struct EntryColumns<'a> {
     start_position: &'a [Vec2],
     frozen: &'a [bool],
     shapes: &'a ShapeTable,
-    sweeping: &'a [bool],
-    separate_swept: &'a [bool],
+    /// Per layer, [`SWEEPS`] and [`SEPARATE_SWEPT`].
+    widen: &'a [u8; 256],
 }
+
+/// A layer in `sweeping` ([`World::mover_entries`]).
+const SWEEPS: u8 = 1;
+/// A layer in `separate_swept`.
+const SEPARATE_SWEPT: u8 = 2;
 
 impl EntryColumns<'_> {
     /// The entry of body `i`, of row `r`, its bounds shown to `visit` first.
@@ -230,13 +241,15 @@ impl EntryColumns<'_> {
         let shape = || &shapes.get(id).0;
         let mut bounds = self.local_bounds[r].at_with(shape, self.angle[i], p);
         let layer = self.layers[i];
-        let moved = self.start_position[r] - p;
-        if moved != Vec2::ZERO
-            && (self.sweeping[usize::from(layer)]
-                || (self.separate_swept[usize::from(layer)]
-                    && moved.length() > 0.5 * shape().min_width()))
-        {
-            bounds = bounds.union(bounds.translated(moved));
+        let widen = self.widen[usize::from(layer)];
+        // The frame's start is read only for a layer that may be widened.
+        if widen != 0 {
+            let moved = self.start_position[r] - p;
+            if moved != Vec2::ZERO
+                && (widen & SWEEPS != 0 || moved.length() > 0.5 * shape().min_width())
+            {
+                bounds = bounds.union(bounds.translated(moved));
+            }
         }
         visit(&bounds);
         let e = self.entity[i];
