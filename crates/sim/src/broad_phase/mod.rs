@@ -441,51 +441,6 @@ impl BroadPhase {
         self.split(statics, static_generation, movers, interactions, false, out)
     }
 
-    /// Starts the count of this call's moving bodies, for a caller that counts them itself
-    /// from columns of its own ([`Tally::add_run`], then [`Tally::flush`]), faster than
-    /// from the entries: it then calls [`BroadPhase::pairs_counted_handles`] with the
-    /// bodies it counted, which are not read again to be counted.
-    pub(crate) fn tally(&mut self) -> Tally<'_> {
-        Tally::new(&mut self.layer_start, &mut self.dynamic, &mut self.runs)
-    }
-
-    /// [`BroadPhase::pairs_split_handles`] of moving bodies counted by the caller through
-    /// [`BroadPhase::tally`] (checked against a count of the entries in a debug build).
-    pub(crate) fn pairs_counted_handles(
-        &mut self,
-        statics: &[BodyEntry],
-        static_generation: u64,
-        movers: &[BodyEntry],
-        interactions: &Interactions,
-        out: &mut Vec<(u32, u32)>,
-    ) -> BroadPhaseStats {
-        #[cfg(debug_assertions)]
-        {
-            let (mut counts, mut dynamic, mut runs) = (
-                vec![0; self.layer_start.len()],
-                vec![0; self.dynamic.len()],
-                Vec::new(),
-            );
-            let mut tally = Tally::new(&mut counts, &mut dynamic, &mut runs);
-            for (i, b) in movers.iter().enumerate() {
-                tally.add(b, i as u32);
-            }
-            tally.flush();
-            assert_eq!(
-                (counts, dynamic, runs),
-                (
-                    self.layer_start.clone(),
-                    self.dynamic.clone(),
-                    self.runs.clone()
-                ),
-                "the caller's count is the entries'"
-            );
-        }
-        self.load_statics(statics, static_generation, movers);
-        self.group_movers(movers, |_| true);
-        self.run(movers, (false, false), interactions, out)
-    }
-
     /// [`BroadPhase::pairs_split`], resolved to dense indices or not.
     fn split(
         &mut self,
