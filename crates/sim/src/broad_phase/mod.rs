@@ -452,11 +452,7 @@ impl BroadPhase {
         out: &mut Vec<(u32, u32)>,
     ) -> BroadPhaseStats {
         self.load_statics(statics, static_generation, movers);
-        let mut tally = Tally::new(&mut self.layer_start, &mut self.dynamic, &mut self.runs);
-        for (i, b) in movers.iter().enumerate() {
-            tally.add(b, i as u32);
-        }
-        tally.flush();
+        Tally::new(&mut self.layer_start, &mut self.dynamic, &mut self.runs).count(movers);
         self.group_movers(movers, |_| true);
         self.run(movers, (false, dense), interactions, out)
     }

@@ -31,11 +31,7 @@ impl BroadPhase {
                 vec![0; self.dynamic.len()],
                 Vec::new(),
             );
-            let mut tally = Tally::new(&mut counts, &mut dynamic, &mut runs);
-            for (i, b) in movers.iter().enumerate() {
-                tally.add(b, i as u32);
-            }
-            tally.flush();
+            Tally::new(&mut counts, &mut dynamic, &mut runs).count(movers);
             assert_eq!(
                 (counts, dynamic, runs),
                 (
@@ -160,6 +156,14 @@ impl<'a> Tally<'a> {
         }
         self.n += len;
         self.d += dynamic;
+    }
+
+    /// Counts every body of `bodies` (all moving), at its place, and flushes.
+    pub(super) fn count(mut self, bodies: &[BodyEntry]) {
+        for (i, b) in bodies.iter().enumerate() {
+            self.add(b, i as u32);
+        }
+        self.flush();
     }
 
     /// Adds the current run to the counts; call once after the last [`Tally::add`].
