@@ -127,9 +127,6 @@ pub struct World {
     disturbed: Disturbed,
     /// The last answer of [`World::active_not_inside`] kept for the same step's next ask.
     kept_outside: KeptOutside,
-    /// Tests only: every pass goes body by body, as if no list were a run (`runs.rs`).
-    #[cfg(test)]
-    no_runs: bool,
 }
 
 impl World {

@@ -32,7 +32,7 @@ impl World {
     /// [`World::active`]) as one [`RowRun`], if it is one and is not empty.
     pub(super) fn row_run(&self, list: &[u32]) -> Option<RowRun> {
         #[cfg(test)]
-        if self.no_runs {
+        if tests::NO_RUNS.get() {
             return None;
         }
         let (&first, &last) = (list.first()?, list.last()?);
@@ -67,10 +67,18 @@ impl World {
 
 #[cfg(test)]
 mod tests {
+    use std::cell::Cell;
+
     use ricochet_geom::{Bounds, Shape, Vec2};
 
     use crate::def::{BodyDef, BodyKind};
     use crate::world::World;
+
+    thread_local! {
+        /// Every pass of this thread goes body by body, as if no list were a run: the
+        /// reference the run paths are compared with.
+        pub(super) static NO_RUNS: Cell<bool> = const { Cell::new(false) };
+    }
 
     fn body(kind: BodyKind) -> BodyDef {
         BodyDef {
@@ -167,14 +175,14 @@ mod tests {
             run.spawn(&varied(k));
         }
         let mut plain = run.clone();
-        plain.no_runs = true;
         assert!(run.row_run(run.movers()).is_some());
-        assert!(plain.row_run(plain.movers()).is_none());
         let dt = 1.0 / 60.0;
         // Layer 1 sweeps, layer 2 is swept when it moves more than half its width.
         let (sweeping, separate_swept) = ([false, true, false], [false, false, true]);
         let mut seen = Vec::new();
-        for w in [&mut run, &mut plain] {
+        for (w, body_by_body) in [(&mut run, false), (&mut plain, true)] {
+            NO_RUNS.set(body_by_body);
+            assert_eq!(w.row_run(w.movers()).is_none(), body_by_body);
             let mut frames = Vec::new();
             for _ in 0..3 {
                 w.start_frame();
@@ -195,6 +203,7 @@ mod tests {
             }
             seen.push(frames);
         }
+        NO_RUNS.set(false);
         assert_eq!(seen[0], seen[1]);
     }
 }

@@ -192,8 +192,6 @@ impl World {
             layout: _,
             disturbed,
             kept_outside: _,
-            #[cfg(test)]
-            no_runs,
         } = self;
         World {
             ids: EntityAllocator::default(),
@@ -221,8 +219,6 @@ impl World {
             // Another world: its own serial, every body named.
             disturbed: disturbed.clone(),
             kept_outside: Default::default(),
-            #[cfg(test)]
-            no_runs: *no_runs,
         }
     }
 
