@@ -6,10 +6,11 @@ use crate::def::BodyKind;
 use super::{BodyEntry, BroadPhase, BroadPhaseStats, Interactions, LAYERS};
 
 impl BroadPhase {
-    /// Starts the count of this call's moving bodies, for a caller that counts them itself
+    /// Starts the count of this call's moving bodies, for a caller that counts them itself:
     /// from columns of its own ([`Tally::add_run`], then [`Tally::flush`]), faster than
-    /// from the entries: it then calls [`BroadPhase::pairs_counted_handles`] with the
-    /// bodies it counted, which are not read again to be counted.
+    /// from the entries, or from the entries ([`Tally::count`]). It then calls
+    /// [`BroadPhase::pairs_counted_handles`] with the bodies it counted, which are not read
+    /// again to be counted.
     pub(crate) fn tally(&mut self) -> Tally<'_> {
         Tally::new(&mut self.layer_start, &mut self.dynamic, &mut self.runs)
     }
@@ -159,7 +160,7 @@ impl<'a> Tally<'a> {
     }
 
     /// Counts every body of `bodies` (all moving), at its place, and flushes.
-    pub(super) fn count(mut self, bodies: &[BodyEntry]) {
+    pub(crate) fn count(mut self, bodies: &[BodyEntry]) {
         for (i, b) in bodies.iter().enumerate() {
             self.add(b, i as u32);
         }

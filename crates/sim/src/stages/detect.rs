@@ -213,33 +213,24 @@ fn candidate_pairs(ctx: &mut StageCtx, st: &mut DetectState) -> Vec<(u32, u32)> 
     }
     let generation = st.statics_version;
     let mut pairs = std::mem::take(&mut st.pairs);
-    // Counted from the world's columns when it can (one run of movers), else by the broad
-    // phase from the entries.
+    // Counted from the world's columns when it can (one run of movers), else from the
+    // entries.
     let mut tally = st.broad_phase.tally();
-    let counted = w.count_movers(&mut tally);
-    tally.flush();
+    if w.count_movers(&mut tally) {
+        tally.flush();
+    } else {
+        tally.count(&st.movers);
+    }
     // By handles (a place among the movers, or among `statics` with `STATIC_BIT`), turned
     // into world indices here: `statics` holds only some of the static bodies, so places
     // in the broad phase's dense order are not world indices.
-    let bp = if counted {
-        let bp = &mut st.broad_phase;
-        bp.pairs_counted_handles(
-            &st.statics,
-            generation,
-            &st.movers,
-            &st.interactions,
-            &mut pairs,
-        )
-    } else {
-        let bp = &mut st.broad_phase;
-        bp.pairs_split_handles(
-            &st.statics,
-            generation,
-            &st.movers,
-            &st.interactions,
-            &mut pairs,
-        )
-    };
+    let bp = st.broad_phase.pairs_counted_handles(
+        &st.statics,
+        generation,
+        &st.movers,
+        &st.interactions,
+        &mut pairs,
+    );
     {
         let (movers, statics) = (w.movers(), &st.statics);
         let world_index = |h: u32| -> u32 {
