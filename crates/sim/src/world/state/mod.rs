@@ -32,7 +32,6 @@ use crate::snapshot::codec::Sink;
 mod decode;
 mod packed;
 mod restore;
-mod run_code;
 
 pub(crate) use packed::PackedWorld;
 
