@@ -44,12 +44,13 @@ pub trait MessageSink {
         schema_json: &str,
     ) -> Result<ChannelId, LogError>;
 
-    /// Writes `json`, one JSON value already encoded, on the JSON channel `channel`.
-    fn write_json_bytes(
+    /// Writes `bytes`, one message already encoded as `channel`'s schema says (protobuf,
+    /// or a JSON value on a JSON channel), like [`write`](Self::write).
+    fn write_encoded(
         &mut self,
         channel: ChannelId,
         time_ns: u64,
-        json: Vec<u8>,
+        bytes: Vec<u8>,
     ) -> Result<(), LogError>;
 
     /// Attaches a file to a recording (the scenario, the game's name); a live stream
@@ -98,12 +99,12 @@ impl MessageSink for LogWriter {
         LogWriter::attach(self, name, media_type, data)
     }
 
-    fn write_json_bytes(
+    fn write_encoded(
         &mut self,
         channel: ChannelId,
         time_ns: u64,
-        json: Vec<u8>,
+        bytes: Vec<u8>,
     ) -> Result<(), LogError> {
-        LogWriter::write_encoded(self, channel, time_ns, json)
+        LogWriter::write_encoded(self, channel, time_ns, bytes)
     }
 }

@@ -335,11 +335,11 @@ impl<S: MessageSink> Recorder<S> {
                     }
                     let redraw = !statics && std::mem::take(&mut self.moving_skipped);
                     if let (Some(ch), true) = (channel, changed || whole || redraw) {
-                        let message = scene::snapshot(w, layers, statics, style, ts);
+                        let message = scene::snapshot_encoded(w, layers, statics, style, ts);
                         if counted {
-                            bytes += message.encoded_len();
+                            bytes += message.len();
                         }
-                        self.writer.write(ch, t, message)?;
+                        self.writer.write_encoded(ch, t, message)?;
                         self.built += 1;
                     }
                 }

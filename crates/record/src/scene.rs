@@ -44,6 +44,11 @@ use ricochet_log::messages::fox::{
 };
 use ricochet_sim::{BodyKind, ContactRecord, Entity, Layers, World};
 
+mod encoded;
+mod wire;
+
+pub use encoded::snapshot_encoded;
+
 /// The root frame: world coordinates.
 pub const WORLD: &str = "world";
 
@@ -159,21 +164,65 @@ fn p3(v: Vec2) -> Point3 {
     }
 }
 
-/// Adds a convex outline, in world coordinates, to the entity's one triangle list (made in
-/// `color` if it has none yet): a fan of triangles from its first point.
-fn fill(entity: &mut SceneEntity, outline: impl Iterator<Item = Vec2>, color: Color) {
-    if entity.triangles.is_empty() {
-        entity
-            .triangles
-            .push(triangle_list(color, &Room::default()));
+/// Where [`draw`] puts a body's primitives: an entity's lists ([`SceneEntity`]), or their
+/// encoding (`scene/encoded.rs`). The message is the same either way.
+trait Canvas {
+    fn cube(&mut self, cube: CubePrimitive);
+    fn cylinder(&mut self, cylinder: CylinderPrimitive);
+    /// A convex outline, in world coordinates, as a fan of triangles from its first point in
+    /// the one triangle list (made in `color` if there is none yet).
+    fn fan(&mut self, outline: impl Iterator<Item = Vec2>, color: Color);
+    /// A segment, in world coordinates, of the one line list (made in `color` if there is
+    /// none yet).
+    fn segment(&mut self, a: Vec2, b: Vec2, color: Color);
+}
+
+impl Canvas for SceneEntity {
+    fn cube(&mut self, cube: CubePrimitive) {
+        self.cubes.push(cube);
     }
-    let list = &mut entity.triangles[0];
-    debug_assert_eq!(list.color, Some(color), "one colour a batch");
-    let first = list.points.len() as u32;
-    list.points.extend(outline.map(p3));
-    let n = list.points.len() as u32 - first;
-    list.indices
-        .extend((1..n.saturating_sub(1)).flat_map(|k| [first, first + k, first + k + 1]));
+
+    fn cylinder(&mut self, cylinder: CylinderPrimitive) {
+        self.cylinders.push(cylinder);
+    }
+
+    fn fan(&mut self, outline: impl Iterator<Item = Vec2>, color: Color) {
+        if self.triangles.is_empty() {
+            self.triangles.push(triangle_list(color, &Room::default()));
+        }
+        let list = &mut self.triangles[0];
+        debug_assert_eq!(list.color, Some(color), "one colour a batch");
+        let first = list.points.len() as u32;
+        list.points.extend(outline.map(p3));
+        let n = list.points.len() as u32 - first;
+        list.indices.extend(fan_indices(first, n));
+    }
+
+    fn segment(&mut self, a: Vec2, b: Vec2, color: Color) {
+        if self.lines.is_empty() {
+            self.lines.push(line_list(color));
+        }
+        self.lines[0].points.extend([a, b].map(p3));
+    }
+}
+
+/// The indices of a fan of triangles over the `n` points from `first`.
+fn fan_indices(first: u32, n: u32) -> impl Iterator<Item = u32> {
+    (1..n.saturating_sub(1)).flat_map(move |k| [first, first + k, first + k + 1])
+}
+
+/// An empty line list (segments, two points each) in `color`: a chain's drawing.
+fn line_list(color: Color) -> LinePrimitive {
+    LinePrimitive {
+        r#type: line_primitive::Type::LineList as i32,
+        pose: planar(Vec2::ZERO, 0.0),
+        thickness: r(CHAIN_THICKNESS),
+        scale_invariant: false,
+        points: Vec::new(),
+        color: Some(color),
+        colors: Vec::new(),
+        indices: Vec::new(),
+    }
 }
 
 /// An entity's one triangle list, empty, in `color`, with room for `room`'s points and
@@ -223,7 +272,7 @@ impl Room {
 /// Adds the drawing of one primitive of a body at `at`, turned by `angle`, to `entity`, in
 /// world coordinates. An AABB part does not turn: only its centre turns with the body.
 /// Polygons and capsules join the entity's one triangle list (one batch for the viewer).
-fn draw(entity: &mut SceneEntity, prim: &Primitive, at: Vec2, angle: f64, color: Color) {
+fn draw(canvas: &mut impl Canvas, prim: &Primitive, at: Vec2, angle: f64, color: Color) {
     // The turn is found only for a part off the body's centre: a centred circle is at `at`
     // whatever the angle (but for a zero's sign, which proto3 never encodes), and a sine and
     // cosine per body were a quarter of a big scene's drawing.
@@ -236,7 +285,7 @@ fn draw(entity: &mut SceneEntity, prim: &Primitive, at: Vec2, angle: f64, color:
         }
     };
     match prim {
-        Primitive::Circle(c) => entity.cylinders.push(CylinderPrimitive {
+        Primitive::Circle(c) => canvas.cylinder(CylinderPrimitive {
             // Foxglove cylinders stand along z: lying in the XY plane needs no turn.
             pose: planar(place(c.center), 0.0),
             size: vec3(2.0 * c.radius, 2.0 * c.radius, DEPTH),
@@ -244,12 +293,12 @@ fn draw(entity: &mut SceneEntity, prim: &Primitive, at: Vec2, angle: f64, color:
             top_scale: 1.0,
             color: Some(color),
         }),
-        Primitive::Aabb(b) => entity.cubes.push(CubePrimitive {
+        Primitive::Aabb(b) => canvas.cube(CubePrimitive {
             pose: planar(place(b.center), 0.0),
             size: vec3(2.0 * b.half_extents.x, 2.0 * b.half_extents.y, DEPTH),
             color: Some(color),
         }),
-        Primitive::Obb(b) => entity.cubes.push(CubePrimitive {
+        Primitive::Obb(b) => canvas.cube(CubePrimitive {
             pose: planar(place(b.center), angle + b.angle),
             size: vec3(2.0 * b.half_extents.x, 2.0 * b.half_extents.y, DEPTH),
             color: Some(color),
@@ -265,13 +314,13 @@ fn draw(entity: &mut SceneEntity, prim: &Primitive, at: Vec2, angle: f64, color:
             } else {
                 libm::atan2(d.y, d.x)
             };
-            entity.cubes.push(CubePrimitive {
+            canvas.cube(CubePrimitive {
                 pose: planar((a + b) * 0.5, turn),
                 size: vec3(d.length(), 2.0 * c.radius, DEPTH),
                 color: Some(color),
             });
             for end in [a, b] {
-                entity.cylinders.push(CylinderPrimitive {
+                canvas.cylinder(CylinderPrimitive {
                     pose: planar(end, 0.0),
                     size: vec3(2.0 * c.radius, 2.0 * c.radius, DEPTH),
                     bottom_scale: 1.0,
@@ -282,30 +331,12 @@ fn draw(entity: &mut SceneEntity, prim: &Primitive, at: Vec2, angle: f64, color:
         }
         Primitive::Polygon(p) => {
             let rot = rot();
-            fill(
-                entity,
-                p.vertices().iter().map(|v| at + rot.apply(*v)),
-                color,
-            );
+            canvas.fan(p.vertices().iter().map(|v| at + rot.apply(*v)), color);
         }
         // A chain segment (zero thickness) is drawn as a line of the entity's one line list.
         Primitive::Segment(s) => {
-            if entity.lines.is_empty() {
-                entity.lines.push(LinePrimitive {
-                    r#type: line_primitive::Type::LineList as i32,
-                    pose: planar(Vec2::ZERO, 0.0),
-                    thickness: r(CHAIN_THICKNESS),
-                    scale_invariant: false,
-                    points: Vec::new(),
-                    color: Some(color),
-                    colors: Vec::new(),
-                    indices: Vec::new(),
-                });
-            }
             let rot = rot();
-            entity.lines[0]
-                .points
-                .extend([at + rot.apply(s.a), at + rot.apply(s.b)].map(p3));
+            canvas.segment(at + rot.apply(s.a), at + rot.apply(s.b), color);
         }
     }
 }
@@ -338,7 +369,8 @@ fn kind_name(kind: BodyKind) -> &'static str {
 }
 
 /// The whole of one topic at time `ts`: a delete-all, then the static bodies
-/// (`statics`) or the moving ones of `w`, as `style` says.
+/// (`statics`) or the moving ones of `w`, as `style` says. [`snapshot_encoded`] gives its
+/// encoding, without building it.
 pub fn snapshot(
     w: &World,
     layers: &Layers,
@@ -368,44 +400,95 @@ pub fn snapshot(
                 drawn
             })
             .collect(),
-        Style::Batched => batches(w, layers, chosen, ts),
+        Style::Batched => {
+            let mut all = Vec::new();
+            for_each_batch(w, layers, chosen, |batch| {
+                let mut drawn = batch.entity(w, ts);
+                let room = batch.room;
+                drawn.cubes.reserve_exact(room.cubes);
+                drawn.cylinders.reserve_exact(room.cylinders);
+                if room.points > 0 {
+                    drawn.triangles.push(triangle_list(batch.color(w), &room));
+                }
+                for &i in batch.bodies {
+                    draw_body(&mut drawn, w, i);
+                }
+                all.push(drawn);
+            });
+            all
+        }
     };
     SceneUpdate {
-        deletions: vec![SceneEntityDeletion {
-            timestamp: Some(ts),
-            r#type: scene_entity_deletion::Type::All as i32,
-            id: String::new(),
-        }],
+        deletions: vec![delete_all(ts)],
         entities,
     }
 }
 
-/// Adds body `i`'s primitives to `entity`.
-fn draw_body(entity: &mut SceneEntity, w: &World, i: usize) {
-    let color = color(w.layer[i], w.kind[i]);
-    for prim in w.shape(i).primitives() {
-        draw(entity, prim, w.position[i], w.angle[i], color);
+/// What removes every entity of a topic before its whole state.
+fn delete_all(ts: Timestamp) -> SceneEntityDeletion {
+    SceneEntityDeletion {
+        timestamp: Some(ts),
+        r#type: scene_entity_deletion::Type::All as i32,
+        id: String::new(),
     }
 }
 
-/// The bodies `chosen` (in id order), each layer's in entities `LAYER/K` of at most
-/// [`CHUNK_PARTS`] body parts (a body is never split), by layer, then by `K`.
-fn batches(
+/// Adds body `i`'s primitives to `canvas`.
+fn draw_body(canvas: &mut impl Canvas, w: &World, i: usize) {
+    let color = color(w.layer[i], w.kind[i]);
+    for prim in w.shape(i).primitives() {
+        draw(canvas, prim, w.position[i], w.angle[i], color);
+    }
+}
+
+/// The bodies of one batched entity, `LAYER/K`.
+struct Batch<'a> {
+    layer: &'a str,
+    k: usize,
+    /// In id order; at least one.
+    bodies: &'a [usize],
+    /// What their drawing holds.
+    room: Room,
+}
+
+impl Batch<'_> {
+    /// The entity, with its metadata and no primitive yet.
+    fn entity(&self, w: &World, ts: Timestamp) -> SceneEntity {
+        let (first, last) = (self.bodies[0], self.bodies[self.bodies.len() - 1]);
+        let metadata = vec![
+            pair("layer", self.layer.to_owned()),
+            pair("bodies", self.bodies.len().to_string()),
+            pair("first", w.entity[first].to_string()),
+            pair("last", w.entity[last].to_string()),
+        ];
+        entity(format!("{}/{}", self.layer, self.k), ts, metadata)
+    }
+
+    /// The colour of its triangle list: a batch is of one layer and one side of static.
+    fn color(&self, w: &World) -> Color {
+        let first = self.bodies[0];
+        color(w.layer[first], w.kind[first])
+    }
+}
+
+/// Calls `f` with the bodies `chosen` (in id order) in batches: each layer's in entities
+/// `LAYER/K` of at most [`CHUNK_PARTS`] body parts (a body is never split), by layer, then
+/// by `K`.
+fn for_each_batch(
     w: &World,
     layers: &Layers,
     chosen: impl Iterator<Item = usize>,
-    ts: Timestamp,
-) -> Vec<SceneEntity> {
+    mut f: impl FnMut(Batch),
+) {
     let names = layers.names();
     let mut by_layer: Vec<Vec<usize>> = vec![Vec::new(); names.len()];
     for i in chosen {
         by_layer[usize::from(w.layer[i])].push(i);
     }
-    let mut all = Vec::new();
     for (name, bodies) in names.iter().zip(&by_layer) {
         let mut rest = bodies.as_slice();
         let mut k = 0;
-        while let Some(&first) = rest.first() {
+        while !rest.is_empty() {
             // The batch: bodies while their parts fit (the first one whatever its parts).
             let (mut parts, mut room, mut n) = (0, Room::default(), 0);
             for &i in rest {
@@ -417,31 +500,17 @@ fn batches(
                 prims.iter().for_each(|p| room.add(p));
                 n += 1;
             }
-            let (batch, after) = rest.split_at(n);
-            let mut drawn = entity(format!("{name}/{k}"), ts, Vec::new());
-            drawn.cubes.reserve_exact(room.cubes);
-            drawn.cylinders.reserve_exact(room.cylinders);
-            if room.points > 0 {
-                // A batch is of one layer and one side of static: one colour.
-                let color = color(w.layer[first], w.kind[first]);
-                drawn.triangles.push(triangle_list(color, &room));
-            }
-            for &i in batch {
-                draw_body(&mut drawn, w, i);
-            }
-            let last = w.entity[batch[batch.len() - 1]];
-            drawn.metadata = vec![
-                pair("layer", name.to_owned()),
-                pair("bodies", batch.len().to_string()),
-                pair("first", w.entity[first].to_string()),
-                pair("last", last.to_string()),
-            ];
-            all.push(drawn);
+            let (bodies, after) = rest.split_at(n);
+            f(Batch {
+                layer: name,
+                k,
+                bodies,
+                room,
+            });
             rest = after;
             k += 1;
         }
     }
-    all
 }
 
 /// Where the layout's camera looks: the body the active region follows while it is alive

@@ -336,7 +336,7 @@ impl<G: Game, S: MessageSink> GameSession<G, S> {
                 let sink = self.recorder.sink_mut();
                 match kept {
                     Unwritten::Scenario(message) => sink.write(ch, t, message)?,
-                    Unwritten::Game(json) => sink.write_json_bytes(ch, t, json)?,
+                    Unwritten::Game(json) => sink.write_encoded(ch, t, json)?,
                 }
             }
             if let (Some(line), Some(ch)) = (line, self.events) {
@@ -346,7 +346,7 @@ impl<G: Game, S: MessageSink> GameSession<G, S> {
         self.recorder.record(self.run.sim(), &out)?;
         if let (Some(ch), Some(state)) = (self.game, self.run.game().state()) {
             let json = serde_json::to_vec(state).map_err(LogError::from)?;
-            self.recorder.sink_mut().write_json_bytes(ch, t, json)?;
+            self.recorder.sink_mut().write_encoded(ch, t, json)?;
         }
         self.next = out.frame + 1;
         Ok(out)

@@ -77,13 +77,13 @@ impl MessageSink for LiveSink {
         Ok(ChannelId::from_index(id as u16))
     }
 
-    fn write_json_bytes(
+    fn write_encoded(
         &mut self,
         channel: ChannelId,
         time_ns: u64,
-        json: Vec<u8>,
+        bytes: Vec<u8>,
     ) -> Result<(), LogError> {
-        self.publish(channel, time_ns, json);
+        self.publish(channel, time_ns, bytes);
         Ok(())
     }
 
@@ -159,20 +159,20 @@ impl MessageSink for ServeSink {
         }
     }
 
-    fn write_json_bytes(
+    fn write_encoded(
         &mut self,
         channel: ChannelId,
         time_ns: u64,
-        json: Vec<u8>,
+        bytes: Vec<u8>,
     ) -> Result<(), LogError> {
         if let Some((file, ids)) = &mut self.file {
             let id = ids[usize::from(channel.index()) - 1];
-            file.write_json_bytes(id, time_ns, json.clone())?;
+            file.write_encoded(id, time_ns, bytes.clone())?;
         }
         if self.muted {
             return Ok(());
         }
-        self.live.write_json_bytes(channel, time_ns, json)
+        self.live.write_encoded(channel, time_ns, bytes)
     }
 
     fn write_live<M: prost::Message + Clone + Send + 'static>(
