@@ -26,6 +26,7 @@
 pub mod diff;
 pub mod messages;
 
+mod backlog;
 mod bodies;
 mod decode;
 mod error;

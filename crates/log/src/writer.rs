@@ -14,6 +14,7 @@ use mcap::records::MessageHeader;
 use serde::Serialize;
 
 use crate::LogError;
+use crate::backlog::{Backlog, CloseOnDrop};
 use crate::messages::Schema;
 use crate::sink::ChannelId;
 
@@ -22,8 +23,14 @@ use crate::sink::ChannelId;
 const CHUNK_SIZE: u64 = 1024 * 1024;
 
 /// Messages queued for the writer thread before [`LogWriter::write`] waits: bounds the
-/// memory a fast simulation can fill while the thread compresses.
-const QUEUE: usize = 256;
+/// memory a fast simulation can fill while the thread compresses, with [`QUEUE_BYTES`].
+/// A frame is a few messages, so the caller can run some 250 frames ahead: it no longer
+/// waits for the thread after a frame that hands it much (the first, a drawing).
+const QUEUE: usize = 1024;
+
+/// Bytes of encoded messages (a big scene's drawings: 1.5 MB for 10,000 bodies) queued for
+/// the writer thread before [`LogWriter::write`] waits (see `backlog.rs`).
+const QUEUE_BYTES: usize = 64 << 20;
 
 /// Jobs queued for the writer thread from which [`LogWriter::write`] encodes the message
 /// on the caller's thread by default (see [`LogWriter::share_encoding_from`]).
@@ -75,6 +82,20 @@ enum Job {
         media_type: String,
         data: Vec<u8>,
     },
+}
+
+impl Job {
+    /// The bytes of the encoded message it carries, counted in the writer's backlog (a
+    /// message still to encode is counted as a job only).
+    fn encoded_bytes(&self) -> usize {
+        match self {
+            Job::Message {
+                payload: Payload::Bytes(b),
+                ..
+            } => b.len(),
+            _ => 0,
+        }
+    }
 }
 
 /// The MCAP writer and its encode buffer: runs the jobs, on whichever thread owns it.
@@ -147,6 +168,8 @@ enum Engine {
         queued: Arc<AtomicUsize>,
         /// From this many queued jobs, [`LogWriter::write`] encodes on the caller's thread.
         share_from: usize,
+        /// The bytes of encoded messages queued.
+        backlog: Arc<Backlog>,
     },
     /// Between a failure and the error's report.
     Failed,
@@ -277,12 +300,17 @@ impl LogWriter {
                 let (jobs, queue) = mpsc::sync_channel::<Job>(QUEUE);
                 let queued = Arc::new(AtomicUsize::new(0));
                 let ran = Arc::clone(&queued);
+                let backlog = Arc::new(Backlog::new(QUEUE_BYTES));
+                let written = Arc::clone(&backlog);
                 let thread = std::thread::Builder::new()
                     .name("log-writer".into())
                     .spawn(move || {
+                        let _close = CloseOnDrop(&written);
                         let mut sink = sink;
                         for job in queue {
+                            let bytes = job.encoded_bytes();
                             sink.run(job)?;
+                            written.take(bytes);
                             ran.fetch_sub(1, Ordering::Relaxed);
                         }
                         Ok(sink)
@@ -296,6 +324,7 @@ impl LogWriter {
                     thread,
                     queued,
                     share_from: SHARE_ENCODING_FROM,
+                    backlog,
                 }
             }
         };
@@ -460,7 +489,13 @@ impl LogWriter {
     fn submit(&mut self, job: Job) -> Result<(), LogError> {
         match &mut self.engine {
             Engine::Inline(sink) => sink.run(job).map_err(|source| self.write_error(source)),
-            Engine::Thread { jobs, queued, .. } => {
+            Engine::Thread {
+                jobs,
+                queued,
+                backlog,
+                ..
+            } => {
+                backlog.add(job.encoded_bytes());
                 queued.fetch_add(1, Ordering::Relaxed);
                 match jobs.send(job) {
                     Ok(()) => Ok(()),
