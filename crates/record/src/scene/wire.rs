@@ -127,15 +127,20 @@ pub(super) fn point3(out: &mut Vec<u8>, tag: u8, p: &Point3) {
     });
 }
 
+/// A cube's or a cylinder's first two fields: its `pose` (1) and `size` (2), when set.
+fn placed(out: &mut Vec<u8>, at: Option<&Pose>, size: Option<&Vector3>) {
+    if let Some(p) = at {
+        pose(out, 1, p);
+    }
+    if let Some(s) = size {
+        vector3(out, 2, s);
+    }
+}
+
 /// Field `tag` holding a `foxglove.CubePrimitive`.
 pub(super) fn cube(out: &mut Vec<u8>, tag: u8, c: &CubePrimitive) {
     nested(out, tag, |out| {
-        if let Some(p) = &c.pose {
-            pose(out, 1, p);
-        }
-        if let Some(s) = &c.size {
-            vector3(out, 2, s);
-        }
+        placed(out, c.pose.as_ref(), c.size.as_ref());
         if let Some(k) = &c.color {
             color(out, 3, k);
         }
@@ -145,12 +150,7 @@ pub(super) fn cube(out: &mut Vec<u8>, tag: u8, c: &CubePrimitive) {
 /// Field `tag` holding a `foxglove.CylinderPrimitive`.
 pub(super) fn cylinder(out: &mut Vec<u8>, tag: u8, c: &CylinderPrimitive) {
     nested(out, tag, |out| {
-        if let Some(p) = &c.pose {
-            pose(out, 1, p);
-        }
-        if let Some(s) = &c.size {
-            vector3(out, 2, s);
-        }
+        placed(out, c.pose.as_ref(), c.size.as_ref());
         double(out, 3, c.bottom_scale);
         double(out, 4, c.top_scale);
         if let Some(k) = &c.color {
