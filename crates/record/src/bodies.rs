@@ -24,6 +24,7 @@ pub const KEYFRAME_INTERVAL: u64 = 60;
 /// (issue #37, BENCHMARKS.md). Bytes, never time: the same log on every machine.
 pub const KEYFRAME_BYTES_PER_FRAME: u64 = 4 * 1024;
 
+mod listed;
 mod undisturbed;
 
 /// What was last recorded of a body alive at the end of the previous frame (or, for a body
@@ -191,8 +192,11 @@ pub fn removed_message(r: &RemovedBody, layers: &Layers) -> pb::Body {
 
 /// One frame's changes.
 pub struct Changes {
-    /// `/bodies`.
+    /// `/bodies`, but for its list of bodies, which is `listed`.
     pub bodies: pb::Bodies,
+    /// The `bodies` field of `/bodies`, each body encoded as it was listed: a keyframe's
+    /// 10,000 bodies are never built as messages (`bodies/listed.rs`).
+    pub listed: Vec<u8>,
     /// `/scene` (moving bodies) must be sent again: one moved, turned, appeared or went
     /// (or, when velocities are drawn, changed its velocity).
     pub scene_changed: bool,
@@ -354,10 +358,10 @@ impl Tracker {
         }
         self.started = true;
         self.frame = frame;
-        // A keyframe lists every moving body: one allocation for all of them (10,000 bodies'
-        // messages are about 2 MB, which would otherwise be copied as the list grows).
-        let mut bodies = Vec::with_capacity(if keyframe && want_bodies {
-            world.len()
+        // A keyframe lists every moving body: room for all of them at once (10,000 bodies
+        // are about 1.4 MB, which would otherwise be copied as the list grows).
+        let mut listed = Vec::with_capacity(if keyframe && want_bodies {
+            world.len() * listed::BODY_BYTES
         } else {
             0
         });
@@ -459,7 +463,22 @@ impl Tracker {
             let still = same2(position, k.position) && same(angle, k.angle);
             let full = fresh || (keyframe && !k.is_static);
             let predicted = moved_as_predicted && turned_as_predicted;
-            if want_bodies && (full || !as_predicted || spun || !predicted) {
+            if want_bodies && full {
+                let shape = shape_message(&ShapeDef::from_shape(world.shape(i)));
+                let body = listed::Whole {
+                    entity: e,
+                    name: world.name(i),
+                    layer: layers.name(world.layer[i]),
+                    shape: &shape,
+                    is_static: world.kind[i] == BodyKind::Static,
+                    position,
+                    angle,
+                    velocity,
+                    angular_velocity,
+                    falling: if k.falling { Some(true) } else { mode },
+                };
+                body.encode(&mut listed);
+            } else if want_bodies && (!as_predicted || spun || !predicted) {
                 let mut b = pb::Body {
                     id: e.index,
                     generation: e.generation,
@@ -489,7 +508,7 @@ impl Tracker {
                 if full || spun {
                     b.angular_velocity = Some(angular_velocity);
                 }
-                bodies.push(b);
+                listed::encode(&b, &mut listed);
             }
             k.position = position;
             k.angle = angle;
@@ -534,7 +553,7 @@ impl Tracker {
                 frame,
                 time: 0.0,
                 keyframe,
-                bodies,
+                bodies: Vec::new(),
                 removed,
                 dt,
                 gravity: if gravity == Vec2::ZERO {
@@ -543,9 +562,18 @@ impl Tracker {
                     xy(gravity)
                 },
             },
+            listed,
             scene_changed,
             static_changed,
         }
+    }
+}
+
+impl Changes {
+    /// `/bodies`, encoded: [`Changes::bodies`] with [`Changes::listed`] as its list of
+    /// bodies (`bodies/listed.rs`).
+    pub fn encode_bodies(&self) -> Vec<u8> {
+        listed::message(&self.bodies, &self.listed)
     }
 }
 

@@ -379,11 +379,12 @@ impl<S: MessageSink> Recorder<S> {
             }
             if let (Some(ch), true) = (self.topics.bodies, want_bodies) {
                 changes.bodies.time = out.frame as f64 * self.dt;
+                let bodies = changes.encode_bodies();
                 if changes.bodies.keyframe {
-                    let bytes = changes.bodies.encoded_len() as u64;
-                    self.tracker.keyframe_written(out.frame, bytes);
+                    self.tracker
+                        .keyframe_written(out.frame, bodies.len() as u64);
                 }
-                self.writer.write(ch, t, changes.bodies)?;
+                self.writer.write_encoded(ch, t, bodies)?;
                 self.built += 1;
             }
         }

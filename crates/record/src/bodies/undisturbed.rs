@@ -211,7 +211,6 @@ pub(super) fn check(
     got: &super::Changes,
     pass: super::Pass,
 ) {
-    use prost::Message;
     let wants = (want_bodies, velocities_drawn);
     let full = match pass {
         super::Pass::KeyframeNamed => super::Pass::Keyframe,
@@ -220,7 +219,7 @@ pub(super) fn check(
     let want = oracle.changes(world, out, def, wants, full);
     let frame = out.frame;
     assert!(
-        want.bodies.encode_to_vec() == got.bodies.encode_to_vec(),
+        want.encode_bodies() == got.encode_bodies(),
         "frame {frame}: /bodies differs from the full comparison's"
     );
     assert_eq!(

@@ -1,0 +1,234 @@
+//! The list of bodies of a `/bodies` message, encoded as the tracker lists them.
+//!
+//! A keyframe lists 10,000 bodies of a big scene whole. Built as prost messages first, each
+//! was a dozen allocations (its name, layer, shape, position and velocity) in a list of
+//! 2.5 MB touched for the first time: most of the first frame's recording of the
+//! 10,000-asteroid level (BENCHMARKS.md). A body listed whole is written here from the world's
+//! values, each field by prost's own encoding of it, in the order and with the presence
+//! rules of prost's derived code for `ricochet.Body`; any other body is built and encoded by
+//! prost. The tests compare the bytes with prost's encoding of the same `Body`.
+
+use prost::Message;
+use prost::encoding::{
+    WireType, bool as pbool, double, encode_key, encode_varint, encoded_len_varint, key_len,
+    message as pmessage, uint32,
+};
+use ricochet_geom::Vec2;
+use ricochet_log::messages::ricochet as pb;
+use ricochet_sim::Entity;
+
+/// About what a body listed whole takes, encoded (a hexagon's is 160 bytes, a circle's 110):
+/// the room a keyframe reserves for each.
+pub(super) const BODY_BYTES: usize = 144;
+
+/// The field number of `ricochet.Bodies.bodies`.
+const BODIES: u32 = 4;
+
+/// A body listed with every field (in a keyframe, or new), as `ricochet.Body` holds it.
+pub(super) struct Whole<'a> {
+    pub entity: Entity,
+    pub name: &'a str,
+    pub layer: &'a str,
+    pub shape: &'a pb::Shape,
+    pub is_static: bool,
+    pub position: Vec2,
+    pub angle: f64,
+    pub velocity: Vec2,
+    pub angular_velocity: f64,
+    pub falling: Option<bool>,
+}
+
+/// A string field's key, length and bytes.
+fn string(tag: u32, s: &str, out: &mut Vec<u8>) {
+    encode_key(tag, WireType::LengthDelimited, out);
+    encode_varint(s.len() as u64, out);
+    out.extend_from_slice(s.as_bytes());
+}
+
+fn string_len(tag: u32, s: &str) -> usize {
+    key_len(tag) + encoded_len_varint(s.len() as u64) + s.len()
+}
+
+impl Whole<'_> {
+    /// Appends the body to `out` as a `bodies` field of `ricochet.Bodies`.
+    pub(super) fn encode(&self, out: &mut Vec<u8>) {
+        let Entity { index, generation } = self.entity;
+        let (position, velocity) = (self.position.to_array(), self.velocity.to_array());
+        let len = if index != 0 {
+            uint32::encoded_len(1, &index)
+        } else {
+            0
+        } + if generation != 0 {
+            uint32::encoded_len(2, &generation)
+        } else {
+            0
+        } + string_len(3, self.name)
+            + string_len(4, self.layer)
+            + pmessage::encoded_len(5, self.shape)
+            + pbool::encoded_len(6, &self.is_static)
+            + double::encoded_len_packed(7, &position)
+            + double::encoded_len(8, &self.angle)
+            + double::encoded_len_packed(9, &velocity)
+            + double::encoded_len(10, &self.angular_velocity)
+            + self.falling.map_or(0, |f| pbool::encoded_len(12, &f));
+        encode_key(BODIES, WireType::LengthDelimited, out);
+        encode_varint(len as u64, out);
+        if index != 0 {
+            uint32::encode(1, &index, out);
+        }
+        if generation != 0 {
+            uint32::encode(2, &generation, out);
+        }
+        string(3, self.name, out);
+        string(4, self.layer, out);
+        pmessage::encode(5, self.shape, out);
+        pbool::encode(6, &self.is_static, out);
+        double::encode_packed(7, &position, out);
+        double::encode(8, &self.angle, out);
+        double::encode_packed(9, &velocity, out);
+        double::encode(10, &self.angular_velocity, out);
+        // `still` (11) is false for a body listed whole: left out.
+        if let Some(f) = self.falling {
+            pbool::encode(12, &f, out);
+        }
+    }
+}
+
+/// Appends `body` to `out` as a `bodies` field of `ricochet.Bodies`.
+pub(super) fn encode(body: &pb::Body, out: &mut Vec<u8>) {
+    pmessage::encode(BODIES, body, out);
+}
+
+/// The encoding of `bodies` (whose own list is empty) with `listed` as its list of bodies:
+/// fields are written in the order of their numbers, and the list's (4) is between
+/// `keyframe` (3) and `removed` (5).
+pub(super) fn message(bodies: &pb::Bodies, listed: &[u8]) -> Vec<u8> {
+    debug_assert!(bodies.bodies.is_empty(), "the list is `listed`");
+    let head = pb::Bodies {
+        frame: bodies.frame,
+        time: bodies.time,
+        keyframe: bodies.keyframe,
+        ..pb::Bodies::default()
+    };
+    let tail = pb::Bodies {
+        frame: 0,
+        time: 0.0,
+        keyframe: false,
+        bodies: Vec::new(),
+        removed: bodies.removed.clone(),
+        dt: bodies.dt,
+        gravity: bodies.gravity.clone(),
+    };
+    let mut out = Vec::with_capacity(head.encoded_len() + listed.len() + tail.encoded_len());
+    head.encode_raw(&mut out);
+    out.extend_from_slice(listed);
+    tail.encode_raw(&mut out);
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// The `Body` prost would encode for `w`: how the tracker built a body listed whole.
+    fn built(w: &Whole) -> pb::Body {
+        pb::Body {
+            id: w.entity.index,
+            generation: w.entity.generation,
+            name: Some(w.name.to_owned()),
+            layer: Some(w.layer.to_owned()),
+            shape: Some(w.shape.clone()),
+            r#static: Some(w.is_static),
+            position: w.position.to_array().to_vec(),
+            angle: Some(w.angle),
+            velocity: w.velocity.to_array().to_vec(),
+            angular_velocity: Some(w.angular_velocity),
+            still: false,
+            falling: w.falling,
+        }
+    }
+
+    fn number() -> impl Strategy<Value = f64> {
+        prop_oneof![
+            Just(0.0),
+            Just(-0.0),
+            Just(f64::NAN),
+            Just(f64::NEG_INFINITY),
+            any::<f64>(),
+        ]
+    }
+
+    fn shape() -> impl Strategy<Value = pb::Shape> {
+        use pb::shape::Kind;
+        prop_oneof![
+            (number(), number()).prop_map(|(r, c)| Kind::Circle(pb::Circle {
+                radius: r,
+                center: vec![c, 0.5],
+            })),
+            proptest::collection::vec(number(), 0..40)
+                .prop_map(|vertices| Kind::Polygon(pb::Polygon { vertices })),
+        ]
+        .prop_map(|kind| pb::Shape { kind: Some(kind) })
+    }
+
+    proptest! {
+        #[test]
+        fn a_body_listed_whole_is_prosts_encoding_of_it(
+            index in prop_oneof![Just(0u32), any::<u32>()],
+            generation in prop_oneof![Just(0u32), any::<u32>()],
+            name in ".{0,200}", layer in "[a-z]{0,12}", shape in shape(),
+            is_static: bool,
+            (px, py, angle, vx, vy, spin) in
+                (number(), number(), number(), number(), number(), number()),
+            falling in proptest::option::of(any::<bool>()),
+        ) {
+            let w = Whole {
+                entity: Entity { index, generation },
+                name: &name,
+                layer: &layer,
+                shape: &shape,
+                is_static,
+                position: Vec2::new(px, py),
+                angle,
+                velocity: Vec2::new(vx, vy),
+                angular_velocity: spin,
+                falling,
+            };
+            let mut out = vec![9];
+            w.encode(&mut out);
+            let mut want = vec![9];
+            pmessage::encode(BODIES, &built(&w), &mut want);
+            prop_assert_eq!(out, want);
+        }
+    }
+
+    #[test]
+    fn the_message_is_prosts_encoding_of_it_with_its_list() {
+        let body = |index| pb::Body {
+            id: index,
+            generation: 1,
+            position: vec![1.0, -2.0],
+            still: index % 2 == 0,
+            ..pb::Body::default()
+        };
+        let whole = pb::Bodies {
+            frame: 420,
+            time: 7.0,
+            keyframe: true,
+            bodies: (0..5).map(body).collect(),
+            removed: vec![body(9)],
+            dt: 1.0 / 60.0,
+            gravity: vec![0.0, -9.8],
+        };
+        let mut listed = Vec::new();
+        whole.bodies.iter().for_each(|b| encode(b, &mut listed));
+        let rest = pb::Bodies {
+            bodies: Vec::new(),
+            ..whole.clone()
+        };
+        assert_eq!(message(&rest, &listed), whole.encode_to_vec());
+        let empty = pb::Bodies::default();
+        assert_eq!(message(&empty, &[]), empty.encode_to_vec());
+    }
+}
