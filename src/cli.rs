@@ -69,7 +69,7 @@ pub enum Command {
         /// default a drawing of N encoded bytes waits N / 24 KiB frames before the next:
         /// scenes of at most 256 bodies are drawn every frame anyway, 10,000
         /// asteroids about every 63rd frame, so that recording keeps up with the simulation
-        /// (drawing them every frame records at about 190 frames/s on 2 cores). /bodies,
+        /// (drawing them every frame records at about 300 frames/s on 2 cores). /bodies,
         /// /contacts, /stats and /events are exact in every frame either way; in the viewer
         /// a time between two drawings shows the earlier one.
         #[arg(long)]
