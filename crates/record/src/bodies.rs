@@ -191,6 +191,7 @@ pub fn removed_message(r: &RemovedBody, layers: &Layers) -> pb::Body {
 }
 
 /// One frame's changes.
+#[derive(Clone)]
 pub struct Changes {
     /// `/bodies`, but for its list of bodies, which is `listed`.
     pub bodies: pb::Bodies,
@@ -571,9 +572,9 @@ impl Tracker {
 
 impl Changes {
     /// `/bodies`, encoded: [`Changes::bodies`] with [`Changes::listed`] as its list of
-    /// bodies (`bodies/listed.rs`).
-    pub fn encode_bodies(&self) -> Vec<u8> {
-        listed::message(&self.bodies, &self.listed)
+    /// bodies (`bodies/listed.rs`). Takes the list.
+    pub fn encode_bodies(&mut self) -> Vec<u8> {
+        listed::message(&self.bodies, std::mem::take(&mut self.listed))
     }
 }
 

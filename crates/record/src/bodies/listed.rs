@@ -101,8 +101,10 @@ pub(super) fn encode(body: &pb::Body, out: &mut Vec<u8>) {
 
 /// The encoding of `bodies` (whose own list is empty) with `listed` as its list of bodies:
 /// fields are written in the order of their numbers, and the list's (4) is between
-/// `keyframe` (3) and `removed` (5).
-pub(super) fn message(bodies: &pb::Bodies, listed: &[u8]) -> Vec<u8> {
+/// `keyframe` (3) and `removed` (5). The list's bytes move along in place to make room for
+/// the fields before it, rather than being copied into a new allocation (a keyframe's is
+/// 1.4 MB, its pages then touched for the first time).
+pub(super) fn message(bodies: &pb::Bodies, mut listed: Vec<u8>) -> Vec<u8> {
     debug_assert!(bodies.bodies.is_empty(), "the list is `listed`");
     let head = pb::Bodies {
         frame: bodies.frame,
@@ -119,11 +121,10 @@ pub(super) fn message(bodies: &pb::Bodies, listed: &[u8]) -> Vec<u8> {
         dt: bodies.dt,
         gravity: bodies.gravity.clone(),
     };
-    let mut out = Vec::with_capacity(head.encoded_len() + listed.len() + tail.encoded_len());
-    head.encode_raw(&mut out);
-    out.extend_from_slice(listed);
-    tail.encode_raw(&mut out);
-    out
+    listed.reserve(head.encoded_len() + tail.encoded_len());
+    listed.splice(0..0, head.encode_to_vec());
+    tail.encode_raw(&mut listed);
+    listed
 }
 
 #[cfg(test)]
@@ -227,8 +228,8 @@ mod tests {
             bodies: Vec::new(),
             ..whole.clone()
         };
-        assert_eq!(message(&rest, &listed), whole.encode_to_vec());
+        assert_eq!(message(&rest, listed), whole.encode_to_vec());
         let empty = pb::Bodies::default();
-        assert_eq!(message(&empty, &[]), empty.encode_to_vec());
+        assert_eq!(message(&empty, Vec::new()), empty.encode_to_vec());
     }
 }
