@@ -2,11 +2,12 @@
 //!
 //! A keyframe lists 10,000 bodies of a big scene whole. Built as prost messages first, each
 //! was a dozen allocations (its name, layer, shape, position and velocity) in a list of
-//! 2.5 MB touched for the first time: most of the first frame's recording of the
-//! 10,000-asteroid level (BENCHMARKS.md). A body listed whole is written here from the world's
-//! values, each field by prost's own encoding of it, in the order and with the presence
-//! rules of prost's derived code for `ricochet.Body`; any other body is built and encoded by
-//! prost. The tests compare the bytes with prost's encoding of the same `Body`.
+//! 2.5 MB touched for the first time, measured whole to pace the keyframes, then encoded on
+//! the writer thread (BENCHMARKS.md, "the drawing and the keyframe encoded as they are
+//! made"). A body listed whole is written here from the world's values (its shape still
+//! built as a message), each field by prost's own encoding of it, in the order and with the
+//! presence rules of prost's derived code for `ricochet.Body`; any other body is built and
+//! encoded by prost. The tests compare the bytes with prost's encoding of the same `Body`.
 
 use prost::Message;
 use prost::encoding::{
