@@ -389,6 +389,8 @@ impl Tracker {
             }
         }
         let unsettled = std::mem::take(&mut self.unsettled);
+        // A body's shape, encoded, while it is listed whole.
+        let mut shape = Vec::new();
         for &i in &unsettled {
             let e = world.entity[i];
             let (position, angle) = (world.position[i], world.angle[i]);
@@ -465,7 +467,8 @@ impl Tracker {
             let full = fresh || (keyframe && !k.is_static);
             let predicted = moved_as_predicted && turned_as_predicted;
             if want_bodies && full {
-                let shape = shape_message(&ShapeDef::from_shape(world.shape(i)));
+                shape.clear();
+                listed::shape(world.shape(i), &mut shape);
                 let body = listed::Whole {
                     entity: e,
                     name: world.name(i),
