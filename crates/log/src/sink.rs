@@ -70,6 +70,17 @@ pub trait MessageSink {
     ) -> Result<(), LogError> {
         Ok(())
     }
+
+    /// Writes `bytes`, one message already encoded as `channel`'s schema says, to live
+    /// viewers only, like [`write_live`](Self::write_live). A file ignores it.
+    fn write_live_encoded(
+        &mut self,
+        _channel: ChannelId,
+        _time_ns: u64,
+        _bytes: Vec<u8>,
+    ) -> Result<(), LogError> {
+        Ok(())
+    }
 }
 
 impl MessageSink for LogWriter {

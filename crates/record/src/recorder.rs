@@ -192,8 +192,8 @@ impl<S: MessageSink> Recorder<S> {
         let style = self.style(w);
         for (channel, statics) in [(self.topics.statics, true), (self.topics.scene, false)] {
             if let Some(ch) = channel {
-                let message = scene::snapshot(w, layers, statics, style, ts);
-                self.writer.write_live(ch, t, message)?;
+                let bytes = scene::snapshot_encoded(w, layers, statics, style, ts);
+                self.writer.write_live_encoded(ch, t, bytes)?;
             }
         }
         if let Some(ch) = self.topics.tf {
@@ -218,8 +218,8 @@ impl<S: MessageSink> Recorder<S> {
         let t = frame * self.dt_ns;
         let (w, layers) = (sim.world(), &sim.scenario().world.layers);
         let style = self.style(w);
-        let message = scene::snapshot(w, layers, false, style, timestamp(t));
-        self.writer.write_live(ch, t, message)
+        let bytes = scene::snapshot_encoded(w, layers, false, style, timestamp(t));
+        self.writer.write_live_encoded(ch, t, bytes)
     }
 
     /// How bodies become entities: chosen at the first frame from its body count, then kept.

@@ -95,6 +95,16 @@ impl MessageSink for LiveSink {
     ) -> Result<(), LogError> {
         self.write(channel, time_ns, message)
     }
+
+    fn write_live_encoded(
+        &mut self,
+        channel: ChannelId,
+        time_ns: u64,
+        bytes: Vec<u8>,
+    ) -> Result<(), LogError> {
+        self.publish(channel, time_ns, bytes);
+        Ok(())
+    }
 }
 
 /// Where a served session's messages go: the live stream, and the recording if any.
@@ -185,6 +195,18 @@ impl MessageSink for ServeSink {
             return Ok(());
         }
         self.live.write(channel, time_ns, message)
+    }
+
+    fn write_live_encoded(
+        &mut self,
+        channel: ChannelId,
+        time_ns: u64,
+        bytes: Vec<u8>,
+    ) -> Result<(), LogError> {
+        if self.muted {
+            return Ok(());
+        }
+        self.live.write_live_encoded(channel, time_ns, bytes)
     }
 }
 
