@@ -163,8 +163,18 @@ impl World {
         out: &mut Vec<BodyEntry>,
         mut visit: impl FnMut(usize, &Bounds),
     ) {
-        out.clear();
-        out.reserve(self.movers.len());
+        // Written in place, by place: the vector keeps its length from call to call (only a
+        // change in the count of movers resizes it), so no length is stored a body.
+        let placeholder = BodyEntry {
+            key: 0,
+            bounds: Bounds {
+                min: Vec2::ZERO,
+                max: Vec2::ZERO,
+            },
+            layer: 0,
+            kind: BodyKind::Dynamic,
+        };
+        out.resize(self.movers.len(), placeholder);
         let run = self.row_run(&self.movers);
         // Every column sliced to its exact length first: the columns of one index then share
         // one bounds check (`i < n`, `r < m`) instead of one each.
@@ -196,14 +206,14 @@ impl World {
         match run {
             Some(run) => {
                 for (k, (i, r)) in run.indices().zip(run.rows()).enumerate() {
-                    out.push(columns.entry(i, r, |b| visit(k, b)));
+                    out[k] = columns.entry(i, r, |b| visit(k, b));
                 }
             }
             None => {
                 let row = &self.row[..n];
                 for (k, &i) in self.movers.iter().enumerate() {
                     let i = i as usize;
-                    out.push(columns.entry(i, row[i] as usize, |b| visit(k, b)));
+                    out[k] = columns.entry(i, row[i] as usize, |b| visit(k, b));
                 }
             }
         }
