@@ -281,7 +281,7 @@ impl Simulation {
         if !force.is_finite() {
             return Err(ControlError::OutOfRange { field: "force" });
         }
-        *self.world.force_mut(i) = force;
+        self.world.set_force(i, force);
         self.world.wake(i);
         self.world.refresh_active();
         Ok(())

@@ -1,7 +1,7 @@
 //! Snapshots (issue #22): a restored simulation steps exactly like the original, equal
 //! checksums, another scene refused, damaged bytes refused.
 
-use ricochet_sim::{Simulation, Snapshot, load_scenario};
+use ricochet_sim::{BodyKind, Simulation, Snapshot, Vec2, load_scenario};
 
 fn sim(name: &str) -> Simulation {
     let path = format!("{}/../../scenarios/{name}", env!("CARGO_MANIFEST_DIR"));
@@ -92,6 +92,36 @@ fn a_rollback_patches_in_place_and_costs_at_most_48_bytes_a_moving_body() {
     assert_eq!((a.frame(), a.checksum()), (300, sum));
     let again: Vec<_> = (0..40).map(|_| a.step()).collect();
     assert_eq!(first, again);
+}
+
+/// A constant force set during a run is part of the state a snapshot holds: restored, it
+/// acts again (the forces stage runs), and a restored zero force stops acting.
+#[test]
+fn a_restored_force_acts_and_a_restored_zero_force_does_not() {
+    let mut a = sim("asteroids.toml");
+    a.step();
+    let w = a.world();
+    let dynamic = (w.movers().iter().map(|&i| i as usize))
+        .find(|&i| w.kind[i] == BodyKind::Dynamic)
+        .expect("a dynamic body");
+    let e = w.entity[dynamic];
+    a.set_force(e, Vec2::new(3000.0, -2000.0)).unwrap();
+    a.step();
+    let with_force = a.snapshot();
+    let mut run =
+        |a: &mut Simulation| -> Vec<_> { (0..5).map(|_| (a.step(), a.checksum())).collect() };
+    let pushed = run(&mut a);
+    a.set_force(e, Vec2::ZERO).unwrap();
+    let without = a.snapshot();
+    let coasting = run(&mut a);
+    assert_ne!(
+        pushed[4].0.stats.kinetic_energy,
+        coasting[4].0.stats.kinetic_energy
+    );
+    a.restore(&with_force).unwrap();
+    assert_eq!(run(&mut a), pushed);
+    a.restore(&without).unwrap();
+    assert_eq!(run(&mut a), coasting);
 }
 
 /// The snapshot format's checksum (module docs: XXH3-64 of every byte before it, with the

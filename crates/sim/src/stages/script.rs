@@ -68,7 +68,7 @@ fn apply(ctx: &mut StageCtx, i: usize, action: &Action) {
             ScriptInput::Impulse(*impulse)
         }
         Action::SetForce(force) => {
-            *w.force_mut(i) = *force;
+            w.set_force(i, *force);
             ScriptInput::Force(*force)
         }
         Action::Thrust(on) => {

@@ -51,7 +51,7 @@ pub use rows::Motion;
 pub(crate) use state::{Bodies, PackedWorld};
 
 use bounds::LocalBounds;
-use motion::{KeptOutside, any_in_blocks};
+use motion::KeptOutside;
 use rows::Rows;
 
 /// What a controller's inputs currently are.
@@ -111,6 +111,8 @@ pub struct World {
     sleeping: usize,
     /// How many bodies have a controller.
     with_controller: usize,
+    /// How many rows have a constant force other than zero (`any_force` without a pass).
+    with_force: usize,
     /// Per layer, how many bodies are not a single AABB (the per-axis stages own box pairs).
     non_boxes: Vec<u32>,
     /// Scratch for a shape's key.
@@ -345,6 +347,7 @@ impl World {
         } else {
             self.row.insert(i, self.rows.entity.len() as u32);
             self.rows.push(e, def);
+            self.with_force += usize::from(def.force != Vec2::ZERO);
         }
         let moves = def.kind != BodyKind::Static;
         let i = i as u32;
@@ -421,6 +424,9 @@ impl World {
             if self.rows.lifetime[r].is_some() {
                 self.with_lifetime -= 1;
             }
+            if self.rows.force[r] != Vec2::ZERO {
+                self.with_force -= 1;
+            }
             self.rows.swap_remove(r);
             // The last row moved into `r`: its body points there now.
             if let Some(&moved) = self.rows.entity.get(r) {
@@ -488,10 +494,25 @@ impl World {
             .is_none_or(|&n| n == 0)
     }
 
+    /// Sets body `i`'s constant force (a row it lacked given first), counted for
+    /// [`World::any_force`].
+    pub(crate) fn set_force(&mut self, i: usize, force: Vec2) {
+        let r = self.row_of(i);
+        let old = &mut self.rows.force[r];
+        self.with_force -= usize::from(*old != Vec2::ZERO);
+        self.with_force += usize::from(force != Vec2::ZERO);
+        *old = force;
+    }
+
     /// Whether any body has a constant force (scenery has none).
     #[must_use]
     pub fn any_force(&self) -> bool {
-        any_in_blocks(&self.rows.force, |f| *f != Vec2::ZERO)
+        debug_assert_eq!(
+            self.with_force,
+            self.rows.force.iter().filter(|f| **f != Vec2::ZERO).count(),
+            "the count of forces is the rows'"
+        );
+        self.with_force > 0
     }
 
     /// Whether any body has a lifetime.

@@ -111,7 +111,6 @@ row_readers! {
 }
 
 row_writers! {
-    force, force_mut: Vec2;
     inputs, inputs_mut: Inputs;
     grounded, grounded_mut: bool;
     on_static, on_static_mut: bool;

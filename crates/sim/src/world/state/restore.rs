@@ -96,6 +96,8 @@ impl World {
     /// Row `r`'s motion group set to `m` (its `turned` is the caller's).
     fn set_motion(&mut self, r: usize, m: &Motion) {
         let rows = &mut self.rows;
+        self.with_force -= usize::from(rows.force[r] != Vec2::ZERO);
+        self.with_force += usize::from(m.force != Vec2::ZERO);
         rows.force[r] = m.force;
         if rows.controller[r].is_some() || m.controller.is_some() {
             rows.controller[r].clone_from(&m.controller);
