@@ -465,7 +465,7 @@ impl Simulation {
         self.world.end_step();
         out.stats.bodies = self.world.len();
         out.stats.contacts = out.contacts.len() as u64;
-        out.stats.kinetic_energy = self.world.kinetic_energy();
+        out.stats.kinetic_energy = self.world.step_kinetic_energy();
         if self.history.on() {
             // After every stage: the end of the frame, as a snapshot taken now holds it.
             self.history.record(&self.world, self.frame);

@@ -108,8 +108,7 @@ fn a_restored_force_acts_and_a_restored_zero_force_does_not() {
     a.set_force(e, Vec2::new(3000.0, -2000.0)).unwrap();
     a.step();
     let with_force = a.snapshot();
-    let mut run =
-        |a: &mut Simulation| -> Vec<_> { (0..5).map(|_| (a.step(), a.checksum())).collect() };
+    let run = |a: &mut Simulation| -> Vec<_> { (0..5).map(|_| (a.step(), a.checksum())).collect() };
     let pushed = run(&mut a);
     a.set_force(e, Vec2::ZERO).unwrap();
     let without = a.snapshot();

@@ -74,6 +74,24 @@ impl World {
         self.energies().map(|(_, e)| e).sum()
     }
 
+    /// [`World::kinetic_energy`] at the end of a step, kept until a velocity changes
+    /// ([`World::velocity_mut`], the forces stage), a body comes or goes, or a restore:
+    /// mass and kind never change, so summing the same terms again in the same order would
+    /// give the same bits. A debug build sums again and asserts them.
+    pub(crate) fn step_kinetic_energy(&mut self) -> f64 {
+        if let Some(kept) = self.kept_energy {
+            debug_assert_eq!(
+                kept.to_bits(),
+                self.kinetic_energy().to_bits(),
+                "no velocity changed, the same sum"
+            );
+            return kept;
+        }
+        let e = self.kinetic_energy();
+        self.kept_energy = Some(e);
+        e
+    }
+
     /// The first dynamic body (world index, in [`World::kinetic_energy`]'s order) at which
     /// that sum stops being finite, if it does: every velocity can be finite while `m v²`
     /// overflows (a velocity past 1e154, or two bodies near `f64::MAX` each). `total` is

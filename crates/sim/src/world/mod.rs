@@ -129,6 +129,9 @@ pub struct World {
     disturbed: Disturbed,
     /// The last answer of [`World::active_not_inside`] kept for the same step's next ask.
     kept_outside: KeptOutside,
+    /// The kinetic energy summed at the end of a step, until a velocity changes or a body
+    /// comes or goes ([`World::step_kinetic_energy`]).
+    kept_energy: Option<f64>,
 }
 
 impl World {
@@ -328,6 +331,7 @@ impl World {
     /// place in id order.
     fn insert(&mut self, e: Entity, def: &BodyDef) {
         self.layout += 1;
+        self.kept_energy = None;
         let i = self.entity.partition_point(|x| *x < e);
         self.entity.insert(i, e);
         self.disturb(i);
@@ -400,6 +404,7 @@ impl World {
     /// Removes the body at dense index `i`, keeping the order of the rest.
     pub fn despawn(&mut self, i: usize) {
         self.layout += 1;
+        self.kept_energy = None;
         self.disturb(i);
         let e = self.entity.remove(i);
         self.ids.free(e);

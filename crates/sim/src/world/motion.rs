@@ -42,6 +42,8 @@ impl World {
         g: Vec2,
         thrust: impl Fn(&Controller, &Inputs, f64) -> Vec2,
     ) {
+        // Velocities change: the kept kinetic energy is dropped.
+        self.kept_energy = None;
         if self.disturbed.all() {
             self.accelerate_naming::<false>(dt, g, thrust);
         } else {

@@ -123,10 +123,11 @@ row_writers! {
 
 impl World {
     /// [`World::velocity`] of body `i`, to change: the body is named as disturbed
-    /// ([`World::disturbed`]).
+    /// ([`World::disturbed`]), and the kept kinetic energy dropped.
     #[inline]
     pub(crate) fn velocity_mut(&mut self, i: usize) -> &mut Vec2 {
         self.disturb(i);
+        self.kept_energy = None;
         let r = self.row_of(i);
         &mut self.rows.velocity[r]
     }

@@ -193,6 +193,7 @@ impl World {
             layout: _,
             disturbed,
             kept_outside: _,
+            kept_energy: _,
         } = self;
         World {
             ids: EntityAllocator::default(),
@@ -221,6 +222,7 @@ impl World {
             // Another world: its own serial, every body named.
             disturbed: disturbed.clone(),
             kept_outside: Default::default(),
+            kept_energy: None,
         }
     }
 

@@ -14,6 +14,7 @@ impl World {
         }
         self.layout = crate::interned::next_serial();
         self.disturb_all();
+        self.kept_energy = None;
     }
 
     /// Patches the columns in place; false (nothing changed) when this world's bodies are
