@@ -130,6 +130,8 @@ fn change(sim: &mut Simulation, field: &str, i: usize) {
         asleep,
         rest_frames,
         local_bounds,
+        // A cache, not state: kept right below when a lifetime is given.
+        no_lifetime_below,
     } = &mut w.rows;
     match field {
         "mass" => mass[r] += 1.0,
@@ -137,7 +139,10 @@ fn change(sim: &mut Simulation, field: &str, i: usize) {
         "angular_velocity" => angular_velocity[r] += 0.25,
         "force" => force[r].x = -0.0,
         "gravity_scale" => gravity_scale[r] = 2.0,
-        "lifetime" => lifetime[r] = Some(9),
+        "lifetime" => {
+            lifetime[r] = Some(9);
+            *no_lifetime_below = (*no_lifetime_below).min(r);
+        }
         "controller" => controller[r] = Some(Controller::Walker { speed: 1.0 }),
         "inputs" => inputs[r].run = 0.5,
         "grounded" => grounded[r] = !grounded[r],

@@ -16,7 +16,17 @@ impl World {
         // row order (two narrow columns, no gather through the dense index), the few that
         // ran out then sorted into id order.
         let rows = &mut self.rows;
-        for ((l, &frozen), &e) in rows.lifetime.iter_mut().zip(&rows.frozen).zip(&rows.entity) {
+        // The rows from the first that may have a lifetime (`Rows::no_lifetime_below`).
+        let from = rows.no_lifetime_below.min(rows.lifetime.len());
+        debug_assert!(
+            rows.lifetime[..from].iter().all(Option::is_none),
+            "no lifetime below the mark"
+        );
+        let lifetimes = rows.lifetime[from..].iter_mut();
+        for ((l, &frozen), &e) in lifetimes
+            .zip(&rows.frozen[from..])
+            .zip(&rows.entity[from..])
+        {
             if let Some(l) = l
                 && !frozen
             {

@@ -33,6 +33,9 @@ pub(super) struct Rows {
     pub(super) rest_frames: Vec<u32>,
     pub(super) local_bounds: Vec<LocalBounds>,
     pub(super) user_data: Vec<u128>,
+    /// No row below this one has a lifetime (0 claims nothing): an asteroid field spawned
+    /// before its bullets counts down only the bullets' rows.
+    pub(super) no_lifetime_below: usize,
 }
 
 /// The row columns every body reads (a copy), with what scenery reads: each gets a reader
@@ -212,6 +215,9 @@ impl Rows {
             .push(if moves { def.angular_velocity } else { 0.0 });
         self.force.push(def.force);
         self.gravity_scale.push(def.gravity_scale);
+        if def.lifetime.is_none() && self.no_lifetime_below == self.lifetime.len() {
+            self.no_lifetime_below += 1;
+        }
         self.lifetime.push(def.lifetime);
         self.controller.push(def.controller.clone());
         self.inputs.push(Inputs::default());
@@ -238,6 +244,12 @@ impl Rows {
         self.force.swap_remove(r);
         self.gravity_scale.swap_remove(r);
         self.lifetime.swap_remove(r);
+        // The last row moved into `r` (if `r` was not the last).
+        let below = self.no_lifetime_below.min(self.lifetime.len());
+        self.no_lifetime_below = match self.lifetime.get(r) {
+            Some(Some(_)) => below.min(r),
+            _ => below,
+        };
         self.controller.swap_remove(r);
         self.inputs.swap_remove(r);
         self.grounded.swap_remove(r);

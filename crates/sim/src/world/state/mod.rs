@@ -359,6 +359,7 @@ impl World {
             rest_frames: _,
             local_bounds: _, // `turned`, below
             user_data: _,
+            no_lifetime_below: _, // a cache: counted again by a restore
         } = &self.rows;
         // The `_` columns above are the motion group's ([`World::motion`] reads them all).
         s.entity(self.entity[i]);

@@ -120,6 +120,9 @@ impl World {
         self.sleeping = rows.asleep.iter().filter(|&&a| a).count();
         self.with_lifetime = rows.lifetime.iter().filter(|l| l.is_some()).count();
         self.with_controller = rows.controller.iter().filter(|c| c.is_some()).count();
+        self.rows.no_lifetime_below = (self.rows.lifetime.iter())
+            .take_while(|l| l.is_none())
+            .count();
     }
 
     /// A world of `b`'s bodies, built body by body (the baseline's definitions cloned).
