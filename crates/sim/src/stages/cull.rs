@@ -39,7 +39,7 @@ pub(crate) fn run(ctx: &mut StageCtx, focus: &mut Option<Entity>) {
         if w.frozen(i) != outside {
             w.disturb(i);
         }
-        *w.frozen_mut(i) = outside;
+        w.set_frozen(i, outside);
         if outside {
             // Thawed, it finds what it stands on again: the lift it rode has moved on.
             *w.carrier_mut(i) = None;

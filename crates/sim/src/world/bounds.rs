@@ -277,27 +277,48 @@ impl EntryColumns<'_> {
     }
 }
 
+/// [`World::count_movers`]' answer, kept while the bodies and their frozen bits stay.
+#[derive(Clone, Debug, Default)]
+pub(super) struct KeptCount {
+    /// The `layout` and `frozen_changes` it was counted at.
+    at: Option<(u64, u64)>,
+    /// Each stretch of one layer: its layer, first place, length and dynamic bodies.
+    stretches: Vec<(u8, u32, u32, u32)>,
+}
+
 impl World {
     /// Counts the moving bodies by layer into `tally`, as the broad phase would count their
     /// entries ([`World::mover_entries`], where a frozen body is kinematic), when they are
     /// one run (`runs.rs`): the layer and kind columns are read in place, one layer's
-    /// stretch at a time, instead of every 48-byte entry. Returns whether it counted them
-    /// (nothing is counted when they are not one run).
-    pub(crate) fn count_movers(&self, tally: &mut Tally) -> bool {
+    /// stretch at a time, instead of every 48-byte entry, and only when a body came, went,
+    /// was given another look or had its frozen bit changed since the last count (kind and
+    /// layer never change else). Returns whether it counted them (nothing is counted when
+    /// they are not one run).
+    pub(crate) fn count_movers(&mut self, tally: &mut Tally) -> bool {
         let Some(run) = self.row_run(&self.movers) else {
             return false;
         };
-        let (layers, kinds) = (&self.layer[run.indices()], &self.kind[run.indices()]);
-        let frozen = &self.rows.frozen[run.rows()];
-        let mut start = 0;
-        while start < layers.len() {
-            let layer = layers[start];
-            let end = start + stretch(&layers[start..], layer);
-            let dynamic: u32 = (kinds[start..end].iter().zip(&frozen[start..end]))
-                .map(|(&k, &f)| u32::from(k == BodyKind::Dynamic && !f))
-                .sum();
-            tally.add_run(layer, start as u32, (end - start) as u32, dynamic);
-            start = end;
+        let at = (self.layout, self.frozen_changes);
+        let kept = &mut self.kept_count;
+        if kept.at != Some(at) {
+            kept.at = Some(at);
+            kept.stretches.clear();
+            let (layers, kinds) = (&self.layer[run.indices()], &self.kind[run.indices()]);
+            let frozen = &self.rows.frozen[run.rows()];
+            let mut start = 0;
+            while start < layers.len() {
+                let layer = layers[start];
+                let end = start + stretch(&layers[start..], layer);
+                let dynamic: u32 = (kinds[start..end].iter().zip(&frozen[start..end]))
+                    .map(|(&k, &f)| u32::from(k == BodyKind::Dynamic && !f))
+                    .sum();
+                let stretch = (layer, start as u32, (end - start) as u32, dynamic);
+                kept.stretches.push(stretch);
+                start = end;
+            }
+        }
+        for &(layer, start, len, dynamic) in &kept.stretches {
+            tally.add_run(layer, start, len, dynamic);
         }
         true
     }

@@ -50,7 +50,7 @@ pub use disturbed::Disturbed;
 pub use rows::Motion;
 pub(crate) use state::{Bodies, PackedWorld};
 
-use bounds::LocalBounds;
+use bounds::{KeptCount, LocalBounds};
 use motion::KeptOutside;
 use rows::Rows;
 
@@ -132,6 +132,11 @@ pub struct World {
     /// The kinetic energy summed at the end of a step, until a velocity changes or a body
     /// comes or goes ([`World::step_kinetic_energy`]).
     kept_energy: Option<f64>,
+    /// Counts every change of a body's frozen bit ([`World::set_frozen`]).
+    frozen_changes: u64,
+    /// [`World::count_movers`]' stretches, with the `layout` and `frozen_changes` they
+    /// were counted at.
+    kept_count: KeptCount,
 }
 
 impl World {

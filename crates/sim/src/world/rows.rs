@@ -119,12 +119,22 @@ row_writers! {
     on_static, on_static_mut: bool;
     carrier, carrier_mut: Option<Entity>;
     still, still_mut: bool;
-    frozen, frozen_mut: bool;
     rest_frames, rest_frames_mut: u32;
     user_data, user_data_mut: u128;
 }
 
 impl World {
+    /// Sets whether body `i` is frozen; a change is counted ([`World::count_movers`] keeps
+    /// its count until one).
+    #[inline]
+    pub(crate) fn set_frozen(&mut self, i: usize, frozen: bool) {
+        let r = self.row_of(i);
+        if self.rows.frozen[r] != frozen {
+            self.rows.frozen[r] = frozen;
+            self.frozen_changes += 1;
+        }
+    }
+
     /// [`World::velocity`] of body `i`, to change: the body is named as disturbed
     /// ([`World::disturbed`]), and the kept kinetic energy dropped.
     #[inline]

@@ -194,6 +194,8 @@ impl World {
             disturbed,
             kept_outside: _,
             kept_energy: _,
+            frozen_changes: _,
+            kept_count: _,
         } = self;
         World {
             ids: EntityAllocator::default(),
@@ -223,6 +225,8 @@ impl World {
             disturbed: disturbed.clone(),
             kept_outside: Default::default(),
             kept_energy: None,
+            frozen_changes: 0,
+            kept_count: Default::default(),
         }
     }
 
