@@ -102,8 +102,8 @@ impl MessageSink for LiveSink {
         time_ns: u64,
         bytes: Vec<u8>,
     ) -> Result<(), LogError> {
-        self.publish(channel, time_ns, bytes);
-        Ok(())
+        // Everything a live sink writes is live.
+        self.write_encoded(channel, time_ns, bytes)
     }
 }
 
