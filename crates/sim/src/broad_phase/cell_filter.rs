@@ -5,7 +5,10 @@
 //! bounds mark the cells of a coarse bitmap over their union box; each body of the big layer
 //! reads the bits its own bounds cover (one pass in the caller's order, a few instructions a
 //! body), and only a body on a marked cell is tested exactly against the small layers' sorted
-//! lists. The filter is conservative (cells from one monotone map of both bounds), so the
+//! lists. The union box maps onto the inner cells only: what lies outside it is clamped onto
+//! the border cells, which no small body marks, so a big layer far from a cluster of small
+//! bodies (bullets near their ship) is passed over, not tested body by body. The filter is
+//! conservative (cells from one monotone map of both bounds), so the
 //! pairs found are exactly those whose bounds overlap, as the sweep finds them; only the
 //! order in which they are found differs, and every caller sorts them.
 
@@ -37,16 +40,22 @@ pub(super) struct CellFilter {
 
 /// The monotone map from a coordinate to a cell along one axis (clamped to the grid): two
 /// closed intervals that overlap map to cell ranges that overlap, whatever their values
-/// (NaN maps to cell 0, and a NaN bound overlaps nothing anyway).
+/// (NaN maps to cell 0, and a NaN bound overlaps nothing anyway). `min..=max` maps onto
+/// cells `1..=CELLS - 2`; cell 0 and cell `CELLS - 1` hold only values outside it.
 #[derive(Clone, Copy)]
 struct Axis {
     min: f64,
     scale: f64,
 }
 
+/// Where `min` maps to: the first inner cell.
+const INNER: f64 = 1.0;
+
 impl Axis {
     fn new(min: f64, max: f64) -> Axis {
-        let scale = CELLS as f64 / (max - min);
+        // `max` maps to `INNER + CELLS - 3`, the last inner cell (within roundings far below
+        // half a cell).
+        let scale = (CELLS - 3) as f64 / (max - min);
         // A zero or infinite span (or NaN) leaves one cell: still conservative.
         let scale = if scale.is_finite() { scale } else { 0.0 };
         Axis { min, scale }
@@ -58,7 +67,7 @@ impl Axis {
         // nearest integer by adding 2^52, whose low mantissa bits are then that integer: a
         // monotone map in a few instructions, where a saturating cast to an integer costs
         // a dozen (it is computed four times a body).
-        let t = (v - self.min) * self.scale;
+        let t = (v - self.min) * self.scale + INNER;
         // Written as comparisons (one `maxsd`/`minsd` each); NaN fails the first and is 0.
         let t = if t > 0.0 { t } else { 0.0 };
         let t = if t < (CELLS - 1) as f64 {
@@ -89,7 +98,7 @@ impl Corner {
 
     #[inline]
     fn bit(self, p: Vec2) -> usize {
-        let t = (p - self.min) * self.scale;
+        let t = (p - self.min) * self.scale + Vec2::splat(INNER);
         let top = (CELLS - 1) as f64;
         let t = Vec2::new(
             if t.x > 0.0 { t.x } else { 0.0 },
@@ -388,19 +397,33 @@ mod tests {
 
     #[test]
     fn the_cell_map_is_monotone_and_clamped() {
-        let a = Axis::new(0.0, 256.0);
+        // 253 units over the 253 steps between the first inner cell (1) and the last (254):
+        // a unit a cell, `v` in cell `round(v) + 1`, clamped to 0..=255.
+        let a = Axis::new(0.0, 253.0);
         assert_eq!(a.cell(-1e300), 0);
         assert_eq!(a.cell(f64::NEG_INFINITY), 0);
         assert_eq!(a.cell(f64::NAN), 0);
-        assert_eq!(a.cell(0.49), 0);
-        assert_eq!(a.cell(0.51), 1);
-        assert_eq!(a.cell(1.0), 1);
-        assert_eq!(a.cell(254.6), 255);
-        assert_eq!(a.cell(255.9), 255);
+        assert_eq!(a.cell(-0.51), 0);
+        assert_eq!(a.cell(-0.49), 1);
+        assert_eq!(a.cell(0.0), 1);
+        assert_eq!(a.cell(1.0), 2);
+        assert_eq!(a.cell(253.0), 254);
+        assert_eq!(a.cell(253.49), 254);
+        assert_eq!(a.cell(253.51), 255);
         assert_eq!(a.cell(1e300), 255);
         assert_eq!(a.cell(f64::INFINITY), 255);
+        // No span: every value in the one inner cell.
         let flat = Axis::new(3.0, 3.0);
-        assert_eq!(flat.cell(-5.0), 0);
-        assert_eq!(flat.cell(7.0), 0);
+        assert_eq!(flat.cell(-5.0), 1);
+        assert_eq!(flat.cell(7.0), 1);
+    }
+
+    #[test]
+    fn the_union_box_fills_the_inner_cells_only() {
+        for (min, max) in [(-3.0, 1e3), (0.5, 0.75), (1e6, 1e6 + 1e-7), (-1e150, 1e150)] {
+            let a = Axis::new(min, max);
+            assert_eq!(a.cell(min), 1, "{min}..{max}");
+            assert_eq!(a.cell(max), CELLS - 2, "{min}..{max}");
+        }
     }
 }

@@ -28,8 +28,10 @@
 //!   (`static_tree.rs`), which each dynamic body queries in `O(log n + k)`. A layer of at
 //!   least 1,024 moving bodies that does not meet itself, met only by layers with a
 //!   sixteenth of its bodies or fewer (asteroids met by bullets), is not kept sorted: the
-//!   small layers mark a 256 × 256 bitmap of cells, and a big body is tested only when the
-//!   cell of its lower-left corner is marked (`cell_filter.rs`).
+//!   small layers mark a 256 × 256 bitmap of cells over their union box (on its inner
+//!   cells: whatever lies outside that box falls on the border, never marked), and a big
+//!   body is tested only when the cell of its lower-left corner is marked
+//!   (`cell_filter.rs`).
 //! - `Grid` (`hash_grid.rs`): a uniform grid per layer, dense over the occupied cells or
 //!   hashed; two interacting layers: the grid of the larger is queried with the bodies of the
 //!   smaller. Static bodies have their own grid per layer, with its own cell size. What every
