@@ -35,8 +35,20 @@ pub(crate) fn controls(w: &mut World) {
     if !w.any_controller() {
         return;
     }
-    for k in 0..w.active().len() {
-        let i = w.active()[k] as usize;
+    #[cfg(debug_assertions)]
+    let expected: Vec<usize> = (w.active().iter().map(|&i| i as usize))
+        .filter(|&i| w.controller(i).is_some())
+        .collect();
+    #[cfg(debug_assertions)]
+    let mut visited = Vec::new();
+    // The bodies with a controller, in the active bodies' (dense) order: each body's new
+    // velocity reads only its own inputs, so the order changes nothing anyway.
+    for k in 0..w.controlled() {
+        let Some(i) = w.active_controlled(k) else {
+            continue;
+        };
+        #[cfg(debug_assertions)]
+        visited.push(i);
         match w.controller(i) {
             Some(Controller::Ship { turn_rate, .. }) => {
                 *w.angular_velocity_mut(i) = w.inputs(i).turn * turn_rate;
@@ -48,6 +60,8 @@ pub(crate) fn controls(w: &mut World) {
             None => {}
         }
     }
+    #[cfg(debug_assertions)]
+    assert_eq!(visited, expected, "the active bodies with a controller");
 }
 
 /// The ship's engine force along its heading, when the engine is on.

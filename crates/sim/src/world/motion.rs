@@ -110,11 +110,16 @@ impl World {
         any_in_blocks(grounded, |&g| g) && self.any_active(|_, r| grounded[r])
     }
 
-    /// Whether an active body has a controller.
+    /// Whether an active body has a controller: each body with one looked up (a few),
+    /// not every active body.
     pub(crate) fn any_active_controller(&self) -> bool {
-        let controller = &self.rows.controller;
-        any_in_blocks(controller, Option::is_some)
-            && self.any_active(|_, r| controller[r].is_some())
+        let any = (0..self.controlled()).any(|k| self.active_controlled(k).is_some());
+        debug_assert_eq!(
+            any,
+            self.any_active(|_, r| self.rows.controller[r].is_some()),
+            "the controlled bodies' answer is the active bodies'"
+        );
+        any
     }
 
     /// Whether an active body `i` ([`World::active`]), of row `r`, has `on(i, r)`. The

@@ -119,7 +119,11 @@ impl World {
         let rows = &self.rows;
         self.sleeping = rows.asleep.iter().filter(|&&a| a).count();
         self.with_lifetime = rows.lifetime.iter().filter(|l| l.is_some()).count();
-        self.with_controller = rows.controller.iter().filter(|c| c.is_some()).count();
+        self.controlled = (rows.controller.iter().zip(&rows.entity))
+            .filter(|(c, _)| c.is_some())
+            .map(|(_, &e)| e)
+            .collect();
+        self.controlled.sort_unstable();
         self.rows.no_lifetime_below = (self.rows.lifetime.iter())
             .take_while(|l| l.is_none())
             .count();
