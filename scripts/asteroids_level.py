@@ -18,6 +18,11 @@ byte, on any machine (Python's `random` is Mersenne Twister; floats are printed 
 nothing else: a log of it differs from the plain level's from frame 0 on, in that body
 only (for testing `ricochet diff`).
 
+--firing adds a game's ship: at the world's centre, turning and firing a bullet every third
+frame (bullets live 60 frames and destroy the asteroid they hit, both removed), so bodies
+come and go every few frames and the small layers (the ship and its bullets) are a cluster
+in a big field, as in a real Asteroids game.
+
 Standard library only; the format is the one of scenarios/README.md, which both the JSON-log
 (891484c) and the protobuf-log binaries load.
 """
@@ -64,6 +69,11 @@ def main() -> int:
         metavar="K",
         help="change asteroid K's x velocity by one ulp (0-based)",
     )
+    ap.add_argument(
+        "--firing",
+        action="store_true",
+        help="add a ship at the centre turning and firing every third frame",
+    )
     args = ap.parse_args()
     if args.n < 1:
         ap.error("n must be at least 1")
@@ -74,11 +84,21 @@ def main() -> int:
     out = []
     w = out.append
     w(f"# {args.n} asteroids (scripts/asteroids_level.py {args.n} --seed {args.seed}"
-      + (f" --nudge {args.nudge}" if args.nudge is not None else "") + ")")
-    w(f'name = "asteroids-level-{args.n}"')
+      + (f" --nudge {args.nudge}" if args.nudge is not None else "")
+      + (" --firing" if args.firing else "") + ")")
+    w(f'name = "asteroids-level-{args.n}' + ("-firing" if args.firing else "") + '"')
     w(f"hz = {HZ}")
     w(f"frames = {args.frames}")
-    w('layers = ["asteroid"]')
+    if args.firing:
+        w('layers = ["ship", "asteroid", "bullet"]')
+        w('fast_layers = ["bullet"]')
+        w("script = [")
+        w('  { frame = 0, action = "turn", body = "ship", input = 1 },')
+        for f in range(1, args.frames, 3):
+            w(f'  {{ frame = {f}, action = "fire", body = "ship" }},')
+        w("]")
+    else:
+        w('layers = ["asteroid"]')
     w("")
     w("[world]")
     w("gravity = [0, 0]")
@@ -89,6 +109,31 @@ def main() -> int:
     w('a = "asteroid"')
     w('b = "asteroid"')
     w('response = "ignore"')
+    if args.firing:
+        w("")
+        w("[[collide]]")
+        w('a = "bullet"')
+        w('b = "asteroid"')
+        w('response = "destroy"')
+        w("")
+        w("[[collide]]")
+        w('a = "ship"')
+        w('b = "asteroid"')
+        w('response = "report"')
+        w("")
+        w("[templates.bullet]")
+        w('layer = "bullet"')
+        w('shape = { kind = "circle", radius = 0.2 }')
+        w("mass = 0.05")
+        w("lifetime = 60")
+        w("")
+        w("[[bodies]]")
+        w('name = "ship"')
+        w('layer = "ship"')
+        w('shape = { kind = "polygon", vertices = [[1.0, 0.0], [-0.7, 0.6], [-0.7, -0.6]] }')
+        w(f"position = [{num(SIDE / 2)}, {num(SIDE / 2)}]")
+        w('controller = { kind = "ship", thrust = 12, turn_rate = 3, bullet = "bullet", '
+          'bullet_speed = 30, muzzle = 1.5 }')
     for k in range(args.n):
         radius = rng.uniform(0.5, 3.0)
         if k % 2 == 0:
