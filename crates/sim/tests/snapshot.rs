@@ -1,7 +1,7 @@
 //! Snapshots (issue #22): a restored simulation steps exactly like the original, equal
 //! checksums, another scene refused, damaged bytes refused.
 
-use ricochet_sim::{BodyKind, Simulation, Snapshot, Vec2, load_scenario};
+use ricochet_sim::{Action, BodyKind, Simulation, Snapshot, Vec2, load_scenario};
 
 fn sim(name: &str) -> Simulation {
     let path = format!("{}/../../scenarios/{name}", env!("CARGO_MANIFEST_DIR"));
@@ -120,6 +120,38 @@ fn a_restored_force_acts_and_a_restored_zero_force_does_not() {
     a.restore(&with_force).unwrap();
     assert_eq!(run(&mut a), pushed);
     a.restore(&without).unwrap();
+    assert_eq!(run(&mut a), coasting);
+}
+
+/// A ship's thrust input is part of the state a snapshot holds: restored on, the engine
+/// pushes again (the forces stage runs); restored off, it stops.
+#[test]
+fn a_restored_thrust_input_pushes_and_a_restored_idle_engine_does_not() {
+    let mut a = sim("asteroids.toml");
+    a.step();
+    let w = a.world();
+    let ship = w.entity[w.find("ship").expect("the ship")];
+    a.apply(ship, Action::Thrust(true)).unwrap();
+    a.step();
+    let thrusting = a.snapshot();
+    let run = |a: &mut Simulation| -> Vec<_> { (0..5).map(|_| (a.step(), a.checksum())).collect() };
+    let pushed = run(&mut a);
+    a.apply(ship, Action::Thrust(false)).unwrap();
+    a.step();
+    let idle = a.snapshot();
+    let coasting = run(&mut a);
+    let energy =
+        |frames: &[(ricochet_sim::FrameOutput, u64)], k: usize| frames[k].0.stats.kinetic_energy;
+    // The engine adds energy while on; nothing else here does (the rocks drift).
+    assert!(energy(&pushed, 4) > energy(&pushed, 0), "the engine pushes");
+    assert_eq!(
+        energy(&coasting, 4),
+        energy(&coasting, 0),
+        "an idle engine does not"
+    );
+    a.restore(&thrusting).unwrap();
+    assert_eq!(run(&mut a), pushed);
+    a.restore(&idle).unwrap();
     assert_eq!(run(&mut a), coasting);
 }
 

@@ -72,7 +72,7 @@ fn apply(ctx: &mut StageCtx, i: usize, action: &Action) {
             ScriptInput::Force(*force)
         }
         Action::Thrust(on) => {
-            w.inputs_mut(i).thrust = *on;
+            w.set_thrust(i, *on);
             ScriptInput::Thrust(*on)
         }
         Action::Turn(input) => {

@@ -114,6 +114,8 @@ pub struct World {
     controlled: Vec<Entity>,
     /// How many rows have a constant force other than zero (`any_force` without a pass).
     with_force: usize,
+    /// How many rows have their thrust input on (`any_thrust_input` without a pass).
+    thrusting: usize,
     /// Per layer, how many bodies are not a single AABB (the per-axis stages own box pairs).
     non_boxes: Vec<u32>,
     /// Scratch for a shape's key.
@@ -443,6 +445,9 @@ impl World {
             if self.rows.force[r] != Vec2::ZERO {
                 self.with_force -= 1;
             }
+            if self.rows.inputs[r].thrust {
+                self.thrusting -= 1;
+            }
             self.rows.swap_remove(r);
             // The last row moved into `r`: its body points there now.
             if let Some(&moved) = self.rows.entity.get(r) {
@@ -542,6 +547,25 @@ impl World {
         self.with_force -= usize::from(*old != Vec2::ZERO);
         self.with_force += usize::from(force != Vec2::ZERO);
         *old = force;
+    }
+
+    /// Sets body `i`'s thrust input (a row it lacked given first), counted for
+    /// [`World::any_thrust_input`].
+    pub(crate) fn set_thrust(&mut self, i: usize, on: bool) {
+        let inputs = self.inputs_mut(i);
+        let was = std::mem::replace(&mut inputs.thrust, on);
+        self.thrusting -= usize::from(was);
+        self.thrusting += usize::from(on);
+    }
+
+    /// How many rows have their thrust input on.
+    pub(crate) fn thrusting(&self) -> usize {
+        debug_assert_eq!(
+            self.thrusting,
+            self.rows.inputs.iter().filter(|x| x.thrust).count(),
+            "the count of thrust inputs is the rows'"
+        );
+        self.thrusting
     }
 
     /// Whether any body has a constant force (scenery has none).

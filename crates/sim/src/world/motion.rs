@@ -100,7 +100,8 @@ impl World {
     /// Whether an active dynamic body's thrust input is on.
     pub(crate) fn any_thrust_input(&self) -> bool {
         let inputs = &self.rows.inputs;
-        any_in_blocks(inputs, |x| x.thrust)
+        // Counted, not scanned: a ship's engine is off most frames.
+        self.thrusting() > 0
             && self.any_active(|i, r| self.kind[i] == BodyKind::Dynamic && inputs[r].thrust)
     }
 

@@ -103,6 +103,8 @@ impl World {
         if rows.controller[r].is_some() || m.controller.is_some() {
             rows.controller[r].clone_from(&m.controller);
         }
+        self.thrusting -= usize::from(rows.inputs[r].thrust);
+        self.thrusting += usize::from(m.inputs.thrust);
         rows.inputs[r] = m.inputs;
         rows.grounded[r] = m.grounded;
         rows.on_static[r] = m.on_static;
