@@ -205,9 +205,10 @@ impl<S: MessageSink> Recorder<S> {
         Ok(())
     }
 
-    /// Sends live viewers `/scene` at `frame`, the last frame recorded, if a frame's was
-    /// not drawn since it was last sent ([`Recorder::draw_moving`]): stepping stopped, so no
-    /// later frame will draw it. Never recorded.
+    /// Sends live viewers `/scene` (and `/tf`, stamped with it) at `frame`, the last frame
+    /// recorded, if a frame's was not drawn since it was last sent
+    /// ([`Recorder::draw_moving`]): stepping stopped, so no later frame will draw it. Never
+    /// recorded.
     pub fn show_moving_live(&mut self, sim: &Simulation, frame: u64) -> Result<(), LogError> {
         let Some(ch) = self.topics.scene else {
             return Ok(());
@@ -219,7 +220,14 @@ impl<S: MessageSink> Recorder<S> {
         let (w, layers) = (sim.world(), &sim.scenario().world.layers);
         let style = self.style(w);
         let bytes = scene::snapshot_encoded(w, layers, false, style, timestamp(t));
-        self.writer.write_live_encoded(ch, t, bytes)
+        self.writer.write_live_encoded(ch, t, bytes)?;
+        // The camera's frame with the drawing, stamped now, as `record` sends it live.
+        if let Some(ch) = self.topics.tf {
+            let transforms = vec![scene::view_transform(timestamp(t), self.view_at(sim))];
+            self.writer
+                .write_live(ch, t, FrameTransforms { transforms })?;
+        }
+        Ok(())
     }
 
     /// How bodies become entities: chosen at the first frame from its body count, then kept.
@@ -321,6 +329,7 @@ impl<S: MessageSink> Recorder<S> {
                 // Only a batched drawing is paced, so only its bytes are counted.
                 let counted = style == scene::Style::Batched;
                 let mut bytes = 0;
+                let mut drew_moving = false;
                 for (channel, statics, changed) in [
                     (
                         self.topics.statics,
@@ -341,20 +350,28 @@ impl<S: MessageSink> Recorder<S> {
                         }
                         self.writer.write_encoded(ch, t, message)?;
                         self.built += 1;
+                        drew_moving |= !statics;
                     }
                 }
                 if let Some(ch) = self.topics.tf {
                     let at = self.view_at(sim);
+                    let transforms = FrameTransforms {
+                        transforms: vec![scene::view_transform(ts, at)],
+                    };
                     if whole || self.view.is_none_or(|(sent, _)| !same_point(sent, at)) {
                         self.view = Some((at, self.fallback_view(sim)));
-                        let transforms = FrameTransforms {
-                            transforms: vec![scene::view_transform(ts, at)],
-                        };
                         if counted {
                             bytes += transforms.encoded_len();
                         }
                         self.writer.write(ch, t, transforms)?;
                         self.built += 1;
+                    } else if drew_moving {
+                        // Live viewers only (a file ignores it): the camera's frame again,
+                        // stamped now, with each drawing. Lichtblick's live 3D panel does not
+                        // apply a transform stamped long before the frames it shows: a viewer
+                        // that connected after the camera last moved got the latched /tf of
+                        // frame 0 and looked at the world's origin, not the view.
+                        self.writer.write_live(ch, t, transforms)?;
                     }
                 }
                 if let Some(ch) = self.topics.normals
