@@ -32,6 +32,7 @@ use crate::snapshot::codec::Sink;
 mod decode;
 mod packed;
 mod restore;
+mod runs_code;
 
 pub(crate) use packed::PackedWorld;
 

@@ -18,7 +18,7 @@
 use ricochet_geom::Vec2;
 
 use super::super::{NO_ROW, World};
-use crate::def::{BodyKind, LayerId};
+use super::runs_code::{Run, RunCoder, RunKind, RunReader, at, same};
 use crate::entity::{Entity, EntityAllocator};
 
 /// Scenery in a shorter run stays loose (a run costs 4 to 20 bytes, a loose body 42).
@@ -36,39 +36,6 @@ pub(crate) struct PackedWorld {
     /// The allocator's generations, run-length coded: `(generation, slots)` (a world as
     /// built has every slot at generation 0). Its free slots are every slot not alive.
     generations: Vec<(u32, u32)>,
-}
-
-/// Scenery bodies with consecutive ids `index..index + count`, the `k`-th at
-/// `start + step * k`.
-#[derive(Clone, Copy, Debug)]
-struct Run {
-    index: u32,
-    count: u32,
-    start: Vec2,
-    /// Its place in `kinds`.
-    kind: u32,
-}
-
-/// What the bodies of a run share, bit for bit.
-#[derive(Clone, Copy, Debug, PartialEq)]
-struct RunKind {
-    generation: u32,
-    layer: LayerId,
-    kind: BodyKind,
-    /// The look: shape and name.
-    shape_id: u32,
-    angle: u64,
-    step: (u64, u64),
-}
-
-/// The `k`-th position of a run: the formula of [`World::spawn_tiles`].
-fn at(start: Vec2, step: Vec2, k: u32) -> Vec2 {
-    start + step * f64::from(k)
-}
-
-/// Whether two positions are the same bits.
-fn same(a: Vec2, b: Vec2) -> bool {
-    a.x.to_bits() == b.x.to_bits() && a.y.to_bits() == b.y.to_bits()
 }
 
 impl World {
@@ -255,128 +222,6 @@ impl World {
     }
 }
 
-/// Writes runs as bytes, each as LEB128 numbers: the distance of its first id from the end
-/// of the run before, its length, its kind, and `m + 1` when its start is the previous
-/// run's start plus `m` steps of its kind (the same kind, bit for bit), else 0 and the
-/// start's 16 bytes.
-#[derive(Default)]
-struct RunCoder {
-    bytes: Vec<u8>,
-    last: Option<Run>,
-}
-
-impl RunCoder {
-    fn push(&mut self, r: Run, kinds: &[RunKind]) {
-        let end = self.last.map_or(0, |l| l.index + l.count);
-        self.var(u64::from(r.index - end));
-        self.var(u64::from(r.count));
-        self.var(u64::from(r.kind));
-        match self.last.and_then(|l| steps_between(l, r, kinds)) {
-            Some(m) => self.var(u64::from(m) + 1),
-            None => {
-                self.var(0);
-                self.bytes
-                    .extend_from_slice(&r.start.x.to_bits().to_le_bytes());
-                self.bytes
-                    .extend_from_slice(&r.start.y.to_bits().to_le_bytes());
-            }
-        }
-        self.last = Some(r);
-    }
-
-    fn var(&mut self, mut x: u64) {
-        while x >= 0x80 {
-            self.bytes.push((x as u8) | 0x80);
-            x >>= 7;
-        }
-        self.bytes.push(x as u8);
-    }
-}
-
-/// The `m` for which `b`'s start is exactly `a`'s plus `m` steps, when `a` and `b` are runs
-/// of one kind.
-fn steps_between(a: Run, b: Run, kinds: &[RunKind]) -> Option<u32> {
-    if a.kind != b.kind {
-        return None;
-    }
-    let step = kinds[a.kind as usize].step();
-    let d = b.start - a.start;
-    // The larger component of the step gives the count; the check below is bit for bit.
-    let m = if step.x.abs() >= step.y.abs() {
-        d.x / step.x
-    } else {
-        d.y / step.y
-    };
-    let m = m.round();
-    if !(0.0..=f64::from(u32::MAX)).contains(&m) {
-        return None;
-    }
-    let m = m as u32;
-    same(at(a.start, step, m), b.start).then_some(m)
-}
-
-/// Reads what [`RunCoder`] wrote (bytes it wrote itself: never malformed).
-struct RunReader<'a> {
-    bytes: &'a [u8],
-    kinds: &'a [RunKind],
-    last: Option<Run>,
-}
-
-impl RunReader<'_> {
-    fn var(&mut self) -> u64 {
-        let mut x = 0u64;
-        for shift in (0..64).step_by(7) {
-            let Some((&b, rest)) = self.bytes.split_first() else {
-                break;
-            };
-            self.bytes = rest;
-            x |= u64::from(b & 0x7f) << shift;
-            if b < 0x80 {
-                break;
-            }
-        }
-        x
-    }
-
-    fn bits(&mut self) -> f64 {
-        let (b, rest) = self.bytes.split_at(8);
-        self.bytes = rest;
-        f64::from_bits(u64::from_le_bytes(b.try_into().expect("8 bytes")))
-    }
-}
-
-impl Iterator for RunReader<'_> {
-    type Item = Run;
-
-    fn next(&mut self) -> Option<Run> {
-        if self.bytes.is_empty() {
-            return None;
-        }
-        let end = self.last.map_or(0, |l| l.index + l.count);
-        let index = end + self.var() as u32;
-        let count = self.var() as u32;
-        let kind = self.var() as u32;
-        let start = match (self.var(), self.last) {
-            (0, _) | (_, None) => Vec2::new(self.bits(), self.bits()),
-            (m, Some(l)) => at(l.start, self.kinds[kind as usize].step(), (m - 1) as u32),
-        };
-        let r = Run {
-            index,
-            count,
-            start,
-            kind,
-        };
-        self.last = Some(r);
-        Some(r)
-    }
-}
-
-impl RunKind {
-    fn step(&self) -> Vec2 {
-        Vec2::new(f64::from_bits(self.step.0), f64::from_bits(self.step.1))
-    }
-}
-
 impl PackedWorld {
     /// The runs, in id order.
     fn runs(&self) -> RunReader<'_> {
@@ -447,7 +292,7 @@ mod tests {
     use ricochet_geom::Shape;
 
     use super::*;
-    use crate::def::BodyDef;
+    use crate::def::{BodyDef, BodyKind};
     use crate::scenario::TileRows;
 
     /// Every column of `a` and `b` (the every-body ones bit for bit).
