@@ -355,11 +355,12 @@ impl<S: MessageSink> Recorder<S> {
                 }
                 if let Some(ch) = self.topics.tf {
                     let at = self.view_at(sim);
-                    let transforms = FrameTransforms {
+                    let transforms = || FrameTransforms {
                         transforms: vec![scene::view_transform(ts, at)],
                     };
                     if whole || self.view.is_none_or(|(sent, _)| !same_point(sent, at)) {
                         self.view = Some((at, self.fallback_view(sim)));
+                        let transforms = transforms();
                         if counted {
                             bytes += transforms.encoded_len();
                         }
@@ -371,7 +372,7 @@ impl<S: MessageSink> Recorder<S> {
                         // apply a transform stamped long before the frames it shows: a viewer
                         // that connected after the camera last moved got the latched /tf of
                         // frame 0 and looked at the world's origin, not the view.
-                        self.writer.write_live(ch, t, transforms)?;
+                        self.writer.write_live(ch, t, transforms())?;
                     }
                 }
                 if let Some(ch) = self.topics.normals

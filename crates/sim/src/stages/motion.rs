@@ -43,7 +43,7 @@ pub(crate) fn controls(w: &mut World) {
     let mut visited = Vec::new();
     // The bodies with a controller, in the active bodies' (dense) order: each body's new
     // velocity reads only its own inputs, so the order changes nothing anyway.
-    for k in 0..w.controlled() {
+    for k in 0..w.controlled_count() {
         let Some(i) = w.active_controlled(k) else {
             continue;
         };

@@ -507,8 +507,8 @@ impl World {
         !self.controlled.is_empty()
     }
 
-    /// The dense index of the `k`-th body with a controller ([`World::controlled`]'s order,
-    /// which is the dense order), when it is active.
+    /// The dense index of the `k`-th body with a controller (in id order, which is the dense
+    /// order; `k` below [`World::controlled_count`]), when it is active.
     pub(crate) fn active_controlled(&self, k: usize) -> Option<usize> {
         let i = self
             .index_of(self.controlled[k])
@@ -517,7 +517,7 @@ impl World {
     }
 
     /// How many bodies have a controller.
-    pub(crate) fn controlled(&self) -> usize {
+    pub(crate) fn controlled_count(&self) -> usize {
         debug_assert!(
             self.controlled.windows(2).all(|w| w[0] < w[1])
                 && self.controlled.len()

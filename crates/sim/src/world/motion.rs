@@ -114,7 +114,7 @@ impl World {
     /// Whether an active body has a controller: each body with one looked up (a few),
     /// not every active body.
     pub(crate) fn any_active_controller(&self) -> bool {
-        let any = (0..self.controlled()).any(|k| self.active_controlled(k).is_some());
+        let any = (0..self.controlled_count()).any(|k| self.active_controlled(k).is_some());
         debug_assert_eq!(
             any,
             self.any_active(|_, r| self.rows.controller[r].is_some()),
