@@ -249,6 +249,12 @@ struct Settled {
 }
 
 impl Tracker {
+    /// Whether a frame was tracked yet. The first one finds every body new: both the scene
+    /// and the static scene changed.
+    pub fn started(&self) -> bool {
+        self.started
+    }
+
     /// The keyframe of frame `frame` was `bytes` encoded bytes: the next waits for them.
     pub fn keyframe_written(&mut self, frame: u64, bytes: u64) {
         self.next_keyframe = frame.saturating_add(bytes.div_ceil(KEYFRAME_BYTES_PER_FRAME));
@@ -389,6 +395,13 @@ impl Tracker {
             }
         }
         let unsettled = std::mem::take(&mut self.unsettled);
+        // A record for every slot at once: the entities are in id order, so the last has
+        // the highest slot (10,000 records grown one by one were copied as they grew).
+        if let Some(last) = world.entity.last()
+            && self.known.len() <= last.index as usize
+        {
+            self.known.resize_with(last.index as usize + 1, || None);
+        }
         // A body's shape, encoded, while it is listed whole.
         let mut shape = Vec::new();
         for &i in &unsettled {

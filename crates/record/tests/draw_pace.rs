@@ -13,9 +13,9 @@ use ricochet_sim::Simulation;
 
 const SCENE_TOPICS: [&str; 4] = ["/scene", "/scene/static", "/tf", "/scene/contacts"];
 
-/// Frame → (scene-channel bytes, `/scene` messages, `/bodies` messages), for each frame of
-/// `name` recorded for `frames` frames.
-fn record(name: &str, frames: u64, every_frame: bool, path: &Path) -> BTreeMap<u64, [u64; 3]> {
+/// Frame → (scene-channel bytes, `/scene` messages, `/bodies` messages, `/scene/static`
+/// messages), for each frame of `name` recorded for `frames` frames.
+fn record(name: &str, frames: u64, every_frame: bool, path: &Path) -> BTreeMap<u64, [u64; 4]> {
     let scenario = Scene::parse(name).unwrap().build(frames);
     let mut recorder = Recorder::create(path, scenario.world.dt, Channels::default()).unwrap();
     if every_frame {
@@ -30,7 +30,7 @@ fn record(name: &str, frames: u64, every_frame: bool, path: &Path) -> BTreeMap<u
     recorder.finish().unwrap();
     let log = LogFile::open(path).unwrap();
     let mut messages = log.messages().unwrap();
-    let mut by_frame: BTreeMap<u64, [u64; 3]> = BTreeMap::new();
+    let mut by_frame: BTreeMap<u64, [u64; 4]> = BTreeMap::new();
     while let Some(m) = messages.next_raw() {
         let m = m.unwrap();
         assert_eq!(m.log_time() % dt_ns, 0);
@@ -40,6 +40,7 @@ fn record(name: &str, frames: u64, every_frame: bool, path: &Path) -> BTreeMap<u
         }
         row[1] += u64::from(m.topic() == "/scene");
         row[2] += u64::from(m.topic() == "/bodies");
+        row[3] += u64::from(m.topic() == "/scene/static");
     }
     by_frame
 }
@@ -76,6 +77,22 @@ fn a_big_scene_is_drawn_after_its_bytes_and_its_bodies_every_frame() {
     );
     let scenes: u64 = log.values().map(|row| row[1]).sum();
     assert_eq!(scenes, drawn.len() as u64, "one whole /scene per drawing");
+}
+
+#[test]
+fn a_big_scenes_static_bodies_are_drawn_once_when_none_changes() {
+    let dir = tempfile::tempdir().unwrap();
+    // 300 static tiles and 100 actors (batched: over 256 bodies), drawn at frame 0 and
+    // again as the budget allows; the tiles never move.
+    let log = record("platformer-300-100", 120, false, &dir.path().join("p.mcap"));
+    let drawings = log.values().filter(|row| row[1] > 0).count();
+    assert!(drawings > 2, "{drawings} drawings of /scene");
+    let statics: Vec<u64> = log
+        .iter()
+        .filter(|(_, row)| row[3] > 0)
+        .map(|(&f, _)| f)
+        .collect();
+    assert_eq!(statics, [0], "/scene/static at the first frame only");
 }
 
 #[test]
