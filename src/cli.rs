@@ -66,9 +66,9 @@ pub enum Command {
         #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=256))]
         threads: Option<u16>,
         /// Draw the scene (/scene, /scene/static, /tf, /scene/contacts) in every frame. By
-        /// default a drawing of N encoded bytes waits N / 16 KiB frames before the next:
+        /// default a drawing of N encoded bytes waits N / 12 KiB frames before the next:
         /// scenes of at most 256 bodies are drawn every frame anyway, 10,000
-        /// asteroids about every 94th frame, so that recording keeps up with the simulation
+        /// asteroids about every 124th frame, so that recording keeps up with the simulation
         /// (drawing them every frame records at about 300 frames/s on 2 cores). /bodies,
         /// /contacts, /stats and /events are exact in every frame either way; in the viewer
         /// a time between two drawings shows the earlier one.

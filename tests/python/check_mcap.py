@@ -59,7 +59,7 @@ section's, each chunk's, the summary's), and every message is decoded with
 - The drawing's pace (README, "Drawing a big scene"): with at most 256 bodies at frame 0
   every frame may draw; with more, frame 0 draws, and a frame that drew `n` bytes of
   `/scene`, `/scene/static`, `/tf` and `/scene/contacts` (as the file holds them) lets the
-  next draw no sooner than `ceil(n / 16384)` frames later: a frame before that sends none of
+  next draw no sooner than `ceil(n / 12288)` frames later: a frame before that sends none of
   the four, and what a seek shows there is the last drawing.
 - `/tf`: one transform a message, the camera's frame `view` in `world`, upright, at f32
   precision, stamped at its time; sent at frame 0, then only when it moves.
@@ -105,7 +105,7 @@ WORLD = "world"
 PER_BODY_LIMIT = 256
 CHUNK_PARTS = 1024
 # A batched scene's drawing of n bytes waits ceil(n / DRAW_BYTES_PER_FRAME) frames.
-DRAW_BYTES_PER_FRAME = 16 * 1024
+DRAW_BYTES_PER_FRAME = 12 * 1024
 SCENE_TOPICS = ("/scene", "/scene/static", "/tf", "/scene/contacts")
 # Drawings are at f32 precision: within a few f32 roundings of max(1, |value|).
 F32_TOLERANCE = 4 * 2.0**-23

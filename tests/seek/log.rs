@@ -89,11 +89,11 @@ impl Planar {
 /// README.md states it ("Drawing a big scene"): a scene drawn per body draws every frame;
 /// else frame 0 draws; a drawing of `n` encoded
 /// bytes (the scene topics' messages of its frame, as the file holds them) lets the next
-/// frame draw `ceil(n / 16 KiB)` frames later; a frame allowed to draw that sends nothing
+/// frame draw `ceil(n / 12 KiB)` frames later; a frame allowed to draw that sends nothing
 /// changed nothing drawn, so it shows its own bodies as the last drawing does. With
 /// `--draw-every-frame`, every frame shows itself.
 pub(super) fn shown_frames(log: &Path, dt_ns: u64, frames: usize, every_frame: bool) -> Vec<usize> {
-    const BUDGET: u64 = 16 * 1024;
+    const BUDGET: u64 = 12 * 1024;
     let file = ricochet_log::LogFile::open(log).unwrap();
     let mut bytes = vec![0_u64; frames];
     let mut messages = file.messages().unwrap();

@@ -48,9 +48,9 @@ fn record(name: &str, frames: u64, every_frame: bool, path: &Path) -> BTreeMap<u
 #[test]
 fn a_big_scene_is_drawn_after_its_bytes_and_its_bodies_every_frame() {
     let dir = tempfile::tempdir().unwrap();
-    // 2,000 asteroids, every one moving every frame: about 300 KB a drawing, every 19th
+    // 2,000 asteroids, every one moving every frame: about 300 KB a drawing, every 25th
     // frame.
-    let frames = 240;
+    let frames = 300;
     let log = record("asteroids-2000", frames, false, &dir.path().join("a.mcap"));
     assert_eq!(log.len() as u64, frames + 1);
     assert!(
