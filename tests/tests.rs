@@ -13,6 +13,7 @@ mod dump_cli;
 mod fuzz_corpus;
 mod golden;
 mod hostile;
+mod hostile_diff;
 mod large_scenario;
 mod run_cli;
 mod scenario_limits;
