@@ -4,243 +4,26 @@
 //! on; bad room names and bad inputs are refused by name; the per-room and server-wide
 //! caps; an empty room closes after its grace. Loopback only; every wait bounded.
 
-use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use futures_util::StreamExt;
-use ricochet_serve::{Listener, RoomMaker, RoomOptions, ServedRooms};
+use ricochet_serve::RoomOptions;
+use ricochet_sim::Player;
 use ricochet_sim::prelude::*;
-use ricochet_sim::{Game, Player};
 use serde_json::Value;
 use tokio_tungstenite::tungstenite::Message;
 
 use crate::serve_client::*;
 
-/// A ball per player, pushed by `{"push": [vx, vy]}`.
-#[derive(Default)]
-struct Balls {
-    /// The game panics just after this frame's step.
-    panic_at: Option<u64>,
-    balls: BTreeMap<Player, Entity>,
-    state: BallsState,
-}
+mod game;
+mod harness;
 
-#[derive(Default, serde::Serialize)]
-struct BallsState {
-    frame: u64,
-    players: u64,
-    pushes: u64,
-}
-
-#[derive(serde::Deserialize, serde::Serialize)]
-#[serde(deny_unknown_fields)]
-struct Push {
-    push: [f64; 2],
-}
-
-impl Game for Balls {
-    type Input = Push;
-    type State = BallsState;
-
-    fn name(&self) -> &str {
-        "balls"
-    }
-
-    fn join(&mut self, sim: &mut Simulation, player: Player, name: &str) -> Result<(), String> {
-        if name == "nobody" {
-            return Err("nobody may not play".to_owned());
-        }
-        let ball = sim.spawn(&BodyDef {
-            position: Vec2::new(2.0 * f64::from(player.0), 0.0),
-            ..BodyDef::default()
-        });
-        self.balls.insert(player, ball);
-        self.state.players += 1;
-        Ok(())
-    }
-
-    fn leave(&mut self, sim: &mut Simulation, player: Player) {
-        if let Some(ball) = self.balls.remove(&player) {
-            let _ = sim.despawn(ball);
-            self.state.players -= 1;
-        }
-    }
-
-    fn input(&mut self, sim: &mut Simulation, player: Player, input: Push) -> Result<(), String> {
-        let ball = *self.balls.get(&player).ok_or("no ball")?;
-        sim.set_velocity(ball, Vec2::new(input.push[0], input.push[1]))
-            .map_err(|e| e.to_string())?;
-        self.state.pushes += 1;
-        Ok(())
-    }
-
-    fn after_step(&mut self, _sim: &mut Simulation, out: &FrameOutput) {
-        if self.panic_at == Some(out.frame) {
-            panic!("the test game panics at frame {}", out.frame);
-        }
-        self.state.frame = out.frame;
-    }
-
-    fn state(&self) -> Option<&BallsState> {
-        Some(&self.state)
-    }
-}
-
-/// Rooms of [`Balls`]; the room named `boom` panics after frame 30.
-struct Maker;
-
-const PANIC_AT: u64 = 30;
-
-fn new_game(room: &str) -> (Simulation, Balls) {
-    let sim = Simulation::from_def(WorldDef {
-        gravity: Vec2::ZERO,
-        ..WorldDef::default()
-    })
-    .unwrap();
-    let game = Balls {
-        panic_at: (room == "boom").then_some(PANIC_AT),
-        ..Balls::default()
-    };
-    (sim, game)
-}
-
-impl RoomMaker for Maker {
-    type Game = Balls;
-
-    fn make(&self, room: &str) -> Result<(Simulation, Balls), String> {
-        Ok(new_game(room))
-    }
-
-    fn input_schema(&self) -> String {
-        r#"{"type": "object", "properties": {"push": {"type": "array"}}, "required": ["push"]}"#
-            .to_owned()
-    }
-}
-
-/// A rooms server on a free loopback port, stopped (and its result kept) when asked.
-struct Rooms {
-    base: String,
-    stop: Arc<AtomicBool>,
-    thread: Option<std::thread::JoinHandle<ServedRooms>>,
-}
-
-impl Rooms {
-    fn start(options: RoomOptions) -> Rooms {
-        let listener = Listener::bind("127.0.0.1:0".parse().unwrap()).unwrap();
-        let base = format!("ws://{}", listener.local_addr());
-        let stop = Arc::new(AtomicBool::new(false));
-        let flag = Arc::clone(&stop);
-        let thread = std::thread::spawn(move || {
-            ricochet_serve::serve_rooms(listener, Maker, &options, &flag).unwrap()
-        });
-        Rooms {
-            base,
-            stop,
-            thread: Some(thread),
-        }
-    }
-
-    fn url(&self, room: &str) -> String {
-        format!("{}/rooms/{room}", self.base)
-    }
-
-    fn stop(mut self) -> ServedRooms {
-        self.stop.store(true, Ordering::SeqCst);
-        self.thread.take().unwrap().join().unwrap()
-    }
-}
-
-impl Drop for Rooms {
-    fn drop(&mut self) {
-        self.stop.store(true, Ordering::SeqCst);
-    }
-}
-
-fn quiet() -> RoomOptions {
-    RoomOptions {
-        note: Arc::new(|_: &str| {}),
-        threads: 2,
-        ..RoomOptions::default()
-    }
-}
-
-/// Connects to a room: the socket, its channels and its services.
-async fn enter(url: &str) -> (Ws, Value, Value) {
-    let (mut ws, _) = connect(url, "foxglove.websocket.v1").await.unwrap();
-    let (mut channels, mut services) = (Value::Null, Value::Null);
-    while channels.is_null() || services.is_null() {
-        let v = any_json(&mut ws).await;
-        match v["op"].as_str() {
-            Some("advertise") => channels = v,
-            Some("advertiseServices") => services = v,
-            _ => {}
-        }
-    }
-    (ws, channels, services)
-}
-
-/// The next `/game` state on subscription `sub` (JSON).
-async fn next_game(ws: &mut Ws, sub: u32) -> Value {
-    loop {
-        let (s, _, payload) = next_data(ws).await;
-        if s == sub {
-            return serde_json::from_slice(&payload).unwrap();
-        }
-    }
-}
-
-/// Waits (at most 10 s) until `/game` shows `pushes` (on subscription 1).
-async fn until_pushes(ws: &mut Ws, pushes: u64) -> Value {
-    within(async {
-        loop {
-            let game = next_game(ws, 1).await;
-            if game["pushes"] == pushes {
-                return game;
-            }
-        }
-    })
-    .await
-}
-
-/// `f`'s answer, which must come within 10 s (data keeps coming, so a wait for one kind
-/// of message is bounded as a whole).
-async fn within<T>(f: impl std::future::Future<Output = T>) -> T {
-    tokio::time::timeout(Duration::from_secs(10), f)
-        .await
-        .expect("within 10 s")
-}
-
-/// The next status message (level, text), within 10 s.
-async fn status_within(ws: &mut Ws) -> (u64, String) {
-    within(next_status(ws)).await
-}
-
-/// A log's `/input` messages, as JSON.
-fn commands(log: &Path) -> Vec<Value> {
-    let bytes = std::fs::read(log).unwrap();
-    mcap::MessageStream::new(&bytes)
-        .unwrap()
-        .map(Result::unwrap)
-        .filter(|m| m.channel.topic == "/input")
-        .map(|m| serde_json::from_slice(&m.data).unwrap())
-        .collect()
-}
-
-/// Replays `log` with a new game for `room` and says whether the replay is the same
-/// bytes; also the frames it holds.
-fn replays_byte_for_byte(log: &Path, room: &str, dir: &Path) -> (bool, u64) {
-    let recorded = ricochet_log::LogFile::open(log).unwrap();
-    let again = dir.join(format!("{room}.again.mcap"));
-    let out = ricochet_record::log_writer(&again).unwrap();
-    let (sim, game) = new_game(room);
-    let replayed = ricochet_record::replay::replay(&recorded, sim, game, out).unwrap();
-    replayed.sink.finish().unwrap();
-    let same = std::fs::read(log).unwrap() == std::fs::read(&again).unwrap();
-    (same, replayed.frames)
-}
+use game::{PANIC_AT, Push, new_game};
+use harness::{
+    Rooms, commands, enter, next_game, quiet, replays_byte_for_byte, status_within, until_pushes,
+    within,
+};
 
 #[test]
 fn two_rooms_step_apart_each_recording_its_own_players_and_replaying_byte_for_byte() {
