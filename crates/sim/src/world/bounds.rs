@@ -27,15 +27,24 @@ impl LocalBounds {
     /// The bounds of `shape` at `angle` and position `p`.
     #[inline]
     pub(super) fn at(&mut self, shape: &Shape, angle: f64, p: Vec2) -> Bounds {
-        self.at_with(|| shape, angle, p)
+        self.at_with(|| shape, || angle, p)
     }
 
     /// [`LocalBounds::at`], looking the shape up only when the bounds must be recomputed
     /// (once per body: a body that turned keeps its any-angle bounds).
     #[inline]
-    fn at_with<'s>(&mut self, shape: impl FnOnce() -> &'s Shape, angle: f64, p: Vec2) -> Bounds {
-        if !self.any_angle && self.angle.to_bits() != angle.to_bits() {
-            *self = LocalBounds::turned(shape(), angle);
+    fn at_with<'s>(
+        &mut self,
+        shape: impl FnOnce() -> &'s Shape,
+        angle: impl FnOnce() -> f64,
+        p: Vec2,
+    ) -> Bounds {
+        // The angle too is read only when needed: bounds for any angle do not ask it.
+        if !self.any_angle {
+            let angle = angle();
+            if self.angle.to_bits() != angle.to_bits() {
+                *self = LocalBounds::turned(shape(), angle);
+            }
         }
         placed(self.bounds, p)
     }
@@ -247,9 +256,9 @@ impl EntryColumns<'_> {
     fn entry(&mut self, i: usize, r: usize, visit: impl FnOnce(&Bounds)) -> BodyEntry {
         let p = self.position[i];
         // The shape table is read only when needed (a scene's shapes may all differ).
-        let (shapes, id) = (self.shapes, self.shape_id[i]);
-        let shape = || &shapes.get(id).0;
-        let mut bounds = self.local_bounds[r].at_with(shape, self.angle[i], p);
+        let (shapes, ids) = (self.shapes, self.shape_id);
+        let shape = || &shapes.get(ids[i]).0;
+        let mut bounds = self.local_bounds[r].at_with(shape, || self.angle[i], p);
         let layer = self.layers[i];
         let widen = self.widen[usize::from(layer)];
         // The frame's start is read only for a layer that may be widened.
