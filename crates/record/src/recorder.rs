@@ -196,11 +196,7 @@ impl<S: MessageSink> Recorder<S> {
                 self.writer.write_live_encoded(ch, t, bytes)?;
             }
         }
-        if let Some(ch) = self.topics.tf {
-            let transforms = vec![scene::view_transform(ts, self.view_at(sim))];
-            self.writer
-                .write_live(ch, t, FrameTransforms { transforms })?;
-        }
+        self.send_view_live(sim, t)?;
         self.moving_skipped = false;
         Ok(())
     }
@@ -222,10 +218,14 @@ impl<S: MessageSink> Recorder<S> {
         let bytes = scene::snapshot_encoded(w, layers, false, style, timestamp(t));
         self.writer.write_live_encoded(ch, t, bytes)?;
         // The camera's frame with the drawing, stamped now, as `record` sends it live.
+        self.send_view_live(sim, t)
+    }
+
+    /// Sends live viewers the camera's frame stamped at `t` (never recorded).
+    fn send_view_live(&mut self, sim: &Simulation, t: u64) -> Result<(), LogError> {
         if let Some(ch) = self.topics.tf {
-            let transforms = vec![scene::view_transform(timestamp(t), self.view_at(sim))];
-            self.writer
-                .write_live(ch, t, FrameTransforms { transforms })?;
+            let message = view_message(t, self.view_at(sim));
+            self.writer.write_live(ch, t, message)?;
         }
         Ok(())
     }
@@ -416,12 +416,9 @@ impl<S: MessageSink> Recorder<S> {
             }
             if let Some(ch) = self.topics.tf {
                 let at = self.view_at(sim);
-                let transforms = || FrameTransforms {
-                    transforms: vec![scene::view_transform(ts, at)],
-                };
                 if whole || self.view.is_none_or(|(sent, _)| !same_point(sent, at)) {
                     self.view = Some((at, self.fallback_view(sim)));
-                    let transforms = transforms();
+                    let transforms = view_message(t, at);
                     if counted {
                         bytes += transforms.encoded_len();
                     }
@@ -433,7 +430,7 @@ impl<S: MessageSink> Recorder<S> {
                     // apply a transform stamped long before the frames it shows: a viewer
                     // that connected after the camera last moved got the latched /tf of
                     // frame 0 and looked at the world's origin, not the view.
-                    self.writer.write_live(ch, t, transforms())?;
+                    self.writer.write_live(ch, t, view_message(t, at))?;
                 }
             }
             if let Some(ch) = self.topics.normals
@@ -457,6 +454,13 @@ impl<S: MessageSink> Recorder<S> {
             }
         }
         Ok(())
+    }
+}
+
+/// `/tf`'s message at `t`: the camera's frame looking at `at`.
+fn view_message(t: u64, at: Vec2) -> FrameTransforms {
+    FrameTransforms {
+        transforms: vec![scene::view_transform(timestamp(t), at)],
     }
 }
 

@@ -508,11 +508,10 @@ impl World {
     }
 
     /// The dense index of the `k`-th body with a controller (in id order, which is the dense
-    /// order; `k` below [`World::controlled_count`]), when it is active.
+    /// order; `k` below [`World::controlled_count`]), when it is active (a controlled body is
+    /// always alive: [`World::controlled_count`] checks it in debug builds).
     pub(crate) fn active_controlled(&self, k: usize) -> Option<usize> {
-        let i = self
-            .index_of(self.controlled[k])
-            .expect("a controlled body is alive");
+        let i = self.index_of(self.controlled[k])?;
         self.active.binary_search(&(i as u32)).is_ok().then_some(i)
     }
 
