@@ -140,6 +140,7 @@ mod sort_and_sweep;
 mod sorted;
 mod static_set;
 pub(crate) mod static_tree;
+mod strip_height;
 mod strips;
 mod tally;
 mod tile_map;

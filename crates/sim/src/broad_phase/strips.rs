@@ -37,6 +37,7 @@ use ricochet_geom::Bounds;
 
 use super::grid::cell_coord;
 use super::sorted::{self, order_key};
+use super::strip_height::{extent, inv_strip_height, restrip};
 use super::{BodyEntry, BroadPhase, BroadPhaseStats, LAYERS, Member, STATIC_BIT, member, of_layer};
 
 /// No index: a body gone from a list.
@@ -114,33 +115,6 @@ impl Swept {
             m,
         }
     }
-}
-
-/// `1 / H` for bodies at most `height` tall with coordinates up to `max_abs`: `H` the least
-/// power of two at least `height * (1 + 1e-9)` (and `max_abs / 2^30`, so strips stay well
-/// inside `i32`), between `2^-1000` and `2^1000`; 0 (one strip) when there is no such `H`.
-pub(super) fn inv_strip_height(height: f64, max_abs: f64) -> f64 {
-    /// `2^e` for `-1022 <= e <= 1023`, exactly.
-    fn pow2(e: i64) -> f64 {
-        f64::from_bits(((1023 + e) as u64) << 52)
-    }
-    let need = (height * (1.0 + 1e-9)).max(max_abs * pow2(-30));
-    if need.is_nan() || need > pow2(1000) {
-        return 0.0; // NaN, infinite or too tall
-    }
-    let need = need.max(pow2(-1000));
-    // The power of two at or below `need` (its exponent bits), doubled if below.
-    let mut h = f64::from_bits(need.to_bits() & 0x7ff0_0000_0000_0000);
-    if h < need {
-        h *= 2.0;
-    }
-    1.0 / h
-}
-
-/// Whether `inv_h` should be replaced by `want` (a strip height that fits this call's
-/// bodies): when it is too small for them, or more than 8 times taller than they need.
-pub(super) fn restrip(inv_h: f64, want: f64) -> bool {
-    inv_h.to_bits() != want.to_bits() && (inv_h > want || want > 8.0 * inv_h || inv_h == 0.0)
 }
 
 impl StripList {
@@ -478,25 +452,6 @@ pub(super) fn strip_cross(x: &StripList, y: &StripList, out: &mut Vec<(u32, u32)
     tested
 }
 
-/// The tallest finite `max.y - min.y` of `bounds` (NaN and inverted boxes ignored; an
-/// infinite one gives infinity), and the largest finite `|coordinate|`.
-pub(super) fn extent<'a>(bounds: impl Iterator<Item = &'a Bounds>) -> (f64, f64) {
-    let (mut height, mut max_abs): (f64, f64) = (0.0, 0.0);
-    for b in bounds {
-        let h = b.max.y - b.min.y;
-        if h > height {
-            height = h;
-        }
-        for v in [b.min.x, b.min.y, b.max.x, b.max.y] {
-            let a = v.abs();
-            if a > max_abs && a.is_finite() {
-                max_abs = a;
-            }
-        }
-    }
-    (height, max_abs)
-}
-
 impl BroadPhase {
     /// Before a `Strips` call: the strip height for this call's bodies (kept while it fits,
     /// see [`restrip`]), and the static lists, sorted again when the static bodies or the
@@ -505,7 +460,13 @@ impl BroadPhase {
         if !self.statics.built_strips {
             self.static_extent = extent(self.statics.entries.iter().map(|(b, _)| b));
         }
-        let (height, max_abs) = extent(self.movers.iter().map(|&h| &bodies[h as usize].bounds));
+        // Every body given is a mover when there are as many movers (the usual call): read
+        // them in place, in sequence.
+        let (height, max_abs) = if self.movers.len() == bodies.len() {
+            extent(bodies.iter().map(|b| &b.bounds))
+        } else {
+            extent(self.movers.iter().map(|&h| &bodies[h as usize].bounds))
+        };
         let want = inv_strip_height(
             height.max(self.static_extent.0),
             max_abs.max(self.static_extent.1),

@@ -69,6 +69,36 @@ impl World {
         g: Vec2,
         thrust: impl Fn(&Controller, &Inputs, f64) -> Vec2,
     ) {
+        if self.controlled_count() == 0
+            && let Some(run) = self.row_run(&self.active)
+        {
+            // The usual case without a controller, over one run (`runs.rs`): each column a
+            // slice, in place; the same arithmetic as below with a zero thrust.
+            let rows = &mut self.rows;
+            let (kind, entity) = (&self.kind[run.indices()], &self.entity[run.indices()]);
+            let (mass, force) = (&rows.mass[run.rows()], &rows.force[run.rows()]);
+            let scale = &rows.gravity_scale[run.rows()];
+            let velocity = &mut rows.velocity[run.rows()];
+            let (disturbed, len) = (&mut self.disturbed, self.entity.len());
+            for k in 0..run.len {
+                if kind[k] != BodyKind::Dynamic {
+                    continue;
+                }
+                let m = mass[k];
+                let sum = force[k] + Vec2::ZERO + g * (m * scale[k]);
+                let a = sum / m;
+                let v = velocity[k];
+                let changed = v + a * dt;
+                if NAME
+                    && (changed.x.to_bits() != v.x.to_bits()
+                        || changed.y.to_bits() != v.y.to_bits())
+                {
+                    disturbed.name(entity[k], len);
+                }
+                velocity[k] = changed;
+            }
+            return;
+        }
         let (row, rows, kind, angle) = (&self.row, &mut self.rows, &self.kind, &self.angle);
         let (entity, disturbed) = (&self.entity, &mut self.disturbed);
         for &i in &self.active {
