@@ -40,9 +40,9 @@
 //!   grids (`fixed_grid.rs`, `mover_grid.rs`).
 //! - `Strips` (`strips.rs`): sort and sweep within horizontal strips as tall as the tallest
 //!   body (one strip height per call, a power of two, for every list): each layer's moving
-//!   bodies sorted by `(strip, min.x)`, kept and re-sorted like `SortAndSweep`, swept within
-//!   a strip and against the next one; static bodies in lists of their own, sorted once.
-//!   Overlapping boxes are in the same or neighbouring strips, so a crowd sharing one x
+//!   bodies filed in the one or two strips they reach and sorted by `(strip, min.x)`, kept
+//!   and re-sorted like `SortAndSweep`, swept within each strip; static bodies in lists of
+//!   their own, sorted once. Overlapping boxes share a strip, so a crowd sharing one x
 //!   range (rain) costs what its neighbours in y cost, not the whole column.
 //! - `Quadtree` (`quadtree.rs`): a loose quadtree per layer, rebuilt every call for the
 //!   moving bodies (one pass of stable partitions, `O(n log n)`), built once for the static
@@ -141,6 +141,7 @@ mod sorted;
 mod static_set;
 pub(crate) mod static_tree;
 mod strip_height;
+mod strip_list;
 mod strips;
 mod tally;
 mod tile_map;
@@ -159,7 +160,7 @@ use quadtree::Quadtree;
 use sort_and_sweep::{Slot, SweepList};
 use static_set::StaticSet;
 use static_tree::StaticTree;
-use strips::StripList;
+use strip_list::StripList;
 pub(crate) use tally::Tally;
 pub(crate) use tile_map::{StaticBox, TileMap};
 

@@ -1,0 +1,375 @@
+//! One list of `Strips` (`strips.rs`): a layer's bodies filed in every strip their bounds
+//! reach, sorted by strip, then by `min.x`, with their bounds beside them in the same order
+//! for the sweeps.
+//!
+//! `H` is at least as tall as every body (`strip_height.rs`), so a body reaches one strip or
+//! two: the strip of its `min.y` (its lower slot) and, when its top is in the next one, that
+//! one too (its upper slot). Two bodies whose bounds overlap then share the strip of
+//! `max(p.min.y, q.min.y)`, which both reach; the sweeps look within strips only, and keep a
+//! pair only in that strip.
+//!
+//! Like `SortAndSweep`, a moving list is kept from the previous call and re-sorted by
+//! insertion sort: a slot whose body still reaches the same strips is rewritten in place
+//! (nearly sorted: `min.x` moves a little a frame); a body that reaches other strips than
+//! last time leaves the list and comes back as fresh slots, sorted apart and merged in (a
+//! body that wraps from the bottom of the world to the top would cost an insertion sort the
+//! whole list). A slot is only the sort key and the body's index (16 bytes), so the sorts and
+//! the merge move little; once the order is settled the bounds are gathered beside it.
+//!
+//! # Determinism
+//! The order is `(strip, min.x as f64::total_cmp, local, upper)`, `local` the body's index in
+//! the list's key order: a function of the input.
+
+use ricochet_geom::Bounds;
+
+use super::grid::cell_coord;
+use super::sorted::{self, order_key};
+use super::{BodyEntry, Member, member};
+
+/// No index: a body gone from a list.
+const NONE: u32 = u32::MAX;
+
+/// The bit of a slot's `local` field that marks a body's upper slot (indices stay below
+/// `2^31`: the broad phase asserts fewer bodies).
+const UPPER: u32 = 1 << 31;
+
+/// One list: bodies sorted by strip, then by `min.x`.
+#[derive(Debug, Default, Clone)]
+pub(super) struct StripList {
+    /// The call the list was last brought up to (moving bodies).
+    pub(super) frame: u64,
+    /// `1 / H` of the current order (0: one strip).
+    pub(super) inv_h: f64,
+    /// The slots' sort keys, sorted.
+    order: Vec<Slot>,
+    /// The slots' bounds in `order`'s order, gathered once the order is settled: the sweeps
+    /// read this one array in sequence.
+    swept: Vec<Swept>,
+    /// The keys of the list's bodies at the last update, in key order (`local` indexes it).
+    keys: Vec<u64>,
+    /// Each body's lower strip and whether it has an upper slot, by `local`, at the last
+    /// update (moving lists); and the buffer it is remade in when the bodies change.
+    reach: Vec<Reach>,
+    reach_next: Vec<Reach>,
+    /// The widest body's `max.x - min.x` (at least 0; NaN ignored).
+    pub(super) width: f64,
+    /// `(strip, first slot)` of each run of one strip, in order, then `(_, order.len())`.
+    runs: Vec<(i32, u32)>,
+    /// Update buffers: old local to new, bodies whose strips changed, fresh slots, the merge.
+    remap: Vec<u32>,
+    moved: Vec<u32>,
+    fresh: Vec<Slot>,
+    merged: Vec<Slot>,
+}
+
+/// The strips a body reaches: its lower one, and the next one too when `two`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct Reach {
+    lower: i32,
+    two: bool,
+}
+
+impl Reach {
+    /// The strips `b` reaches at `1 / H` = `inv_h`. A box with a NaN or inverted `y` range
+    /// overlaps nothing, and has its lower slot only.
+    #[inline]
+    fn of(b: &Bounds, inv_h: f64) -> Reach {
+        let lower = cell_coord(b.min.y, inv_h);
+        let top = cell_coord(b.max.y, inv_h);
+        // `top` is `lower` or `lower + 1` for every box at most `H` tall; anything else is a
+        // box that overlaps nothing (NaN maps to strip 0).
+        let ordered = b.min.y <= b.max.y;
+        let two = ordered && i64::from(top) == i64::from(lower) + 1;
+        debug_assert!(
+            top == lower || two || !ordered,
+            "H is at least as tall as every body"
+        );
+        Reach { lower, two }
+    }
+}
+
+/// A body's place in a [`StripList`] (16 bytes, so the insertion sort and the merge move a
+/// quarter of what they would with the bounds): `(strip, min.x, local)` packed into one
+/// integer whose order is the list order. From the high bits: the strip (`floor(min.y / H)`,
+/// clamped, plus one for an upper slot) with its sign bit flipped, `min.x` as [`order_key`],
+/// and the body's index in the list's key order with [`UPPER`] on an upper slot, which breaks
+/// ties so the order is a function of the input.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+struct Slot(u128);
+
+impl Slot {
+    #[inline]
+    fn new(strip: i32, b: &Bounds, local: u32) -> Slot {
+        let strip = strip as u32 ^ (1 << 31);
+        Slot(u128::from(strip) << 96 | u128::from(order_key(b.min.x)) << 32 | u128::from(local))
+    }
+
+    /// The slots of a body reaching `reach`: its lower one, then its upper one if any.
+    #[inline]
+    fn both(reach: Reach, b: &Bounds, local: u32) -> (Slot, Option<Slot>) {
+        let lower = Slot::new(reach.lower, b, local);
+        // Two strips means `lower + 1` did not overflow.
+        let upper = reach
+            .two
+            .then(|| Slot::new(reach.lower + 1, b, local | UPPER));
+        (lower, upper)
+    }
+
+    #[inline]
+    fn strip(self) -> i32 {
+        ((self.0 >> 96) as u32 ^ (1 << 31)) as i32
+    }
+
+    /// The body's index in the list's key order.
+    #[inline]
+    fn local(self) -> u32 {
+        self.0 as u32 & !UPPER
+    }
+
+    #[inline]
+    fn upper(self) -> bool {
+        self.0 as u32 & UPPER != 0
+    }
+
+    /// A slot that sorts after every other (a body gone from the list).
+    const GONE: Slot = Slot(u128::MAX);
+}
+
+/// What a sweep reads of a body, in list order.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Swept {
+    /// `min.x` as [`order_key`].
+    pub(super) min: u64,
+    /// `max.x + 0.0` as [`order_key`].
+    pub(super) max: u64,
+    pub(super) m: Member,
+}
+
+impl Swept {
+    #[inline]
+    fn new(m: Member) -> Swept {
+        Swept {
+            min: order_key(m.bounds.min.x),
+            max: order_key(m.bounds.max.x + 0.0),
+            m,
+        }
+    }
+}
+
+impl StripList {
+    /// A list of static `members` (in key order), fully sorted.
+    pub(super) fn statics(members: &[Member], inv_h: f64) -> StripList {
+        let mut list = StripList {
+            inv_h,
+            ..StripList::default()
+        };
+        for (i, m) in members.iter().enumerate() {
+            let (lower, upper) = Slot::both(Reach::of(&m.bounds, inv_h), &m.bounds, i as u32);
+            list.order.push(lower);
+            list.order.extend(upper);
+        }
+        list.order.sort_unstable();
+        list.swept = list
+            .order
+            .iter()
+            .map(|s| Swept::new(members[s.local() as usize]))
+            .collect();
+        list.width = members
+            .iter()
+            .map(|m| m.bounds.max.x - m.bounds.min.x)
+            .fold(0.0, f64::max);
+        list.find_runs();
+        list
+    }
+
+    /// Reconciles the list with this call's bodies (`handles` into `bodies`, key order) and
+    /// strip height: bodies gone are dropped, bodies that reach the same strips get their
+    /// new keys in place, and the others' slots are made again, sorted apart and merged in.
+    /// Then the bounds are gathered in the new order. Returns the insertion sort's moves.
+    pub(super) fn update(&mut self, handles: &[u32], bodies: &[BodyEntry], inv_h: f64) -> u64 {
+        let restripped = self.inv_h.to_bits() != inv_h.to_bits();
+        self.inv_h = inv_h;
+        self.fresh.clear();
+        self.moved.clear();
+        let same = self.keys.len() == handles.len()
+            && self.reach.len() == handles.len()
+            && handles
+                .iter()
+                .zip(&self.keys)
+                .all(|(&h, &k)| bodies[h as usize].key == k);
+        if !same {
+            self.reconcile(handles, bodies);
+        }
+        // In list order: the slots are written in sequence, the bodies read at random. A
+        // body that reaches other strips than last time leaves the list (at its lower slot,
+        // which comes first: its strip is lower) for `moved`: the rest close up behind a
+        // write cursor in the same pass.
+        let mut kept = 0;
+        for k in 0..self.order.len() {
+            let old = self.order[k];
+            let local = old.local();
+            let b = &bodies[handles[local as usize] as usize];
+            let was = self.reach[local as usize];
+            if !old.upper() {
+                let now = Reach::of(&b.bounds, inv_h);
+                if now != was || restripped {
+                    self.moved.push(local);
+                    self.reach[local as usize] = now;
+                    continue;
+                }
+                self.order[kept] = Slot::new(now.lower, &b.bounds, local);
+            } else {
+                // The lower slot came first: a body that moved has its new reach stored,
+                // whose upper strip is not this slot's (the reach differs, so its lower strip
+                // or its having two does; when the height changed, every body moved).
+                if !was.two || i64::from(was.lower) + 1 != i64::from(old.strip()) || restripped {
+                    continue;
+                }
+                self.order[kept] = Slot::new(old.strip(), &b.bounds, local | UPPER);
+            }
+            kept += 1;
+        }
+        self.order.truncate(kept);
+        for &local in &self.moved {
+            let b = &bodies[handles[local as usize] as usize].bounds;
+            let (lower, upper) = Slot::both(self.reach[local as usize], b, local);
+            self.fresh.push(lower);
+            self.fresh.extend(upper);
+        }
+        let moved = self.settle();
+        self.gather(handles, bodies);
+        self.find_runs();
+        moved
+    }
+
+    /// [`StripList::update`]'s first step when the bodies are not the same as last time:
+    /// merges the old keys with the new ones (both ascending), drops the slots of bodies
+    /// gone, renumbers the kept ones, and sends each body new to the list to `moved` (it has
+    /// no slot yet) with its reach.
+    fn reconcile(&mut self, handles: &[u32], bodies: &[BodyEntry]) {
+        self.remap.clear();
+        self.remap.resize(self.keys.len(), NONE);
+        let mut reach = std::mem::take(&mut self.reach_next);
+        reach.clear();
+        reach.resize(handles.len(), Reach::default());
+        let mut i = 0;
+        for (j, &h) in handles.iter().enumerate() {
+            let b = &bodies[h as usize];
+            while i < self.keys.len() && self.keys[i] < b.key {
+                i += 1;
+            }
+            if i < self.keys.len() && self.keys[i] == b.key {
+                self.remap[i] = j as u32;
+                reach[j] = self.reach[i];
+                i += 1;
+            } else {
+                // A body new to the list has no slot: it is made as a moved one.
+                reach[j] = Reach::of(&b.bounds, self.inv_h);
+                self.moved.push(j as u32);
+            }
+        }
+        self.reach_next = std::mem::replace(&mut self.reach, reach);
+        self.keys.clear();
+        self.keys
+            .extend(handles.iter().map(|&h| bodies[h as usize].key));
+        for s in &mut self.order {
+            let j = self.remap[s.local() as usize];
+            *s = if j == NONE {
+                Slot::GONE
+            } else {
+                Slot((s.0 & !u128::from(!UPPER)) | u128::from(j))
+            };
+        }
+        self.order.retain(|&s| s != Slot::GONE);
+    }
+
+    /// Sorts `order` again (no slot is [`Slot::GONE`] any more): insertion-sorts it (nearly
+    /// sorted) and merges in `fresh` (sorted first). Returns the insertion sort's moves.
+    fn settle(&mut self) -> u64 {
+        let moved = sorted::insertion_sort(&mut self.order, Slot::cmp, |_, _| {});
+        if self.fresh.is_empty() {
+            return moved;
+        }
+        self.fresh.sort_unstable();
+        self.merged.clear();
+        self.merged.reserve(self.order.len() + self.fresh.len());
+        // A few fresh slots among thousands: each finds its place by binary search and the
+        // slots between are copied as one block. The order is total (`local` breaks ties),
+        // so this is the one merge of the two lists.
+        let mut from = 0;
+        for &f in &self.fresh {
+            let rest = &self.order[from..];
+            let at = from + rest.partition_point(|&s| s < f);
+            self.merged.extend_from_slice(&self.order[from..at]);
+            self.merged.push(f);
+            from = at;
+        }
+        self.merged.extend_from_slice(&self.order[from..]);
+        std::mem::swap(&mut self.order, &mut self.merged);
+        moved
+    }
+
+    /// Reads the bodies' bounds in list order into `swept`, and the widest body.
+    fn gather(&mut self, handles: &[u32], bodies: &[BodyEntry]) {
+        // The widest body (NaN ignored): a maximum, so any order gives it.
+        let mut width = 0.0;
+        self.swept.clear();
+        self.swept.extend(self.order.iter().map(|s| {
+            let h = handles[s.local() as usize];
+            let b = &bodies[h as usize];
+            let x = b.bounds.max.x - b.bounds.min.x;
+            if x > width {
+                width = x;
+            }
+            Swept::new(member(b, h))
+        }));
+        self.width = width;
+    }
+
+    /// Finds the runs of one strip in `order`.
+    fn find_runs(&mut self) {
+        self.runs.clear();
+        let mut last = None;
+        for (k, s) in self.order.iter().enumerate() {
+            if last != Some(s.strip()) {
+                self.runs.push((s.strip(), k as u32));
+                last = Some(s.strip());
+            }
+        }
+        self.runs.push((i32::MAX, self.order.len() as u32));
+    }
+
+    /// The strip of run `r`.
+    #[inline]
+    pub(super) fn run_strip(&self, r: usize) -> i32 {
+        self.runs[r].0
+    }
+
+    /// The bodies of run `r`, and its strip.
+    #[inline]
+    pub(super) fn run(&self, r: usize) -> (i32, &[Swept]) {
+        let (strip, start) = self.runs[r];
+        (
+            strip,
+            &self.swept[start as usize..self.runs[r + 1].1 as usize],
+        )
+    }
+
+    /// How many runs.
+    #[inline]
+    pub(super) fn run_count(&self) -> usize {
+        self.runs.len() - 1
+    }
+
+    /// The heap bytes the list holds (capacities, its update buffers included), for the
+    /// broad-phase study.
+    pub(super) fn heap_bytes(&self) -> usize {
+        let slots = self.order.capacity() + self.fresh.capacity() + self.merged.capacity();
+        slots * size_of::<Slot>()
+            + self.swept.capacity() * size_of::<Swept>()
+            + self.keys.capacity() * 8
+            + (self.reach.capacity() + self.reach_next.capacity()) * size_of::<Reach>()
+            + self.runs.capacity() * size_of::<(i32, u32)>()
+            + (self.remap.capacity() + self.moved.capacity()) * 4
+    }
+}
