@@ -9,12 +9,15 @@
 //! pair only in that strip.
 //!
 //! Like `SortAndSweep`, a moving list is kept from the previous call and re-sorted by
-//! insertion sort: a slot whose body still reaches the same strips is rewritten in place
-//! (nearly sorted: `min.x` moves a little a frame); a body that reaches other strips than
-//! last time leaves the list and comes back as fresh slots, sorted apart and merged in (a
-//! body that wraps from the bottom of the world to the top would cost an insertion sort the
-//! whole list). A slot is only the sort key and the body's index (16 bytes), so the sorts and
-//! the merge move little; once the order is settled the bounds are gathered beside it.
+//! insertion sort. The bodies are read once in key order, in sequence, for their new `min.x`
+//! keys and strips; a slot whose body still reaches the same strips then gets its new key
+//! in place, read from that 8-byte-a-body column (nearly sorted: `min.x` moves a little a
+//! frame). Reading the 48-byte entries in list order instead, at random, was most of the
+//! list's cost at 10,000 bodies. A body that reaches other strips than last time leaves the
+//! list and comes back as fresh slots, sorted apart and merged in (a body that wraps from
+//! the bottom of the world to the top would cost an insertion sort the whole list). A slot is
+//! only the sort key and the body's index (16 bytes), so the sorts and the merge move little;
+//! once the order is settled the bounds are gathered beside it.
 //!
 //! # Determinism
 //! The order is `(strip, min.x as f64::total_cmp, local, upper)`, `local` the body's index in
@@ -55,8 +58,11 @@ pub(super) struct StripList {
     pub(super) width: f64,
     /// `(strip, first slot)` of each run of one strip, in order, then `(_, order.len())`.
     runs: Vec<(i32, u32)>,
-    /// Update buffers: old local to new, bodies whose strips changed, fresh slots, the merge.
+    /// Update buffers: old local to new; this call's `min.x` keys and whether each body
+    /// reaches other strips than last time, by `local`; those bodies; fresh slots; the merge.
     remap: Vec<u32>,
+    x: Vec<u64>,
+    is_moved: Vec<bool>,
     moved: Vec<u32>,
     fresh: Vec<Slot>,
     merged: Vec<Slot>,
@@ -70,6 +76,15 @@ struct Reach {
 }
 
 impl Reach {
+    /// A reach no body has: a finite coordinate's strip is within `2^30` of 0
+    /// (`strip_height.rs` makes `H` at least the largest finite coordinate over `2^30`), and
+    /// a box reaching down to `-inf` is infinitely tall (one strip for all) or reaches only
+    /// `i32::MIN`.
+    const NONE: Reach = Reach {
+        lower: i32::MIN,
+        two: true,
+    };
+
     /// The strips `b` reaches at `1 / H` = `inv_h`. A box with a NaN or inverted `y` range
     /// overlaps nothing, and has its lower slot only.
     #[inline]
@@ -99,20 +114,27 @@ struct Slot(u128);
 
 impl Slot {
     #[inline]
-    fn new(strip: i32, b: &Bounds, local: u32) -> Slot {
+    fn new(strip: i32, x: u64, local: u32) -> Slot {
         let strip = strip as u32 ^ (1 << 31);
-        Slot(u128::from(strip) << 96 | u128::from(order_key(b.min.x)) << 32 | u128::from(local))
+        Slot(u128::from(strip) << 96 | u128::from(x) << 32 | u128::from(local))
     }
 
-    /// The slots of a body reaching `reach`: its lower one, then its upper one if any.
+    /// The slots of a body reaching `reach` with `min.x` at `x` (as [`order_key`]): its
+    /// lower one, then its upper one if any.
     #[inline]
-    fn both(reach: Reach, b: &Bounds, local: u32) -> (Slot, Option<Slot>) {
-        let lower = Slot::new(reach.lower, b, local);
+    fn both(reach: Reach, x: u64, local: u32) -> (Slot, Option<Slot>) {
+        let lower = Slot::new(reach.lower, x, local);
         // Two strips means `lower + 1` did not overflow.
         let upper = reach
             .two
-            .then(|| Slot::new(reach.lower + 1, b, local | UPPER));
+            .then(|| Slot::new(reach.lower + 1, x, local | UPPER));
         (lower, upper)
+    }
+
+    /// The slot with `min.x` at `x` instead (its strip and body kept).
+    #[inline]
+    fn at_x(self, x: u64) -> Slot {
+        Slot(self.0 & !(u128::from(u64::MAX) << 32) | u128::from(x) << 32)
     }
 
     #[inline]
@@ -124,11 +146,6 @@ impl Slot {
     #[inline]
     fn local(self) -> u32 {
         self.0 as u32 & !UPPER
-    }
-
-    #[inline]
-    fn upper(self) -> bool {
-        self.0 as u32 & UPPER != 0
     }
 
     /// A slot that sorts after every other (a body gone from the list).
@@ -164,7 +181,8 @@ impl StripList {
             ..StripList::default()
         };
         for (i, m) in members.iter().enumerate() {
-            let (lower, upper) = Slot::both(Reach::of(&m.bounds, inv_h), &m.bounds, i as u32);
+            let reach = Reach::of(&m.bounds, inv_h);
+            let (lower, upper) = Slot::both(reach, order_key(m.bounds.min.x), i as u32);
             list.order.push(lower);
             list.order.extend(upper);
         }
@@ -187,7 +205,6 @@ impl StripList {
     /// new keys in place, and the others' slots are made again, sorted apart and merged in.
     /// Then the bounds are gathered in the new order. Returns the insertion sort's moves.
     pub(super) fn update(&mut self, handles: &[u32], bodies: &[BodyEntry], inv_h: f64) -> u64 {
-        let restripped = self.inv_h.to_bits() != inv_h.to_bits();
         self.inv_h = inv_h;
         self.fresh.clear();
         self.moved.clear();
@@ -200,39 +217,40 @@ impl StripList {
         if !same {
             self.reconcile(handles, bodies);
         }
-        // In list order: the slots are written in sequence, the bodies read at random. A
-        // body that reaches other strips than last time leaves the list (at its lower slot,
-        // which comes first: its strip is lower) for `moved`: the rest close up behind a
-        // write cursor in the same pass.
+        // In key order, in sequence: each body's `min.x` key and the strips it reaches; a
+        // body that reaches other strips than last time (or is new) is `moved`. A slot is
+        // numbers only (strip, key, body), so when `H` changed, a body whose strips have the
+        // same numbers as before keeps its slots.
+        self.x.clear();
+        self.is_moved.clear();
+        for (j, &h) in handles.iter().enumerate() {
+            let b = &bodies[h as usize].bounds;
+            let now = Reach::of(b, inv_h);
+            let moved = now != self.reach[j];
+            if moved {
+                self.reach[j] = now;
+                self.moved.push(j as u32);
+            }
+            self.x.push(order_key(b.min.x));
+            self.is_moved.push(moved);
+        }
+        // In list order: the slots are written in sequence, each reading its body's new key
+        // from `x` (8 bytes a body, where the bodies are 48). A moved body's slots leave the
+        // list: the rest close up behind a write cursor in the same pass.
         let mut kept = 0;
         for k in 0..self.order.len() {
             let old = self.order[k];
-            let local = old.local();
-            let b = &bodies[handles[local as usize] as usize];
-            let was = self.reach[local as usize];
-            if !old.upper() {
-                let now = Reach::of(&b.bounds, inv_h);
-                if now != was || restripped {
-                    self.moved.push(local);
-                    self.reach[local as usize] = now;
-                    continue;
-                }
-                self.order[kept] = Slot::new(now.lower, &b.bounds, local);
-            } else {
-                // The lower slot came first: a body that moved has its new reach stored,
-                // whose upper strip is not this slot's (the reach differs, so its lower strip
-                // or its having two does; when the height changed, every body moved).
-                if !was.two || i64::from(was.lower) + 1 != i64::from(old.strip()) || restripped {
-                    continue;
-                }
-                self.order[kept] = Slot::new(old.strip(), &b.bounds, local | UPPER);
+            let local = old.local() as usize;
+            if self.is_moved[local] {
+                continue;
             }
+            self.order[kept] = old.at_x(self.x[local]);
             kept += 1;
         }
         self.order.truncate(kept);
         for &local in &self.moved {
-            let b = &bodies[handles[local as usize] as usize].bounds;
-            let (lower, upper) = Slot::both(self.reach[local as usize], b, local);
+            let (lower, upper) =
+                Slot::both(self.reach[local as usize], self.x[local as usize], local);
             self.fresh.push(lower);
             self.fresh.extend(upper);
         }
@@ -244,8 +262,8 @@ impl StripList {
 
     /// [`StripList::update`]'s first step when the bodies are not the same as last time:
     /// merges the old keys with the new ones (both ascending), drops the slots of bodies
-    /// gone, renumbers the kept ones, and sends each body new to the list to `moved` (it has
-    /// no slot yet) with its reach.
+    /// gone, renumbers the kept ones, and gives each body new to the list (it has no slot
+    /// yet) [`Reach::NONE`], so that it is made as a moved one.
     fn reconcile(&mut self, handles: &[u32], bodies: &[BodyEntry]) {
         self.remap.clear();
         self.remap.resize(self.keys.len(), NONE);
@@ -263,9 +281,9 @@ impl StripList {
                 reach[j] = self.reach[i];
                 i += 1;
             } else {
-                // A body new to the list has no slot: it is made as a moved one.
-                reach[j] = Reach::of(&b.bounds, self.inv_h);
-                self.moved.push(j as u32);
+                // A body new to the list has no slot: a reach no body has makes it a moved
+                // one.
+                reach[j] = Reach::NONE;
             }
         }
         self.reach_next = std::mem::replace(&mut self.reach, reach);
@@ -371,5 +389,7 @@ impl StripList {
             + (self.reach.capacity() + self.reach_next.capacity()) * size_of::<Reach>()
             + self.runs.capacity() * size_of::<(i32, u32)>()
             + (self.remap.capacity() + self.moved.capacity()) * 4
+            + self.x.capacity() * 8
+            + self.is_moved.capacity()
     }
 }
