@@ -322,6 +322,12 @@ pub(crate) fn run(
         workers.map(
             plan.len(),
             |k| {
+                // A pair two ahead has its shapes looked up now: the look-up misses the cache
+                // (a shape table far bigger than it, read at random), and issued here it
+                // overlaps this pair's work instead of stalling its own.
+                if let Some(&(i, j, _)) = plan.get(k + AHEAD) {
+                    std::hint::black_box((w.shape(i), w.shape(j)));
+                }
                 let (i, j, response) = plan[k];
                 narrow(w, (i, j), response, &w.pose(j))
             },
@@ -432,6 +438,9 @@ fn threshold(response: Response) -> f64 {
         0.0
     }
 }
+
+/// How many pairs ahead of the narrow phase their shapes are looked up.
+const AHEAD: usize = 2;
 
 /// The contact of bodies `i` and `j` with `j` at `pose_b`: always for a `separate` pair (its
 /// time of impact starts from it), otherwise `None` when it is no deeper than the threshold
