@@ -130,19 +130,13 @@ impl SweepList {
         remap.clear();
         remap.resize(self.keys.len(), NONE);
         fresh.clear();
-        let mut i = 0;
-        for (j, &h) in handles.iter().enumerate() {
-            let b = &bodies[h as usize];
-            while i < self.keys.len() && self.keys[i] < b.key {
-                i += 1;
-            }
-            if i < self.keys.len() && self.keys[i] == b.key {
-                remap[i] = j as u32;
-                i += 1;
-            } else {
-                fresh.push(Slot::new(&b.bounds, j as u32));
-            }
-        }
+        sorted::match_keys(
+            &self.keys,
+            handles,
+            bodies,
+            |i, j| remap[i] = j as u32,
+            |j, b| fresh.push(Slot::new(&b.bounds, j as u32)),
+        );
         self.keys.clear();
         self.keys
             .extend(handles.iter().map(|&h| bodies[h as usize].key));

@@ -1,8 +1,35 @@
-//! What the broad phase's kept, sorted lists (`sort_and_sweep.rs`, `strips.rs`) share: the
-//! integer key of an `f64` coordinate, and the insertion sort that brings a nearly sorted
-//! list back in order.
+//! What the broad phase's kept, sorted lists (`sort_and_sweep.rs`, `strip_list.rs`) share:
+//! the integer key of an `f64` coordinate, the insertion sort that brings a nearly sorted
+//! list back in order, and the match of a list's bodies with this call's.
 
 use std::cmp::Ordering;
+
+use super::BodyEntry;
+
+/// Walks a list's keys of the last call (`old`, ascending) and this call's bodies (`handles`
+/// into `bodies`, key order) together: `kept(i, j)` for a body at place `i` then and `j` now,
+/// `new(j, body)` for a body new to the list.
+pub(super) fn match_keys(
+    old: &[u64],
+    handles: &[u32],
+    bodies: &[BodyEntry],
+    mut kept: impl FnMut(usize, usize),
+    mut new: impl FnMut(usize, &BodyEntry),
+) {
+    let mut i = 0;
+    for (j, &h) in handles.iter().enumerate() {
+        let b = &bodies[h as usize];
+        while i < old.len() && old[i] < b.key {
+            i += 1;
+        }
+        if i < old.len() && old[i] == b.key {
+            kept(i, j);
+            i += 1;
+        } else {
+            new(j, b);
+        }
+    }
+}
 
 /// `f64::total_cmp` as an integer: `order_key(a) < order_key(b)` exactly when `a` comes
 /// first. `-0.0` comes before `+0.0`, so a query bound is normalised with `+ 0.0` first.

@@ -269,23 +269,19 @@ impl StripList {
         self.remap.resize(self.keys.len(), NONE);
         let mut reach = std::mem::take(&mut self.reach_next);
         reach.clear();
-        reach.resize(handles.len(), Reach::default());
-        let mut i = 0;
-        for (j, &h) in handles.iter().enumerate() {
-            let b = &bodies[h as usize];
-            while i < self.keys.len() && self.keys[i] < b.key {
-                i += 1;
-            }
-            if i < self.keys.len() && self.keys[i] == b.key {
-                self.remap[i] = j as u32;
-                reach[j] = self.reach[i];
-                i += 1;
-            } else {
-                // A body new to the list has no slot: a reach no body has makes it a moved
-                // one.
-                reach[j] = Reach::NONE;
-            }
-        }
+        // A body new to the list has no slot: a reach no body has makes it a moved one.
+        reach.resize(handles.len(), Reach::NONE);
+        let (remap, was) = (&mut self.remap, &self.reach);
+        sorted::match_keys(
+            &self.keys,
+            handles,
+            bodies,
+            |i, j| {
+                remap[i] = j as u32;
+                reach[j] = was[i];
+            },
+            |_, _| {},
+        );
         self.reach_next = std::mem::replace(&mut self.reach, reach);
         self.keys.clear();
         self.keys
