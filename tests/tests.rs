@@ -33,6 +33,7 @@ mod suite_cli;
 mod suite_files;
 mod suite_hardening;
 mod sweep_cli;
+mod sweep_hardening;
 mod threads;
 mod tiled;
 mod touch_log;
