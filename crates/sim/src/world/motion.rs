@@ -73,7 +73,7 @@ impl World {
             && let Some(run) = self.row_run(&self.active)
         {
             // The usual case without a controller, over one run (`runs.rs`): each column a
-            // slice, in place; the same arithmetic as below with a zero thrust.
+            // slice, in place; the loop below with a zero thrust.
             let rows = &mut self.rows;
             let (kind, entity) = (&self.kind[run.indices()], &self.entity[run.indices()]);
             let (mass, force) = (&rows.mass[run.rows()], &rows.force[run.rows()]);
@@ -84,15 +84,9 @@ impl World {
                 if kind[k] != BodyKind::Dynamic {
                     continue;
                 }
-                let m = mass[k];
-                let sum = force[k] + Vec2::ZERO + g * (m * scale[k]);
-                let a = sum / m;
                 let v = velocity[k];
-                let changed = v + a * dt;
-                if NAME
-                    && (changed.x.to_bits() != v.x.to_bits()
-                        || changed.y.to_bits() != v.y.to_bits())
-                {
+                let changed = accelerated(v, force[k] + Vec2::ZERO, g, mass[k], scale[k], dt);
+                if NAME && differs(changed, v) {
                     disturbed.name(entity[k], len);
                 }
                 velocity[k] = changed;
@@ -107,23 +101,17 @@ impl World {
                 continue;
             }
             let r = row[i] as usize;
-            let m = rows.mass[r];
             let push = match &rows.controller[r] {
                 Some(c) => thrust(c, &rows.inputs[r], angle[i]),
                 None => Vec2::ZERO,
             };
-            let sum = rows.force[r] + push + g * (m * rows.gravity_scale[r]);
-            let a = sum / m;
-            if NAME {
-                let v = rows.velocity[r];
-                let changed = v + a * dt;
-                if changed.x.to_bits() != v.x.to_bits() || changed.y.to_bits() != v.y.to_bits() {
-                    disturbed.name(entity[i], entity.len());
-                }
-                rows.velocity[r] = changed;
-            } else {
-                rows.velocity[r] += a * dt;
+            let v = rows.velocity[r];
+            let (m, scale) = (rows.mass[r], rows.gravity_scale[r]);
+            let changed = accelerated(v, rows.force[r] + push, g, m, scale, dt);
+            if NAME && differs(changed, v) {
+                disturbed.name(entity[i], entity.len());
             }
+            rows.velocity[r] = changed;
         }
     }
 
@@ -320,4 +308,19 @@ pub(super) struct KeptOutside {
     min: Vec2,
     max: Vec2,
     list: Vec<u32>,
+}
+
+/// Velocity `v` after `dt` under the body's own force and thrust `pushed` and gravity `g` at
+/// `scale`, for mass `m`: `v + (pushed + g * (m * scale)) / m * dt`, in that order (the
+/// order is part of the log).
+#[inline]
+fn accelerated(v: Vec2, pushed: Vec2, g: Vec2, m: f64, scale: f64, dt: f64) -> Vec2 {
+    let a = (pushed + g * (m * scale)) / m;
+    v + a * dt
+}
+
+/// Whether `a` and `b` differ in any bit.
+#[inline]
+fn differs(a: Vec2, b: Vec2) -> bool {
+    a.x.to_bits() != b.x.to_bits() || a.y.to_bits() != b.y.to_bits()
 }
