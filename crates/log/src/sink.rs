@@ -61,14 +61,16 @@ pub trait MessageSink {
     }
 
     /// Writes `message` to live viewers only, never to a recording (the current state again
-    /// for a viewer that just subscribed). A file ignores it.
+    /// for a viewer that just subscribed): encoded, through
+    /// [`write_live_encoded`](Self::write_live_encoded), which a live sink implements. A file
+    /// ignores it.
     fn write_live<M: prost::Message + Clone + Send + 'static>(
         &mut self,
-        _channel: ChannelId,
-        _time_ns: u64,
-        _message: M,
+        channel: ChannelId,
+        time_ns: u64,
+        message: M,
     ) -> Result<(), LogError> {
-        Ok(())
+        self.write_live_encoded(channel, time_ns, message.encode_to_vec())
     }
 
     /// Writes `bytes`, one message already encoded as `channel`'s schema says, to live

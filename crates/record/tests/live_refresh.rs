@@ -60,16 +60,6 @@ impl MessageSink for Kept {
         Ok(())
     }
 
-    fn write_live<M: prost::Message + Clone + Send + 'static>(
-        &mut self,
-        channel: ChannelId,
-        time_ns: u64,
-        message: M,
-    ) -> Result<(), LogError> {
-        self.keep(true, channel, time_ns, message.encode_to_vec());
-        Ok(())
-    }
-
     fn write_live_encoded(
         &mut self,
         ch: ChannelId,

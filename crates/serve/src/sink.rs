@@ -87,15 +87,6 @@ impl MessageSink for LiveSink {
         Ok(())
     }
 
-    fn write_live<M: prost::Message + Clone + Send + 'static>(
-        &mut self,
-        channel: ChannelId,
-        time_ns: u64,
-        message: M,
-    ) -> Result<(), LogError> {
-        self.write(channel, time_ns, message)
-    }
-
     fn write_live_encoded(
         &mut self,
         channel: ChannelId,
@@ -183,18 +174,6 @@ impl MessageSink for ServeSink {
             return Ok(());
         }
         self.live.write_encoded(channel, time_ns, bytes)
-    }
-
-    fn write_live<M: prost::Message + Clone + Send + 'static>(
-        &mut self,
-        channel: ChannelId,
-        time_ns: u64,
-        message: M,
-    ) -> Result<(), LogError> {
-        if self.muted {
-            return Ok(());
-        }
-        self.live.write(channel, time_ns, message)
     }
 
     fn write_live_encoded(
