@@ -85,6 +85,8 @@ impl World {
                     continue;
                 }
                 let v = velocity[k];
+                // `+ Vec2::ZERO` is the loop's zero thrust, added as there: it turns a force
+                // of -0.0 into +0.0, which can change the sum's sign bit, so the log's.
                 let changed = accelerated(v, force[k] + Vec2::ZERO, g, mass[k], scale[k], dt);
                 if NAME && differs(changed, v) {
                     disturbed.name(entity[k], len);
