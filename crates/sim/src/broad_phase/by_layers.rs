@@ -43,7 +43,6 @@ impl BroadPhase {
         }
         let layers = std::mem::take(&mut self.mover_layers);
         let static_layers = std::mem::take(&mut self.statics.layers);
-        self.plan_filters(kind, &layers, interactions);
         for (k, &a) in layers.iter().enumerate() {
             if self.filter.filtered(a) {
                 // Every pair of `a` with the moving layers it meets (`cell_filter.rs`).

@@ -14,16 +14,16 @@
 
 use ricochet_geom::{Bounds, Vec2};
 
-use super::sort_and_sweep::SweepView;
+use super::sort_and_sweep::{SweepList, SweepView};
 use super::{BodyEntry, BroadPhase, BroadPhaseKind, Interactions, member, of_layer};
 
 /// A layer is filtered when it holds at least this many moving bodies...
-const BIG: usize = 1024;
+pub(super) const BIG: usize = 1024;
 /// ...and at least this many times as many as every other moving layer it meets together.
-const RATIO: usize = 16;
+pub(super) const RATIO: usize = 16;
 /// Cells along each axis of the bitmap: 4 words a row, 8 KB in all, in the L1 cache.
-const CELLS: usize = 256;
-const WORDS: usize = CELLS / 64;
+pub(super) const CELLS: usize = 256;
+pub(super) const WORDS: usize = CELLS / 64;
 
 /// The bitmap of one call, kept to reuse its allocation.
 #[derive(Debug, Clone, Default)]
@@ -31,11 +31,15 @@ pub(super) struct CellFilter {
     /// Per layer, whether it is filtered this call.
     filtered: Vec<bool>,
     /// `CELLS` rows of `WORDS` words, bit `x` of row `y` set when a small body covers it.
-    bits: Vec<u64>,
+    pub(super) bits: Vec<u64>,
     /// The small layers met by the layer being filtered.
-    partners: Vec<u8>,
+    pub(super) partners: Vec<u8>,
     /// Per layer, the widest and tallest body of its last filtered call.
-    reach: Vec<Vec2>,
+    pub(super) reach: Vec<Vec2>,
+    /// When the big layer was left out of the entries (`left_out.rs`): its bodies on a
+    /// marked cell, found as their bounds were made, and the reach to keep.
+    pub(super) marked: Vec<u32>,
+    pub(super) left_out: Option<Vec2>,
 }
 
 /// The monotone map from a coordinate to a cell along one axis (clamped to the grid): two
@@ -43,7 +47,7 @@ pub(super) struct CellFilter {
 /// (NaN maps to cell 0, and a NaN bound overlaps nothing anyway). `min..=max` maps onto
 /// cells `1..=CELLS - 2`; cell 0 and cell `CELLS - 1` hold only values outside it.
 #[derive(Clone, Copy)]
-struct Axis {
+pub(super) struct Axis {
     min: f64,
     scale: f64,
 }
@@ -83,13 +87,13 @@ impl Axis {
 /// arithmetic of [`Axis::cell`] on each axis, written on both lanes of one vector (half the
 /// instructions of two calls; it is asked once for every big body).
 #[derive(Clone, Copy)]
-struct Corner {
+pub(super) struct Corner {
     min: Vec2,
     scale: Vec2,
 }
 
 impl Corner {
-    fn new(ax: Axis, ay: Axis) -> Corner {
+    pub(super) fn new(ax: Axis, ay: Axis) -> Corner {
         Corner {
             min: Vec2::new(ax.min, ay.min),
             scale: Vec2::new(ax.scale, ay.scale),
@@ -97,7 +101,7 @@ impl Corner {
     }
 
     #[inline]
-    fn bit(self, p: Vec2) -> usize {
+    pub(super) fn bit(self, p: Vec2) -> usize {
         let t = (p - self.min) * self.scale + Vec2::splat(INNER);
         let top = (CELLS - 1) as f64;
         let t = Vec2::new(
@@ -176,19 +180,7 @@ impl BroadPhase {
         }
         let count = |l: u8| of_layer(&self.movers, &self.layer_start, l).len();
         for &l in layers {
-            let n = count(l);
-            if n < BIG || interactions.interacts(l, l) {
-                continue;
-            }
-            let mut others = 0;
-            let mut any = false;
-            for &m in layers {
-                if m != l && interactions.interacts(l, m) {
-                    others += count(m);
-                    any = true;
-                }
-            }
-            if any && others.saturating_mul(RATIO) <= n {
+            if worth_filtering(l, layers, count, interactions) {
                 if f.filtered.is_empty() {
                     f.filtered.resize(256, false);
                 }
@@ -199,7 +191,8 @@ impl BroadPhase {
 
     /// Every pair of a dynamic body with one body of `big` (a filtered layer) and one of a
     /// moving layer it meets (`layers`, the moving layers), whose bounds overlap, into `out`
-    /// as `(small, big)` handles. Returns the exact tests.
+    /// as `(small, big)` handles. Returns the exact tests. When the big layer was left out
+    /// of the entries (`left_out.rs`), its bodies on a marked cell are listed already.
     pub(super) fn filtered_pairs(
         &mut self,
         big: u8,
@@ -228,10 +221,23 @@ impl BroadPhase {
         // The big layer's widest and tallest body, as of the last call: a big body that
         // overlaps a small one has its lower-left corner within the small one's bounds
         // widened down and left by these, so one cell a big body is enough. The pass measures
-        // them again; if a body outgrew them, it is done again with this call's.
+        // them again; if a body outgrew them, it is done again with this call's
+        // ([`kept_reach`]).
         let mut reach = f.reach[usize::from(big)];
         let (start, mut tested) = (out.len(), 0);
         let smalls = |m: u8| of_layer(&self.movers, &self.layer_start, m);
+        let sweeps = &self.sweeps;
+        let pair = |h: u32, tested: &mut u64, out: &mut Vec<(u32, u32)>| {
+            pair_with_smalls(h, &partners, (sweeps, smalls), bodies, tested, out);
+        };
+        if let Some(kept) = f.left_out.take() {
+            for &h in &f.marked {
+                pair(h, &mut tested, out);
+            }
+            f.reach[usize::from(big)] = kept;
+            f.partners = partners;
+            return (tested, resorted);
+        }
         let big_handles = smalls(big);
         while let Some((ax, ay)) = mark(&mut f.bits, &partners, smalls, bodies, reach) {
             let bits: &[u64; CELLS * WORDS] = f.bits[..].try_into().expect("marked as many");
@@ -254,29 +260,14 @@ impl BroadPhase {
                 if bits[c / 64] & (1 << (c % 64)) == 0 {
                     continue;
                 }
-                let q = member(e, h);
-                for &m in &partners {
-                    let view = SweepView {
-                        list: &self.sweeps[usize::from(m)],
-                        handles: smalls(m),
-                        bodies,
-                    };
-                    view.each_along_x(e, |s| {
-                        if q.dynamic || s.dynamic {
-                            tested += 1;
-                            if q.bounds.overlaps(&s.bounds) {
-                                out.push((s.handle, q.handle));
-                            }
-                        }
-                    });
-                }
+                pair(h, &mut tested, out);
             }
-            if seen.x <= reach.x && seen.y <= reach.y {
-                reach = seen;
+            let enough = seen.x <= reach.x && seen.y <= reach.y;
+            reach = kept_reach(seen);
+            if enough {
                 break;
             }
             out.truncate(start);
-            reach = seen;
         }
         f.reach[usize::from(big)] = reach;
         f.partners = partners;
@@ -284,10 +275,73 @@ impl BroadPhase {
     }
 }
 
+/// The reach kept for the next call from the widest and tallest body measured (`seen`): a
+/// sixteenth more, so that bounds a rounding larger (placed at another position) or a body
+/// growing slowly (widened over a motion that speeds up) do not mark the cells again. The
+/// cells marked are only a little wider: the filter stays conservative with any reach at
+/// least the bodies' sizes.
+pub(super) fn kept_reach(seen: Vec2) -> Vec2 {
+    seen + seen / 16.0
+}
+
+/// Whether sort and sweep filters moving layer `l`, of the moving `layers` whose bodies
+/// `count` gives: 1,024 bodies or more, not meeting itself, and 16 times as many as every
+/// moving layer it meets together (one at least).
+pub(super) fn worth_filtering(
+    l: u8,
+    layers: &[u8],
+    count: impl Fn(u8) -> usize,
+    interactions: &Interactions,
+) -> bool {
+    let n = count(l);
+    if n < BIG || interactions.interacts(l, l) {
+        return false;
+    }
+    let mut others = 0;
+    let mut any = false;
+    for &m in layers {
+        if m != l && interactions.interacts(l, m) {
+            others += count(m);
+            any = true;
+        }
+    }
+    any && others.saturating_mul(RATIO) <= n
+}
+
+/// Tests big body `h` against the small layers (`partners`, each with its sorted list in
+/// `sweeps` and its handles from `smalls`), pushing each pair with a dynamic body whose
+/// bounds overlap as `(small, big)`, and counting the tests in `tested`.
+fn pair_with_smalls<'a>(
+    h: u32,
+    partners: &[u8],
+    (sweeps, smalls): (&[SweepList], impl Fn(u8) -> &'a [u32]),
+    bodies: &[BodyEntry],
+    tested: &mut u64,
+    out: &mut Vec<(u32, u32)>,
+) {
+    let e = &bodies[h as usize];
+    let q = member(e, h);
+    for &m in partners {
+        let view = SweepView {
+            list: &sweeps[usize::from(m)],
+            handles: smalls(m),
+            bodies,
+        };
+        view.each_along_x(e, |s| {
+            if q.dynamic || s.dynamic {
+                *tested += 1;
+                if q.bounds.overlaps(&s.bounds) {
+                    out.push((s.handle, q.handle));
+                }
+            }
+        });
+    }
+}
+
 /// Marks in `bits` the cells of the small layers' bodies (`partners`, each layer's handles
 /// from `of`) widened by `reach`; returns the map of each axis, or `None` when no small body
 /// has bounds without NaN (nothing to pair).
-fn mark<'a>(
+pub(super) fn mark<'a>(
     bits: &mut Vec<u64>,
     partners: &[u8],
     of: impl Fn(u8) -> &'a [u32],

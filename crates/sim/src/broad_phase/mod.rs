@@ -31,7 +31,8 @@
 //!   small layers mark a 256 × 256 bitmap of cells over their union box (on its inner
 //!   cells: whatever lies outside that box falls on the border, never marked), and a big
 //!   body is tested only when the cell of its lower-left corner is marked
-//!   (`cell_filter.rs`).
+//!   (`cell_filter.rs`). A caller that counts its moving bodies itself may leave such a
+//!   layer out of the entries but for the bodies on a marked cell (`left_out.rs`).
 //! - `Grid` (`hash_grid.rs`): a uniform grid per layer, dense over the occupied cells or
 //!   hashed; two interacting layers: the grid of the larger is queried with the bodies of the
 //!   smaller. Static bodies have their own grid per layer, with its own cell size. What every
@@ -134,6 +135,7 @@ mod grid;
 mod hash_grid;
 mod interactions;
 mod kept_tree;
+mod left_out;
 mod mover_grid;
 mod quadtree;
 mod sort_and_sweep;
@@ -155,6 +157,7 @@ pub(crate) use fixed_grid::FixedGrid;
 use hash_grid::HashGrid;
 pub use interactions::Interactions;
 use kept_tree::KeptTree;
+pub(crate) use left_out::BigPass;
 pub(crate) use mover_grid::MoverGrid;
 use quadtree::Quadtree;
 use sort_and_sweep::{Slot, SweepList};
@@ -455,7 +458,11 @@ impl BroadPhase {
         dense: bool,
         out: &mut Vec<(u32, u32)>,
     ) -> BroadPhaseStats {
-        self.load_statics(statics, static_generation, movers);
+        debug_assert!(
+            movers.windows(2).all(|w| w[0].key < w[1].key),
+            "keys increase"
+        );
+        self.load_statics(statics, static_generation);
         Tally::new(&mut self.layer_start, &mut self.dynamic, &mut self.runs).count(movers);
         self.group_movers(movers, |_| true);
         self.run(movers, (false, dense), interactions, out)
@@ -463,16 +470,7 @@ impl BroadPhase {
 
     /// Loads `statics` when `static_generation` differs from the loaded one's (or nothing
     /// is loaded).
-    fn load_statics(
-        &mut self,
-        statics: &[BodyEntry],
-        static_generation: u64,
-        movers: &[BodyEntry],
-    ) {
-        debug_assert!(
-            movers.windows(2).all(|w| w[0].key < w[1].key),
-            "keys increase"
-        );
+    pub(crate) fn load_statics(&mut self, statics: &[BodyEntry], static_generation: u64) {
         if self.statics.generation != Some(static_generation) || !self.statics.loaded {
             debug_assert!(
                 statics.windows(2).all(|w| w[0].key < w[1].key),
@@ -480,10 +478,6 @@ impl BroadPhase {
             );
             self.statics.load(statics.iter(), Some(static_generation));
         }
-        assert!(
-            self.statics.keys.len() + movers.len() < STATIC_BIT as usize,
-            "fewer than 2^31 bodies"
-        );
     }
 
     /// This call's moving bodies of `layer`, in key order.
@@ -500,15 +494,41 @@ impl BroadPhase {
         interactions: &Interactions,
         out: &mut Vec<(u32, u32)>,
     ) -> BroadPhaseStats {
+        self.choose(bodies, interactions);
+        self.execute(bodies, (all_given, dense), interactions, out)
+    }
+
+    /// Starts a call whose bodies are grouped: chooses the algorithm (what `Auto` picks,
+    /// into `chosen`) and the layers sort and sweep filters (`cell_filter.rs`).
+    fn choose(&mut self, bodies: &[BodyEntry], interactions: &Interactions) {
+        assert!(
+            self.statics.keys.len() + self.movers.len() < STATIC_BIT as usize,
+            "fewer than 2^31 bodies"
+        );
         self.frame += 1;
-        out.clear();
-        let n_movers = self.movers.len();
-        let n_statics = self.statics.count();
         let kind = match self.kind {
             BroadPhaseKind::Auto => self.auto_kind(bodies, interactions),
             k => k,
         };
         self.chosen = kind;
+        let layers = std::mem::take(&mut self.mover_layers);
+        self.plan_filters(kind, &layers, interactions);
+        self.mover_layers = layers;
+    }
+
+    /// Finds the pairs of a call [`BroadPhase::choose`] started and, with `dense`, resolves
+    /// them.
+    fn execute(
+        &mut self,
+        bodies: &[BodyEntry],
+        (all_given, dense): (bool, bool),
+        interactions: &Interactions,
+        out: &mut Vec<(u32, u32)>,
+    ) -> BroadPhaseStats {
+        out.clear();
+        let n_movers = self.movers.len();
+        let n_statics = self.statics.count();
+        let kind = self.chosen;
         let mut stats = BroadPhaseStats {
             kind,
             movers: n_movers as u64,

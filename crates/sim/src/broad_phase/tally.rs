@@ -25,6 +25,15 @@ impl BroadPhase {
         interactions: &Interactions,
         out: &mut Vec<(u32, u32)>,
     ) -> BroadPhaseStats {
+        self.check_counted(movers);
+        self.load_statics(statics, static_generation);
+        self.begin_counted(movers, interactions);
+        self.finish_counted(movers, interactions, out)
+    }
+
+    /// In a debug build, checks that the caller counted `movers` (all of them made) as a
+    /// count of them would: call it before [`BroadPhase::begin_counted`].
+    pub(crate) fn check_counted(&self, movers: &[BodyEntry]) {
         #[cfg(debug_assertions)]
         {
             let (mut counts, mut dynamic, mut runs) = (
@@ -42,10 +51,34 @@ impl BroadPhase {
                 ),
                 "the caller's count is the entries'"
             );
+            assert!(
+                movers.windows(2).all(|w| w[0].key < w[1].key),
+                "keys increase"
+            );
         }
-        self.load_statics(statics, static_generation, movers);
+        #[cfg(not(debug_assertions))]
+        let _ = movers;
+    }
+
+    /// Starts a call of moving bodies the caller counted ([`BroadPhase::tally`]), once the
+    /// statics are loaded: groups them and chooses the algorithm. `movers` need hold only
+    /// the entries `Auto` reads (those of a layer that meets itself), and
+    /// [`BroadPhase::big_pass`] tells which others must be made before
+    /// [`BroadPhase::finish_counted`].
+    pub(crate) fn begin_counted(&mut self, movers: &[BodyEntry], interactions: &Interactions) {
         self.group_movers(movers, |_| true);
-        self.run(movers, (false, false), interactions, out)
+        self.choose(movers, interactions);
+    }
+
+    /// Finds the pairs of a call [`BroadPhase::begin_counted`] started, as handles
+    /// ([`BroadPhase::pairs_split_handles`]).
+    pub(crate) fn finish_counted(
+        &mut self,
+        movers: &[BodyEntry],
+        interactions: &Interactions,
+        out: &mut Vec<(u32, u32)>,
+    ) -> BroadPhaseStats {
+        self.execute(movers, (false, false), interactions, out)
     }
 
     /// Groups the moving bodies by layer (a counting sort, so key order is kept within),

@@ -48,6 +48,7 @@ use crate::entity::Entity;
 use crate::event::Removal;
 use crate::output::{ContactRecord, Phase};
 use crate::parallel::Workers;
+use crate::stages::mover_pairs::{MoverCall, mover_pairs};
 use crate::stages::push::{Statics, separate_along_normal};
 use crate::stages::remove::remove;
 use crate::stages::separate::is_box;
@@ -202,35 +203,33 @@ fn candidate_pairs(ctx: &mut StageCtx, st: &mut DetectState) -> Vec<(u32, u32)> 
             st.seam.statics_changed(&b, &st.statics);
         }
     }
-    match wrap {
-        Some(b) => {
-            let seam = &mut st.seam;
-            seam.begin(&b);
-            let separate = &st.separate_swept;
-            w.mover_entries(&st.sweeping, separate, &mut st.movers, seam.visitor());
-        }
-        None => w.mover_entries(&st.sweeping, &st.separate_swept, &mut st.movers, |_, _| {}),
-    }
     let generation = st.statics_version;
     let mut pairs = std::mem::take(&mut st.pairs);
-    // Counted from the world's columns when it can (one run of movers), else from the
-    // entries.
-    let mut tally = st.broad_phase.tally();
-    if w.count_movers(&mut tally) {
-        tally.flush();
-    } else {
-        tally.count(&st.movers);
-    }
     // By handles (a place among the movers, or among `statics` with `STATIC_BIT`), turned
     // into world indices here: `statics` holds only some of the static bodies, so places
     // in the broad phase's dense order are not world indices.
-    let bp = st.broad_phase.pairs_counted_handles(
-        &st.statics,
-        generation,
-        &st.movers,
-        &st.interactions,
-        &mut pairs,
-    );
+    let call = MoverCall {
+        world: w,
+        broad_phase: &mut st.broad_phase,
+        widen: (&st.sweeping, &st.separate_swept),
+        statics: (&st.statics, generation),
+        interactions: &st.interactions,
+        movers: &mut st.movers,
+    };
+    let (bp, not_made) = match wrap {
+        Some(b) => {
+            st.seam.begin(&b);
+            mover_pairs(call, st.seam.visitor(), &mut pairs)
+        }
+        None => mover_pairs(call, |_, _| false, &mut pairs),
+    };
+    if let Some(b) = wrap
+        && !not_made.is_empty()
+        && st.seam.reads_every_mover(&b, &st.movers)
+    {
+        let widen = (&st.sweeping[..], &st.separate_swept[..]);
+        w.some_mover_entries(widen, &mut st.movers, not_made, |_, _| false, None);
+    }
     {
         let (movers, statics) = (w.movers(), &st.statics);
         let world_index = |h: u32| -> u32 {

@@ -17,6 +17,7 @@ pub(crate) mod detect;
 pub(crate) mod far_path;
 pub(crate) mod lifetimes;
 pub(crate) mod motion;
+pub(crate) mod mover_pairs;
 pub(crate) mod obstacles;
 pub(crate) mod one_way;
 pub(crate) mod pass_order;

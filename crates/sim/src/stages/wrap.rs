@@ -192,16 +192,39 @@ impl Seam {
     }
 
     /// What notes the moving body at place `m` of the entries if its bounds `b` are outside
-    /// the guessed edges (one pass, as the entries are made; the edges held in it, not read
-    /// again for each body).
-    pub(crate) fn visitor(&mut self) -> impl FnMut(usize, &Bounds) + '_ {
+    /// the guessed edges, and says whether it did (one pass, as the entries are made, in any
+    /// order; the edges held in it, not read again for each body). A noted body's entry is
+    /// read again.
+    pub(crate) fn visitor(&mut self) -> impl FnMut(usize, &Bounds) -> bool + '_ {
         let (lo, hi) = (self.guess_lo, self.guess_hi);
         let candidates = &mut self.candidates;
         move |m, b| {
-            if !(b.min.x > lo.x && b.max.x < hi.x && b.min.y > lo.y && b.max.y < hi.y) {
+            let near = !(b.min.x > lo.x && b.max.x < hi.x && b.min.y > lo.y && b.max.y < hi.y);
+            if near {
                 candidates.push(m as u32);
             }
+            near
         }
+    }
+
+    /// This frame's reach, measured on the noted bodies (`movers`, the entries), the edges
+    /// moved in by it, and whether the noted bodies hold every near one (the reach is within
+    /// the guess).
+    fn edges(&self, world: &WorldBounds, movers: &[BodyEntry]) -> (Vec2, Vec2, Vec2, bool) {
+        let slack = world.size() * SLACK;
+        let r = self.candidates.iter().fold(self.static_reach, |r, &m| {
+            r.max(reach(world, &movers[m as usize].bounds))
+        });
+        let (lo, hi) = (world.min + r + slack, world.max - r - slack);
+        // Inside the guessed edges is inside these: the candidates hold every near body.
+        let within_guess = self.guess_lo.cmpge(lo).all() && self.guess_hi.cmple(hi).all();
+        (r, lo, hi, within_guess)
+    }
+
+    /// Whether [`Seam::add_pairs`] will read every moving body's entry this frame, not only
+    /// the noted ones' (the reach outgrew the guess).
+    pub(crate) fn reads_every_mover(&self, world: &WorldBounds, movers: &[BodyEntry]) -> bool {
+        !self.edges(world, movers).3
     }
 
     /// Adds to `pairs` (the main broad phase's: dense indices, sorted) the pairs that meet
@@ -228,14 +251,12 @@ impl Seam {
         self.entries.clear();
         self.bodies.clear();
         let slack = world.size() * SLACK;
-        let r = self.candidates.iter().fold(self.static_reach, |r, &m| {
-            r.max(reach(world, &movers[m as usize].bounds))
-        });
-        let (lo, hi) = (world.min + r + slack, world.max - r - slack);
-        // Inside the guessed edges is inside these: the candidates hold every near body.
-        let within_guess = self.guess_lo.cmpge(lo).all() && self.guess_hi.cmple(hi).all();
+        let (r, lo, hi, within_guess) = self.edges(world, movers);
         self.guess = r * 1.25;
-        if !within_guess {
+        if within_guess {
+            // Noted in the order the entries were made, which need not be theirs.
+            self.candidates.sort_unstable();
+        } else {
             self.candidates.clear();
             self.candidates.extend(0..movers.len() as u32);
         }

@@ -1,10 +1,12 @@
 //! Each body's bounds for the broad phase: the bounds relative to the body kept from frame
 //! to frame ([`LocalBounds`]), placed at the body's position, and the moving bodies' entries.
 
+use std::ops::Range;
+
 use ricochet_geom::{Bounds, Pose, Shape, Vec2};
 
 use super::{NO_ROW, World};
-use crate::broad_phase::{BodyEntry, Tally};
+use crate::broad_phase::{BigPass, BodyEntry, Tally};
 use crate::def::BodyKind;
 use crate::entity::Entity;
 use crate::interned::ShapeTable;
@@ -32,7 +34,7 @@ impl LocalBounds {
 
     /// [`LocalBounds::at`], looking the shape up only when the bounds must be recomputed
     /// (once per body: a body that turned keeps its any-angle bounds).
-    #[inline]
+    #[inline(always)]
     fn at_with<'s>(
         &mut self,
         shape: impl FnOnce() -> &'s Shape,
@@ -165,12 +167,15 @@ impl World {
     /// a frozen body handed over as kinematic (it keeps its place in the dense order; the
     /// caller drops its pairs). `visit` sees each entry's place in `out` and its bounds as
     /// they are made (the wrap seam looks for bodies near an edge without another pass).
+    ///
+    /// The places in `skip` are left as they were: [`World::some_mover_entries`] makes them
+    /// (`out` is sized to every mover first).
     pub(crate) fn mover_entries(
         &mut self,
-        sweeping: &[bool],
-        separate_swept: &[bool],
+        (sweeping, separate_swept): (&[bool], &[bool]),
         out: &mut Vec<BodyEntry>,
-        mut visit: impl FnMut(usize, &Bounds),
+        skip: Range<usize>,
+        mut visit: impl FnMut(usize, &Bounds) -> bool,
     ) {
         // Written in place, by place: the vector keeps its length from call to call (only a
         // change in the count of movers resizes it), so no length is stored a body.
@@ -184,6 +189,40 @@ impl World {
             kind: BodyKind::Dynamic,
         };
         out.resize(self.movers.len(), placeholder);
+        let (before, after) = (0..skip.start, skip.end..out.len());
+        for places in [before, after] {
+            self.entries_where((sweeping, separate_swept), out, places, &mut visit, None);
+        }
+    }
+
+    /// [`World::mover_entries`] of the places in `places` only (within the movers), each
+    /// shown to `visit`. With a `pass` (the broad phase's big layer left out of the
+    /// entries: `broad_phase/left_out.rs`), a place is made only when `visit` or the pass
+    /// keeps it, the others left as they were: only the bodies near a small one, or noted
+    /// by `visit`, are read again.
+    pub(crate) fn some_mover_entries(
+        &mut self,
+        widen: (&[bool], &[bool]),
+        out: &mut [BodyEntry],
+        places: Range<usize>,
+        mut visit: impl FnMut(usize, &Bounds) -> bool,
+        pass: Option<&mut BigPass>,
+    ) {
+        self.entries_where(widen, out, places, &mut visit, pass);
+    }
+
+    /// The entries of `places` ([`World::some_mover_entries`]).
+    fn entries_where(
+        &mut self,
+        (sweeping, separate_swept): (&[bool], &[bool]),
+        out: &mut [BodyEntry],
+        places: Range<usize>,
+        visit: &mut impl FnMut(usize, &Bounds) -> bool,
+        mut pass: Option<&mut BigPass>,
+    ) {
+        if places.is_empty() {
+            return;
+        }
         let run = self.row_run(&self.movers);
         // Every column sliced to its exact length first: the columns of one index then share
         // one bounds check (`i < n`, `r < m`) instead of one each.
@@ -210,22 +249,50 @@ impl World {
             shapes: &self.shapes,
             widen: &widen,
         };
+        let out = &mut out[places.clone()];
+        let first = places.start;
         // Each body with its row: in place over one run (`runs.rs`), else through the list
         // and the row column.
         match run {
             Some(run) => {
-                for (k, (i, r)) in run.indices().zip(run.rows()).enumerate() {
-                    out[k] = columns.entry(i, r, |b| visit(k, b));
+                let (i0, r0) = (run.index + first, run.row + first);
+                for (k, out) in out.iter_mut().enumerate() {
+                    let (i, r) = (i0 + k, r0 + k);
+                    let bounds = columns.bounds(i, r);
+                    if kept(visit, &mut pass, first + k, &bounds) {
+                        *out = columns.entry(i, r, bounds);
+                    }
                 }
             }
             None => {
                 let row = &self.row[..n];
-                for (k, &i) in self.movers.iter().enumerate() {
-                    let i = i as usize;
-                    out[k] = columns.entry(i, row[i] as usize, |b| visit(k, b));
+                for (k, (out, &i)) in out.iter_mut().zip(&self.movers[places]).enumerate() {
+                    let (i, r) = (i as usize, row[i as usize] as usize);
+                    let bounds = columns.bounds(i, r);
+                    if kept(visit, &mut pass, first + k, &bounds) {
+                        *out = columns.entry(i, r, bounds);
+                    }
                 }
             }
         }
+    }
+}
+
+/// Whether [`World::some_mover_entries`] makes the entry at place `k`, of bounds `b`,
+/// shown to `visit` first: always without a pass. Always inlined: the pass's test, in a
+/// closure called from both loops, was not, and the call cost a quarter of the asteroids'
+/// step.
+#[inline(always)]
+fn kept(
+    visit: &mut impl FnMut(usize, &Bounds) -> bool,
+    pass: &mut Option<&mut BigPass>,
+    k: usize,
+    b: &Bounds,
+) -> bool {
+    let near = visit(k, b);
+    match pass {
+        Some(pass) => pass.keep(k, b) || near,
+        None => true,
     }
 }
 
@@ -251,32 +318,36 @@ const SWEEPS: u8 = 1;
 const SEPARATE_SWEPT: u8 = 2;
 
 impl EntryColumns<'_> {
-    /// The entry of body `i`, of row `r`, its bounds shown to `visit` first.
+    /// The broad phase's bounds of body `i`, of row `r`.
     #[inline(always)]
-    fn entry(&mut self, i: usize, r: usize, visit: impl FnOnce(&Bounds)) -> BodyEntry {
+    fn bounds(&mut self, i: usize, r: usize) -> Bounds {
         let p = self.position[i];
         // The shape table is read only when needed (a scene's shapes may all differ).
         let (shapes, ids) = (self.shapes, self.shape_id);
         let shape = || &shapes.get(ids[i]).0;
-        let mut bounds = self.local_bounds[r].at_with(shape, || self.angle[i], p);
-        let layer = self.layers[i];
-        let widen = self.widen[usize::from(layer)];
+        let bounds = self.local_bounds[r].at_with(shape, || self.angle[i], p);
+        let widen = self.widen[usize::from(self.layers[i])];
         // The frame's start is read only for a layer that may be widened.
         if widen != 0 {
             let moved = self.start_position[r] - p;
             if moved != Vec2::ZERO
                 && (widen & SWEEPS != 0 || moved.length() > 0.5 * shape().min_width())
             {
-                bounds = bounds.union(bounds.translated(moved));
+                return bounds.union(bounds.translated(moved));
             }
         }
-        visit(&bounds);
+        bounds
+    }
+
+    /// The entry of body `i`, of row `r`, with its [`EntryColumns::bounds`].
+    #[inline(always)]
+    fn entry(&self, i: usize, r: usize, bounds: Bounds) -> BodyEntry {
         let e = self.entity[i];
         BodyEntry {
             // As [`World::key`].
             key: (u64::from(e.index) << 32) | u64::from(e.generation),
             bounds,
-            layer,
+            layer: self.layers[i],
             kind: if self.frozen[r] {
                 BodyKind::Kinematic
             } else {

@@ -187,11 +187,30 @@ mod tests {
             for _ in 0..3 {
                 w.start_frame();
                 w.integrate(dt, true, true, true);
+                let widen = (&sweeping[..], &separate_swept[..]);
                 let mut entries = Vec::new();
                 let mut visited: Vec<(usize, Bounds)> = Vec::new();
-                w.mover_entries(&sweeping, &separate_swept, &mut entries, |k, b| {
+                w.mover_entries(widen, &mut entries, 0..0, |k, b| {
                     visited.push((k, *b));
+                    false
                 });
+                // Some places made apart: the same entries, each visited once.
+                let (mut some, skipped) = (Vec::new(), 40..90);
+                w.mover_entries(widen, &mut some, skipped.clone(), |k, _| {
+                    assert!(!skipped.contains(&k));
+                    true
+                });
+                w.some_mover_entries(
+                    widen,
+                    &mut some,
+                    skipped.clone(),
+                    |k, b| {
+                        assert_eq!((k, *b), visited[k]);
+                        k % 3 == 0
+                    },
+                    None,
+                );
+                assert_eq!(some, entries);
                 let state: Vec<[u64; 5]> = (w.movers().iter())
                     .map(|&i| {
                         let (i, r) = (i as usize, w.row[i as usize] as usize);
