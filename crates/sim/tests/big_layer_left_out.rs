@@ -255,3 +255,74 @@ fn a_big_layer_is_made_whole_when_the_call_does_not_filter_it() {
     let found = check(sim, &bounds, "Auto with the grid");
     assert!(found > 100, "{found} contacts");
 }
+
+/// A cluster of ships crossing the field fast: the box the bitmap maps moves with them, and
+/// the rocks on their way are marked frame after frame.
+#[test]
+fn ships_in_a_cluster_crossing_the_field_meet_every_rock_on_their_way() {
+    let mut rng = ricochet_scenes::Rng::new(5);
+    let mut bodies: Vec<_> = (0..1200)
+        .map(|k| {
+            let at = Vec2::new(rng.range(0.0, 300.0), rng.range(0.0, 60.0));
+            let v = Vec2::new(rng.range(-3.0, 3.0), rng.range(-3.0, 3.0));
+            let shape = Shape::circle(rng.range(0.3, 1.5)).unwrap();
+            body(&format!("rock{k}"), ROCK, shape, at, v)
+        })
+        .collect();
+    for k in 0..40 {
+        let at = Vec2::new(rng.range(-30.0, -10.0), rng.range(0.0, 60.0));
+        let shape = Shape::circle(rng.range(0.5, 2.0)).unwrap();
+        bodies.push(body(
+            &format!("ship{k}"),
+            SHIP,
+            shape,
+            at,
+            Vec2::new(900.0, 0.0),
+        ));
+    }
+    let world = WorldDef {
+        layers: layers(&["ship", "rock", "wall"], &[(SHIP, ROCK, Response::Report)]),
+        broad_phase: BroadPhaseKind::SortAndSweep,
+        ..WorldDef::default()
+    };
+    let mut sim = Simulation::new(&scenario("cluster", world, bodies, 24));
+    sim.capture_detect_poses = true;
+    let bounds = WorldBounds {
+        min: Vec2::ZERO,
+        max: Vec2::splat(1.0),
+        wrap: false,
+    };
+    let found = check(sim, &bounds, "a cluster crossing");
+    assert!(found > 100, "{found} contacts");
+}
+
+/// The bench's asteroids (2,000, their bullets swept, so each asteroid's bounds are widened
+/// over its motion) find the same contacts, and end every frame in the same state, as
+/// brute force, which tests every pair.
+#[test]
+fn asteroids_with_swept_bullets_step_as_brute_force_does() {
+    let scenario = ricochet_scenes::bench::Scene::parse("asteroids-2000")
+        .unwrap()
+        .build(40);
+    let mut auto = Simulation::new(&scenario);
+    let mut brute = scenario.clone();
+    brute.world.broad_phase = BroadPhaseKind::BruteForce;
+    let mut brute = Simulation::new(&brute);
+    let mut contacts = 0;
+    for frame in 0..=40 {
+        let (a, b) = (auto.step(), brute.step());
+        let key = |o: &FrameOutput| -> Vec<_> {
+            (o.contacts.iter())
+                .map(|c| (c.a, c.b, c.depth.to_bits()))
+                .collect()
+        };
+        assert_eq!(key(&a), key(&b), "frame {frame}");
+        assert_eq!(
+            auto.world().digest(),
+            brute.world().digest(),
+            "frame {frame}"
+        );
+        contacts += a.contacts.len();
+    }
+    assert!(contacts > 20, "{contacts} contacts");
+}
