@@ -6,10 +6,13 @@
 //! the reach the filter last measured) and some are fast and large, so the bodies sticking
 //! out of a wrapping world outgrow the seam's guess: both ask for the entries left out.
 
-use ricochet_geom::{Pose, Shape, Vec2, contact};
+mod seam_reference;
+
+use ricochet_geom::{Shape, Vec2};
 use ricochet_scenes::{layers, moving_body as body, scenario};
 use ricochet_sim::broad_phase::BroadPhaseKind;
 use ricochet_sim::{BodyKind, FrameOutput, Response, Simulation, WorldBounds, WorldDef};
+use seam_reference::reference;
 
 const SHIP: u8 = 0;
 const ROCK: u8 = 1;
@@ -96,55 +99,16 @@ fn simulation(kind: BroadPhaseKind, bounds: WorldBounds, walls: usize) -> Simula
     sim
 }
 
-/// Every ship–rock pair overlapping at the poses `detect` saw, directly or (in a wrapping
-/// world) through an image: `(i, j, depth, where b was met)`, the deepest image first on a
-/// tie, as `detect` reports it.
-fn reference(
-    sim: &Simulation,
-    frame: &FrameOutput,
-    bounds: &WorldBounds,
-) -> Vec<(usize, usize, f64, Vec2)> {
-    let w = sim.world();
-    let poses = frame.detect_poses.as_ref().unwrap();
-    let pose = |i: usize| poses[i].1;
-    let offsets = if bounds.wrap {
-        bounds.image_offsets().to_vec()
-    } else {
-        vec![Vec2::ZERO]
-    };
-    let mut out = Vec::new();
-    for i in 0..w.len() {
-        for j in i + 1..w.len() {
-            // Ships meet rocks and walls; nothing else meets.
-            let layers = (w.layer[i].min(w.layer[j]), w.layer[i].max(w.layer[j]));
-            if !matches!(layers, (SHIP, ROCK) | (SHIP, WALL)) {
-                continue;
-            }
-            let mut best: Option<(f64, Vec2)> = None;
-            for &o in &offsets {
-                let image = Pose::new(pose(j).position + o, pose(j).angle);
-                let c = contact(w.shape(i), &pose(i), w.shape(j), &image);
-                if best.is_none_or(|(d, _)| c.depth > d) {
-                    best = Some((c.depth, image.position));
-                }
-            }
-            if let Some((d, p)) = best
-                && d > 0.0
-            {
-                out.push((i, j, d, p));
-            }
-        }
-    }
-    out
-}
-
-/// Steps `sim` (frame 0 too) and checks every frame's contacts against [`reference`].
+/// Steps `sim` (frame 0 too) and checks every frame's contacts against every ship–rock and
+/// ship–wall pair tested exactly ([`reference`]).
 /// Returns the contacts found.
 fn check(mut sim: Simulation, bounds: &WorldBounds, label: &str) -> usize {
     let mut found_any = 0;
     for frame in 0..=sim.scenario().frames {
         let out = sim.step();
-        let expected = reference(&sim, &out, bounds);
+        // Ships meet rocks and walls; nothing else meets.
+        let meets = |a: u8, b: u8| matches!((a.min(b), a.max(b)), (SHIP, ROCK) | (SHIP, WALL));
+        let expected = reference(&sim, &out, bounds, meets);
         let w = sim.world();
         let found: Vec<_> = out
             .contacts
