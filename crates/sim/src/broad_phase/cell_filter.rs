@@ -18,9 +18,9 @@ use super::sort_and_sweep::{SweepList, SweepView};
 use super::{BodyEntry, BroadPhase, BroadPhaseKind, Interactions, member, of_layer};
 
 /// A layer is filtered when it holds at least this many moving bodies...
-pub(super) const BIG: usize = 1024;
+const BIG: usize = 1024;
 /// ...and at least this many times as many as every other moving layer it meets together.
-pub(super) const RATIO: usize = 16;
+const RATIO: usize = 16;
 /// Cells along each axis of the bitmap: 4 words a row, 8 KB in all, in the L1 cache.
 pub(super) const CELLS: usize = 256;
 pub(super) const WORDS: usize = CELLS / 64;

@@ -97,21 +97,20 @@ impl BroadPhase {
             counts[l + 1] += counts[l];
         }
         self.movers.clear();
+        if self.runs.len() <= MAX_RUNS {
+            // Bodies of a layer usually come in a few runs of consecutive indices: each
+            // layer's, in order, appended (no cleared buffer to scatter into).
+            for &l in &self.mover_layers {
+                for &(start, len, _) in self.runs.iter().filter(|r| r.2 == l) {
+                    self.movers.extend(start..start + len);
+                }
+            }
+            debug_assert_eq!(self.movers.len(), counts[LAYERS] as usize);
+            return;
+        }
         self.movers.resize(counts[LAYERS] as usize, 0);
         let mut next: [u32; LAYERS] = [0; LAYERS];
         next.copy_from_slice(&counts[..LAYERS]);
-        if self.runs.len() <= MAX_RUNS {
-            // Bodies of a layer usually come in a few runs of consecutive indices.
-            for &(start, len, layer) in &self.runs {
-                let at = &mut next[usize::from(layer)];
-                let dst = &mut self.movers[*at as usize..(*at + len) as usize];
-                for (d, i) in dst.iter_mut().zip(start..) {
-                    *d = i;
-                }
-                *at += len;
-            }
-            return;
-        }
         // Too many runs: scatter body by body, the current layer's cursor in a register.
         let (mut layer, mut at) = (0, next[0]);
         for (i, b) in bodies.iter().enumerate() {
