@@ -12,24 +12,12 @@ use ricochet_geom::{Shape, Vec2};
 use ricochet_scenes::{layers, moving_body as body, scenario};
 use ricochet_sim::broad_phase::BroadPhaseKind;
 use ricochet_sim::{BodyKind, FrameOutput, Response, Simulation, WorldBounds, WorldDef};
-use seam_reference::reference;
+use seam_reference::{contacts, pentagon, reference};
 
 const SHIP: u8 = 0;
 const ROCK: u8 = 1;
 const WALL: u8 = 2;
 const FRAMES: u64 = 12;
-
-/// An irregular pentagon about `r` across.
-fn pentagon(r: f64) -> Shape {
-    let v = [
-        (1.0, 0.1),
-        (0.3, 0.95),
-        (-0.8, 0.6),
-        (-0.9, -0.5),
-        (0.2, -1.0),
-    ];
-    Shape::polygon(&v.map(|(x, y)| Vec2::new(x * r, y * r))).unwrap()
-}
 
 /// The rocks and ships in `bounds` with the broad phase `kind`, and `walls` static bodies
 /// that only the ships meet.
@@ -109,15 +97,7 @@ fn check(mut sim: Simulation, bounds: &WorldBounds, label: &str) -> usize {
         // Ships meet rocks and walls; nothing else meets.
         let meets = |a: u8, b: u8| matches!((a.min(b), a.max(b)), (SHIP, ROCK) | (SHIP, WALL));
         let expected = reference(&sim, &out, bounds, meets);
-        let w = sim.world();
-        let found: Vec<_> = out
-            .contacts
-            .iter()
-            .map(|c| {
-                let (i, j) = (w.index_of(c.a).unwrap(), w.index_of(c.b).unwrap());
-                (i, j, c.depth, c.pose_b.position)
-            })
-            .collect();
+        let found = contacts(&sim, &out);
         assert_eq!(found, expected, "{label}, frame {frame}");
         found_any += found.len();
     }

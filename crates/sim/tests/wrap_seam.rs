@@ -11,7 +11,7 @@ use ricochet_sim::{
     BodyDef, BodyKind, ContactRecord, Doomed, FrameOutput, GameEvent, Phase, Response, Simulation,
     WorldBounds, WorldDef,
 };
-use seam_reference::reference;
+use seam_reference::{contacts, pentagon, reference};
 
 const SHIP: u8 = 0;
 const ROCK: u8 = 1;
@@ -45,18 +45,6 @@ use ricochet_scenes::moving_body as body;
 
 fn circle(r: f64) -> Shape {
     Shape::circle(r).unwrap()
-}
-
-/// A rock: an irregular pentagon about `r` across.
-fn pentagon(r: f64) -> Shape {
-    let v = [
-        (1.0, 0.1),
-        (0.3, 0.95),
-        (-0.8, 0.6),
-        (-0.9, -0.5),
-        (0.2, -1.0),
-    ];
-    Shape::polygon(&v.map(|(x, y)| Vec2::new(x * r, y * r))).unwrap()
 }
 
 const SIZE: Vec2 = Vec2::new(100.0, 80.0);
@@ -354,16 +342,8 @@ fn every_broad_phase_finds_every_pair_through_the_seam_of_a_random_crowd() {
         for frame in 0..=12 {
             let out = sim.step();
             let expected = reference(&sim, &out, &bounds, |_, _| true);
-            let w = sim.world();
             let poses = out.detect_poses.as_ref().unwrap();
-            let found: Vec<_> = out
-                .contacts
-                .iter()
-                .map(|c| {
-                    let (i, j) = (w.index_of(c.a).unwrap(), w.index_of(c.b).unwrap());
-                    (i, j, c.depth, c.pose_b.position)
-                })
-                .collect();
+            let found = contacts(&sim, &out);
             seam += found
                 .iter()
                 .filter(|c| c.3 != poses[c.1].1.position)

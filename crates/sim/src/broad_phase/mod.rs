@@ -12,10 +12,10 @@
 //!   against the layers it interacts with (10,000 asteroids that ignore each other cost no
 //!   asteroid–asteroid test).
 //!
-//! This file holds the public types and the orchestration: the moving bodies are counted and
-//! grouped by layer (`tally.rs`), then each pair of interacting layers goes to the chosen
-//! algorithm's structures, and the pairs found, named by handles, are turned into dense
-//! indices and sorted.
+//! This file holds the public types and the entry points: the moving bodies are counted and
+//! grouped by layer (`tally.rs`), then the call chooses its algorithm, each pair of
+//! interacting layers goes to that algorithm's structures, and the pairs found, named by
+//! handles, are turned into dense indices and sorted (`call.rs`).
 //!
 //! # Algorithms ([`BroadPhaseKind`])
 //! All six produce the same pairs; they differ only in speed.
@@ -128,6 +128,7 @@ pub const STRIPS_ENTER: f64 = 4.0;
 mod auto;
 mod brute_force;
 mod by_layers;
+mod call;
 mod cell_filter;
 mod dynamic_tree;
 mod fixed_grid;
@@ -399,7 +400,8 @@ impl BroadPhase {
             st.load(bodies.iter().filter(|b| b.kind == BodyKind::Static), None);
         }
         self.group_movers(bodies, |b| b.kind != BodyKind::Static);
-        self.run(bodies, (true, true), interactions, out)
+        self.choose(bodies, interactions);
+        self.execute(bodies, (true, true), interactions, out)
     }
 
     /// Like [`BroadPhase::pairs`], with the static bodies apart: `statics` is read only when
@@ -465,7 +467,8 @@ impl BroadPhase {
         self.load_statics(statics, static_generation);
         Tally::new(&mut self.layer_start, &mut self.dynamic, &mut self.runs).count(movers);
         self.group_movers(movers, |_| true);
-        self.run(movers, (false, dense), interactions, out)
+        self.choose(movers, interactions);
+        self.execute(movers, (false, dense), interactions, out)
     }
 
     /// Loads `statics` when `static_generation` differs from the loaded one's (or nothing
@@ -483,106 +486,6 @@ impl BroadPhase {
     /// This call's moving bodies of `layer`, in key order.
     fn layer_movers(&self, layer: u8) -> &[u32] {
         of_layer(&self.movers, &self.layer_start, layer)
-    }
-
-    /// Chooses the algorithm, finds the pairs and, with `dense`, resolves them (`all_given`:
-    /// whether `bodies` holds the static bodies too).
-    fn run(
-        &mut self,
-        bodies: &[BodyEntry],
-        (all_given, dense): (bool, bool),
-        interactions: &Interactions,
-        out: &mut Vec<(u32, u32)>,
-    ) -> BroadPhaseStats {
-        self.choose(bodies, interactions);
-        self.execute(bodies, (all_given, dense), interactions, out)
-    }
-
-    /// Starts a call whose bodies are grouped: chooses the algorithm (what `Auto` picks,
-    /// into `chosen`) and the layers sort and sweep filters (`cell_filter.rs`).
-    fn choose(&mut self, bodies: &[BodyEntry], interactions: &Interactions) {
-        assert!(
-            self.statics.keys.len() + self.movers.len() < STATIC_BIT as usize,
-            "fewer than 2^31 bodies"
-        );
-        self.frame += 1;
-        let kind = match self.kind {
-            BroadPhaseKind::Auto => self.auto_kind(bodies, interactions),
-            k => k,
-        };
-        self.chosen = kind;
-        let layers = std::mem::take(&mut self.mover_layers);
-        self.plan_filters(kind, &layers, interactions);
-        self.mover_layers = layers;
-    }
-
-    /// Finds the pairs of a call [`BroadPhase::choose`] started and, with `dense`, resolves
-    /// them.
-    fn execute(
-        &mut self,
-        bodies: &[BodyEntry],
-        (all_given, dense): (bool, bool),
-        interactions: &Interactions,
-        out: &mut Vec<(u32, u32)>,
-    ) -> BroadPhaseStats {
-        out.clear();
-        let n_movers = self.movers.len();
-        let n_statics = self.statics.count();
-        let kind = self.chosen;
-        let mut stats = BroadPhaseStats {
-            kind,
-            movers: n_movers as u64,
-            statics: n_statics as u64,
-            ..BroadPhaseStats::default()
-        };
-        if kind == BroadPhaseKind::BruteForce {
-            self.brute_force(bodies, interactions, out, &mut stats);
-        } else {
-            self.by_layers(kind, bodies, interactions, out, &mut stats);
-        }
-        if dense {
-            self.resolve(bodies, all_given, out);
-        }
-        stats.pairs = out.len() as u64;
-        stats.static_rebuilds = self.static_rebuilds;
-        stats
-    }
-
-    /// Turns handles into dense indices, orders each pair and sorts them.
-    fn resolve(&self, bodies: &[BodyEntry], all_given: bool, out: &mut [(u32, u32)]) {
-        let st = &self.statics;
-        let dense = |h: u32| -> u32 {
-            match (h & STATIC_BIT != 0, all_given) {
-                (false, true) => h,
-                (true, true) => st.dense[(h & !STATIC_BIT) as usize],
-                // Ranks in the other slice; the first two checks spare a binary search (and
-                // its cache misses) when every static body comes before every moving one.
-                (false, false) => {
-                    let key = bodies[h as usize].key;
-                    let rank = match st.keys.last() {
-                        Some(&last) if last > key => st.keys.partition_point(|&k| k < key),
-                        _ => st.keys.len(),
-                    };
-                    h + rank as u32
-                }
-                (true, false) => {
-                    let s = h & !STATIC_BIT;
-                    let key = st.keys[s as usize];
-                    let rank = match bodies.first() {
-                        Some(first) if first.key < key => bodies.partition_point(|b| b.key < key),
-                        _ => 0,
-                    };
-                    s + rank as u32
-                }
-            }
-        };
-        for p in out.iter_mut() {
-            let (i, j) = (dense(p.0), dense(p.1));
-            *p = (i.min(j), i.max(j));
-        }
-        // One integer comparison per step.
-        out.sort_unstable_by_key(|&(i, j)| (u64::from(i) << 32) | u64::from(j));
-        debug_assert!(out.windows(2).all(|w| w[0] < w[1]), "each pair once");
     }
 }
 

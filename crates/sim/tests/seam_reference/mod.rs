@@ -1,8 +1,8 @@
 //! The reference of the wrap seam's tests and the left-out layer's: every pair of bodies of
 //! layers that meet, tested exactly at the poses `detect` saw, directly and (in a wrapping
-//! world) at each of the nine translations by whole world sizes.
+//! world) at each of the nine translations by whole world sizes; and the rock both use.
 
-use ricochet_geom::{Pose, Vec2, contact};
+use ricochet_geom::{Pose, Shape, Vec2, contact};
 use ricochet_sim::{BodyKind, FrameOutput, Simulation, WorldBounds};
 
 /// Every overlapping pair `(i, j, depth, where b was met)` of bodies of layers that `meets`
@@ -51,4 +51,27 @@ pub fn reference(
         }
     }
     out
+}
+
+/// The frame's contacts in [`reference`]'s form: `(i, j, depth, where b was met)`.
+pub fn contacts(sim: &Simulation, frame: &FrameOutput) -> Vec<(usize, usize, f64, Vec2)> {
+    let w = sim.world();
+    (frame.contacts.iter())
+        .map(|c| {
+            let (i, j) = (w.index_of(c.a).unwrap(), w.index_of(c.b).unwrap());
+            (i, j, c.depth, c.pose_b.position)
+        })
+        .collect()
+}
+
+/// A rock: an irregular pentagon about `r` across.
+pub fn pentagon(r: f64) -> Shape {
+    let v = [
+        (1.0, 0.1),
+        (0.3, 0.95),
+        (-0.8, 0.6),
+        (-0.9, -0.5),
+        (0.2, -1.0),
+    ];
+    Shape::polygon(&v.map(|(x, y)| Vec2::new(x * r, y * r))).unwrap()
 }
