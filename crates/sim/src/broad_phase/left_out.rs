@@ -129,25 +129,23 @@ pub(crate) struct BigPass<'a> {
 }
 
 impl BigPass<'_> {
-    /// Whether the big body at place `k`, of bounds `b`, is on a marked cell: its entry is
-    /// then read again and must be made.
+    /// The pass's test of each body, its state copied out of the pass to live in registers
+    /// through the loop (behind `&mut`, it was stored and read again for every body), or
+    /// `None` when no small body can pair (nothing is marked: no body is kept, none
+    /// measured). [`BigPass::measured`] takes its measure back.
     #[inline(always)]
-    pub(crate) fn keep(&mut self, k: usize, b: &Bounds) -> bool {
-        let Some(corner) = self.cells else {
-            return false;
-        };
-        // Selections (`maxpd`), NaN ignored: no branch in the loop.
-        let (size, seen) = (b.max - b.min, self.seen);
-        self.seen = Vec2::new(
-            if size.x > seen.x { size.x } else { seen.x },
-            if size.y > seen.y { size.y } else { seen.y },
-        );
-        let c = corner.bit(b.min);
-        let on = self.bits[c / 64] & (1 << (c % 64)) != 0;
-        if on {
-            self.marked.push(k as u32);
-        }
-        on
+    pub(crate) fn marking(&mut self) -> Option<Marking<'_>> {
+        Some(Marking {
+            corner: self.cells?,
+            bits: self.bits,
+            marked: &mut *self.marked,
+            seen: self.seen,
+        })
+    }
+
+    /// The widest and tallest body a [`Marking`] measured.
+    pub(crate) fn measured(&mut self, seen: Vec2) {
+        self.seen = seen;
     }
 
     /// Ends the pass: whether the bodies it kept are all the call reads. If a body outgrew
@@ -167,5 +165,35 @@ impl BigPass<'_> {
             None
         };
         enough
+    }
+}
+
+/// [`BigPass::marking`]: it lists the big bodies on a marked cell and measures the layer's
+/// widest and tallest body.
+pub(crate) struct Marking<'a> {
+    corner: Corner,
+    bits: &'a [u64; CELLS * WORDS],
+    marked: &'a mut Vec<u32>,
+    /// The widest and tallest body seen so far.
+    pub(crate) seen: Vec2,
+}
+
+impl Marking<'_> {
+    /// Whether the big body at place `k`, of bounds `b`, is on a marked cell: its entry is
+    /// then read again and must be made.
+    #[inline(always)]
+    pub(crate) fn keep(&mut self, k: usize, b: &Bounds) -> bool {
+        // Selections (`maxpd`), NaN ignored: no branch in the loop.
+        let (size, seen) = (b.max - b.min, self.seen);
+        self.seen = Vec2::new(
+            if size.x > seen.x { size.x } else { seen.x },
+            if size.y > seen.y { size.y } else { seen.y },
+        );
+        let c = self.corner.bit(b.min);
+        let on = self.bits[c / 64] & (1 << (c % 64)) != 0;
+        if on {
+            self.marked.push(k as u32);
+        }
+        on
     }
 }

@@ -158,7 +158,7 @@ pub(crate) use fixed_grid::FixedGrid;
 use hash_grid::HashGrid;
 pub use interactions::Interactions;
 use kept_tree::KeptTree;
-pub(crate) use left_out::BigPass;
+pub(crate) use left_out::{BigPass, Marking};
 pub(crate) use mover_grid::MoverGrid;
 use quadtree::Quadtree;
 use sort_and_sweep::{Slot, SweepList};

@@ -3,106 +3,15 @@
 
 use std::ops::Range;
 
-use ricochet_geom::{Bounds, Pose, Shape, Vec2};
+use ricochet_geom::{Bounds, Pose, Vec2};
 
+use super::local_bounds::LocalBoundsRows;
+use super::runs::RowRun;
 use super::{NO_ROW, World};
-use crate::broad_phase::{BigPass, BodyEntry, Tally};
+use crate::broad_phase::{BigPass, BodyEntry, Marking, Tally};
 use crate::def::BodyKind;
 use crate::entity::Entity;
 use crate::interned::ShapeTable;
-
-/// A body's bounds relative to its position, kept from one frame to the next.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct LocalBounds {
-    /// The angle they were computed at.
-    angle: f64,
-    /// Good at every angle (a shape that turning does not change, or a body that has turned
-    /// and is bounded by the disc that holds it at every angle).
-    any_angle: bool,
-    /// `turning_keeps_bounds` of the shape they were computed for, kept so that a snapshot
-    /// asks it of 10,000 bodies without looking a shape up (it fits in the padding).
-    keeps: bool,
-    bounds: Bounds,
-}
-
-impl LocalBounds {
-    /// The bounds of `shape` at `angle` and position `p`.
-    #[inline]
-    pub(super) fn at(&mut self, shape: &Shape, angle: f64, p: Vec2) -> Bounds {
-        self.at_with(|| shape, || angle, p)
-    }
-
-    /// [`LocalBounds::at`], looking the shape up only when the bounds must be recomputed
-    /// (once per body: a body that turned keeps its any-angle bounds).
-    #[inline(always)]
-    fn at_with<'s>(
-        &mut self,
-        shape: impl FnOnce() -> &'s Shape,
-        angle: impl FnOnce() -> f64,
-        p: Vec2,
-    ) -> Bounds {
-        // The angle too is read only when needed: bounds for any angle do not ask it.
-        if !self.any_angle {
-            let angle = angle();
-            if self.angle.to_bits() != angle.to_bits() {
-                *self = LocalBounds::turned(shape(), angle);
-            }
-        }
-        placed(self.bounds, p)
-    }
-
-    /// The bounds of a body of `shape` that has turned: the square around the disc that
-    /// holds the shape at every angle.
-    pub(super) fn turned(shape: &Shape, angle: f64) -> LocalBounds {
-        // The farthest corner of the angle-0 box is as far as any point of the shape.
-        let b = shape.bounds(&Pose::default());
-        let r = b.min.abs().max(b.max.abs()).length();
-        // A rotated point may round one ulp past the exact radius.
-        let r = r + r * 1e-12;
-        LocalBounds {
-            angle,
-            any_angle: true,
-            keeps: turning_keeps_bounds(shape),
-            bounds: Bounds {
-                min: Vec2::splat(-r),
-                max: Vec2::splat(r),
-            },
-        }
-    }
-
-    /// Whether the bounds of the body, at `angle`, are (or, at their next use,
-    /// become) the any-angle square of [`LocalBounds::turned`]: the body turned since they
-    /// were computed exactly. False for a shape that turning does not change. A snapshot
-    /// keeps this bit: the broad phase's candidates, counted in `Stats`, depend on it.
-    pub(super) fn has_turned(&self, angle: f64) -> bool {
-        (self.any_angle || self.angle.to_bits() != angle.to_bits()) && !self.keeps
-    }
-
-    /// Bounds that [`LocalBounds::has_turned`] tells `turned` of, for `shape` at `angle`.
-    pub(super) fn restored(shape: &Shape, angle: f64, turned: bool) -> LocalBounds {
-        if turned {
-            LocalBounds::turned(shape, angle)
-        } else {
-            LocalBounds::new(shape, angle)
-        }
-    }
-
-    pub(super) fn new(shape: &Shape, angle: f64) -> LocalBounds {
-        let keeps = turning_keeps_bounds(shape);
-        LocalBounds {
-            angle,
-            any_angle: keeps,
-            keeps,
-            bounds: shape.bounds(&Pose::new(Vec2::ZERO, angle)),
-        }
-    }
-}
-
-/// Whether a shape's bounds are the same at every angle: circles and AABBs (which ignore
-/// rotation) centred on the body origin.
-fn turning_keeps_bounds(shape: &Shape) -> bool {
-    !shape.primitives().iter().any(|p| p.turns_with_body())
-}
 
 impl World {
     /// Bounds of body `i` for the broad phase: they hold the shape, and are exact for a body
@@ -115,7 +24,9 @@ impl World {
             NO_ROW => self.scenery_bounds(i),
             r => {
                 let shape = &self.shapes.get(self.shape_id[i]).0;
-                self.rows.local_bounds[r as usize].at(shape, self.angle[i], p)
+                self.rows
+                    .local_bounds
+                    .at(r as usize, shape, self.angle[i], p)
             }
         }
     }
@@ -218,7 +129,7 @@ impl World {
         out: &mut [BodyEntry],
         places: Range<usize>,
         visit: &mut impl FnMut(usize, &Bounds) -> bool,
-        mut pass: Option<&mut BigPass>,
+        pass: Option<&mut BigPass>,
     ) {
         if places.is_empty() {
             return;
@@ -243,7 +154,7 @@ impl World {
             kinds: &self.kind[..n],
             entity: &self.entity[..n],
             shape_id: &self.shape_id[..n],
-            local_bounds: &mut rows.local_bounds[..m],
+            local_bounds: rows.local_bounds.rows(0, m),
             start_position: &rows.start_position[..m],
             frozen: &rows.frozen[..m],
             shapes: &self.shapes,
@@ -251,48 +162,98 @@ impl World {
         };
         let out = &mut out[places.clone()];
         let first = places.start;
-        // Each body with its row: in place over one run (`runs.rs`), else through the list
-        // and the row column.
-        match run {
-            Some(run) => {
-                let (i0, r0) = (run.index + first, run.row + first);
-                for (k, out) in out.iter_mut().enumerate() {
-                    let (i, r) = (i0 + k, r0 + k);
-                    let bounds = columns.bounds(i, r);
-                    if kept(visit, &mut pass, first + k, &bounds) {
-                        *out = columns.entry(i, r, bounds);
-                    }
+        let list = match run {
+            Some(_) => None,
+            None => Some((&self.row[..n], &self.movers[places])),
+        };
+        // One loop for each test (monomorphised), the pass's state in locals.
+        match pass {
+            None => fill(&mut columns, run, list, out, first, visit, &mut Every),
+            Some(pass) => match pass.marking() {
+                None => fill(&mut columns, run, list, out, first, visit, &mut Noted),
+                Some(mut marking) => {
+                    fill(&mut columns, run, list, out, first, visit, &mut marking);
+                    let seen = marking.seen;
+                    pass.measured(seen);
                 }
-            }
-            None => {
-                let row = &self.row[..n];
-                for (k, (out, &i)) in out.iter_mut().zip(&self.movers[places]).enumerate() {
-                    let (i, r) = (i as usize, row[i as usize] as usize);
-                    let bounds = columns.bounds(i, r);
-                    if kept(visit, &mut pass, first + k, &bounds) {
-                        *out = columns.entry(i, r, bounds);
-                    }
-                }
-            }
+            },
         }
     }
 }
 
-/// Whether [`World::some_mover_entries`] makes the entry at place `k`, of bounds `b`,
-/// shown to `visit` first: always without a pass. Always inlined: the pass's test, in a
-/// closure called from both loops, was not, and the call cost a quarter of the asteroids'
-/// step.
+/// Which entries [`World::some_mover_entries`] makes, besides those `visit` notes.
+trait Keep {
+    /// Whether the entry at place `k`, of bounds `b`, is made.
+    fn keep(&mut self, k: usize, b: &Bounds) -> bool;
+}
+
+/// Every entry (no pass).
+struct Every;
+
+impl Keep for Every {
+    #[inline(always)]
+    fn keep(&mut self, _: usize, _: &Bounds) -> bool {
+        true
+    }
+}
+
+/// Only the entries `visit` notes (a pass with nothing marked).
+struct Noted;
+
+impl Keep for Noted {
+    #[inline(always)]
+    fn keep(&mut self, _: usize, _: &Bounds) -> bool {
+        false
+    }
+}
+
+impl Keep for Marking<'_> {
+    #[inline(always)]
+    fn keep(&mut self, k: usize, b: &Bounds) -> bool {
+        Marking::keep(self, k, b)
+    }
+}
+
+/// The entries of the places from `first` on, into `out`: each body with its row in place
+/// over one `run` (`runs.rs`), else through `list` (the movers' indices and the row
+/// column). Always inlined: the test, in a closure called from both loops, was not, and
+/// the call cost a quarter of the asteroids' step.
 #[inline(always)]
-fn kept(
+fn fill(
+    columns: &mut EntryColumns,
+    run: Option<RowRun>,
+    list: Option<(&[u32], &[u32])>,
+    out: &mut [BodyEntry],
+    first: usize,
     visit: &mut impl FnMut(usize, &Bounds) -> bool,
-    pass: &mut Option<&mut BigPass>,
-    k: usize,
-    b: &Bounds,
-) -> bool {
-    let near = visit(k, b);
-    match pass {
-        Some(pass) => pass.keep(k, b) || near,
-        None => true,
+    keep: &mut impl Keep,
+) {
+    match (run, list) {
+        (Some(run), _) => {
+            // Every column sliced to the places first: one index then reads them all
+            // without a bounds check.
+            let len = out.len();
+            let (i0, r0) = (run.index + first, run.row + first);
+            let mut columns = columns.slice(i0, r0, len);
+            for (k, out) in out.iter_mut().enumerate() {
+                let bounds = columns.bounds(k, k);
+                let near = visit(first + k, &bounds);
+                if keep.keep(first + k, &bounds) || near {
+                    *out = columns.entry(k, k, bounds);
+                }
+            }
+        }
+        (None, Some((row, movers))) => {
+            for (k, (out, &i)) in out.iter_mut().zip(movers).enumerate() {
+                let (i, r) = (i as usize, row[i as usize] as usize);
+                let bounds = columns.bounds(i, r);
+                let near = visit(first + k, &bounds);
+                if keep.keep(first + k, &bounds) || near {
+                    *out = columns.entry(i, r, bounds);
+                }
+            }
+        }
+        (None, None) => {}
     }
 }
 
@@ -304,7 +265,7 @@ struct EntryColumns<'a> {
     kinds: &'a [BodyKind],
     entity: &'a [Entity],
     shape_id: &'a [u32],
-    local_bounds: &'a mut [LocalBounds],
+    local_bounds: LocalBoundsRows<'a>,
     start_position: &'a [Vec2],
     frozen: &'a [bool],
     shapes: &'a ShapeTable,
@@ -318,6 +279,25 @@ const SWEEPS: u8 = 1;
 const SEPARATE_SWEPT: u8 = 2;
 
 impl EntryColumns<'_> {
+    /// The columns of `len` bodies from `i` and rows from `r`, indexed from 0.
+    #[inline(always)]
+    fn slice(&mut self, i: usize, r: usize, len: usize) -> EntryColumns<'_> {
+        // Each `[start..][..len]`: the compiler then knows every length is `len`.
+        EntryColumns {
+            position: &self.position[i..][..len],
+            angle: &self.angle[i..][..len],
+            layers: &self.layers[i..][..len],
+            kinds: &self.kinds[i..][..len],
+            entity: &self.entity[i..][..len],
+            shape_id: &self.shape_id[i..][..len],
+            local_bounds: self.local_bounds.rows(r, len),
+            start_position: &self.start_position[r..][..len],
+            frozen: &self.frozen[r..][..len],
+            shapes: self.shapes,
+            widen: self.widen,
+        }
+    }
+
     /// The broad phase's bounds of body `i`, of row `r`.
     #[inline(always)]
     fn bounds(&mut self, i: usize, r: usize) -> Bounds {
@@ -325,7 +305,8 @@ impl EntryColumns<'_> {
         // The shape table is read only when needed (a scene's shapes may all differ).
         let (shapes, ids) = (self.shapes, self.shape_id);
         let shape = || &shapes.get(ids[i]).0;
-        let bounds = self.local_bounds[r].at_with(shape, || self.angle[i], p);
+        // Of the kept bounds, only their half extents when they have some (16 bytes).
+        let bounds = self.local_bounds.placed(r, shape, || self.angle[i], p);
         let widen = self.widen[usize::from(self.layers[i])];
         // The frame's start is read only for a layer that may be widened.
         if widen != 0 {

@@ -12,7 +12,7 @@
 use ricochet_geom::{Pose, Shape, Vec2};
 
 use super::World;
-use super::bounds::LocalBounds;
+use super::local_bounds::LocalBounds;
 use super::rows::Rows;
 use crate::action::Action;
 use crate::def::{BodyDef, BodyKind, Controller, Split};
@@ -159,8 +159,8 @@ fn change(sim: &mut Simulation, field: &str, i: usize) {
         "rest_frames" => rest_frames[r] += 1,
         // A triangle's bounds: exact at its angle, or the any-angle square once it turned.
         "local_bounds" => {
-            let turned = local_bounds[r].has_turned(w.angle[i]);
-            local_bounds[r] = LocalBounds::restored(&triangle(), w.angle[i], !turned);
+            let turned = local_bounds.get(r).has_turned(w.angle[i]);
+            local_bounds.set(r, LocalBounds::restored(&triangle(), w.angle[i], !turned));
         }
         _ => change_other(sim, field, i),
     }

@@ -37,6 +37,7 @@ mod bounds;
 #[cfg(test)]
 mod checksum_fields;
 mod disturbed;
+mod local_bounds;
 mod measures;
 mod motion;
 mod rows;
@@ -50,7 +51,7 @@ pub use disturbed::Disturbed;
 pub use rows::Motion;
 pub(crate) use state::{Bodies, PackedWorld};
 
-use bounds::{KeptCount, LocalBounds};
+use bounds::KeptCount;
 use motion::KeptOutside;
 use rows::Rows;
 

@@ -4,7 +4,7 @@
 
 use ricochet_geom::Vec2;
 
-use super::bounds::LocalBounds;
+use super::local_bounds::{LocalBounds, LocalBoundsColumn};
 use super::{Inputs, NO_ROW, World};
 use crate::def::{BodyDef, BodyKind, Controller, Split};
 use crate::entity::Entity;
@@ -31,7 +31,7 @@ pub(super) struct Rows {
     pub(super) frozen: Vec<bool>,
     pub(super) asleep: Vec<bool>,
     pub(super) rest_frames: Vec<u32>,
-    pub(super) local_bounds: Vec<LocalBounds>,
+    pub(super) local_bounds: LocalBoundsColumn,
     pub(super) user_data: Vec<u128>,
     /// No row below this one has a lifetime (0 claims nothing): an asteroid field spawned
     /// before its bullets counts down only the bullets' rows.
@@ -299,7 +299,7 @@ impl Rows {
             + cap(&self.frozen)
             + cap(&self.asleep)
             + cap(&self.rest_frames)
-            + cap(&self.local_bounds)
+            + self.local_bounds.heap_bytes()
             + cap(&self.user_data)
     }
 }

@@ -2,6 +2,7 @@
 //! velocity, each keeping the caches (bounds, static generation, sleep, the active list)
 //! right and naming the body as disturbed ([`World::disturbed`]).
 
+use super::local_bounds::LocalBounds;
 use super::*;
 
 impl World {
@@ -19,7 +20,9 @@ impl World {
             self.rows.start_position[r] = position;
             self.rows.carrier[r] = None;
             if self.kind[i] == BodyKind::Static {
-                self.rows.local_bounds[r] = LocalBounds::new(self.shape(i), angle);
+                self.rows
+                    .local_bounds
+                    .set(r, LocalBounds::new(self.shape(i), angle));
             }
         }
         // A turned body's bounds follow from the cache (it widens to the any-angle disc).
@@ -56,7 +59,7 @@ impl World {
         }
         let r = self.row[i];
         if r != NO_ROW {
-            self.rows.local_bounds[r as usize] = LocalBounds::new(shape, self.angle[i]);
+            (self.rows.local_bounds).set(r as usize, LocalBounds::new(shape, self.angle[i]));
         }
         self.changed_in_place(i);
     }

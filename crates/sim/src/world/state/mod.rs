@@ -21,7 +21,7 @@
 
 use ricochet_geom::{Shape, Vec2};
 
-use super::bounds::LocalBounds;
+use super::local_bounds::LocalBounds;
 use super::rows::Rows;
 use super::{Inputs, NO_ROW, World};
 use crate::def::{BodyDef, BodyKind, Controller, LayerId, Split};
@@ -157,7 +157,11 @@ impl World {
     fn turned(&self, i: usize) -> bool {
         match self.row[i] {
             NO_ROW => false,
-            r => self.rows.local_bounds[r as usize].has_turned(self.angle[i]),
+            r => self
+                .rows
+                .local_bounds
+                .get(r as usize)
+                .has_turned(self.angle[i]),
         }
     }
 

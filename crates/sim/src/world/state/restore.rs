@@ -80,11 +80,11 @@ impl World {
             }
             let turned = base.turned(j) != pick(group::TURNED);
             let (shape, angle) = (&self.shapes.get(self.shape_id[i]).0, self.angle[i]);
-            let lb = &mut self.rows.local_bounds[r];
+            let column = &mut self.rows.local_bounds;
             // Bounds that tell `turned` as they should are what a restore would build: an
             // exact box at another angle becomes the square at its next use.
-            if lb.has_turned(angle) != turned {
-                *lb = LocalBounds::restored(shape, angle, turned);
+            if column.get(r).has_turned(angle) != turned {
+                column.set(r, LocalBounds::restored(shape, angle, turned));
             }
         }
         self.recount();
@@ -218,7 +218,7 @@ impl World {
         // A static body's velocity stays zero in its row as `spawn` makes it.
         rows.velocity[k] = def.velocity;
         rows.angular_velocity[k] = def.angular_velocity;
-        rows.local_bounds[k] = LocalBounds::restored(&def.shape, def.angle, row.turned);
+        (rows.local_bounds).set(k, LocalBounds::restored(&def.shape, def.angle, row.turned));
         // Awake until every body is in: a static body inserted later wakes every sleeper.
         let m = row.motion;
         sleep.push((k, m.asleep, m.rest_frames));
