@@ -134,7 +134,7 @@ impl World {
         if places.is_empty() {
             return;
         }
-        let run = self.row_run(&self.movers);
+        let run = self.movers_run();
         // Every column sliced to its exact length first: the columns of one index then share
         // one bounds check (`i < n`, `r < m`) instead of one each.
         let n = self.row.len();
@@ -356,7 +356,7 @@ impl World {
     /// layer never change else). Returns whether it counted them (nothing is counted when
     /// they are not one run).
     pub(crate) fn count_movers(&mut self, tally: &mut Tally) -> bool {
-        let Some(run) = self.row_run(&self.movers) else {
+        let Some(run) = self.movers_run() else {
             return false;
         };
         let at = (self.layout, self.frozen_changes);

@@ -54,6 +54,7 @@ pub(crate) use state::{Bodies, PackedWorld};
 use bounds::KeptCount;
 use motion::KeptOutside;
 use rows::Rows;
+use runs::RowRun;
 
 /// What a controller's inputs currently are.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -141,6 +142,8 @@ pub struct World {
     /// [`World::count_movers`]' stretches, with the `layout` and `frozen_changes` they
     /// were counted at.
     kept_count: KeptCount,
+    /// [`World::movers_run`]'s answer, with the `layout` it was found at.
+    kept_run: Option<(u64, Option<RowRun>)>,
 }
 
 impl World {
@@ -299,7 +302,7 @@ impl World {
     /// Copies every moving body's position to its start position: the frame's swept tests
     /// run from there (static bodies never move; their start is their position).
     pub fn start_frame(&mut self) {
-        if let Some(run) = self.row_run(&self.movers) {
+        if let Some(run) = self.movers_run() {
             // One run (`runs.rs`): one copy.
             self.rows.start_position[run.rows()].copy_from_slice(&self.position[run.indices()]);
             return;

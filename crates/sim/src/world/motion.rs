@@ -70,7 +70,7 @@ impl World {
         thrust: impl Fn(&Controller, &Inputs, f64) -> Vec2,
     ) {
         if self.controlled_count() == 0
-            && let Some(run) = self.row_run(&self.active)
+            && let Some(run) = self.active_run()
         {
             // The usual case without a controller, over one run (`runs.rs`): each column a
             // slice, in place; the loop below with a zero thrust.
@@ -161,7 +161,7 @@ impl World {
     pub(crate) fn integrate(&mut self, dt: f64, x: bool, y: bool, turn: bool) {
         if x && y
             && turn
-            && let Some(run) = self.row_run(&self.active)
+            && let Some(run) = self.active_run()
         {
             // The usual case over one run (`runs.rs`): each column a slice, in place.
             let rows = &self.rows;

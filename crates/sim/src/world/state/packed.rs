@@ -164,6 +164,7 @@ impl World {
             kept_energy: _,
             frozen_changes: _,
             kept_count: _,
+            kept_run: _,
         } = self;
         World {
             ids: EntityAllocator::default(),
@@ -196,6 +197,7 @@ impl World {
             kept_energy: None,
             frozen_changes: 0,
             kept_count: Default::default(),
+            kept_run: None,
         }
     }
 
