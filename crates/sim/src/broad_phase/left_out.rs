@@ -16,9 +16,11 @@
 //! 1. [`BroadPhase::tally`], flushed; [`BroadPhase::load_statics`];
 //! 2. [`BroadPhase::layer_to_leave_out`]: the layer and its places, if any;
 //! 3. the entries of every other place; [`BroadPhase::begin_counted`];
-//! 4. [`BroadPhase::big_pass`]: `Some` when the call filters that layer. Its
-//!    [`BigPass::keep`] is shown every big body's place and bounds, in order, and says
-//!    which to write; [`BigPass::finish`] says whether that was enough;
+//! 4. [`BroadPhase::big_pass`]: `Some` when the call filters that layer. The
+//!    [`Marking::keep`] of its [`BigPass::marking`] is shown every big body's place and
+//!    bounds, in order, and says which to write (no body, when nothing is marked);
+//!    [`BigPass::measured`] takes back the widest body it saw, and [`BigPass::finish`] says
+//!    whether that was enough;
 //! 5. else (or not enough), every remaining entry; then [`BroadPhase::finish_counted`].
 
 use std::ops::Range;

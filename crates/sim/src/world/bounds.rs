@@ -1,5 +1,5 @@
 //! Each body's bounds for the broad phase: the bounds relative to the body kept from frame
-//! to frame ([`LocalBounds`]), placed at the body's position, and the moving bodies' entries.
+//! to frame (`local_bounds.rs`), placed at the body's position, and the moving bodies' entries.
 
 use std::ops::Range;
 
@@ -73,7 +73,7 @@ impl World {
     /// The broad phase's view of every moving body, in [`World::movers`] order, into `out`:
     /// [`World::bounds`], widened over the frame's motion for a body of a layer in
     /// `sweeping` (a bullet that went right through something is still paired with it), or of
-    /// a layer in `separate_swept` that moved more than half its [`Shape::min_width`] (a
+    /// a layer in `separate_swept` that moved more than half its [`ricochet_geom::Shape::min_width`] (a
     /// `separate` pair that time of impact may have to stop), and
     /// a frozen body handed over as kinematic (it keeps its place in the dense order; the
     /// caller drops its pairs). `visit` sees each entry's place in `out` and its bounds as
