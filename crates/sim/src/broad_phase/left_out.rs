@@ -114,6 +114,7 @@ impl BroadPhase {
             left_out: &mut f.left_out,
             reach,
             seen: Vec2::ZERO,
+            layer: big,
         })
     }
 }
@@ -128,6 +129,8 @@ pub(crate) struct BigPass<'a> {
     left_out: &'a mut Option<Vec2>,
     reach: Vec2,
     seen: Vec2,
+    /// The big layer.
+    layer: u8,
 }
 
 impl BigPass<'_> {
@@ -142,6 +145,7 @@ impl BigPass<'_> {
             bits: self.bits,
             marked: &mut *self.marked,
             seen: self.seen,
+            layer: self.layer,
         })
     }
 
@@ -178,6 +182,8 @@ pub(crate) struct Marking<'a> {
     marked: &'a mut Vec<u32>,
     /// The widest and tallest body seen so far.
     pub(crate) seen: Vec2,
+    /// The big layer: every body shown is of it.
+    pub(crate) layer: u8,
 }
 
 impl Marking<'_> {

@@ -185,6 +185,11 @@ impl World {
 trait Keep {
     /// Whether the entry at place `k`, of bounds `b`, is made.
     fn keep(&mut self, k: usize, b: &Bounds) -> bool;
+
+    /// The one layer of every place shown, when the caller knows it.
+    fn layer(&self) -> Option<u8> {
+        None
+    }
 }
 
 /// Every entry (no pass).
@@ -212,6 +217,10 @@ impl Keep for Marking<'_> {
     fn keep(&mut self, k: usize, b: &Bounds) -> bool {
         Marking::keep(self, k, b)
     }
+
+    fn layer(&self) -> Option<u8> {
+        Some(self.layer)
+    }
 }
 
 /// The entries of the places from `first` on, into `out`: each body with its row in place
@@ -235,6 +244,19 @@ fn fill(
             let len = out.len();
             let (i0, r0) = (run.index + first, run.row + first);
             let mut columns = columns.slice(i0, r0, len);
+            // The big pass's places are all of its layer: its flags read once.
+            if let Some(layer) = keep.layer() {
+                let widen = columns.widen[usize::from(layer)];
+                for (k, out) in out.iter_mut().enumerate() {
+                    debug_assert_eq!(columns.layers[k], layer, "the pass's one layer");
+                    let bounds = columns.widened(k, k, widen);
+                    let near = visit(first + k, &bounds);
+                    if keep.keep(first + k, &bounds) || near {
+                        *out = columns.entry(k, k, bounds);
+                    }
+                }
+                return;
+            }
             for (k, out) in out.iter_mut().enumerate() {
                 let bounds = columns.bounds(k, k);
                 let near = visit(first + k, &bounds);
@@ -301,13 +323,19 @@ impl EntryColumns<'_> {
     /// The broad phase's bounds of body `i`, of row `r`.
     #[inline(always)]
     fn bounds(&mut self, i: usize, r: usize) -> Bounds {
+        let widen = self.widen[usize::from(self.layers[i])];
+        self.widened(i, r, widen)
+    }
+
+    /// [`EntryColumns::bounds`] of a body of a layer whose widening flags are `widen`.
+    #[inline(always)]
+    fn widened(&mut self, i: usize, r: usize, widen: u8) -> Bounds {
         let p = self.position[i];
         // The shape table is read only when needed (a scene's shapes may all differ).
         let (shapes, ids) = (self.shapes, self.shape_id);
         let shape = || &shapes.get(ids[i]).0;
         // Of the kept bounds, only their half extents when they have some (16 bytes).
         let bounds = self.local_bounds.placed(r, shape, || self.angle[i], p);
-        let widen = self.widen[usize::from(self.layers[i])];
         // The frame's start is read only for a layer that may be widened.
         if widen != 0 {
             let moved = self.start_position[r] - p;
