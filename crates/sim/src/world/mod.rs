@@ -273,32 +273,6 @@ impl World {
         self.row[i] == NO_ROW
     }
 
-    /// Body `i`'s row, made for scenery first (with what scenery reads: nothing changes
-    /// but where the body's state is kept).
-    #[inline]
-    fn row_of(&mut self, i: usize) -> usize {
-        match self.row[i] {
-            NO_ROW => self.give_row(i),
-            r => r as usize,
-        }
-    }
-
-    #[cold]
-    fn give_row(&mut self, i: usize) -> usize {
-        let def = BodyDef {
-            layer: self.layer[i],
-            shape: self.shape(i).clone(),
-            kind: self.kind[i],
-            position: self.position[i],
-            angle: self.angle[i],
-            ..BodyDef::default()
-        };
-        let r = self.rows.entity.len();
-        self.rows.push(self.entity[i], &def);
-        self.row[i] = r as u32;
-        r
-    }
-
     /// Copies every moving body's position to its start position: the frame's swept tests
     /// run from there (static bodies never move; their start is their position).
     pub fn start_frame(&mut self) {

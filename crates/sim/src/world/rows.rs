@@ -303,3 +303,31 @@ impl Rows {
             + cap(&self.user_data)
     }
 }
+
+impl World {
+    /// Body `i`'s row, made for scenery first (with what scenery reads: nothing changes
+    /// but where the body's state is kept).
+    #[inline]
+    pub(super) fn row_of(&mut self, i: usize) -> usize {
+        match self.row[i] {
+            NO_ROW => self.give_row(i),
+            r => r as usize,
+        }
+    }
+
+    #[cold]
+    fn give_row(&mut self, i: usize) -> usize {
+        let def = BodyDef {
+            layer: self.layer[i],
+            shape: self.shape(i).clone(),
+            kind: self.kind[i],
+            position: self.position[i],
+            angle: self.angle[i],
+            ..BodyDef::default()
+        };
+        let r = self.rows.entity.len();
+        self.rows.push(self.entity[i], &def);
+        self.row[i] = r as u32;
+        r
+    }
+}
