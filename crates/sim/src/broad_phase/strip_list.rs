@@ -152,6 +152,20 @@ impl Slot {
     const GONE: Slot = Slot(u128::MAX);
 }
 
+/// How many slots at the start of `rest` (sorted, `rest[0]` of `strip`) are of `strip`: a
+/// galloping search, doubling its step while the slot it lands on is still of `strip`, then
+/// a binary search in the last step.
+fn run_length(rest: &[Slot], strip: i32) -> usize {
+    // Every slot before `known` is of `strip`; the slot at `step`, if any, is not.
+    let (mut known, mut step) = (1, 1);
+    while step < rest.len() && rest[step].strip() == strip {
+        known = step + 1;
+        step *= 2;
+    }
+    let end = step.min(rest.len());
+    known + rest[known..end].partition_point(|s| s.strip() == strip)
+}
+
 /// What a sweep reads of a body, in list order.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Swept {
@@ -340,17 +354,29 @@ impl StripList {
         self.width = width;
     }
 
-    /// Finds the runs of one strip in `order`.
+    /// Finds the runs of one strip in `order`. The slots sort by strip first, so each run's
+    /// end is found by a galloping search from its start: about `2 log2(run)` reads a run
+    /// (a hundred runs of a hundred slots at 10,000 drops of rain) instead of one a slot.
     fn find_runs(&mut self) {
         self.runs.clear();
-        let mut last = None;
-        for (k, s) in self.order.iter().enumerate() {
-            if last != Some(s.strip()) {
-                self.runs.push((s.strip(), k as u32));
-                last = Some(s.strip());
-            }
+        let mut k = 0;
+        while k < self.order.len() {
+            let strip = self.order[k].strip();
+            self.runs.push((strip, k as u32));
+            k += run_length(&self.order[k..], strip);
         }
         self.runs.push((i32::MAX, self.order.len() as u32));
+        #[cfg(debug_assertions)]
+        {
+            // Every slot in the run that holds it, every run one strip, in order.
+            for r in 0..self.runs.len() - 1 {
+                let ((strip, start), (_, end)) = (self.runs[r], self.runs[r + 1]);
+                assert!(start < end, "a run holds a slot");
+                let run = &self.order[start as usize..end as usize];
+                assert!(run.iter().all(|s| s.strip() == strip), "one strip a run");
+                assert!(r == 0 || self.runs[r - 1].0 < strip, "runs in strip order");
+            }
+        }
     }
 
     /// The strip of run `r`.
@@ -387,5 +413,49 @@ impl StripList {
             + (self.remap.capacity() + self.moved.capacity()) * 4
             + self.x.capacity() * 8
             + self.is_moved.capacity()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use proptest::prelude::*;
+
+    use super::{Slot, run_length};
+
+    proptest! {
+        /// The galloping search ends each run where a scan slot by slot does: runs of one
+        /// slot, of a power of two and one either side of it, and one run for all.
+        #[test]
+        fn a_run_ends_where_a_scan_finds_its_end(
+            mut strips in prop::collection::vec(
+                prop_oneof![-3..3i32, Just(i32::MIN), Just(i32::MAX)],
+                1..300,
+            ),
+        ) {
+            strips.sort_unstable();
+            let order: Vec<Slot> = strips
+                .iter()
+                .enumerate()
+                .map(|(k, &s)| Slot::new(s, k as u64, k as u32))
+                .collect();
+            let mut k = 0;
+            while k < order.len() {
+                let strip = order[k].strip();
+                let scanned = order[k..].iter().take_while(|s| s.strip() == strip).count();
+                prop_assert_eq!(run_length(&order[k..], strip), scanned);
+                k += scanned;
+            }
+        }
+    }
+
+    #[test]
+    fn runs_of_every_length_around_the_doublings() {
+        for len in 1..70 {
+            for tail in 0..3 {
+                let mut order: Vec<Slot> = (0..len).map(|k| Slot::new(5, k, k as u32)).collect();
+                order.extend((0..tail).map(|k| Slot::new(6, k, (len + k) as u32)));
+                assert_eq!(run_length(&order, 5), len as usize, "{len} then {tail}");
+            }
+        }
     }
 }
