@@ -38,6 +38,9 @@ pub struct Disturbed {
     last_end: usize,
     /// `bodies` holds [`ALL`]: a name adds nothing.
     full: bool,
+    /// How many names so far, those that added nothing included: it tells "touched since"
+    /// even once every body is named ([`Disturbed::mark`]).
+    touches: u64,
 }
 
 impl Default for Disturbed {
@@ -48,6 +51,7 @@ impl Default for Disturbed {
             bodies: Vec::new(),
             last_end: 0,
             full: false,
+            touches: 0,
         }
     }
 }
@@ -80,11 +84,11 @@ impl Disturbed {
         self.full
     }
 
-    /// A mark that changes with every name and every step: while it is the same, no body
-    /// was touched but by the integrator, which runs once a step. `None` once every body
-    /// is named (nothing can be told apart then).
-    pub(super) fn mark(&self) -> Option<(u64, usize)> {
-        (!self.full).then_some((self.steps, self.bodies.len()))
+    /// A mark that changes with every name, every step and every copy, every body named or
+    /// not: while it is the same, no body was touched but by the integrator, which runs
+    /// once a step.
+    pub(super) fn mark(&self) -> (u64, u64, u64) {
+        (self.serial, self.steps, self.touches)
     }
 
     /// The bodies named since the step before last ended, repeats and gone bodies included
@@ -98,6 +102,7 @@ impl Disturbed {
     /// become "all" (a reader would compare every body anyway).
     #[inline]
     pub(super) fn name(&mut self, e: Entity, len: usize) {
+        self.touches += 1;
         if self.full {
             return;
         }
@@ -110,6 +115,7 @@ impl Disturbed {
 
     /// Names every body.
     fn name_all(&mut self) {
+        self.touches += 1;
         if !self.full {
             self.bodies.push(ALL);
             self.full = true;
@@ -140,7 +146,9 @@ impl World {
     /// Names body `i` as touched by something other than the usual integration.
     #[inline]
     pub(crate) fn disturb(&mut self, i: usize) {
-        if !self.disturbed.full {
+        if self.disturbed.full {
+            self.disturbed.touches += 1;
+        } else {
             let e = self.entity[i];
             self.disturbed.name(e, self.entity.len());
         }

@@ -227,8 +227,7 @@ impl World {
     pub(crate) fn active_not_inside(&self, min: Vec2, max: Vec2, out: &mut Vec<u32>) {
         let kept = &self.kept_outside;
         let bits = |v: Vec2| [v.x.to_bits(), v.y.to_bits()];
-        if kept.mark.is_some()
-            && kept.mark == self.disturbed.mark()
+        if kept.mark == Some(self.disturbed.mark())
             && bits(kept.min) == bits(min)
             && bits(kept.max) == bits(max)
         {
@@ -258,7 +257,7 @@ impl World {
                 .filter(|&&i| outside(&position[i as usize])),
         );
         (kept.min, kept.max) = (min, max);
-        kept.mark = self.disturbed.mark();
+        kept.mark = Some(self.disturbed.mark());
     }
 
     /// [`World::active_not_inside`]'s loop.
@@ -306,7 +305,7 @@ pub(super) fn any_in_blocks<T>(column: &[T], on: impl Fn(&T) -> bool) -> bool {
 /// the mark of what the world had touched then ([`super::Disturbed`]).
 #[derive(Clone, Debug, Default)]
 pub(super) struct KeptOutside {
-    mark: Option<(u64, usize)>,
+    mark: Option<(u64, u64, u64)>,
     min: Vec2,
     max: Vec2,
     list: Vec<u32>,
