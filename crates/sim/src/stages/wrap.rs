@@ -81,6 +81,30 @@ pub(crate) struct Seam {
     /// Moving bodies (places in the entries) outside the guessed edges.
     candidates: Vec<u32>,
     found: Vec<(u32, u32)>,
+    /// The pairs met through the seam, sorted apart ([`merge_tail`]).
+    tail: Vec<(u32, u32)>,
+}
+
+/// Sorts `v`, whose items before `sorted` are in order already: the rest (the few pairs met
+/// through the seam, after thousands) are sorted apart into `buffer` and merged in from the
+/// back, an item of the front moved once at most. The order of sorting the whole of `v`
+/// (items that compare equal are equal), without sorting it again.
+fn merge_tail<T: Copy + Ord>(v: &mut [T], sorted: usize, buffer: &mut Vec<T>) {
+    debug_assert!(v[..sorted].is_sorted(), "the front is in order");
+    buffer.clear();
+    buffer.extend_from_slice(&v[sorted..]);
+    buffer.sort_unstable();
+    // `v[..front]` is what is left of the front; every place from `free` on is written.
+    let (mut front, mut free) = (sorted, v.len());
+    for &x in buffer.iter().rev() {
+        while front > 0 && v[front - 1] > x {
+            front -= 1;
+            free -= 1;
+            v[free] = v[front];
+        }
+        free -= 1;
+        v[free] = x;
+    }
 }
 
 /// `p` wrapped into `[min, max)` on one axis (`size = max - min`). `rem_euclid` is exact
@@ -171,6 +195,7 @@ impl Seam {
             guess_hi: Vec2::ZERO,
             candidates: Vec::new(),
             found: Vec::new(),
+            tail: Vec::new(),
         }
     }
 
@@ -329,7 +354,7 @@ impl Seam {
         }
         self.found = found;
         if pairs.len() > before {
-            pairs.sort_unstable_by_key(|&(i, j)| (u64::from(i) << 32) | u64::from(j));
+            merge_tail(pairs, before, &mut self.tail);
             pairs.dedup();
         }
     }
@@ -354,5 +379,31 @@ impl Seam {
         (1..9)
             .filter(move |k| mask & (1 << k) != 0)
             .map(|k| self.offsets[k])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use proptest::prelude::*;
+
+    use super::merge_tail;
+
+    proptest! {
+        /// A sorted front and any tail come out as the whole sorted: tails before, between,
+        /// after and equal to the front's items, empty fronts and tails.
+        #[test]
+        fn a_merged_tail_is_the_whole_sorted(
+            mut front in prop::collection::vec((0..40u32, 0..40u32), 0..60),
+            tail in prop::collection::vec((0..40u32, 0..40u32), 0..12),
+        ) {
+            front.sort_unstable();
+            let sorted = front.len();
+            let mut v = front;
+            v.extend(&tail);
+            let mut want = v.clone();
+            want.sort_unstable();
+            merge_tail(&mut v, sorted, &mut Vec::new());
+            prop_assert_eq!(v, want);
+        }
     }
 }
