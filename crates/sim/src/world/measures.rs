@@ -4,6 +4,7 @@
 use ricochet_geom::{Shape, Vec2};
 
 use super::World;
+use super::runs::RowRun;
 use crate::def::BodyKind;
 
 impl World {
@@ -60,7 +61,12 @@ impl World {
     /// Kinetic energy of the dynamic bodies, `sum(m v² / 2)` (translation only).
     #[must_use]
     pub fn kinetic_energy(&self) -> f64 {
-        if let Some(run) = self.row_run(&self.movers) {
+        self.energy_sum(self.row_run(&self.movers))
+    }
+
+    /// [`World::kinetic_energy`], given [`World::row_run`] of the movers.
+    fn energy_sum(&self, run: Option<RowRun>) -> f64 {
+        if let Some(run) = run {
             // One run (`runs.rs`): the same terms, in the same order, read in place.
             let rows = &self.rows;
             return self.kind[run.indices()]
@@ -87,7 +93,9 @@ impl World {
             );
             return kept;
         }
-        let e = self.kinetic_energy();
+        // The movers' run as kept (`runs.rs`), not found again by a scan of their rows.
+        let run = self.movers_run();
+        let e = self.energy_sum(run);
         self.kept_energy = Some(e);
         e
     }
