@@ -90,13 +90,21 @@ impl Reach {
     #[inline]
     fn of(b: &Bounds, inv_h: f64) -> Reach {
         let lower = cell_coord(b.min.y, inv_h);
-        let top = cell_coord(b.max.y, inv_h);
-        // `top` is `lower` or `lower + 1` for every box at most `H` tall; anything else is a
-        // box that overlaps nothing (NaN maps to strip 0).
+        // The top's strip, `cell_coord(b.max.y)`, is `lower` or `lower + 1` for every box at
+        // most `H` tall (anything else is a box that overlaps nothing: NaN maps to strip 0),
+        // so only whether it reaches `lower + 1` is asked: the clamped top against that
+        // integer (exact in an `f64`), without a second cast. A top clamped to `i32::MAX`
+        // reaches no strip past it, as the cast's `lower + 1` would not.
         let ordered = b.min.y <= b.max.y;
-        let two = ordered && i64::from(top) == i64::from(lower) + 1;
+        let top = (b.max.y * inv_h).min(f64::from(i32::MAX));
+        let two = ordered && top >= f64::from(lower) + 1.0;
+        debug_assert_eq!(
+            two,
+            ordered && i64::from(cell_coord(b.max.y, inv_h)) == i64::from(lower) + 1,
+            "the top's strip, without the cast"
+        );
         debug_assert!(
-            top == lower || two || !ordered,
+            !ordered || cell_coord(b.max.y, inv_h) == lower || two,
             "H is at least as tall as every body"
         );
         Reach { lower, two }
