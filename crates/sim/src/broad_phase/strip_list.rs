@@ -174,6 +174,20 @@ fn run_length(rest: &[Slot], strip: i32) -> usize {
     known + rest[known..end].partition_point(|s| s.strip() == strip)
 }
 
+/// `rest.partition_point(|&s| s < f)` (`rest` sorted) by a galloping search: a step that
+/// doubles while the slot it lands on is still below `f`, then a binary search in the last
+/// step. About `2 log2(answer)` reads, all near the start.
+fn first_not_below(rest: &[Slot], f: Slot) -> usize {
+    // Every slot before `below` is below `f`; the slot at `step - 1`, if any, is not.
+    let (mut below, mut step) = (0, 1);
+    while step <= rest.len() && rest[step - 1] < f {
+        below = step;
+        step *= 2;
+    }
+    let end = (step - 1).min(rest.len());
+    below + rest[below..end].partition_point(|&s| s < f)
+}
+
 /// What a sweep reads of a body, in list order.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Swept {
@@ -329,13 +343,14 @@ impl StripList {
         self.fresh.sort_unstable();
         self.merged.clear();
         self.merged.reserve(self.order.len() + self.fresh.len());
-        // A few fresh slots among thousands: each finds its place by binary search and the
-        // slots between are copied as one block. The order is total (`local` breaks ties),
-        // so this is the one merge of the two lists.
+        // A few fresh slots among thousands: each finds its place by a galloping search from
+        // the last one's (near it, in memory about to be copied: a binary search over the
+        // rest missed the cache at each step) and the slots between are copied as one
+        // block. The order is total (`local` breaks ties), so this is the one merge of the
+        // two lists.
         let mut from = 0;
         for &f in &self.fresh {
-            let rest = &self.order[from..];
-            let at = from + rest.partition_point(|&s| s < f);
+            let at = from + first_not_below(&self.order[from..], f);
             self.merged.extend_from_slice(&self.order[from..at]);
             self.merged.push(f);
             from = at;
@@ -428,7 +443,7 @@ impl StripList {
 mod tests {
     use proptest::prelude::*;
 
-    use super::{Slot, run_length};
+    use super::{Slot, first_not_below, run_length};
 
     proptest! {
         /// The galloping search ends each run where a scan slot by slot does: runs of one
@@ -452,6 +467,20 @@ mod tests {
                 let scanned = order[k..].iter().take_while(|s| s.strip() == strip).count();
                 prop_assert_eq!(run_length(&order[k..], strip), scanned);
                 k += scanned;
+            }
+        }
+    }
+
+    /// The merge's galloping search finds where a binary search does: before every slot,
+    /// between any two, after all, and on a slot equal to the one looked for.
+    #[test]
+    fn a_fresh_slot_goes_where_a_binary_search_puts_it() {
+        for len in 0..70u64 {
+            let order: Vec<Slot> = (0..len).map(|k| Slot::new(0, 2 * k, 0)).collect();
+            for x in 0..2 * len + 2 {
+                let f = Slot::new(0, x, 0);
+                let want = order.partition_point(|&s| s < f);
+                assert_eq!(first_not_below(&order, f), want, "{x} among {len}");
             }
         }
     }
