@@ -125,10 +125,12 @@ pub struct World {
     /// Whether [`World::set_shape`] ever ran: until then every body has the shape it was
     /// spawned with (a snapshot compares shapes only after it).
     reshaped: bool,
-    /// Counts every body added or removed or given another look: while it stays,
-    /// `entity`, `layer` and the look ids are the same, and kept frames share one copy of
-    /// them (`history.rs`). A world a restore builds or patches takes a number never used
-    /// before ([`crate::interned::next_serial`]): it is another world.
+    /// A number taken anew ([`crate::interned::next_serial`], never used before in the
+    /// process) whenever a body is added or removed or given another look, and by a world a
+    /// restore builds or patches: while it stays, `entity`, `layer` and the look ids are the
+    /// same, and kept frames share one copy of them (`history.rs`). Counting up by one
+    /// instead could reach a number a restore took, and a kept answer would be taken for
+    /// another order of the bodies.
     layout: u64,
     /// The bodies touched other than by the usual integration ([`World::disturbed`]).
     disturbed: Disturbed,
@@ -316,7 +318,7 @@ impl World {
     /// Creates body `e` (an id the caller took from the allocator, or a restored one) at its
     /// place in id order.
     fn insert(&mut self, e: Entity, def: &BodyDef) {
-        self.layout += 1;
+        self.layout = crate::interned::next_serial();
         self.kept_energy = None;
         let i = self.entity.partition_point(|x| *x < e);
         self.entity.insert(i, e);
@@ -392,7 +394,7 @@ impl World {
 
     /// Removes the body at dense index `i`, keeping the order of the rest.
     pub fn despawn(&mut self, i: usize) {
-        self.layout += 1;
+        self.layout = crate::interned::next_serial();
         self.kept_energy = None;
         self.disturb(i);
         let e = self.entity.remove(i);

@@ -34,7 +34,7 @@ impl World {
     /// [`World::static_generation`] (re-indexed by the broad phase and the per-axis stages)
     /// and wakes every sleeper, a moving body wakes.
     pub fn set_shape(&mut self, i: usize, shape: &Shape) {
-        self.layout += 1;
+        self.layout = crate::interned::next_serial();
         self.reshaped = true;
         let old = self.shape_id[i];
         let layer = usize::from(self.layer[i]);
@@ -81,7 +81,7 @@ impl World {
     /// Renames body `i` (tests: no stage renames a body).
     #[cfg(test)]
     pub(crate) fn set_name(&mut self, i: usize, name: &str) {
-        self.layout += 1;
+        self.layout = crate::interned::next_serial();
         let old = self.shape_id[i];
         let id = self.names.acquire(name, || ());
         shape_key(&self.shapes.get(old).0, &mut self.key);
