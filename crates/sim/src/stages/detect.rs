@@ -83,6 +83,9 @@ pub(crate) struct DetectState {
     static_generation: Option<u64>,
     /// Bumped whenever `statics` is rebuilt: the broad phase's static generation.
     statics_version: u64,
+    /// The world index of each of `statics`, with the world's layout and the
+    /// `statics_version` it was found at.
+    static_index: (Option<(u64, u64)>, Vec<u32>),
     statics: Vec<BodyEntry>,
     movers: Vec<BodyEntry>,
     pairs: Vec<(u32, u32)>,
@@ -116,6 +119,7 @@ impl DetectState {
                 .collect(),
             static_generation: None,
             statics_version: 0,
+            static_index: (None, Vec::new()),
             statics: Vec::new(),
             movers: Vec::new(),
             pairs: Vec::new(),
@@ -231,14 +235,26 @@ fn candidate_pairs(ctx: &mut StageCtx, st: &mut DetectState) -> Vec<(u32, u32)> 
         w.some_mover_entries(widen, &mut st.movers, not_made, |_, _| false, None);
     }
     {
-        let (movers, statics) = (w.movers(), &st.statics);
+        // Each static body's world index, found again only when the bodies' order or the
+        // static list changed: a search of the entity column a static pair missed the
+        // cache at each step.
+        let at = (w.layout(), st.statics_version);
+        if st.static_index.0 != Some(at) {
+            st.static_index.1.clear();
+            st.static_index.1.extend(st.statics.iter().map(|s| {
+                // Every static body in `statics` is alive: it was rebuilt since the last
+                // change.
+                w.index_of_key(s.key).map_or(u32::MAX, |i| i as u32)
+            }));
+            st.static_index.0 = Some(at);
+        }
+        let (movers, static_index) = (w.movers(), &st.static_index.1);
         let world_index = |h: u32| -> u32 {
             if h & STATIC_BIT == 0 {
-                return movers[h as usize];
+                movers[h as usize]
+            } else {
+                static_index[(h & !STATIC_BIT) as usize]
             }
-            let key = statics[(h & !STATIC_BIT) as usize].key;
-            // Every static body in `statics` is alive: it was rebuilt since the last change.
-            w.index_of_key(key).map_or(u32::MAX, |i| i as u32)
         };
         for p in &mut pairs {
             let (i, j) = (world_index(p.0), world_index(p.1));
