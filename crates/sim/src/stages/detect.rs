@@ -236,8 +236,8 @@ fn candidate_pairs(ctx: &mut StageCtx, st: &mut DetectState) -> Vec<(u32, u32)> 
     }
     {
         // Each static body's world index, found again only when the bodies' order or the
-        // static list changed: a search of the entity column a static pair missed the
-        // cache at each step.
+        // static list changed. Before, every pair with a static body searched the entity
+        // column for it, a cache miss at each step of the search.
         let at = (w.layout(), st.statics_version);
         if st.static_index.0 != Some(at) {
             st.static_index.1.clear();
