@@ -1,6 +1,7 @@
 //! What the broad phase's kept, sorted lists (`sort_and_sweep.rs`, `strip_list.rs`) share:
 //! the integer key of an `f64` coordinate, the insertion sort that brings a nearly sorted
-//! list back in order, and the match of a list's bodies with this call's.
+//! list back in order, the galloping search for a place near the start, and the match of a
+//! list's bodies with this call's.
 
 use std::cmp::Ordering;
 
@@ -37,6 +38,22 @@ pub(super) fn match_keys(
 pub(super) fn order_key(x: f64) -> u64 {
     let bits = x.to_bits();
     bits ^ (((bits as i64 >> 63) as u64) | (1 << 63))
+}
+
+/// `list.partition_point(pred)` by a galloping search from the start: a step that doubles
+/// while the item it lands on still has `pred`, then a binary search in the last step.
+/// About `2 log2(answer)` reads, all near the start: where the answer is near (a run of one
+/// strip, the place of the next of a few sorted items among thousands), a binary search
+/// over the whole list would miss the cache at each step.
+pub(super) fn gallop<T>(list: &[T], pred: impl Fn(&T) -> bool) -> usize {
+    // Every item before `below` has `pred`; the item at `step - 1`, if any, has not.
+    let (mut below, mut step) = (0, 1);
+    while step <= list.len() && pred(&list[step - 1]) {
+        below = step;
+        step *= 2;
+    }
+    let end = (step - 1).min(list.len());
+    below + list[below..end].partition_point(pred)
 }
 
 /// Insertion sort of a nearly sorted list by `cmp` (a total order); `placed(item, index)`

@@ -160,34 +160,6 @@ impl Slot {
     const GONE: Slot = Slot(u128::MAX);
 }
 
-/// How many slots at the start of `rest` (sorted, `rest[0]` of `strip`) are of `strip`: a
-/// galloping search, doubling its step while the slot it lands on is still of `strip`, then
-/// a binary search in the last step.
-fn run_length(rest: &[Slot], strip: i32) -> usize {
-    // Every slot before `known` is of `strip`; the slot at `step`, if any, is not.
-    let (mut known, mut step) = (1, 1);
-    while step < rest.len() && rest[step].strip() == strip {
-        known = step + 1;
-        step *= 2;
-    }
-    let end = step.min(rest.len());
-    known + rest[known..end].partition_point(|s| s.strip() == strip)
-}
-
-/// `rest.partition_point(|&s| s < f)` (`rest` sorted) by a galloping search: a step that
-/// doubles while the slot it lands on is still below `f`, then a binary search in the last
-/// step. About `2 log2(answer)` reads, all near the start.
-fn first_not_below(rest: &[Slot], f: Slot) -> usize {
-    // Every slot before `below` is below `f`; the slot at `step - 1`, if any, is not.
-    let (mut below, mut step) = (0, 1);
-    while step <= rest.len() && rest[step - 1] < f {
-        below = step;
-        step *= 2;
-    }
-    let end = (step - 1).min(rest.len());
-    below + rest[below..end].partition_point(|&s| s < f)
-}
-
 /// What a sweep reads of a body, in list order.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Swept {
@@ -350,7 +322,7 @@ impl StripList {
         // two lists.
         let mut from = 0;
         for &f in &self.fresh {
-            let at = from + first_not_below(&self.order[from..], f);
+            let at = from + sorted::gallop(&self.order[from..], |&s| s < f);
             self.merged.extend_from_slice(&self.order[from..at]);
             self.merged.push(f);
             from = at;
@@ -386,7 +358,7 @@ impl StripList {
         while k < self.order.len() {
             let strip = self.order[k].strip();
             self.runs.push((strip, k as u32));
-            k += run_length(&self.order[k..], strip);
+            k += sorted::gallop(&self.order[k..], |s| s.strip() == strip);
         }
         self.runs.push((i32::MAX, self.order.len() as u32));
         #[cfg(debug_assertions)]
@@ -443,7 +415,8 @@ impl StripList {
 mod tests {
     use proptest::prelude::*;
 
-    use super::{Slot, first_not_below, run_length};
+    use super::Slot;
+    use crate::broad_phase::sorted::gallop;
 
     proptest! {
         /// The galloping search ends each run where a scan slot by slot does: runs of one
@@ -465,7 +438,7 @@ mod tests {
             while k < order.len() {
                 let strip = order[k].strip();
                 let scanned = order[k..].iter().take_while(|s| s.strip() == strip).count();
-                prop_assert_eq!(run_length(&order[k..], strip), scanned);
+                prop_assert_eq!(gallop(&order[k..], |s| s.strip() == strip), scanned);
                 k += scanned;
             }
         }
@@ -480,7 +453,7 @@ mod tests {
             for x in 0..2 * len + 2 {
                 let f = Slot::new(0, x, 0);
                 let want = order.partition_point(|&s| s < f);
-                assert_eq!(first_not_below(&order, f), want, "{x} among {len}");
+                assert_eq!(gallop(&order, |&s| s < f), want, "{x} among {len}");
             }
         }
     }
@@ -491,7 +464,11 @@ mod tests {
             for tail in 0..3 {
                 let mut order: Vec<Slot> = (0..len).map(|k| Slot::new(5, k, k as u32)).collect();
                 order.extend((0..tail).map(|k| Slot::new(6, k, (len + k) as u32)));
-                assert_eq!(run_length(&order, 5), len as usize, "{len} then {tail}");
+                assert_eq!(
+                    gallop(&order, |s| s.strip() == 5),
+                    len as usize,
+                    "{len} then {tail}"
+                );
             }
         }
     }

@@ -83,9 +83,8 @@ pub(crate) struct DetectState {
     static_generation: Option<u64>,
     /// Bumped whenever `statics` is rebuilt: the broad phase's static generation.
     statics_version: u64,
-    /// The world index of each of `statics`, with the world's layout and the
-    /// `statics_version` it was found at.
-    static_index: (Option<(u64, u64)>, Vec<u32>),
+    /// The world index of each of `statics`.
+    static_index: StaticIndex,
     statics: Vec<BodyEntry>,
     movers: Vec<BodyEntry>,
     pairs: Vec<(u32, u32)>,
@@ -119,7 +118,7 @@ impl DetectState {
                 .collect(),
             static_generation: None,
             statics_version: 0,
-            static_index: (None, Vec::new()),
+            static_index: StaticIndex::default(),
             statics: Vec::new(),
             movers: Vec::new(),
             pairs: Vec::new(),
@@ -131,6 +130,34 @@ impl DetectState {
             moved: Vec::new(),
             push_statics: Statics::default(),
         }
+    }
+}
+
+/// The world index of each body of `detect`'s static list, found again only when the
+/// bodies' order ([`World::layout`]) or the list changed. Before, every pair with a static
+/// body searched the entity column for it, a cache miss at each step of the search.
+#[derive(Debug, Clone, Default)]
+struct StaticIndex {
+    /// The layout and the list's version the indices were found at.
+    at: Option<(u64, u64)>,
+    index: Vec<u32>,
+}
+
+impl StaticIndex {
+    /// The world index of each of `statics` (of version `version`) in `w`.
+    fn of(&mut self, w: &World, statics: &[BodyEntry], version: u64) -> &[u32] {
+        let at = (w.layout(), version);
+        if self.at != Some(at) {
+            self.index.clear();
+            // Every static body in `statics` is alive: it was rebuilt since the last change.
+            self.index.extend(
+                statics
+                    .iter()
+                    .map(|s| w.index_of_key(s.key).map_or(u32::MAX, |i| i as u32)),
+            );
+            self.at = Some(at);
+        }
+        &self.index
     }
 }
 
@@ -235,20 +262,8 @@ fn candidate_pairs(ctx: &mut StageCtx, st: &mut DetectState) -> Vec<(u32, u32)> 
         w.some_mover_entries(widen, &mut st.movers, not_made, |_, _| false, None);
     }
     {
-        // Each static body's world index, found again only when the bodies' order or the
-        // static list changed. Before, every pair with a static body searched the entity
-        // column for it, a cache miss at each step of the search.
-        let at = (w.layout(), st.statics_version);
-        if st.static_index.0 != Some(at) {
-            st.static_index.1.clear();
-            st.static_index.1.extend(st.statics.iter().map(|s| {
-                // Every static body in `statics` is alive: it was rebuilt since the last
-                // change.
-                w.index_of_key(s.key).map_or(u32::MAX, |i| i as u32)
-            }));
-            st.static_index.0 = Some(at);
-        }
-        let (movers, static_index) = (w.movers(), &st.static_index.1);
+        let static_index = st.static_index.of(w, &st.statics, st.statics_version);
+        let movers = w.movers();
         let world_index = |h: u32| -> u32 {
             if h & STATIC_BIT == 0 {
                 movers[h as usize]
