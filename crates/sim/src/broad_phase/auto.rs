@@ -25,7 +25,17 @@ impl BroadPhase {
             return BroadPhaseKind::BruteForce;
         }
         if indexed >= movers {
-            return BroadPhaseKind::Grid;
+            // A band around the world's edge (the wrap seam's bodies and their images)
+            // spans every row of the world while holding few bodies: its own grid of
+            // them, hashed anew each call, cost more than filing them in strips, where
+            // each finds its static candidates by binary search in its strip's run
+            // (rain-10000's seam: 145,000 instructions a frame fewer of 7,560,000; the
+            // platformer's 10,000 tiles: 5,000 more of 4,075,000).
+            return if self.band {
+                BroadPhaseKind::Strips
+            } else {
+                BroadPhaseKind::Grid
+            };
         }
         for &l in &self.mover_layers {
             let handles = of_layer(&self.movers, &self.layer_start, l);
@@ -183,6 +193,49 @@ mod tests {
         bp.set_inert_statics(1_000_000, &[1]);
         assert_eq!(pick(&mut bp, &[], &movers), BroadPhaseKind::SortAndSweep);
         assert!((bp.sweep_overlaps() - 0.8 * N as f64 / 3000.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_band_takes_strips_where_others_take_the_grid() {
+        let movers = row(N, 0.8, 3000.0, 0, 10_000);
+        // A static box on each mover, a little to its right, and the unit tiles below.
+        let mut statics: Vec<BodyEntry> = movers
+            .iter()
+            .enumerate()
+            .map(|(i, m)| BodyEntry {
+                key: i as u64,
+                bounds: m.bounds.translated(Vec2::new(0.5, 0.25)),
+                layer: 1,
+                kind: BodyKind::Static,
+            })
+            .collect();
+        statics.extend(tiles(N).into_iter().map(|t| BodyEntry {
+            key: t.key + N as u64,
+            ..t
+        }));
+        let all = Interactions::all(2);
+        let mut band = BroadPhase::for_band(BroadPhaseKind::Auto);
+        let mut found = Vec::new();
+        let stats = band.pairs_split(&statics, 1, &movers, &all, &mut found);
+        assert_eq!(stats.kind, BroadPhaseKind::Strips);
+        // The same pairs as the grid's: one for each mover.
+        let mut grid = BroadPhase::new(BroadPhaseKind::Auto);
+        let mut want = Vec::new();
+        let stats = grid.pairs_split(&statics, 1, &movers, &all, &mut want);
+        assert_eq!(stats.kind, BroadPhaseKind::Grid);
+        assert_eq!(want.len(), N);
+        assert_eq!(found, want);
+        // Otherwise the band's rule is everybody's.
+        let mut band = BroadPhase::for_band(BroadPhaseKind::Auto);
+        assert_eq!(
+            pick(&mut band, &tiles(N - 1), &movers),
+            BroadPhaseKind::SortAndSweep
+        );
+        let mut band = BroadPhase::for_band(BroadPhaseKind::Auto);
+        assert_eq!(
+            pick(&mut band, &tiles(12), &row(20, 1.0, 100.0, 0, 100)),
+            BroadPhaseKind::BruteForce
+        );
     }
 
     #[test]

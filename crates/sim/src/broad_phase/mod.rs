@@ -84,7 +84,10 @@
 //! count them.
 //! - at most 32 bodies given in all: `BruteForce` (at most 496 tests, no structure to keep);
 //! - at least as many indexed static as moving bodies: `Grid` (a static cell lookup is
-//!   `O(1)` where the static tree is `O(log n)`, and the static grid is built once);
+//!   `O(1)` where the static tree is `O(log n)`, and the static grid is built once); but
+//!   `Strips` for a band along the world's edge (the wrap seam's, `BroadPhase::for_band`:
+//!   few bodies over every row of the world, whose own grid, hashed anew each call, cost
+//!   more than filing them in strips);
 //! - a layer of at least [`CROWD`] moving bodies that interact with each other, on which
 //!   sort and sweep would test each body against at least [`STRIPS_ENTER`] others along x:
 //!   `Strips`. The estimate is `n w / X` for the layer's `n` bodies of mean width `w` over
@@ -216,6 +219,9 @@ pub struct BroadPhase {
     chosen: BroadPhaseKind,
     /// `Auto`'s last estimate of sort and sweep's x-overlaps per body (`auto.rs`).
     overlaps: f64,
+    /// The moving bodies given are a band around the world's edge (the wrap seam's,
+    /// [`BroadPhase::for_band`]): `Auto` takes `Strips` where it would take `Grid`.
+    band: bool,
     /// Calls made, to know which per-layer structures are current.
     frame: u64,
     statics: StaticSet,
@@ -283,6 +289,7 @@ impl BroadPhase {
             kind,
             chosen: kind,
             overlaps: 0.0,
+            band: false,
             frame: 0,
             statics: StaticSet::default(),
             static_rebuilds: 0,
@@ -301,6 +308,16 @@ impl BroadPhase {
             static_extent: (0.0, 0.0),
             scratch: Scratch::default(),
             filter: CellFilter::default(),
+        }
+    }
+
+    /// A broad phase using `kind` for the moving bodies of a band along the world's edge and
+    /// their images across it (the wrap seam's): with more indexed static bodies than
+    /// moving ones, `Auto` takes `Strips`, not `Grid` (see `auto.rs`).
+    pub(crate) fn for_band(kind: BroadPhaseKind) -> BroadPhase {
+        BroadPhase {
+            band: true,
+            ..BroadPhase::new(kind)
         }
     }
 

@@ -183,7 +183,7 @@ impl Seam {
     /// The seam of a world whose broad phase is `kind`.
     pub(crate) fn new(kind: BroadPhaseKind) -> Seam {
         Seam {
-            broad_phase: BroadPhase::new(kind),
+            broad_phase: BroadPhase::for_band(kind),
             offsets: [Vec2::ZERO; 9],
             entries: Vec::new(),
             bodies: Vec::new(),
