@@ -241,6 +241,20 @@ impl Polygon {
     pub fn vertices(&self) -> &[Vec2] {
         &self.vertices[..self.count]
     }
+
+    /// Where the polygon is held: its whole fixed arrays of vertices and normals (past the
+    /// count too) and its count, reached without reading any of them. For a prefetch,
+    /// which asks for memory before it is read: [`Polygon::vertices`] reads the count.
+    #[must_use]
+    pub fn storage(
+        &self,
+    ) -> (
+        &[Vec2; MAX_POLYGON_VERTICES],
+        &[Vec2; MAX_POLYGON_VERTICES],
+        &usize,
+    ) {
+        (&self.vertices, &self.normals, &self.count)
+    }
 }
 
 /// One convex piece: every shape kind except a compound.

@@ -213,6 +213,14 @@ impl ShapeTable {
         self.entries[id as usize].as_ref().expect("an id in use")
     }
 
+    /// Asks for the first cache line of `id`'s entry, without reading it (`prefetch.rs`).
+    #[inline]
+    pub(crate) fn prefetch(&self, id: u32) {
+        if let Some(entry) = self.entries.get(id as usize) {
+            crate::prefetch::line_of(entry);
+        }
+    }
+
     /// The shape and bounds of `id`, if it is in use.
     pub(crate) fn try_get(&self, id: u32) -> Option<&(Shape, Bounds)> {
         self.entries.get(id as usize)?.as_ref()

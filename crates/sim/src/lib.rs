@@ -184,6 +184,7 @@ mod load;
 mod output;
 mod parallel;
 mod pipeline;
+mod prefetch;
 pub mod prelude;
 mod query;
 mod reads;
