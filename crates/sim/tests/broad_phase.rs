@@ -71,10 +71,21 @@ fn make_bounds(family: u8, cx: i8, cy: i8, hx: u8, hy: u8) -> Bounds {
             min: Vec2::new(f64::NEG_INFINITY, cy),
             max: Vec2::new(cx, cy + hy),
         },
-        18 => Bounds {
-            min: Vec2::new(f64::NAN, cy),
-            max: Vec2::new(cx, cy + hy),
-        },
+        // A NaN in one coordinate or another: `min.x`, `max.x` or `max.y`.
+        18 => {
+            let mut b = Bounds {
+                min: Vec2::new(cx, cy),
+                max: Vec2::new(cx + hx, cy + hy),
+            };
+            if hy < 2.0 {
+                b.min.x = f64::NAN;
+            } else if hy < 4.0 {
+                b.max.x = f64::NAN;
+            } else {
+                b.max.y = f64::NAN;
+            }
+            b
+        }
         _ => lattice(0.25, 0.5, 0.5),
     }
 }

@@ -40,6 +40,15 @@ pub(super) fn order_key(x: f64) -> u64 {
     bits ^ (((bits as i64 >> 63) as u64) | (1 << 63))
 }
 
+/// The number whose [`order_key`] is `key`, to the bit.
+#[inline]
+pub(super) fn from_order_key(key: u64) -> f64 {
+    // A key with its top bit set is a number with its sign bit clear, whose key only
+    // flipped that bit; the others had every bit flipped.
+    let flip = if key >> 63 == 1 { 1 << 63 } else { u64::MAX };
+    f64::from_bits(key ^ flip)
+}
+
 /// `list.partition_point(pred)` by a galloping search from the start: a step that doubles
 /// while the item it lands on still has `pred`, then a binary search in the last step.
 /// About `2 log2(answer)` reads, all near the start: where the answer is near (a run of one
@@ -89,4 +98,34 @@ pub(super) fn insertion_sort<T: Copy>(
         }
     }
     moved
+}
+
+#[cfg(test)]
+mod tests {
+    use proptest::prelude::*;
+
+    use super::{from_order_key, order_key};
+
+    proptest! {
+        /// `from_order_key` undoes `order_key` to the bit, NaNs and signed zeros included.
+        #[test]
+        fn a_key_gives_its_number_back(bits in any::<u64>()) {
+            let x = f64::from_bits(bits);
+            prop_assert_eq!(from_order_key(order_key(x)).to_bits(), bits);
+        }
+    }
+
+    #[test]
+    fn a_key_gives_back_zeros_and_infinities() {
+        for x in [
+            0.0,
+            -0.0,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::MIN_POSITIVE,
+            -1.5,
+        ] {
+            assert_eq!(from_order_key(order_key(x)).to_bits(), x.to_bits());
+        }
+    }
 }

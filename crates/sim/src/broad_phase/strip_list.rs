@@ -160,24 +160,51 @@ impl Slot {
     const GONE: Slot = Slot(u128::MAX);
 }
 
-/// What a sweep reads of a body, in list order.
+/// What a sweep reads of a body, in list order: 40 bytes, where the bounds alone are 32 (the
+/// gather writes every slot each frame and the sweeps read them; 16 bytes more cost rain-10000
+/// 1% to 5%).
+///
+/// Along x only the two keys: `min <= max` of two of them is `min.x <= max.x` of the
+/// numbers (`max.x + 0.0` makes no `-0.0` that `total_cmp` would put first). A box with a
+/// NaN anywhere overlaps nothing, as `Bounds::overlaps` says: its `min_y` is NaN, so every
+/// comparison of its `y` range is false.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Swept {
     /// `min.x` as [`order_key`].
     pub(super) min: u64,
     /// `max.x + 0.0` as [`order_key`].
     pub(super) max: u64,
-    pub(super) m: Member,
+    /// `min.y`, or NaN when the box holds a NaN.
+    pub(super) min_y: f64,
+    /// `max.y`.
+    pub(super) max_y: f64,
+    /// The body's handle ([`Member::handle`]).
+    pub(super) handle: u32,
+    /// Whether the body is dynamic.
+    pub(super) dynamic: bool,
 }
+
+const _: () = assert!(size_of::<Swept>() == 40, "a slot of the sweeps stays lean");
 
 impl Swept {
     #[inline]
     fn new(m: Member) -> Swept {
+        let b = &m.bounds;
+        let numbers = !(b.min.x.is_nan() || b.max.x.is_nan() || b.max.y.is_nan());
         Swept {
-            min: order_key(m.bounds.min.x),
-            max: order_key(m.bounds.max.x + 0.0),
-            m,
+            min: order_key(b.min.x),
+            max: order_key(b.max.x + 0.0),
+            min_y: if numbers { b.min.y } else { f64::NAN },
+            max_y: b.max.y,
+            handle: m.handle,
+            dynamic: m.dynamic,
         }
+    }
+
+    /// `min.x` again: [`order_key`] undone, the same bits.
+    #[inline]
+    pub(super) fn min_x(&self) -> f64 {
+        sorted::from_order_key(self.min)
     }
 }
 

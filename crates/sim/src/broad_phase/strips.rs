@@ -51,13 +51,15 @@ impl Sink<'_> {
     /// Tests `p` and `q`, keeping the pair when one is dynamic, their bounds overlap and this
     /// is their strip. Returns the tests (0 or 1).
     #[inline]
-    fn test(&mut self, p: &Member, q: &Member) -> u64 {
+    fn test(&mut self, p: &Swept, q: &Swept) -> u64 {
         if !(p.dynamic || q.dynamic) {
             return 0;
         }
-        if p.bounds.overlaps(&q.bounds) {
+        // `Bounds::overlaps`, x by the keys (`strip_list.rs`, `Swept`).
+        let overlap = p.min <= q.max && q.min <= p.max && p.min_y <= q.max_y && q.min_y <= p.max_y;
+        if overlap {
             // Overlapping bounds hold no NaN.
-            let (a, b) = (p.bounds.min.y, q.bounds.min.y);
+            let (a, b) = (p.min_y, q.min_y);
             let top = if a > b { a } else { b };
             if cell_coord(top, self.inv_h) == self.strip {
                 self.out.push((p.handle, q.handle));
@@ -75,7 +77,7 @@ impl Sink<'_> {
             if s.min > p.max {
                 break;
             }
-            tested += self.test(&p.m, &s.m);
+            tested += self.test(p, s);
         }
         tested
     }
@@ -117,13 +119,13 @@ impl Sink<'_> {
     fn searched(&mut self, small: &[Swept], large: &[Swept], width: f64) -> u64 {
         let mut tested = 0;
         for p in small {
-            let b = &p.m.bounds;
-            if b.min.x.is_nan() {
+            let min_x = p.min_x();
+            if min_x.is_nan() {
                 continue; // overlaps nothing
             }
-            // Slots starting before `lower` end before `b.min.x` (a relative margin far above
+            // Slots starting before `lower` end before `min_x` (a relative margin far above
             // rounding error).
-            let mut lower = b.min.x - width * (1.0 + 1e-12);
+            let mut lower = min_x - width * (1.0 + 1e-12);
             lower -= lower.abs() * 1e-12 + f64::MIN_POSITIVE;
             let lower = order_key(lower);
             let lo = large.partition_point(|s| s.min < lower);
