@@ -138,18 +138,24 @@ impl Core {
 
 /// Calls `f` on the candidate axes of a pair in order (`a`'s, `b`'s, and for two points the
 /// direction between them; a non-finite one, from a degenerate edge, left out) until it
-/// returns `Some`, and returns that. Read in place: nothing is copied.
-#[inline]
+/// returns `Some`, and returns that. Read in place: nothing is copied. Plain loops, always
+/// inlined: through chained iterators, [`min_overlap`] took about 8% more instructions.
+#[inline(always)]
 fn each_axis<T>(a: &Core, b: &Core, mut f: impl FnMut(Vec2) -> Option<T>) -> Option<T> {
     let (mut sa, mut sb) = ([Vec2::ZERO; 2], [Vec2::ZERO; 2]);
-    let between = (a.count == 1 && b.count == 1 && a.points[0] != b.points[0])
-        .then(|| (b.points[0] - a.points[0]).normalize());
-    let (axes_a, axes_b) = (a.axes(&mut sa), b.axes(&mut sb));
-    for &u in axes_a.iter().chain(axes_b).chain(&between) {
-        if u.is_finite()
-            && let Some(t) = f(u)
-        {
-            return Some(t);
+    for axes in [a.axes(&mut sa), b.axes(&mut sb)] {
+        for &u in axes {
+            if u.is_finite()
+                && let Some(t) = f(u)
+            {
+                return Some(t);
+            }
+        }
+    }
+    if a.count == 1 && b.count == 1 && a.points[0] != b.points[0] {
+        let u = (b.points[0] - a.points[0]).normalize();
+        if u.is_finite() {
+            return f(u);
         }
     }
     None
@@ -159,29 +165,9 @@ fn each_axis<T>(a: &Core, b: &Core, mut f: impl FnMut(Vec2) -> Option<T>) -> Opt
 /// (from `a` to `b`) it is reached in; or, as soon as an axis's overlap is below `stop`, that
 /// axis's (the search stops there: the cores are at least that far apart). `None` when there
 /// is no axis at all: two coincident points.
-///
-/// The axes are [`each_axis`]'s, in its order, walked as plain loops over `a`'s and `b`'s.
 fn min_overlap(a: &Core, b: &Core, stop: f64) -> Option<(f64, Vec2)> {
     let mut best: Option<(f64, Vec2)> = None;
-    let (mut sa, mut sb) = ([Vec2::ZERO; 2], [Vec2::ZERO; 2]);
-    for axes in [a.axes(&mut sa), b.axes(&mut sb)] {
-        for &u in axes {
-            if u.is_finite()
-                && let Some(early) = overlap_along(a, b, u, stop, &mut best)
-            {
-                return Some(early);
-            }
-        }
-    }
-    if a.count == 1 && b.count == 1 && a.points[0] != b.points[0] {
-        let u = (b.points[0] - a.points[0]).normalize();
-        if u.is_finite()
-            && let Some(early) = overlap_along(a, b, u, stop, &mut best)
-        {
-            return Some(early);
-        }
-    }
-    best
+    each_axis(a, b, |u| overlap_along(a, b, u, stop, &mut best)).or(best)
 }
 
 /// One axis of [`min_overlap`]: its overlap if below `stop`, else `None` with `best` (the

@@ -135,8 +135,9 @@ impl DetectState {
 }
 
 /// The world index of each body of `detect`'s static list, found again only when the
-/// bodies' order ([`World::layout`]) or the list changed. Before, every pair with a static
-/// body searched the entity column for it, a cache miss at each step of the search.
+/// bodies' order ([`World::layout`]) or the list changed; the main pairs and the wrap seam's
+/// read it. Before, every pair with a static body searched the entity column for it, a
+/// cache miss at each step of the search.
 #[derive(Debug, Clone, Default)]
 struct StaticIndex {
     /// The layout and the list's version the indices were found at.
@@ -262,8 +263,8 @@ fn candidate_pairs(ctx: &mut StageCtx, st: &mut DetectState) -> Vec<(u32, u32)> 
         let widen = (&st.sweeping[..], &st.separate_swept[..]);
         w.some_mover_entries(widen, &mut st.movers, not_made, |_, _| false, None);
     }
+    let static_index = st.static_index.of(w, &st.statics, st.statics_version);
     {
-        let static_index = st.static_index.of(w, &st.statics, st.statics_version);
         let movers = w.movers();
         let world_index = |h: u32| -> u32 {
             if h & STATIC_BIT == 0 {
@@ -283,7 +284,7 @@ fn candidate_pairs(ctx: &mut StageCtx, st: &mut DetectState) -> Vec<(u32, u32)> 
         st.seam.add_pairs(
             &b,
             w,
-            (&st.statics, generation),
+            (&st.statics, generation, static_index),
             &st.movers,
             &st.interactions,
             &mut pairs,

@@ -256,7 +256,7 @@ impl Seam {
     /// through the seam: the images of the moving bodies near an edge (`movers`, whose world
     /// indices are [`World::movers`], each seen by [`Seam::visitor`]) against the near moving
     /// bodies and the static bodies (`statics`, read only when `static_generation`
-    /// changes).
+    /// changes; `static_index` holds the world index of each, as `detect` keeps it).
     ///
     /// Only bodies outside the guessed edges can stick out of the world, so the reach is
     /// measured on them; if it is within the guess, they hold every near body, else (the
@@ -266,7 +266,7 @@ impl Seam {
         &mut self,
         world: &WorldBounds,
         w: &World,
-        (statics, static_generation): (&[BodyEntry], u64),
+        (statics, static_generation, static_index): (&[BodyEntry], u64, &[u32]),
         movers: &[BodyEntry],
         interactions: &Interactions,
         pairs: &mut Vec<(u32, u32)>,
@@ -334,8 +334,7 @@ impl Seam {
         let before = pairs.len();
         let world_index = |h: u32| -> u32 {
             if h & STATIC_BIT != 0 {
-                let key = statics[(h & !STATIC_BIT) as usize].key;
-                w.index_of_key(key).map_or(u32::MAX, |i| i as u32)
+                static_index[(h & !STATIC_BIT) as usize]
             } else {
                 self.bodies[h as usize]
             }
