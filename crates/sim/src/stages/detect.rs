@@ -375,6 +375,12 @@ pub(crate) fn run(
     }
     // Bodies a response of this pass moved: their later pairs are tested again. Only those
     // are set, and cleared after the pass, so a million tiles cost nothing here.
+    // Room at once for about the records this pass makes: the contacts found, and a few
+    // more through the seam (growing the list by doubling copied it about ten times a frame
+    // at rain-10000, and a few records past room for exactly the contacts found copied it
+    // once more).
+    let found = contacts.iter().filter(|c| c.is_some()).count();
+    ctx.out.contacts.reserve(found + found / 8 + 16);
     let (pushed, moved) = (&mut st.pushed, &mut st.moved);
     pushed.resize(ctx.world.len(), false);
     for (k, &(i, j, response)) in plan.iter().enumerate() {
