@@ -63,7 +63,7 @@ pub(super) struct StripList {
     remap: Vec<u32>,
     x: Vec<u64>,
     is_moved: Vec<bool>,
-    moved: Vec<u32>,
+    moved: Vec<(u32, Reach)>,
     fresh: Vec<Slot>,
     merged: Vec<Slot>,
 }
@@ -242,32 +242,14 @@ impl StripList {
     pub(super) fn update(&mut self, handles: &[u32], bodies: &[BodyEntry], inv_h: f64) -> u64 {
         self.inv_h = inv_h;
         self.fresh.clear();
-        self.moved.clear();
-        let same = self.keys.len() == handles.len()
-            && self.reach.len() == handles.len()
-            && handles
-                .iter()
-                .zip(&self.keys)
-                .all(|(&h, &k)| bodies[h as usize].key == k);
-        if !same {
+        // Usually the bodies are the same as last time: their keys are checked in the same
+        // pass that reads their bounds, and only when one differs is the list reconciled
+        // and the pass made again.
+        let same = self.keys.len() == handles.len() && self.reach.len() == handles.len();
+        if !(same && self.read_bodies(handles, bodies, inv_h)) {
             self.reconcile(handles, bodies);
-        }
-        // In key order, in sequence: each body's `min.x` key and the strips it reaches; a
-        // body that reaches other strips than last time (or is new) is `moved`. A slot is
-        // numbers only (strip, key, body), so when `H` changed, a body whose strips have the
-        // same numbers as before keeps its slots.
-        self.x.clear();
-        self.is_moved.clear();
-        for (j, &h) in handles.iter().enumerate() {
-            let b = &bodies[h as usize].bounds;
-            let now = Reach::of(b, inv_h);
-            let moved = now != self.reach[j];
-            if moved {
-                self.reach[j] = now;
-                self.moved.push(j as u32);
-            }
-            self.x.push(order_key(b.min.x));
-            self.is_moved.push(moved);
+            let read = self.read_bodies(handles, bodies, inv_h);
+            debug_assert!(read, "the reconciled keys are the bodies'");
         }
         // In list order: the slots are written in sequence, each reading its body's new key
         // from `x` (8 bytes a body, where the bodies are 48). A moved body's slots leave the
@@ -283,9 +265,9 @@ impl StripList {
             kept += 1;
         }
         self.order.truncate(kept);
-        for &local in &self.moved {
-            let (lower, upper) =
-                Slot::both(self.reach[local as usize], self.x[local as usize], local);
+        for &(local, reach) in &self.moved {
+            self.reach[local as usize] = reach;
+            let (lower, upper) = Slot::both(reach, self.x[local as usize], local);
             self.fresh.push(lower);
             self.fresh.extend(upper);
         }
@@ -293,6 +275,40 @@ impl StripList {
         self.gather(handles, bodies);
         self.find_runs();
         moved
+    }
+
+    /// [`StripList::update`]'s pass over the bodies, in key order, in sequence: each body's
+    /// `min.x` key and the strips it reaches. A body that reaches other strips than last time
+    /// (or is new) is `moved`, with its new reach (written to `reach` once the pass is
+    /// through). A slot is numbers only (strip, key, body), so when `H` changed, a body whose
+    /// strips have the same numbers as before keeps its slots. Returns false, having changed
+    /// nothing the next pass reads, at the first body whose key is not the list's.
+    fn read_bodies(&mut self, handles: &[u32], bodies: &[BodyEntry], inv_h: f64) -> bool {
+        let n = handles.len();
+        // Written in place, by body: the columns keep their length from call to call, so no
+        // length is stored a body.
+        self.x.resize(n, 0);
+        self.is_moved.resize(n, false);
+        self.moved.clear();
+        let (keys, reach) = (&self.keys[..n], &self.reach[..n]);
+        let columns = keys
+            .iter()
+            .zip(reach)
+            .zip(self.x.iter_mut().zip(&mut self.is_moved));
+        for (j, (&h, ((&key, &was), (x, is_moved)))) in handles.iter().zip(columns).enumerate() {
+            let body = &bodies[h as usize];
+            if body.key != key {
+                return false;
+            }
+            let now = Reach::of(&body.bounds, inv_h);
+            let moved = now != was;
+            if moved {
+                self.moved.push((j as u32, now));
+            }
+            *x = order_key(body.bounds.min.x);
+            *is_moved = moved;
+        }
+        true
     }
 
     /// [`StripList::update`]'s first step when the bodies are not the same as last time:
@@ -432,7 +448,8 @@ impl StripList {
             + self.keys.capacity() * 8
             + (self.reach.capacity() + self.reach_next.capacity()) * size_of::<Reach>()
             + self.runs.capacity() * size_of::<(i32, u32)>()
-            + (self.remap.capacity() + self.moved.capacity()) * 4
+            + self.remap.capacity() * 4
+            + self.moved.capacity() * size_of::<(u32, Reach)>()
             + self.x.capacity() * 8
             + self.is_moved.capacity()
     }
