@@ -12,7 +12,8 @@ use super::kept_tree::KeptTree;
 use super::quadtree::Quadtree;
 use super::sort_and_sweep::{SweepView, sweep_cross, sweep_self};
 use super::{
-    BodyEntry, BroadPhase, BroadPhaseKind, BroadPhaseStats, Interactions, Member, member, of_layer,
+    BodyEntry, BroadPhase, BroadPhaseKind, BroadPhaseStats, Extent, Interactions, Member, member,
+    of_layer,
 };
 
 impl BroadPhase {
@@ -21,13 +22,13 @@ impl BroadPhase {
     pub(super) fn by_layers(
         &mut self,
         kind: BroadPhaseKind,
-        bodies: &[BodyEntry],
+        (bodies, given): (&[BodyEntry], Option<Extent>),
         interactions: &Interactions,
         out: &mut Vec<(u32, u32)>,
         stats: &mut BroadPhaseStats,
     ) {
         if kind == BroadPhaseKind::Strips {
-            self.prepare_strips(bodies);
+            self.prepare_strips(bodies, given);
         } else {
             let built = match kind {
                 BroadPhaseKind::SortAndSweep => &mut self.statics.built_trees,

@@ -167,6 +167,7 @@ use quadtree::Quadtree;
 use sort_and_sweep::{Slot, SweepList};
 use static_set::StaticSet;
 use static_tree::StaticTree;
+pub(crate) use strip_height::Extent;
 use strip_list::StripList;
 pub(crate) use tally::Tally;
 pub(crate) use tile_map::{StaticBox, TileMap};
@@ -248,6 +249,9 @@ pub struct BroadPhase {
     static_strips: Vec<StripList>,
     inv_h: f64,
     static_extent: (f64, f64),
+    /// The moving bodies' [`Extent`] as the caller measured it for the next call
+    /// ([`BroadPhase::give_extent`]), taken by that call.
+    given_extent: Option<Extent>,
     scratch: Scratch,
     /// Sort and sweep's filter of a big layer met only by far smaller ones (`cell_filter.rs`).
     filter: CellFilter,
@@ -306,6 +310,7 @@ impl BroadPhase {
             static_strips: Vec::new(),
             inv_h: 0.0,
             static_extent: (0.0, 0.0),
+            given_extent: None,
             scratch: Scratch::default(),
             filter: CellFilter::default(),
         }

@@ -32,31 +32,63 @@ pub(super) fn restrip(inv_h: f64, want: f64) -> bool {
 }
 
 /// The tallest finite `max.y - min.y` of `bounds` (NaN and inverted boxes ignored; an
-/// infinite one gives infinity), and the largest finite `|coordinate|`. Maxima, so any order
+/// infinite one gives infinity), and the largest finite `|coordinate|`: [`Extent`] over them.
+pub(super) fn extent<'a>(bounds: impl Iterator<Item = &'a Bounds>) -> (f64, f64) {
+    let mut e = Extent::default();
+    for b in bounds {
+        e.add(b);
+    }
+    e.get()
+}
+
+/// The running maxima of [`extent`], for a caller that sees the boxes one at a time (the
+/// moving bodies' entries as they are made: `stages/mover_pairs.rs`). Maxima, so any order
 /// of the boxes gives the same; written as comparisons without branches (`maxsd`, a NaN
 /// never taken), each lane of a vector one coordinate.
-pub(super) fn extent<'a>(bounds: impl Iterator<Item = &'a Bounds>) -> (f64, f64) {
-    /// `|v|` per lane, 0 where it is infinite or NaN.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Extent {
+    height: f64,
+    lanes: Vec2,
+}
+
+impl Extent {
+    /// Takes `b` in.
     #[inline]
-    fn finite_abs(v: Vec2) -> Vec2 {
-        let a = v.abs();
-        let keep = |x: f64| if x < f64::INFINITY { x } else { 0.0 };
-        Vec2::new(keep(a.x), keep(a.y))
-    }
-    #[inline]
-    fn larger(a: f64, b: f64) -> f64 {
-        if b > a { b } else { a }
-    }
-    let (mut height, mut lanes) = (0.0, Vec2::ZERO);
-    for b in bounds {
-        height = larger(height, b.max.y - b.min.y);
+    pub(crate) fn add(&mut self, b: &Bounds) {
+        /// `|v|` per lane, 0 where it is infinite or NaN.
+        #[inline]
+        fn finite_abs(v: Vec2) -> Vec2 {
+            let a = v.abs();
+            let keep = |x: f64| if x < f64::INFINITY { x } else { 0.0 };
+            Vec2::new(keep(a.x), keep(a.y))
+        }
+        self.height = larger(self.height, b.max.y - b.min.y);
         let (lo, hi) = (finite_abs(b.min), finite_abs(b.max));
-        lanes = Vec2::new(
-            larger(larger(lanes.x, lo.x), hi.x),
-            larger(larger(lanes.y, lo.y), hi.y),
+        self.lanes = Vec2::new(
+            larger(larger(self.lanes.x, lo.x), hi.x),
+            larger(larger(self.lanes.y, lo.y), hi.y),
         );
     }
-    (height, larger(lanes.x, lanes.y))
+
+    /// Takes in the boxes `other` took in.
+    #[inline]
+    pub(crate) fn merge(&mut self, other: Extent) {
+        self.height = larger(self.height, other.height);
+        self.lanes = Vec2::new(
+            larger(self.lanes.x, other.lanes.x),
+            larger(self.lanes.y, other.lanes.y),
+        );
+    }
+
+    /// The tallest height and the largest coordinate of the boxes taken in.
+    pub(crate) fn get(self) -> (f64, f64) {
+        (self.height, larger(self.lanes.x, self.lanes.y))
+    }
+}
+
+#[inline]
+fn larger(a: f64, b: f64) -> f64 {
+    if b > a { b } else { a }
 }
 
 #[cfg(test)]

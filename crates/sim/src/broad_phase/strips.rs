@@ -36,7 +36,7 @@ use super::grid::cell_coord;
 use super::sorted::order_key;
 use super::strip_height::{extent, inv_strip_height, restrip};
 use super::strip_list::{StripList, Swept};
-use super::{BodyEntry, BroadPhase, BroadPhaseStats, LAYERS, Member, STATIC_BIT, of_layer};
+use super::{BodyEntry, BroadPhase, BroadPhaseStats, Extent, LAYERS, Member, STATIC_BIT, of_layer};
 
 /// Where the sweeps of one strip put their pairs. Both bodies of an overlapping pair reach
 /// the strip of `max(p.min.y, q.min.y)` (`strip_list.rs`), and the pair is kept there only:
@@ -194,16 +194,28 @@ impl BroadPhase {
     /// Before a `Strips` call: the strip height for this call's bodies (kept while it fits,
     /// see [`restrip`]), and the static lists, sorted again when the static bodies or the
     /// height changed.
-    pub(super) fn prepare_strips(&mut self, bodies: &[BodyEntry]) {
+    pub(super) fn prepare_strips(&mut self, bodies: &[BodyEntry], given: Option<Extent>) {
         if !self.statics.built_strips {
             self.static_extent = extent(self.statics.entries.iter().map(|(b, _)| b));
         }
-        // Every body given is a mover when there are as many movers (the usual call): read
-        // them in place, in sequence.
-        let (height, max_abs) = if self.movers.len() == bodies.len() {
-            extent(bodies.iter().map(|b| &b.bounds))
-        } else {
-            extent(self.movers.iter().map(|&h| &bodies[h as usize].bounds))
+        // Every body given is a mover when there are as many movers (the usual call): the
+        // caller's extent of them when it measured it, else read in place, in sequence.
+        let all = self.movers.len() == bodies.len();
+        let (height, max_abs) = match given {
+            Some(given) if all => {
+                let given = given.get();
+                debug_assert_eq!(
+                    (given.0.to_bits(), given.1.to_bits()),
+                    {
+                        let e = extent(bodies.iter().map(|b| &b.bounds));
+                        (e.0.to_bits(), e.1.to_bits())
+                    },
+                    "the caller's extent is the bodies'"
+                );
+                given
+            }
+            _ if all => extent(bodies.iter().map(|b| &b.bounds)),
+            _ => extent(self.movers.iter().map(|&h| &bodies[h as usize].bounds)),
         };
         let want = inv_strip_height(
             height.max(self.static_extent.0),

@@ -46,15 +46,17 @@ pub(crate) fn mover_pairs(
     // entries.
     let mut tally = bp.tally();
     if !w.count_movers(&mut tally) {
-        w.mover_entries(widen, movers, 0..0, visit);
+        let extent = w.mover_entries(widen, movers, 0..0, visit);
         tally.count(movers);
+        bp.give_extent(extent);
         let stats = bp.pairs_counted_handles(statics, generation, movers, interactions, out);
         return (stats, 0..0);
     }
     tally.flush();
     bp.load_statics(statics, generation);
     let Some((big, places)) = bp.layer_to_leave_out(interactions) else {
-        w.mover_entries(widen, movers, 0..0, visit);
+        let extent = w.mover_entries(widen, movers, 0..0, visit);
+        bp.give_extent(extent);
         let stats = bp.pairs_counted_handles(statics, generation, movers, interactions, out);
         return (stats, 0..0);
     };

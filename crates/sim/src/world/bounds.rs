@@ -8,7 +8,7 @@ use ricochet_geom::{Bounds, Pose, Vec2};
 use super::local_bounds::LocalBoundsRows;
 use super::runs::RowRun;
 use super::{NO_ROW, World};
-use crate::broad_phase::{BigPass, BodyEntry, Marking, Tally};
+use crate::broad_phase::{BigPass, BodyEntry, Extent, Marking, Tally};
 use crate::def::BodyKind;
 use crate::entity::Entity;
 use crate::interned::ShapeTable;
@@ -80,14 +80,16 @@ impl World {
     /// they are made (the wrap seam looks for bodies near an edge without another pass).
     ///
     /// The places in `skip` are left as they were: [`World::some_mover_entries`] makes them
-    /// (`out` is sized to every mover first).
+    /// (`out` is sized to every mover first). Returns the [`Extent`] of the entries made,
+    /// measured as they are made: the broad phase's strips choose their height from it
+    /// (`BroadPhase::give_extent`) instead of reading every entry again.
     pub(crate) fn mover_entries(
         &mut self,
         (sweeping, separate_swept): (&[bool], &[bool]),
         out: &mut Vec<BodyEntry>,
         skip: Range<usize>,
         mut visit: impl FnMut(usize, &Bounds) -> bool,
-    ) {
+    ) -> Extent {
         // Written in place, by place: the vector keeps its length from call to call (only a
         // change in the count of movers resizes it), so no length is stored a body.
         let placeholder = BodyEntry {
@@ -101,9 +103,13 @@ impl World {
         };
         out.resize(self.movers.len(), placeholder);
         let (before, after) = (0..skip.start, skip.end..out.len());
+        let mut extent = Extent::default();
         for places in [before, after] {
-            self.entries_where((sweeping, separate_swept), out, places, &mut visit, None);
+            let made: Extent =
+                self.entries_where((sweeping, separate_swept), out, places, &mut visit, None);
+            extent.merge(made);
         }
+        extent
     }
 
     /// [`World::mover_entries`] of the places in `places` only (within the movers), each
@@ -119,20 +125,20 @@ impl World {
         mut visit: impl FnMut(usize, &Bounds) -> bool,
         pass: Option<&mut BigPass>,
     ) {
-        self.entries_where(widen, out, places, &mut visit, pass);
+        let () = self.entries_where(widen, out, places, &mut visit, pass);
     }
 
     /// The entries of `places` ([`World::some_mover_entries`]).
-    fn entries_where(
+    fn entries_where<M: Measure>(
         &mut self,
         (sweeping, separate_swept): (&[bool], &[bool]),
         out: &mut [BodyEntry],
         places: Range<usize>,
         visit: &mut impl FnMut(usize, &Bounds) -> bool,
         pass: Option<&mut BigPass>,
-    ) {
+    ) -> M {
         if places.is_empty() {
-            return;
+            return M::default();
         }
         let run = self.movers_run();
         // Every column sliced to its exact length first: the columns of one index then share
@@ -172,12 +178,33 @@ impl World {
             Some(pass) => match pass.marking() {
                 None => fill(&mut columns, run, list, out, first, visit, &mut Noted),
                 Some(mut marking) => {
-                    fill(&mut columns, run, list, out, first, visit, &mut marking);
+                    let extent = fill(&mut columns, run, list, out, first, visit, &mut marking);
                     let seen = marking.seen;
                     pass.measured(seen);
+                    extent
                 }
             },
         }
+    }
+}
+
+/// What [`fill`] measures of the bounds of the entries it makes: their [`Extent`] for
+/// [`World::mover_entries`] (the broad phase's strips need it), nothing (`()`) for
+/// [`World::some_mover_entries`].
+trait Measure: Default {
+    /// Takes the bounds of an entry made in.
+    fn add(&mut self, b: &Bounds);
+}
+
+impl Measure for () {
+    #[inline(always)]
+    fn add(&mut self, _: &Bounds) {}
+}
+
+impl Measure for Extent {
+    #[inline(always)]
+    fn add(&mut self, b: &Bounds) {
+        Extent::add(self, b);
     }
 }
 
@@ -228,7 +255,7 @@ impl Keep for Marking<'_> {
 /// column). Always inlined: the test, in a closure called from both loops, was not, and
 /// the call cost a quarter of the asteroids' step.
 #[inline(always)]
-fn fill(
+fn fill<M: Measure>(
     columns: &mut EntryColumns,
     run: Option<RowRun>,
     list: Option<(&[u32], &[u32])>,
@@ -236,7 +263,9 @@ fn fill(
     first: usize,
     visit: &mut impl FnMut(usize, &Bounds) -> bool,
     keep: &mut impl Keep,
-) {
+) -> M {
+    // In a local, so that it stays in registers.
+    let mut extent = M::default();
     match (run, list) {
         (Some(run), _) => {
             // Every column sliced to the places first: one index then reads them all
@@ -252,15 +281,17 @@ fn fill(
                     let bounds = columns.widened(k, k, widen);
                     let near = visit(first + k, &bounds);
                     if keep.keep(first + k, &bounds) || near {
+                        extent.add(&bounds);
                         *out = columns.entry(k, k, bounds);
                     }
                 }
-                return;
+                return extent;
             }
             for (k, out) in out.iter_mut().enumerate() {
                 let bounds = columns.bounds(k, k);
                 let near = visit(first + k, &bounds);
                 if keep.keep(first + k, &bounds) || near {
+                    extent.add(&bounds);
                     *out = columns.entry(k, k, bounds);
                 }
             }
@@ -271,12 +302,14 @@ fn fill(
                 let bounds = columns.bounds(i, r);
                 let near = visit(first + k, &bounds);
                 if keep.keep(first + k, &bounds) || near {
+                    extent.add(&bounds);
                     *out = columns.entry(i, r, bounds);
                 }
             }
         }
         (None, None) => {}
     }
+    extent
 }
 
 /// What [`World::mover_entries`] reads of each body, and of its row.
