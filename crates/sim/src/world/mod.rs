@@ -201,13 +201,22 @@ impl World {
         &self.shapes.get(self.shape_id[i]).0
     }
 
-    /// Asks for what the narrow phase reads first of body `i`, without reading it (a hint:
-    /// `prefetch.rs`): its position, its angle and the first cache line of its shape.
+    /// Asks for body `i`'s columns the narrow phase reads, without reading them (a hint:
+    /// `prefetch.rs`): its shape id, position and angle.
     #[inline]
-    pub(crate) fn prefetch_body(&self, i: usize) {
+    pub(crate) fn prefetch_columns(&self, i: usize) {
+        if i < self.shape_id.len() {
+            crate::prefetch::line_of(&self.shape_id[i]);
+            crate::prefetch::line_of(&self.position[i]);
+            crate::prefetch::line_of(&self.angle[i]);
+        }
+    }
+
+    /// Asks for the first cache line of body `i`'s shape (reading its shape id, which
+    /// [`World::prefetch_columns`] should have asked for a little before).
+    #[inline]
+    pub(crate) fn prefetch_shape(&self, i: usize) {
         self.shapes.prefetch(self.shape_id[i]);
-        crate::prefetch::line_of(&self.position[i]);
-        crate::prefetch::line_of(&self.angle[i]);
     }
 
     /// Each body's look id (its shape and name) in [`World::shape_table`], by dense index:
