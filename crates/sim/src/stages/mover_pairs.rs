@@ -10,7 +10,9 @@ use std::ops::Range;
 
 use ricochet_geom::Bounds;
 
-use crate::broad_phase::{BodyEntry, BroadPhase, BroadPhaseStats, Interactions};
+use crate::broad_phase::{
+    BodyEntry, BroadPhase, BroadPhaseKind, BroadPhaseStats, Extent, Interactions,
+};
 use crate::world::World;
 
 /// What the broad phase is given of the moving bodies.
@@ -44,23 +46,29 @@ pub(crate) fn mover_pairs(
     } = call;
     // Counted from the world's columns when it can (one run of movers), else from the
     // entries.
+    // The strips' height is chosen from the movers' extent: measured as their entries are
+    // made when the last call ran strips (a call that turns to strips reads it itself).
+    let measure = bp.chosen() == BroadPhaseKind::Strips;
     let mut tally = bp.tally();
     if !w.count_movers(&mut tally) {
-        let extent = w.mover_entries(widen, movers, 0..0, visit);
+        let extent = every_entry(w, widen, movers, visit, measure);
         tally.count(movers);
-        bp.give_extent(extent);
+        if let Some(extent) = extent {
+            bp.give_extent(extent);
+        }
         let stats = bp.pairs_counted_handles(statics, generation, movers, interactions, out);
         return (stats, 0..0);
     }
     tally.flush();
     bp.load_statics(statics, generation);
     let Some((big, places)) = bp.layer_to_leave_out(interactions) else {
-        let extent = w.mover_entries(widen, movers, 0..0, visit);
-        bp.give_extent(extent);
+        if let Some(extent) = every_entry(w, widen, movers, visit, measure) {
+            bp.give_extent(extent);
+        }
         let stats = bp.pairs_counted_handles(statics, generation, movers, interactions, out);
         return (stats, 0..0);
     };
-    w.mover_entries(widen, movers, places.clone(), &mut visit);
+    let () = w.mover_entries(widen, movers, places.clone(), &mut visit);
     #[cfg(debug_assertions)]
     check_and_poison(w, bp, widen, movers, places.clone());
     bp.begin_counted(movers, interactions);
@@ -82,6 +90,22 @@ pub(crate) fn mover_pairs(
     (stats, if left_out { places } else { 0..0 })
 }
 
+/// Every mover's entry ([`World::mover_entries`]), and when `measure`, their [`Extent`].
+fn every_entry(
+    w: &mut World,
+    widen: (&[bool], &[bool]),
+    movers: &mut Vec<BodyEntry>,
+    visit: impl FnMut(usize, &Bounds) -> bool,
+    measure: bool,
+) -> Option<Extent> {
+    if measure {
+        Some(w.mover_entries(widen, movers, 0..0, visit))
+    } else {
+        let () = w.mover_entries(widen, movers, 0..0, visit);
+        None
+    }
+}
+
 /// In a debug build, where a layer is left out: checks the count against every entry
 /// (made aside), and fills the left-out places with NaN bounds, which pair with nothing, so
 /// that a read of an entry not made shows as a pair missed.
@@ -94,7 +118,7 @@ fn check_and_poison(
     places: Range<usize>,
 ) {
     let mut every = Vec::new();
-    w.mover_entries(widen, &mut every, 0..0, |_, _| false);
+    let () = w.mover_entries(widen, &mut every, 0..0, |_, _| false);
     for k in (0..movers.len()).filter(|k| !places.contains(k)) {
         assert_eq!(movers[k], every[k], "entry {k}");
     }

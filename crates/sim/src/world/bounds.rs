@@ -80,16 +80,16 @@ impl World {
     /// they are made (the wrap seam looks for bodies near an edge without another pass).
     ///
     /// The places in `skip` are left as they were: [`World::some_mover_entries`] makes them
-    /// (`out` is sized to every mover first). Returns the [`Extent`] of the entries made,
-    /// measured as they are made: the broad phase's strips choose their height from it
-    /// (`BroadPhase::give_extent`) instead of reading every entry again.
-    pub(crate) fn mover_entries(
+    /// (`out` is sized to every mover first). Returns what `M` measures of the entries made,
+    /// as they are made: their [`Extent`], from which the broad phase's strips choose their
+    /// height (`BroadPhase::give_extent`) instead of reading every entry again, or nothing.
+    pub(crate) fn mover_entries<M: Measure>(
         &mut self,
         (sweeping, separate_swept): (&[bool], &[bool]),
         out: &mut Vec<BodyEntry>,
         skip: Range<usize>,
         mut visit: impl FnMut(usize, &Bounds) -> bool,
-    ) -> Extent {
+    ) -> M {
         // Written in place, by place: the vector keeps its length from call to call (only a
         // change in the count of movers resizes it), so no length is stored a body.
         let placeholder = BodyEntry {
@@ -103,13 +103,13 @@ impl World {
         };
         out.resize(self.movers.len(), placeholder);
         let (before, after) = (0..skip.start, skip.end..out.len());
-        let mut extent = Extent::default();
+        let mut measured = M::default();
         for places in [before, after] {
-            let made: Extent =
+            let made: M =
                 self.entries_where((sweeping, separate_swept), out, places, &mut visit, None);
-            extent.merge(made);
+            measured.merge(made);
         }
-        extent
+        measured
     }
 
     /// [`World::mover_entries`] of the places in `places` only (within the movers), each
@@ -188,23 +188,33 @@ impl World {
     }
 }
 
-/// What [`fill`] measures of the bounds of the entries it makes: their [`Extent`] for
-/// [`World::mover_entries`] (the broad phase's strips need it), nothing (`()`) for
-/// [`World::some_mover_entries`].
-trait Measure: Default {
+/// What [`World::mover_entries`] measures of the bounds of the entries it makes: their
+/// [`Extent`] (when the broad phase's strips need it), or nothing (`()`).
+pub(crate) trait Measure: Default {
     /// Takes the bounds of an entry made in.
     fn add(&mut self, b: &Bounds);
+
+    /// Takes in what `other` took in.
+    fn merge(&mut self, other: Self);
 }
 
 impl Measure for () {
     #[inline(always)]
     fn add(&mut self, _: &Bounds) {}
+
+    #[inline(always)]
+    fn merge(&mut self, (): ()) {}
 }
 
 impl Measure for Extent {
     #[inline(always)]
     fn add(&mut self, b: &Bounds) {
         Extent::add(self, b);
+    }
+
+    #[inline(always)]
+    fn merge(&mut self, other: Extent) {
+        Extent::merge(self, other);
     }
 }
 

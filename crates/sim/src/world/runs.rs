@@ -107,6 +107,7 @@ mod tests {
 
     use ricochet_geom::{Bounds, Shape, Vec2};
 
+    use crate::broad_phase::Extent;
     use crate::def::{BodyDef, BodyKind};
     use crate::world::World;
 
@@ -264,13 +265,13 @@ mod tests {
                 let widen = (&sweeping[..], &separate_swept[..]);
                 let mut entries = Vec::new();
                 let mut visited: Vec<(usize, Bounds)> = Vec::new();
-                w.mover_entries(widen, &mut entries, 0..0, |k, b| {
+                let extent: Extent = w.mover_entries(widen, &mut entries, 0..0, |k, b| {
                     visited.push((k, *b));
                     false
                 });
                 // Some places made apart: the same entries, each visited once.
                 let (mut some, skipped) = (Vec::new(), 40..90);
-                w.mover_entries(widen, &mut some, skipped.clone(), |k, _| {
+                let () = w.mover_entries(widen, &mut some, skipped.clone(), |k, _| {
                     assert!(!skipped.contains(&k));
                     true
                 });
@@ -285,6 +286,22 @@ mod tests {
                     None,
                 );
                 assert_eq!(some, entries);
+                // The extent measured as the entries were made is theirs: the tallest box
+                // and the largest finite coordinate, each value tested on its own.
+                let (mut height, mut max_abs) = (0.0f64, 0.0f64);
+                for b in entries.iter().map(|e| e.bounds) {
+                    height = height.max(b.max.y - b.min.y);
+                    for v in [b.min.x, b.min.y, b.max.x, b.max.y] {
+                        if v.abs().is_finite() {
+                            max_abs = max_abs.max(v.abs());
+                        }
+                    }
+                }
+                let (h, a) = extent.get();
+                assert_eq!(
+                    (h.to_bits(), a.to_bits()),
+                    (height.to_bits(), max_abs.to_bits())
+                );
                 let state: Vec<[u64; 5]> = (w.movers().iter())
                     .map(|&i| {
                         let (i, r) = (i as usize, w.row[i as usize] as usize);
