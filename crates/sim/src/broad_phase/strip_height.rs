@@ -42,7 +42,7 @@ pub(super) fn extent<'a>(bounds: impl Iterator<Item = &'a Bounds>) -> (f64, f64)
 }
 
 /// The running maxima of [`extent`], for a caller that sees the boxes one at a time (the
-/// moving bodies' entries as they are made: `stages/mover_pairs.rs`). Maxima, so any order
+/// moving bodies' entries as `World::mover_entries` makes them). Maxima, so any order
 /// of the boxes gives the same; written as comparisons without branches (`maxsd`, a NaN
 /// never taken), each lane of a vector one coordinate.
 #[derive(Clone, Copy, Debug, Default)]

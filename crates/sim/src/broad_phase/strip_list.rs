@@ -253,9 +253,8 @@ impl StripList {
         }
         // In list order: the slots are written in sequence, each reading its body's new key
         // from `x` (8 bytes a body, where the bodies are 48). A moved body's slots leave the
-        // list: the rest close up behind a write cursor in the same pass.
-        // Without a branch: every slot is written at the cursor, which moves on past the
-        // kept ones only (a moved body's slot is written over by the next).
+        // list: the rest close up behind a write cursor in the same pass, without a branch
+        // (every slot is written at the cursor, which moves on past the kept ones only).
         let mut kept = 0;
         for k in 0..self.order.len() {
             let old = self.order[k];
