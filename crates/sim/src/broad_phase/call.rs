@@ -64,6 +64,13 @@ impl BroadPhase {
         stats
     }
 
+    /// Whether the next call would use its movers' [`Extent`] ([`BroadPhase::give_extent`]):
+    /// when the last one ran `Strips`, which choose their height from it. A call that turns
+    /// to strips without it reads the entries for it itself.
+    pub(crate) fn wants_extent(&self) -> bool {
+        self.chosen == BroadPhaseKind::Strips
+    }
+
     /// Gives the next call the [`Extent`] of its moving bodies' bounds, measured by the
     /// caller as it made every one of their entries: `Strips` then chooses its strip height
     /// without another pass over them (a tenth of the strips' time at rain-10000). Checked

@@ -378,14 +378,14 @@ pub(crate) fn run(
             &mut contacts,
         );
     }
-    // Bodies a response of this pass moved: their later pairs are tested again. Only those
-    // are set, and cleared after the pass, so a million tiles cost nothing here.
     // Room at once for about the records this pass makes: the contacts found, and a few
     // more through the seam (growing the list by doubling copied it about ten times a frame
     // at rain-10000, and a few records past room for exactly the contacts found copied it
     // once more).
     let found = contacts.iter().filter(|c| c.is_some()).count();
     ctx.out.contacts.reserve(found + found / 8 + 16);
+    // Bodies a response of this pass moved: their later pairs are tested again. Only those
+    // are set, and cleared after the pass, so a million tiles cost nothing here.
     let (pushed, moved) = (&mut st.pushed, &mut st.moved);
     pushed.resize(ctx.world.len(), false);
     for (k, &(i, j, response)) in plan.iter().enumerate() {
@@ -489,10 +489,11 @@ fn threshold(response: Response) -> f64 {
     }
 }
 
-/// How many pairs ahead of the narrow phase their poses and the first line of their shapes
-/// are asked for, and how many the rest of their shapes (`prefetch.rs`). Chosen by timing
-/// rain-10000 (`step_scene`, eight rounds alternated): 8 and 2 took the step from 0.714 to
-/// 0.676 ms; 4 and 2, 12 and 3, 16 and 2 within a percent of that.
+/// How many pairs ahead of the narrow phase the first line of their shapes is asked for,
+/// and ([`AHEAD_REST`]) how many the rest of their shapes (`prefetch.rs`). Chosen by timing
+/// rain-10000 (`step_scene`, eight rounds alternated), when this step asked for the poses
+/// too: 8 and 2 took the step from 0.714 to 0.676 ms; 4 and 2, 12 and 3, 16 and 2 within a
+/// percent of that.
 const AHEAD: usize = 8;
 /// How many pairs ahead the bodies' columns (shape ids, positions, angles) are asked for,
 /// before [`AHEAD`] reads the shape ids for the shapes' lines. Chosen by timing rain-10000

@@ -10,9 +10,7 @@ use std::ops::Range;
 
 use ricochet_geom::Bounds;
 
-use crate::broad_phase::{
-    BodyEntry, BroadPhase, BroadPhaseKind, BroadPhaseStats, Extent, Interactions,
-};
+use crate::broad_phase::{BodyEntry, BroadPhase, BroadPhaseStats, Extent, Interactions};
 use crate::world::World;
 
 /// What the broad phase is given of the moving bodies.
@@ -44,11 +42,9 @@ pub(crate) fn mover_pairs(
         interactions,
         movers,
     } = call;
+    let measure = bp.wants_extent();
     // Counted from the world's columns when it can (one run of movers), else from the
     // entries.
-    // The strips' height is chosen from the movers' extent: measured as their entries are
-    // made when the last call ran strips (a call that turns to strips reads it itself).
-    let measure = bp.chosen() == BroadPhaseKind::Strips;
     let mut tally = bp.tally();
     if !w.count_movers(&mut tally) {
         let extent = every_entry(w, widen, movers, visit, measure);
@@ -90,7 +86,8 @@ pub(crate) fn mover_pairs(
     (stats, if left_out { places } else { 0..0 })
 }
 
-/// Every mover's entry ([`World::mover_entries`]), and when `measure`, their [`Extent`].
+/// Every mover's entry ([`World::mover_entries`]), and when `measure`
+/// ([`BroadPhase::wants_extent`]), their [`Extent`].
 fn every_entry(
     w: &mut World,
     widen: (&[bool], &[bool]),

@@ -178,10 +178,10 @@ impl World {
             Some(pass) => match pass.marking() {
                 None => fill(&mut columns, run, list, out, first, visit, &mut Noted),
                 Some(mut marking) => {
-                    let extent = fill(&mut columns, run, list, out, first, visit, &mut marking);
+                    let made = fill(&mut columns, run, list, out, first, visit, &mut marking);
                     let seen = marking.seen;
                     pass.measured(seen);
-                    extent
+                    made
                 }
             },
         }
@@ -275,7 +275,7 @@ fn fill<M: Measure>(
     keep: &mut impl Keep,
 ) -> M {
     // In a local, so that it stays in registers.
-    let mut extent = M::default();
+    let mut measured = M::default();
     match (run, list) {
         (Some(run), _) => {
             // Every column sliced to the places first: one index then reads them all
@@ -291,17 +291,17 @@ fn fill<M: Measure>(
                     let bounds = columns.widened(k, k, widen);
                     let near = visit(first + k, &bounds);
                     if keep.keep(first + k, &bounds) || near {
-                        extent.add(&bounds);
+                        measured.add(&bounds);
                         *out = columns.entry(k, k, bounds);
                     }
                 }
-                return extent;
+                return measured;
             }
             for (k, out) in out.iter_mut().enumerate() {
                 let bounds = columns.bounds(k, k);
                 let near = visit(first + k, &bounds);
                 if keep.keep(first + k, &bounds) || near {
-                    extent.add(&bounds);
+                    measured.add(&bounds);
                     *out = columns.entry(k, k, bounds);
                 }
             }
@@ -312,14 +312,14 @@ fn fill<M: Measure>(
                 let bounds = columns.bounds(i, r);
                 let near = visit(first + k, &bounds);
                 if keep.keep(first + k, &bounds) || near {
-                    extent.add(&bounds);
+                    measured.add(&bounds);
                     *out = columns.entry(i, r, bounds);
                 }
             }
         }
         (None, None) => {}
     }
-    extent
+    measured
 }
 
 /// What [`World::mover_entries`] reads of each body, and of its row.
