@@ -156,6 +156,12 @@ impl Slot {
         self.0 as u32 & !UPPER
     }
 
+    /// Whether this is the body's lower slot, not its upper one.
+    #[inline]
+    fn is_lower(self) -> bool {
+        self.0 as u32 & UPPER == 0
+    }
+
     /// A slot that sorts after every other (a body gone from the list).
     const GONE: Slot = Slot(u128::MAX);
 }
@@ -182,13 +188,17 @@ pub(super) struct Swept {
     pub(super) handle: u32,
     /// Whether the body is dynamic.
     pub(super) dynamic: bool,
+    /// Whether this is the body's lower slot (its `min.y` is in this strip), not its upper
+    /// one: two overlapping bodies' pair is kept in this strip when one of them is
+    /// (`strips.rs`, `Sink::test`).
+    pub(super) lower: bool,
 }
 
 const _: () = assert!(size_of::<Swept>() == 40, "a slot of the sweeps stays lean");
 
 impl Swept {
     #[inline]
-    fn new(m: Member) -> Swept {
+    fn new(m: Member, lower: bool) -> Swept {
         let b = &m.bounds;
         let numbers = !(b.min.x.is_nan() || b.max.x.is_nan() || b.max.y.is_nan());
         Swept {
@@ -198,6 +208,7 @@ impl Swept {
             max_y: b.max.y,
             handle: m.handle,
             dynamic: m.dynamic,
+            lower,
         }
     }
 
@@ -225,7 +236,7 @@ impl StripList {
         list.swept = list
             .order
             .iter()
-            .map(|s| Swept::new(members[s.local() as usize]))
+            .map(|s| Swept::new(members[s.local() as usize], s.is_lower()))
             .collect();
         list.width = members
             .iter()
@@ -251,28 +262,56 @@ impl StripList {
             let read = self.read_bodies(handles, bodies, inv_h);
             debug_assert!(read, "the reconciled keys are the bodies'");
         }
-        // In list order: the slots are written in sequence, each reading its body's new key
-        // from `x` (8 bytes a body, where the bodies are 48). A moved body's slots leave the
-        // list: the rest close up behind a write cursor in the same pass, without a branch
-        // (every slot is written at the cursor, which moves on past the kept ones only).
-        let mut kept = 0;
-        for k in 0..self.order.len() {
-            let old = self.order[k];
-            let local = old.local() as usize;
-            self.order[kept] = old.at_x(self.x[local]);
-            kept += usize::from(!self.is_moved[local]);
-        }
-        self.order.truncate(kept);
+        // The moved bodies' slots, made again and sorted apart (a few hundred among
+        // thousands).
         for &(local, reach) in &self.moved {
             self.reach[local as usize] = reach;
             let (lower, upper) = Slot::both(reach, self.x[local as usize], local);
             self.fresh.push(lower);
             self.fresh.extend(upper);
         }
-        let moved = self.settle();
+        self.fresh.sort_unstable();
+        self.merge_moved();
+        let moved = sorted::insertion_sort(&mut self.order, Slot::cmp, |_, _| {});
         self.gather(handles, bodies);
         self.find_runs();
         moved
+    }
+
+    /// One pass over the list in its order, into `merged`, which becomes the list: each slot
+    /// gets its body's new key from `x` (8 bytes a body, where the bodies are 48), a moved
+    /// body's slots leave, and the fresh slots come in. A fresh slot goes before the first
+    /// slot written after it that it sorts before: the kept slots are nearly sorted (their
+    /// keys moved a little), so the list is nearly sorted too, and the insertion sort that
+    /// follows puts it in order. The result is the one sorted list of its slots (`local`
+    /// breaks ties), however the fresh ones were placed.
+    ///
+    /// Every kept slot is written at the cursor without a branch (a moved body's slot is
+    /// written too, and the cursor stays: hence room for one slot more than the list will
+    /// hold). `merged` keeps its length from call to call, so only growth is filled.
+    fn merge_moved(&mut self) {
+        let room = self.order.len() + self.fresh.len() + 1;
+        if self.merged.len() < room {
+            self.merged.resize(room, Slot::GONE);
+        }
+        let (fresh, merged) = (&self.fresh, &mut self.merged[..room]);
+        let (mut w, mut f) = (0, 0);
+        for &old in &self.order {
+            let local = old.local() as usize;
+            let new = old.at_x(self.x[local]);
+            while f < fresh.len() && fresh[f] < new {
+                merged[w] = fresh[f];
+                (w, f) = (w + 1, f + 1);
+            }
+            merged[w] = new;
+            w += usize::from(!self.is_moved[local]);
+        }
+        for &s in &fresh[f..] {
+            merged[w] = s;
+            w += 1;
+        }
+        std::mem::swap(&mut self.order, &mut self.merged);
+        self.order.truncate(w);
     }
 
     /// [`StripList::update`]'s pass over the bodies, in key order, in sequence: each body's
@@ -346,33 +385,6 @@ impl StripList {
         self.order.retain(|&s| s != Slot::GONE);
     }
 
-    /// Sorts `order` again (no slot is [`Slot::GONE`] any more): insertion-sorts it (nearly
-    /// sorted) and merges in `fresh` (sorted first). Returns the insertion sort's moves.
-    fn settle(&mut self) -> u64 {
-        let moved = sorted::insertion_sort(&mut self.order, Slot::cmp, |_, _| {});
-        if self.fresh.is_empty() {
-            return moved;
-        }
-        self.fresh.sort_unstable();
-        self.merged.clear();
-        self.merged.reserve(self.order.len() + self.fresh.len());
-        // A few fresh slots among thousands: each finds its place by a galloping search from
-        // the last one's (near it, in memory about to be copied: a binary search over the
-        // rest missed the cache at each step) and the slots between are copied as one
-        // block. The order is total (`local` breaks ties), so this is the one merge of the
-        // two lists.
-        let mut from = 0;
-        for &f in &self.fresh {
-            let at = from + sorted::gallop(&self.order[from..], |&s| s < f);
-            self.merged.extend_from_slice(&self.order[from..at]);
-            self.merged.push(f);
-            from = at;
-        }
-        self.merged.extend_from_slice(&self.order[from..]);
-        std::mem::swap(&mut self.order, &mut self.merged);
-        moved
-    }
-
     /// Reads the bodies' bounds in list order into `swept`, and the widest body.
     fn gather(&mut self, handles: &[u32], bodies: &[BodyEntry]) {
         // The widest body (NaN ignored): a maximum, so any order gives it.
@@ -385,7 +397,7 @@ impl StripList {
             if x > width {
                 width = x;
             }
-            Swept::new(member(b, h))
+            Swept::new(member(b, h), s.is_lower())
         }));
         self.width = width;
     }
@@ -486,7 +498,7 @@ mod tests {
         }
     }
 
-    /// The merge's galloping search finds where a binary search does: before every slot,
+    /// The galloping search finds where a binary search does: before every slot,
     /// between any two, after all, and on a slot equal to the one looked for.
     #[test]
     fn a_fresh_slot_goes_where_a_binary_search_puts_it() {

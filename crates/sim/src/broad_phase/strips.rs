@@ -32,7 +32,6 @@
 //! # Determinism
 //! Orders are by `(strip, min.x as f64::total_cmp, local, upper)`: a function of the input.
 
-use super::grid::cell_coord;
 use super::sorted::order_key;
 use super::strip_height::{extent, inv_strip_height, restrip};
 use super::strip_list::{StripList, Swept};
@@ -41,13 +40,32 @@ use super::{BodyEntry, BroadPhase, BroadPhaseStats, Extent, LAYERS, Member, STAT
 /// Where the sweeps of one strip put their pairs. Both bodies of an overlapping pair reach
 /// the strip of `max(p.min.y, q.min.y)` (`strip_list.rs`), and the pair is kept there only:
 /// a pair sharing two strips is found in both and kept once.
+///
+/// That strip is this one when one of the two slots is its body's lower slot (its `min.y`
+/// is in this strip), and the one below when both are upper slots (both `min.y` are in the
+/// strip below): `floor(max(a, b) / H)` is `max(floor(a / H), floor(b / H))`, floor being
+/// monotone. So the rule is one flag of each slot, not a strip computed a pair.
 struct Sink<'a> {
     out: &'a mut Vec<(u32, u32)>,
+    /// The strip and `1 / H`, for the debug check of the rule.
+    #[cfg(debug_assertions)]
     strip: i32,
+    #[cfg(debug_assertions)]
     inv_h: f64,
 }
 
-impl Sink<'_> {
+impl<'a> Sink<'a> {
+    #[cfg_attr(not(debug_assertions), allow(unused_variables))]
+    fn new(out: &'a mut Vec<(u32, u32)>, strip: i32, inv_h: f64) -> Sink<'a> {
+        Sink {
+            out,
+            #[cfg(debug_assertions)]
+            strip,
+            #[cfg(debug_assertions)]
+            inv_h,
+        }
+    }
+
     /// Tests `p` and `q`, keeping the pair when one is dynamic, their bounds overlap and this
     /// is their strip. Returns the tests (0 or 1).
     #[inline]
@@ -58,10 +76,17 @@ impl Sink<'_> {
         // `Bounds::overlaps`, x by the keys (`strip_list.rs`, `Swept`).
         let overlap = p.min <= q.max && q.min <= p.max && p.min_y <= q.max_y && q.min_y <= p.max_y;
         if overlap {
-            // Overlapping bounds hold no NaN.
-            let (a, b) = (p.min_y, q.min_y);
-            let top = if a > b { a } else { b };
-            if cell_coord(top, self.inv_h) == self.strip {
+            #[cfg(debug_assertions)]
+            {
+                // Overlapping bounds hold no NaN.
+                let top = p.min_y.max(q.min_y);
+                assert_eq!(
+                    super::grid::cell_coord(top, self.inv_h) == self.strip,
+                    p.lower || q.lower,
+                    "the pair's strip is this one when one slot is a lower one"
+                );
+            }
+            if p.lower || q.lower {
                 self.out.push((p.handle, q.handle));
             }
         }
@@ -153,11 +178,7 @@ pub(super) fn strip_self(list: &StripList, out: &mut Vec<(u32, u32)>) -> u64 {
     let mut tested = 0;
     for r in 0..list.run_count() {
         let (strip, run) = list.run(r);
-        let mut sink = Sink {
-            out: &mut *out,
-            strip,
-            inv_h: list.inv_h,
-        };
+        let mut sink = Sink::new(&mut *out, strip, list.inv_h);
         tested += sink.within(run);
     }
     tested
@@ -179,11 +200,7 @@ pub(super) fn strip_cross(x: &StripList, y: &StripList, out: &mut Vec<(u32, u32)
             break;
         }
         if y.run_strip(k) == strip {
-            let mut sink = Sink {
-                out: &mut *out,
-                strip,
-                inv_h: x.inv_h,
-            };
+            let mut sink = Sink::new(&mut *out, strip, x.inv_h);
             tested += sink.pair_runs((run, x.width), (y.run(k).1, y.width));
         }
     }
