@@ -148,6 +148,7 @@ mod static_set;
 pub(crate) mod static_tree;
 mod strip_height;
 mod strip_list;
+mod strip_reach;
 mod strips;
 mod tally;
 mod tile_map;

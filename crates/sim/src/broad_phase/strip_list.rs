@@ -10,23 +10,24 @@
 //!
 //! Like `SortAndSweep`, a moving list is kept from the previous call and re-sorted by
 //! insertion sort. The bodies are read once in key order, in sequence, for their new `min.x`
-//! keys and strips; a slot whose body still reaches the same strips then gets its new key
-//! in place, read from that 8-byte-a-body column (nearly sorted: `min.x` moves a little a
+//! keys and strips; a slot whose body still reaches its strip then gets its new key in
+//! place, read from that 8-byte-a-body column (nearly sorted: `min.x` moves a little a
 //! frame). Reading the 48-byte entries in list order instead, at random, was most of the
-//! list's cost at 10,000 bodies. A body that reaches other strips than last time leaves the
-//! list and comes back as fresh slots, sorted apart and merged in (a body that wraps from
-//! the bottom of the world to the top would cost an insertion sort the whole list). A slot is
-//! only the sort key and the body's index (16 bytes), so the sorts and the merge move little;
-//! once the order is settled the bounds are gathered beside it.
+//! list's cost at 10,000 bodies. A body that reaches other strips than last time keeps its
+//! slots in the strips it still reaches (a lower slot that becomes its upper one, or the
+//! reverse, turns one bit: the same place in the list), its slots in strips it left leave,
+//! and a strip newly reached gets a fresh slot, sorted apart and merged in (a body that wraps
+//! from the bottom of the world to the top would cost an insertion sort the whole list). A
+//! body falling through the strips thus makes one fresh slot a crossing, not three. A slot
+//! is only the sort key and the body's index (16 bytes), so the sorts and the merge move
+//! little; once the order is settled the bounds are gathered beside it.
 //!
 //! # Determinism
 //! The order is `(strip, min.x as f64::total_cmp, local, upper)`, `local` the body's index in
 //! the list's key order: a function of the input.
 
-use ricochet_geom::Bounds;
-
-use super::grid::cell_coord;
 use super::sorted::{self, order_key};
+use super::strip_reach::{Fate, Reach};
 use super::{BodyEntry, Member, member};
 
 /// No index: a body gone from a list.
@@ -58,57 +59,15 @@ pub(super) struct StripList {
     pub(super) width: f64,
     /// `(strip, first slot)` of each run of one strip, in order, then `(_, order.len())`.
     runs: Vec<(i32, u32)>,
-    /// Update buffers: old local to new; this call's `min.x` keys and whether each body
-    /// reaches other strips than last time, by `local`; those bodies; fresh slots; the merge.
+    /// Update buffers: old local to new; this call's `min.x` keys and what becomes of each
+    /// body's slots (its [`Fate`]'s code), by `local`; the bodies that reach other strips
+    /// than last time; fresh slots; the merge.
     remap: Vec<u32>,
     x: Vec<u64>,
-    is_moved: Vec<bool>,
+    fate: Vec<u8>,
     moved: Vec<(u32, Reach)>,
     fresh: Vec<Slot>,
     merged: Vec<Slot>,
-}
-
-/// The strips a body reaches: its lower one, and the next one too when `two`.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-struct Reach {
-    lower: i32,
-    two: bool,
-}
-
-impl Reach {
-    /// A reach no body has: a finite coordinate's strip is within `2^30` of 0
-    /// (`strip_height.rs` makes `H` at least the largest finite coordinate over `2^30`), and
-    /// a box reaching down to `-inf` is infinitely tall (one strip for all) or reaches only
-    /// `i32::MIN`.
-    const NONE: Reach = Reach {
-        lower: i32::MIN,
-        two: true,
-    };
-
-    /// The strips `b` reaches at `1 / H` = `inv_h`. A box with a NaN or inverted `y` range
-    /// overlaps nothing, and has its lower slot only.
-    #[inline]
-    fn of(b: &Bounds, inv_h: f64) -> Reach {
-        let lower = cell_coord(b.min.y, inv_h);
-        // The top's strip, `cell_coord(b.max.y)`, is `lower` or `lower + 1` for every box at
-        // most `H` tall (anything else is a box that overlaps nothing: NaN maps to strip 0),
-        // so only whether it reaches `lower + 1` is asked: the clamped top against that
-        // integer (exact in an `f64`), without a second cast. A top clamped to `i32::MAX`
-        // reaches no strip past it, as the cast's `lower + 1` would not.
-        let ordered = b.min.y <= b.max.y;
-        let top = (b.max.y * inv_h).min(f64::from(i32::MAX));
-        let two = ordered && top >= f64::from(lower) + 1.0;
-        debug_assert_eq!(
-            two,
-            ordered && i64::from(cell_coord(b.max.y, inv_h)) == i64::from(lower) + 1,
-            "the top's strip, without the cast"
-        );
-        debug_assert!(
-            !ordered || cell_coord(b.max.y, inv_h) == lower || two,
-            "H is at least as tall as every body"
-        );
-        Reach { lower, two }
-    }
 }
 
 /// A body's place in a [`StripList`] (16 bytes, so the insertion sort and the merge move a
@@ -154,6 +113,13 @@ impl Slot {
     #[inline]
     fn local(self) -> u32 {
         self.0 as u32 & !UPPER
+    }
+
+    /// The slot with its role turned (a lower slot made its body's upper one, or the
+    /// reverse) when `turn`: the same strip and key.
+    #[inline]
+    fn turned(self, turn: bool) -> Slot {
+        Slot(self.0 ^ (u128::from(turn) << 31))
     }
 
     /// Whether this is the body's lower slot, not its upper one.
@@ -262,13 +228,20 @@ impl StripList {
             let read = self.read_bodies(handles, bodies, inv_h);
             debug_assert!(read, "the reconciled keys are the bodies'");
         }
-        // The moved bodies' slots, made again and sorted apart (a few hundred among
-        // thousands).
-        for &(local, reach) in &self.moved {
-            self.reach[local as usize] = reach;
-            let (lower, upper) = Slot::both(reach, self.x[local as usize], local);
-            self.fresh.push(lower);
-            self.fresh.extend(upper);
+        // The moved bodies: what becomes of their slots, and their slots in strips they did
+        // not reach, made and sorted apart (a few hundred among thousands).
+        for &(local, now) in &self.moved {
+            let l = local as usize;
+            let fate = Fate::of(self.reach[l], now);
+            self.fate[l] = fate.code;
+            self.reach[l] = now;
+            let (lower, upper) = Slot::both(now, self.x[l], local);
+            if fate.new_lower {
+                self.fresh.push(lower);
+            }
+            if fate.new_upper {
+                self.fresh.extend(upper);
+            }
         }
         self.fresh.sort_unstable();
         self.merge_moved();
@@ -298,13 +271,16 @@ impl StripList {
         let (mut w, mut f) = (0, 0);
         for &old in &self.order {
             let local = old.local() as usize;
-            let new = old.at_x(self.x[local]);
+            // This slot's two bits of its body's fate: whether it stays, and whether it
+            // turns from a lower slot to an upper one or back.
+            let fate = self.fate[local] >> (2 * u32::from(!old.is_lower()));
+            let new = old.at_x(self.x[local]).turned(fate & Fate::TURNS != 0);
             while f < fresh.len() && fresh[f] < new {
                 merged[w] = fresh[f];
                 (w, f) = (w + 1, f + 1);
             }
             merged[w] = new;
-            w += usize::from(!self.is_moved[local]);
+            w += usize::from(fate & Fate::STAYS);
         }
         for &s in &fresh[f..] {
             merged[w] = s;
@@ -325,14 +301,14 @@ impl StripList {
         // Written in place, by body: the columns keep their length from call to call, so no
         // length is stored a body.
         self.x.resize(n, 0);
-        self.is_moved.resize(n, false);
+        self.fate.resize(n, Fate::SAME);
         self.moved.clear();
         let (keys, reach) = (&self.keys[..n], &self.reach[..n]);
         let columns = keys
             .iter()
             .zip(reach)
-            .zip(self.x.iter_mut().zip(&mut self.is_moved));
-        for (j, (&h, ((&key, &was), (x, is_moved)))) in handles.iter().zip(columns).enumerate() {
+            .zip(self.x.iter_mut().zip(&mut self.fate));
+        for (j, (&h, ((&key, &was), (x, fate)))) in handles.iter().zip(columns).enumerate() {
             let body = &bodies[h as usize];
             if body.key != key {
                 return false;
@@ -343,7 +319,8 @@ impl StripList {
                 self.moved.push((j as u32, now));
             }
             *x = order_key(body.bounds.min.x);
-            *is_moved = moved;
+            // A moved body's fate is written once the pass is through.
+            *fate = Fate::SAME;
         }
         true
     }
@@ -461,7 +438,7 @@ impl StripList {
             + self.remap.capacity() * 4
             + self.moved.capacity() * size_of::<(u32, Reach)>()
             + self.x.capacity() * 8
-            + self.is_moved.capacity()
+            + self.fate.capacity()
     }
 }
 

@@ -1,0 +1,165 @@
+//! What a body reaches in a `StripList` (`strip_list.rs`): the strip of its `min.y` and
+//! maybe the next ([`Reach`]), and, when that changes from one call to the next, what
+//! becomes of its slots ([`Fate`]).
+
+use ricochet_geom::Bounds;
+
+use super::grid::cell_coord;
+
+/// The strips a body reaches: its lower one, and the next one too when `two`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(super) struct Reach {
+    pub(super) lower: i32,
+    pub(super) two: bool,
+}
+
+impl Reach {
+    /// A reach no body has: a finite coordinate's strip is within `2^30` of 0
+    /// (`strip_height.rs` makes `H` at least the largest finite coordinate over `2^30`), and
+    /// a box reaching down to `-inf` is infinitely tall (one strip for all) or reaches only
+    /// `i32::MIN`.
+    pub(super) const NONE: Reach = Reach {
+        lower: i32::MIN,
+        two: true,
+    };
+
+    /// The strips `b` reaches at `1 / H` = `inv_h`. A box with a NaN or inverted `y` range
+    /// overlaps nothing, and has its lower slot only.
+    #[inline]
+    pub(super) fn of(b: &Bounds, inv_h: f64) -> Reach {
+        let lower = cell_coord(b.min.y, inv_h);
+        // The top's strip, `cell_coord(b.max.y)`, is `lower` or `lower + 1` for every box at
+        // most `H` tall (anything else is a box that overlaps nothing: NaN maps to strip 0),
+        // so only whether it reaches `lower + 1` is asked: the clamped top against that
+        // integer (exact in an `f64`), without a second cast. A top clamped to `i32::MAX`
+        // reaches no strip past it, as the cast's `lower + 1` would not.
+        let ordered = b.min.y <= b.max.y;
+        let top = (b.max.y * inv_h).min(f64::from(i32::MAX));
+        let two = ordered && top >= f64::from(lower) + 1.0;
+        debug_assert_eq!(
+            two,
+            ordered && i64::from(cell_coord(b.max.y, inv_h)) == i64::from(lower) + 1,
+            "the top's strip, without the cast"
+        );
+        debug_assert!(
+            !ordered || cell_coord(b.max.y, inv_h) == lower || two,
+            "H is at least as tall as every body"
+        );
+        Reach { lower, two }
+    }
+}
+
+/// What becomes of a moved body's slots when its reach changes from `was` to `now`: a slot
+/// in a strip the body still reaches stays where it is (a lower slot that becomes the upper
+/// one, or the reverse, has one bit turned: the same strip and key, so the same place in the
+/// list); a slot in a strip it no longer reaches leaves; a strip newly reached gets a fresh
+/// slot. A body falling through strips keeps one of its two slots at each crossing, and
+/// gets at most one fresh one.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) struct Fate {
+    /// Two bits for the body's lower slot, then two for its upper one: [`Fate::STAYS`],
+    /// [`Fate::TURNS`].
+    pub(super) code: u8,
+    /// Whether its new lower slot, and its new upper one (if any), are fresh.
+    pub(super) new_lower: bool,
+    pub(super) new_upper: bool,
+}
+
+impl Fate {
+    /// The slot stays in the list.
+    pub(super) const STAYS: u8 = 1;
+    /// The slot's role turns.
+    pub(super) const TURNS: u8 = 2;
+    /// A body whose reach did not change: both slots stay as they are.
+    pub(super) const SAME: u8 = Fate::STAYS | Fate::STAYS << 2;
+
+    pub(super) fn of(was: Reach, now: Reach) -> Fate {
+        // A body new to the list ([`Reach::NONE`]) has no slot.
+        let old = was != Reach::NONE;
+        let strips = |r: Reach| {
+            let lower = i64::from(r.lower);
+            (lower, r.two.then_some(lower + 1))
+        };
+        let ((was_lower, was_upper), (now_lower, now_upper)) = (strips(was), strips(now));
+        // An old slot in `strip`: stays if the body still reaches that strip, turning if it
+        // does so in the other role.
+        let fate = |strip: i64, upper: bool| -> u8 {
+            if strip == now_lower {
+                Fate::STAYS | if upper { Fate::TURNS } else { 0 }
+            } else if Some(strip) == now_upper {
+                Fate::STAYS | if upper { 0 } else { Fate::TURNS }
+            } else {
+                0
+            }
+        };
+        let lower = if old { fate(was_lower, false) } else { 0 };
+        let upper = match was_upper {
+            Some(strip) if old => fate(strip, true),
+            _ => 0,
+        };
+        let had = |strip: i64| old && (strip == was_lower || Some(strip) == was_upper);
+        Fate {
+            code: lower | upper << 2,
+            new_lower: !had(now_lower),
+            new_upper: now_upper.is_some_and(|strip| !had(strip)),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use proptest::prelude::*;
+
+    use super::{Fate, Reach};
+
+    /// A reach near 0 or at the ends of the strips (`lower + 1` never overflows when `two`).
+    fn reach() -> impl Strategy<Value = Reach> {
+        (
+            prop_oneof![-3..3i32, Just(i32::MIN), Just(i32::MAX - 1)],
+            any::<bool>(),
+        )
+            .prop_map(|(lower, two)| Reach { lower, two })
+    }
+
+    proptest! {
+        /// A moved body's slots after its fate are its new reach's, each once: the old
+        /// slots that stay (in their new role) and the fresh ones, with nothing left over.
+        #[test]
+        fn a_moved_body_ends_with_exactly_its_new_slots(
+            was in prop_oneof![Just(Reach::NONE), reach()],
+            now in reach(),
+        ) {
+            prop_assume!(was != now);
+            let fate = Fate::of(was, now);
+            // (strip, upper) of each slot.
+            let slots = |r: Reach| {
+                let mut v = vec![(i64::from(r.lower), false)];
+                if r.two {
+                    v.push((i64::from(r.lower) + 1, true));
+                }
+                v
+            };
+            let mut after = Vec::new();
+            if was != Reach::NONE {
+                for (strip, upper) in slots(was) {
+                    let bits = fate.code >> (2 * u8::from(upper));
+                    if bits & Fate::STAYS != 0 {
+                        after.push((strip, upper != (bits & Fate::TURNS != 0)));
+                    }
+                }
+            }
+            let want = slots(now);
+            if fate.new_lower {
+                after.push(want[0]);
+            }
+            if fate.new_upper {
+                prop_assert!(now.two, "a fresh upper slot for a body with none");
+                after.push(want[1]);
+            }
+            after.sort_unstable();
+            let mut want = want;
+            want.sort_unstable();
+            prop_assert_eq!(after, want);
+        }
+    }
+}
