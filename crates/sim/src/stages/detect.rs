@@ -277,7 +277,10 @@ fn candidate_pairs(ctx: &mut StageCtx, st: &mut DetectState) -> Vec<(u32, u32)> 
             let (i, j) = (world_index(p.0), world_index(p.1));
             *p = (i.min(j), i.max(j));
         }
-        pairs.sort_unstable_by_key(|&(i, j)| (u64::from(i) << 32) | u64::from(j));
+        // A radix sort by the pair's key: it sorts by the bytes that differ (four at most
+        // below 65,536 bodies) where a comparison sort took 2% of rain-10000's step. Equal
+        // keys are equal pairs, so the order is the same as any sort's.
+        radsort::sort_by_key(&mut pairs, |&(i, j)| (u64::from(i) << 32) | u64::from(j));
     }
     st.static_generation = Some(w.static_generation());
     if let Some(b) = wrap {
