@@ -186,6 +186,9 @@ fn separate_swept(layers: &Layers, box_only: &[bool]) -> Vec<bool> {
         .collect()
 }
 
+/// From how many candidate pairs [`candidate_pairs`] sorts them by a radix sort.
+const RADIX_PAIRS: usize = 256;
+
 /// Fills the broad phase's inputs and finds the candidate pairs (dense indices, sorted).
 fn candidate_pairs(ctx: &mut StageCtx, st: &mut DetectState) -> Vec<(u32, u32)> {
     let w = &mut *ctx.world;
@@ -277,10 +280,17 @@ fn candidate_pairs(ctx: &mut StageCtx, st: &mut DetectState) -> Vec<(u32, u32)> 
             let (i, j) = (world_index(p.0), world_index(p.1));
             *p = (i.min(j), i.max(j));
         }
-        // A radix sort by the pair's key: it sorts by the bytes that differ (four at most
-        // below 65,536 bodies) where a comparison sort took 2% of rain-10000's step. Equal
-        // keys are equal pairs, so the order is the same as any sort's.
-        radsort::sort_by_key(&mut pairs, |&(i, j)| (u64::from(i) << 32) | u64::from(j));
+        // By the pair's key; equal keys are equal pairs, so the order is the same whichever
+        // sort. Many pairs by a radix sort: it sorts by the bytes that differ (four at most
+        // below 65,536 bodies), where a comparison sort took 2% of rain-10000's step; a few
+        // by a comparison sort (a radix sort's tables cost the asteroids' dozens of pairs
+        // 12,000 instructions a frame).
+        let key = |&(i, j): &(u32, u32)| (u64::from(i) << 32) | u64::from(j);
+        if pairs.len() >= RADIX_PAIRS {
+            radsort::sort_by_key(&mut pairs, key);
+        } else {
+            pairs.sort_unstable_by_key(key);
+        }
     }
     st.static_generation = Some(w.static_generation());
     if let Some(b) = wrap {
