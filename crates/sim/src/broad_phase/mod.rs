@@ -210,7 +210,8 @@ pub struct BroadPhaseStats {
     /// Layer combinations present in the scene (moving–moving, including a layer with
     /// itself, and moving–static) that were never looked at because they do not interact.
     pub layer_pairs_skipped: u64,
-    /// `SortAndSweep`: how many places bodies moved in the re-sort.
+    /// `SortAndSweep` and `Strips`: how many places bodies moved in the re-sort (for
+    /// `Strips`, its insertion sort, the fresh slots' moves included).
     pub resorted: u64,
 }
 

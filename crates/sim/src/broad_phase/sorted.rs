@@ -51,9 +51,9 @@ pub(super) fn from_order_key(key: u64) -> f64 {
 
 /// `list.partition_point(pred)` by a galloping search from the start: a step that doubles
 /// while the item it lands on still has `pred`, then a binary search in the last step.
-/// About `2 log2(answer)` reads, all near the start: where the answer is near (a run of one
-/// strip, the place of the next of a few sorted items among thousands), a binary search
-/// over the whole list would miss the cache at each step.
+/// About `2 log2(answer)` reads, all near the start: where the answer is near (the end of a
+/// run of one strip among thousands of slots), a binary search over the whole list would
+/// miss the cache at each step.
 pub(super) fn gallop<T>(list: &[T], pred: impl Fn(&T) -> bool) -> usize {
     // Every item before `below` has `pred`; the item at `step - 1`, if any, has not.
     let (mut below, mut step) = (0, 1);

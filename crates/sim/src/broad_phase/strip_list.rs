@@ -15,7 +15,8 @@
 //! frame). Reading the 48-byte entries in list order instead, at random, was most of the
 //! list's cost at 10,000 bodies. A body that reaches other strips than last time keeps its
 //! slots in the strips it still reaches (a lower slot that becomes its upper one, or the
-//! reverse, turns one bit: the same place in the list), its slots in strips it left leave,
+//! reverse, turns one bit: the same place in the list, up to ties in `min.x`), its slots in
+//! strips it left leave,
 //! and a strip newly reached gets a fresh slot, sorted apart and merged in (a body that wraps
 //! from the bottom of the world to the top would cost an insertion sort the whole list). A
 //! body falling through the strips thus makes one fresh slot a crossing, not three. A slot
@@ -23,7 +24,7 @@
 //! little; once the order is settled the bounds are gathered beside it.
 //!
 //! # Determinism
-//! The order is `(strip, min.x as f64::total_cmp, local, upper)`, `local` the body's index in
+//! The order is `(strip, min.x as f64::total_cmp, upper, local)`, `local` the body's index in
 //! the list's key order: a function of the input.
 
 use super::sorted::{self, order_key};
@@ -213,9 +214,11 @@ impl StripList {
     }
 
     /// Reconciles the list with this call's bodies (`handles` into `bodies`, key order) and
-    /// strip height: bodies gone are dropped, bodies that reach the same strips get their
-    /// new keys in place, and the others' slots are made again, sorted apart and merged in.
-    /// Then the bounds are gathered in the new order. Returns the insertion sort's moves.
+    /// strip height: bodies gone are dropped, and every slot in a strip its body still
+    /// reaches gets its new key (its role turned if need be, [`Fate`]); the others leave, and
+    /// a strip newly reached gets a fresh slot, sorted apart and merged in during the same
+    /// pass. One insertion sort then orders the list, and the bounds are gathered in the new
+    /// order. Returns the insertion sort's moves (the fresh slots' included).
     pub(super) fn update(&mut self, handles: &[u32], bodies: &[BodyEntry], inv_h: f64) -> u64 {
         self.inv_h = inv_h;
         self.fresh.clear();
@@ -245,25 +248,50 @@ impl StripList {
         }
         self.fresh.sort_unstable();
         self.merge_moved();
-        let moved = sorted::insertion_sort(&mut self.order, Slot::cmp, |_, _| {});
+        let moves = sorted::insertion_sort(&mut self.order, Slot::cmp, |_, _| {});
+        #[cfg(debug_assertions)]
+        self.check_order();
         self.gather(handles, bodies);
         self.find_runs();
-        moved
+        moves
+    }
+
+    /// Debug builds, lists of up to 1,024 slots (the broad-phase tests' scenes; the debug
+    /// build's big scenes would sort their list again every frame): the list is every
+    /// body's slots made afresh from its reach and key, sorted.
+    #[cfg(debug_assertions)]
+    fn check_order(&self) {
+        if self.order.len() > 1024 {
+            return;
+        }
+        let mut afresh = Vec::with_capacity(self.order.len());
+        for (local, (&reach, &x)) in self.reach.iter().zip(&self.x).enumerate() {
+            let (lower, upper) = Slot::both(reach, x, local as u32);
+            afresh.push(lower);
+            afresh.extend(upper);
+        }
+        afresh.sort_unstable();
+        assert!(
+            self.order == afresh,
+            "the kept list is its slots made afresh"
+        );
     }
 
     /// One pass over the list in its order, into `merged`, which becomes the list: each slot
-    /// gets its body's new key from `x` (8 bytes a body, where the bodies are 48), a moved
-    /// body's slots leave, and the fresh slots come in. A fresh slot goes before the first
-    /// slot written after it that it sorts before: the kept slots are nearly sorted (their
-    /// keys moved a little), so the list is nearly sorted too, and the insertion sort that
-    /// follows puts it in order. The result is the one sorted list of its slots (`local`
-    /// breaks ties), however the fresh ones were placed.
+    /// gets its body's new key from `x` (8 bytes a body, where the bodies are 48), the slots
+    /// of strips their bodies left leave, and the fresh slots come in. A fresh slot goes
+    /// before the first old slot (kept or leaving, at its new key) that it sorts before: the
+    /// kept slots are nearly sorted (their keys moved a little), so the list is nearly sorted
+    /// too, and the insertion sort that follows puts it in order. The result is the one
+    /// sorted list of its slots (the body breaks ties), however the fresh ones were placed. A
+    /// body whose `min.x` jumped far (a wrap along x) costs that sort a walk over its run.
     ///
-    /// Every kept slot is written at the cursor without a branch (a moved body's slot is
-    /// written too, and the cursor stays: hence room for one slot more than the list will
-    /// hold). `merged` keeps its length from call to call, so only growth is filled.
+    /// Every kept slot is written at the cursor without a branch (a leaving slot is written
+    /// too, and the cursor stays: it is at most the old slots before it plus the fresh ones,
+    /// so within the room of both lists). `merged` keeps its length from call to call, so
+    /// only growth is filled.
     fn merge_moved(&mut self) {
-        let room = self.order.len() + self.fresh.len() + 1;
+        let room = self.order.len() + self.fresh.len();
         if self.merged.len() < room {
             self.merged.resize(room, Slot::GONE);
         }
@@ -271,9 +299,7 @@ impl StripList {
         let (mut w, mut f) = (0, 0);
         for &old in &self.order {
             let local = old.local() as usize;
-            // This slot's two bits of its body's fate: whether it stays, and whether it
-            // turns from a lower slot to an upper one or back.
-            let fate = self.fate[local] >> (2 * u32::from(!old.is_lower()));
+            let fate = Fate::slot_bits(self.fate[local], !old.is_lower());
             let new = old.at_x(self.x[local]).turned(fate & Fate::TURNS != 0);
             while f < fresh.len() && fresh[f] < new {
                 merged[w] = fresh[f];
@@ -478,7 +504,7 @@ mod tests {
     /// The galloping search finds where a binary search does: before every slot,
     /// between any two, after all, and on a slot equal to the one looked for.
     #[test]
-    fn a_fresh_slot_goes_where_a_binary_search_puts_it() {
+    fn gallop_finds_where_a_binary_search_does() {
         for len in 0..70u64 {
             let order: Vec<Slot> = (0..len).map(|k| Slot::new(0, 2 * k, 0)).collect();
             for x in 0..2 * len + 2 {

@@ -32,9 +32,10 @@ impl Reach {
         // most `H` tall (anything else is a box that overlaps nothing: NaN maps to strip 0),
         // so only whether it reaches `lower + 1` is asked: the clamped top against that
         // integer (exact in an `f64`), without a second cast. A top clamped to `i32::MAX`
-        // reaches no strip past it, as the cast's `lower + 1` would not.
+        // reaches no strip past it, as the cast's `lower + 1` would not. A NaN top (an
+        // infinite one at `inv_h = 0`: one strip for all) stays NaN, and reaches no other.
         let ordered = b.min.y <= b.max.y;
-        let top = (b.max.y * inv_h).min(f64::from(i32::MAX));
+        let top = (b.max.y * inv_h).clamp(f64::from(i32::MIN), f64::from(i32::MAX));
         let two = ordered && top >= f64::from(lower) + 1.0;
         debug_assert_eq!(
             two,
@@ -52,7 +53,7 @@ impl Reach {
 /// What becomes of a moved body's slots when its reach changes from `was` to `now`: a slot
 /// in a strip the body still reaches stays where it is (a lower slot that becomes the upper
 /// one, or the reverse, has one bit turned: the same strip and key, so the same place in the
-/// list); a slot in a strip it no longer reaches leaves; a strip newly reached gets a fresh
+/// list up to ties in `min.x`); a slot in a strip it no longer reaches leaves; a strip newly reached gets a fresh
 /// slot. A body falling through strips keeps one of its two slots at each crossing, and
 /// gets at most one fresh one.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -73,6 +74,14 @@ impl Fate {
     /// A body whose reach did not change: both slots stay as they are.
     pub(super) const SAME: u8 = Fate::STAYS | Fate::STAYS << 2;
 
+    /// The two bits of `code` for a body's upper slot when `upper`, else for its lower one.
+    #[inline]
+    pub(super) fn slot_bits(code: u8, upper: bool) -> u8 {
+        code >> (2 * u8::from(upper))
+    }
+
+    /// The fate of the slots of a body whose reach changed from `was` ([`Reach::NONE`] for a
+    /// body new to the list) to `now`.
     pub(super) fn of(was: Reach, now: Reach) -> Fate {
         // A body new to the list ([`Reach::NONE`]) has no slot.
         let old = was != Reach::NONE;
@@ -110,15 +119,40 @@ impl Fate {
 mod tests {
     use proptest::prelude::*;
 
+    use ricochet_geom::{Bounds, Vec2};
+
     use super::{Fate, Reach};
 
     /// A reach near 0 or at the ends of the strips (`lower + 1` never overflows when `two`).
     fn reach() -> impl Strategy<Value = Reach> {
-        (
-            prop_oneof![-3..3i32, Just(i32::MIN), Just(i32::MAX - 1)],
-            any::<bool>(),
-        )
-            .prop_map(|(lower, two)| Reach { lower, two })
+        prop_oneof![
+            (
+                prop_oneof![-3..3i32, Just(i32::MIN), Just(i32::MAX - 1)],
+                any::<bool>(),
+            )
+                .prop_map(|(lower, two)| Reach { lower, two }),
+            Just(Reach {
+                lower: i32::MAX,
+                two: false,
+            }),
+        ]
+    }
+
+    /// A box infinitely tall at its top makes the strip infinitely tall (`inv_h = 0`): one
+    /// strip for all, and the box reaches no other (its top times `inv_h` is NaN).
+    #[test]
+    fn an_infinite_top_at_one_strip_reaches_one_strip() {
+        let b = Bounds {
+            min: Vec2::new(0.0, 2.0),
+            max: Vec2::new(1.0, f64::INFINITY),
+        };
+        assert_eq!(
+            Reach::of(&b, 0.0),
+            Reach {
+                lower: 0,
+                two: false
+            }
+        );
     }
 
     proptest! {
@@ -142,7 +176,7 @@ mod tests {
             let mut after = Vec::new();
             if was != Reach::NONE {
                 for (strip, upper) in slots(was) {
-                    let bits = fate.code >> (2 * u8::from(upper));
+                    let bits = Fate::slot_bits(fate.code, upper);
                     if bits & Fate::STAYS != 0 {
                         after.push((strip, upper != (bits & Fate::TURNS != 0)));
                     }

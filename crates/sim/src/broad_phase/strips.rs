@@ -30,7 +30,7 @@
 //! height, or none below `2^1000`, there is one strip: plain sort and sweep.
 //!
 //! # Determinism
-//! Orders are by `(strip, min.x as f64::total_cmp, local, upper)`: a function of the input.
+//! Orders are by `(strip, min.x as f64::total_cmp, upper, local)`: a function of the input.
 
 use super::sorted::order_key;
 use super::strip_height::{extent, inv_strip_height, restrip};
@@ -55,6 +55,8 @@ struct Sink<'a> {
 }
 
 impl<'a> Sink<'a> {
+    /// A sink for the sweeps of `strip`; release builds keep `out` only (the strip and
+    /// `inv_h` are for the debug check of the rule).
     #[cfg_attr(not(debug_assertions), allow(unused_variables))]
     fn new(out: &'a mut Vec<(u32, u32)>, strip: i32, inv_h: f64) -> Sink<'a> {
         Sink {
