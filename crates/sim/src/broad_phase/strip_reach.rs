@@ -30,13 +30,13 @@ impl Reach {
         let lower = cell_coord(b.min.y, inv_h);
         // The top's strip, `cell_coord(b.max.y)`, is `lower` or `lower + 1` for every box at
         // most `H` tall (anything else is a box that overlaps nothing: NaN maps to strip 0),
-        // so only whether it reaches `lower + 1` is asked: the clamped top against that
-        // integer (exact in an `f64`), without a second cast. A top clamped to `i32::MAX`
-        // reaches no strip past it, as the cast's `lower + 1` would not. A NaN top (an
-        // infinite one at `inv_h = 0`: one strip for all) stays NaN, and reaches no other.
+        // so only whether it reaches `lower + 1` is asked: the top against that integer
+        // (exact in an `f64`), without a second cast. Nothing reaches past strip `i32::MAX`,
+        // as the cast's clamp says; a NaN top (an infinite one at `inv_h = 0`: one strip for
+        // all) reaches no other strip, as the cast's NaN to 0 says.
         let ordered = b.min.y <= b.max.y;
-        let top = (b.max.y * inv_h).clamp(f64::from(i32::MIN), f64::from(i32::MAX));
-        let two = ordered && top >= f64::from(lower) + 1.0;
+        let top = b.max.y * inv_h;
+        let two = ordered && top >= f64::from(lower) + 1.0 && lower < i32::MAX;
         debug_assert_eq!(
             two,
             ordered && i64::from(cell_coord(b.max.y, inv_h)) == i64::from(lower) + 1,
@@ -139,20 +139,28 @@ mod tests {
     }
 
     /// A box infinitely tall at its top makes the strip infinitely tall (`inv_h = 0`): one
-    /// strip for all, and the box reaches no other (its top times `inv_h` is NaN).
+    /// strip for all, and the box reaches no other (its top times `inv_h` is NaN). A box at
+    /// `+inf` is in the last strip, and reaches none past it.
     #[test]
-    fn an_infinite_top_at_one_strip_reaches_one_strip() {
-        let b = Bounds {
+    fn infinite_tops_reach_no_strip_that_is_not_there() {
+        let tall = Bounds {
             min: Vec2::new(0.0, 2.0),
             max: Vec2::new(1.0, f64::INFINITY),
         };
-        assert_eq!(
-            Reach::of(&b, 0.0),
-            Reach {
-                lower: 0,
-                two: false
-            }
-        );
+        let first = Reach {
+            lower: 0,
+            two: false,
+        };
+        assert_eq!(Reach::of(&tall, 0.0), first);
+        let at_inf = Bounds {
+            min: Vec2::new(0.0, f64::INFINITY),
+            max: Vec2::new(1.0, f64::INFINITY),
+        };
+        let last = Reach {
+            lower: i32::MAX,
+            two: false,
+        };
+        assert_eq!(Reach::of(&at_inf, 0.125), last);
     }
 
     proptest! {
