@@ -33,10 +33,12 @@ impl Reach {
         // so only whether it reaches `lower + 1` is asked: the top against that integer
         // (exact in an `f64`), without a second cast. Nothing reaches past strip `i32::MAX`,
         // as the cast's clamp says; a NaN top (an infinite one at `inv_h = 0`: one strip for
-        // all) reaches no other strip, as the cast's NaN to 0 says.
+        // all) reaches no other strip, as the cast's NaN to 0 says. `&`, not `&&`: a branch
+        // here, on whether a body reaches two strips, was mispredicted often enough to cost
+        // rain-10000 7% of its step.
         let ordered = b.min.y <= b.max.y;
         let top = b.max.y * inv_h;
-        let two = ordered && top >= f64::from(lower) + 1.0 && lower < i32::MAX;
+        let two = ordered & (top >= f64::from(lower) + 1.0) & (lower < i32::MAX);
         debug_assert_eq!(
             two,
             ordered && i64::from(cell_coord(b.max.y, inv_h)) == i64::from(lower) + 1,
