@@ -16,12 +16,11 @@
 //! list's cost at 10,000 bodies. A body that reaches other strips than last time keeps its
 //! slots in the strips it still reaches (a lower slot that becomes its upper one, or the
 //! reverse, turns one bit: the same place in the list, up to ties in `min.x`), its slots in
-//! strips it left leave,
-//! and a strip newly reached gets a fresh slot, sorted apart and merged in (a body that wraps
-//! from the bottom of the world to the top would cost an insertion sort the whole list). A
-//! body falling through the strips thus makes one fresh slot a crossing, not three. A slot
-//! is only the sort key and the body's index (16 bytes), so the sorts and the merge move
-//! little; once the order is settled the bounds are gathered beside it.
+//! strips it left leave, and a strip newly reached gets a fresh slot, sorted apart and merged
+//! in (a body that wraps from the bottom of the world to the top would cost an insertion sort
+//! the whole list). A body falling through the strips thus makes one fresh slot a crossing,
+//! not three. A slot is only the sort key and the body's index (16 bytes), so the sorts and
+//! the merge move little; once the order is settled the bounds are gathered beside it.
 //!
 //! # Determinism
 //! The order is `(strip, min.x as f64::total_cmp, upper, local)`, `local` the body's index in

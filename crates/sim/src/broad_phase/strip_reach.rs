@@ -55,9 +55,9 @@ impl Reach {
 /// What becomes of a moved body's slots when its reach changes from `was` to `now`: a slot
 /// in a strip the body still reaches stays where it is (a lower slot that becomes the upper
 /// one, or the reverse, has one bit turned: the same strip and key, so the same place in the
-/// list up to ties in `min.x`); a slot in a strip it no longer reaches leaves; a strip newly reached gets a fresh
-/// slot. A body falling through strips keeps one of its two slots at each crossing, and
-/// gets at most one fresh one.
+/// list up to ties in `min.x`); a slot in a strip it no longer reaches leaves; a strip newly
+/// reached gets a fresh slot. A body falling through strips keeps one of its two slots at
+/// each crossing, and gets at most one fresh one.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) struct Fate {
     /// Two bits for the body's lower slot, then two for its upper one: [`Fate::STAYS`],
