@@ -37,17 +37,23 @@ use super::strip_height::{extent, inv_strip_height, restrip};
 use super::strip_list::{StripList, Swept};
 use super::{BodyEntry, BroadPhase, BroadPhaseStats, Extent, LAYERS, Member, STATIC_BIT, of_layer};
 
-/// Where the sweeps of one strip put their pairs. Both bodies of an overlapping pair reach
-/// the strip of `max(p.min.y, q.min.y)` (`strip_list.rs`), and the pair is kept there only:
-/// a pair sharing two strips is found in both and kept once.
+/// Where the sweeps of one call put their pairs, strip by strip. Both bodies of an
+/// overlapping pair reach the strip of `max(p.min.y, q.min.y)` (`strip_list.rs`), and the
+/// pair is kept there only: a pair sharing two strips is found in both and kept once.
 ///
 /// That strip is this one when one of the two slots is its body's lower slot (its `min.y`
 /// is in this strip), and the one below when both are upper slots (both `min.y` are in the
 /// strip below): `floor(max(a, b) / H)` is `max(floor(a / H), floor(b / H))`, floor being
 /// monotone. So the rule is one flag of each slot, not a strip computed a pair.
+///
+/// The pairs are written without a branch on the verdict: each tested pair is written at
+/// `len`, and `len` moves past it only when it is kept. So `out` holds written slots past
+/// `len` while the sink lives, and is cut back to `len` when it is dropped.
 struct Sink<'a> {
     out: &'a mut Vec<(u32, u32)>,
-    /// The strip and `1 / H`, for the debug check of the rule.
+    /// The pairs kept: `out`'s length once the sink is dropped.
+    len: usize,
+    /// The strip swept and `1 / H`, for the debug check of the rule.
     #[cfg(debug_assertions)]
     strip: i32,
     #[cfg(debug_assertions)]
@@ -55,44 +61,74 @@ struct Sink<'a> {
 }
 
 impl<'a> Sink<'a> {
-    /// A sink for the sweeps of `strip`; release builds keep `out` only (the strip and
-    /// `inv_h` are for the debug check of the rule).
+    /// A sink for the sweeps of one call at `1 / H` = `inv_h` (kept for the debug check of
+    /// the rule only).
     #[cfg_attr(not(debug_assertions), allow(unused_variables))]
-    fn new(out: &'a mut Vec<(u32, u32)>, strip: i32, inv_h: f64) -> Sink<'a> {
+    fn new(out: &'a mut Vec<(u32, u32)>, inv_h: f64) -> Sink<'a> {
         Sink {
+            len: out.len(),
             out,
             #[cfg(debug_assertions)]
-            strip,
+            strip: 0,
             #[cfg(debug_assertions)]
             inv_h,
         }
     }
 
-    /// Tests `p` and `q`, keeping the pair when one is dynamic, their bounds overlap and this
-    /// is their strip. Returns the tests (0 or 1).
+    /// The sweeps that follow are of `strip` (kept for the debug check of the rule only).
+    #[cfg_attr(not(debug_assertions), allow(unused_variables))]
+    #[inline]
+    fn at(&mut self, strip: i32) -> &mut Self {
+        #[cfg(debug_assertions)]
+        {
+            self.strip = strip;
+        }
+        self
+    }
+
+    /// Whether the pair of `p` and `q` is kept (one is dynamic, their bounds overlap and
+    /// this is their strip), and the tests it counts: 1 when one is dynamic and `q` starts
+    /// before `p`'s end along x (always so for a slot that [`Sink::scan`] reaches), else 0.
+    ///
+    /// Without a branch: whether bounds overlap is a coin toss for the sweeps' candidates,
+    /// and a mispredicted branch a test cost more than the test (see [`Sink`]).
+    #[inline(always)]
+    fn verdict(&self, p: &Swept, q: &Swept) -> (bool, u64) {
+        let either = p.dynamic | q.dynamic;
+        let starts = q.min <= p.max;
+        // `Bounds::overlaps`, x by the keys (`strip_list.rs`, `Swept`).
+        let overlap = (p.min <= q.max) & starts & (p.min_y <= q.max_y) & (q.min_y <= p.max_y);
+        #[cfg(debug_assertions)]
+        if overlap {
+            // Overlapping bounds hold no NaN.
+            let top = p.min_y.max(q.min_y);
+            assert_eq!(
+                super::grid::cell_coord(top, self.inv_h) == self.strip,
+                p.lower || q.lower,
+                "the pair's strip is this one when one slot is a lower one"
+            );
+        }
+        (
+            either & overlap & (p.lower | q.lower),
+            u64::from(either & starts),
+        )
+    }
+
+    /// Writes the pair of `p` and `q`, kept (`len` past it) when `keep`. The caller made
+    /// room.
+    #[inline(always)]
+    fn put(&mut self, p: &Swept, q: &Swept, keep: bool) {
+        self.out[self.len] = (p.handle, q.handle);
+        self.len += usize::from(keep);
+    }
+
+    /// Tests `p` and `q` ([`Sink::verdict`]), keeping the pair when it is. Returns the tests.
     #[inline]
     fn test(&mut self, p: &Swept, q: &Swept) -> u64 {
-        if !(p.dynamic || q.dynamic) {
-            return 0;
-        }
-        // `Bounds::overlaps`, x by the keys (`strip_list.rs`, `Swept`).
-        let overlap = p.min <= q.max && q.min <= p.max && p.min_y <= q.max_y && q.min_y <= p.max_y;
-        if overlap {
-            #[cfg(debug_assertions)]
-            {
-                // Overlapping bounds hold no NaN.
-                let top = p.min_y.max(q.min_y);
-                assert_eq!(
-                    super::grid::cell_coord(top, self.inv_h) == self.strip,
-                    p.lower || q.lower,
-                    "the pair's strip is this one when one slot is a lower one"
-                );
-            }
-            if p.lower || q.lower {
-                self.out.push((p.handle, q.handle));
-            }
-        }
-        1
+        let (keep, tested) = self.verdict(p, q);
+        room(self.out, self.len + 1);
+        self.put(p, q, keep);
+        tested
     }
 
     /// Tests `p` against the slots of `others` (sorted by `min.x`) until one starts past
@@ -109,13 +145,32 @@ impl<'a> Sink<'a> {
         tested
     }
 
-    /// Every overlapping pair within one run.
+    /// [`Sink::scan`] out of line: the rare walk past the next slot. In line, the compiler
+    /// kept `p`'s fields on the stack for it in every step of [`Sink::within`].
+    #[inline(never)]
+    fn scan_on(&mut self, p: &Swept, others: &[Swept]) -> u64 {
+        self.scan(p, others)
+    }
+
+    /// Every overlapping pair within one run. Each slot is tested against the next without
+    /// a branch on whether that one starts before its end (a coin toss, where it was the
+    /// sweeps' costliest branch); the walk goes on only when the slot after it does too.
     fn within(&mut self, run: &[Swept]) -> u64 {
         let mut tested = 0;
+        // Room for every slot's test of the next: the loop grows nothing.
+        room(self.out, self.len + run.len());
         for (k, p) in run.iter().enumerate() {
             let rest = &run[k + 1..];
-            if rest.first().is_some_and(|next| next.min <= p.max) {
-                tested += self.scan(p, rest);
+            let Some(next) = rest.first() else {
+                break;
+            };
+            let (keep, t) = self.verdict(p, next);
+            self.put(p, next, keep);
+            tested += t;
+            // The run is sorted by `min`: a slot after one that starts past `p`'s end does too.
+            if rest.get(1).is_some_and(|s| s.min <= p.max) {
+                tested += self.scan_on(p, &rest[1..]);
+                room(self.out, self.len + rest.len());
             }
         }
         tested
@@ -175,13 +230,34 @@ impl<'a> Sink<'a> {
     }
 }
 
+/// `out` made at least `n` long (see [`Sink`]); its growth out of line, away from the
+/// sweeps' loops (in line, the compiler kept the loops' values on the stack around it).
+#[inline(always)]
+fn room(out: &mut Vec<(u32, u32)>, n: usize) {
+    #[cold]
+    #[inline(never)]
+    fn grow(out: &mut Vec<(u32, u32)>, n: usize) {
+        out.resize(n.max(out.len() * 2), (0, 0));
+    }
+    if out.len() < n {
+        grow(out, n);
+    }
+}
+
+impl Drop for Sink<'_> {
+    /// `out` cut back to the pairs kept.
+    fn drop(&mut self) {
+        self.out.truncate(self.len);
+    }
+}
+
 /// Every overlapping pair within one list with a dynamic body. Returns the tests.
 pub(super) fn strip_self(list: &StripList, out: &mut Vec<(u32, u32)>) -> u64 {
     let mut tested = 0;
+    let mut sink = Sink::new(out, list.inv_h);
     for r in 0..list.run_count() {
         let (strip, run) = list.run(r);
-        let mut sink = Sink::new(&mut *out, strip, list.inv_h);
-        tested += sink.within(run);
+        tested += sink.at(strip).within(run);
     }
     tested
 }
@@ -193,6 +269,7 @@ pub(super) fn strip_cross(x: &StripList, y: &StripList, out: &mut Vec<(u32, u32)
     debug_assert_eq!(x.inv_h.to_bits(), y.inv_h.to_bits(), "one strip height");
     let mut tested = 0;
     let mut k = 0;
+    let mut sink = Sink::new(out, x.inv_h);
     for r in 0..x.run_count() {
         let (strip, run) = x.run(r);
         while k < y.run_count() && y.run_strip(k) < strip {
@@ -202,8 +279,9 @@ pub(super) fn strip_cross(x: &StripList, y: &StripList, out: &mut Vec<(u32, u32)
             break;
         }
         if y.run_strip(k) == strip {
-            let mut sink = Sink::new(&mut *out, strip, x.inv_h);
-            tested += sink.pair_runs((run, x.width), (y.run(k).1, y.width));
+            tested += sink
+                .at(strip)
+                .pair_runs((run, x.width), (y.run(k).1, y.width));
         }
     }
     tested
