@@ -8,7 +8,7 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use ricochet_geom::{Bounds, Primitive, Shape, Vec2};
+use ricochet_geom::{Bounds, MAX_POLYGON_VERTICES, Primitive, Shape, Vec2};
 
 /// Values stored once, looked up by a key that is equal exactly when the values are.
 #[derive(Clone, Debug)]
@@ -115,6 +115,9 @@ pub(crate) struct ShapeTable {
     entries: Vec<Option<(Shape, Bounds)>>,
     /// Each id's name id (in the world's name table).
     names: Vec<u32>,
+    /// Each id's [`shape_class`]: the narrow phase groups its pairs by it, reading a byte
+    /// a body instead of the shape.
+    classes: Vec<u8>,
     /// How many bodies use each id.
     users: Vec<u32>,
     /// Ids no body uses, to reuse.
@@ -164,13 +167,16 @@ impl ShapeTable {
                 return id;
             }
         }
-        let entry = Some(value());
+        let entry = value();
+        let class = shape_class(&entry.0);
+        let entry = Some(entry);
         let serial = next_serial();
         self.last_serial = serial;
         let id = match self.free.pop() {
             Some(id) => {
                 self.entries[id as usize] = entry;
                 self.names[id as usize] = name;
+                self.classes[id as usize] = class;
                 self.users[id as usize] = 1;
                 self.serials[id as usize] = serial;
                 id
@@ -178,6 +184,7 @@ impl ShapeTable {
             None => {
                 self.entries.push(entry);
                 self.names.push(name);
+                self.classes.push(class);
                 self.users.push(1);
                 self.serials.push(serial);
                 u32::try_from(self.entries.len() - 1).expect("fewer than 2^32 distinct shapes")
@@ -191,6 +198,12 @@ impl ShapeTable {
     #[inline]
     pub(crate) fn name(&self, id: u32) -> u32 {
         self.names[id as usize]
+    }
+
+    /// The [`shape_class`] of an id in use.
+    #[inline]
+    pub(crate) fn class(&self, id: u32) -> u8 {
+        self.classes[id as usize]
     }
 
     /// One user of `id` fewer; the shape is dropped with its last user.
@@ -247,12 +260,32 @@ impl ShapeTable {
     pub(crate) fn heap_bytes(&self) -> usize {
         self.entries.capacity() * size_of::<Option<(Shape, Bounds)>>()
             + self.names.capacity() * 4
+            + self.classes.capacity()
             + self.users.capacity() * 4
             + self.free.capacity() * 4
             + self.serials.capacity() * 8
             // A B-tree node holds up to 11 keys; count each entry at a full node's share.
             + self.ids.len() * (size_of::<(u64, u32)>() + 8)
             + self.scratch.capacity() * 8
+    }
+}
+
+/// How many values [`shape_class`] gives.
+pub(crate) const SHAPE_CLASSES: u8 = 12;
+
+/// Which code of the narrow phase a shape takes: its one primitive's kind, a polygon's by
+/// its vertex count (3 to 8: the loops over them run as many times), or a compound's.
+pub(crate) fn shape_class(shape: &Shape) -> u8 {
+    const _: () = assert!(MAX_POLYGON_VERTICES == 8, "a class for each polygon size");
+    match shape.primitives() {
+        [Primitive::Circle(_)] => 0,
+        [Primitive::Aabb(_)] => 1,
+        [Primitive::Obb(_)] => 2,
+        [Primitive::Capsule(_)] => 3,
+        [Primitive::Segment(_)] => 4,
+        // 5 to 10.
+        [Primitive::Polygon(p)] => 2 + p.vertices().len().clamp(3, 8) as u8,
+        _ => SHAPE_CLASSES - 1,
     }
 }
 

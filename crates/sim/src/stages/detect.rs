@@ -50,6 +50,7 @@ use crate::output::{ContactRecord, Phase};
 use crate::parallel::Workers;
 use crate::prefetch;
 use crate::stages::mover_pairs::{MoverCall, mover_pairs};
+use crate::stages::narrow_groups::ByClass;
 use crate::stages::push::{Statics, separate_along_normal};
 use crate::stages::remove::remove;
 use crate::stages::separate::is_box;
@@ -96,6 +97,8 @@ pub(crate) struct DetectState {
     /// This frame's pairs for the narrow phase (dense indices, response), their contacts at
     /// the poses the pass started from, and the bodies a response has moved since.
     plan: Vec<(usize, usize, Response)>,
+    /// The order the contacts are computed in (`narrow_groups.rs`), and the contacts in it.
+    by_class: ByClass,
     contacts: Vec<Option<Contact>>,
     /// Per body, all false between passes (only the `moved` ones are set, then cleared).
     pushed: Vec<bool>,
@@ -126,6 +129,7 @@ impl DetectState {
             seam: Seam::new(kind),
             tests: vec![0; n * n],
             plan: Vec::new(),
+            by_class: ByClass::default(),
             contacts: Vec::new(),
             pushed: Vec::new(),
             moved: Vec::new(),
@@ -359,33 +363,36 @@ pub(crate) fn run(
         plan.push((i, j, response));
     }
     // Every planned pair's contact at the poses the pass starts from, on the workers
-    // (`parallel.rs`): a pure function of shapes and poses, gathered in order.
+    // (`parallel.rs`): a pure function of shapes and poses, gathered in order. Computed
+    // grouped by the pairs' shapes (`narrow_groups.rs`), used in the plan's order.
     let mut contacts = std::mem::take(&mut st.contacts);
+    st.by_class.sort(ctx.world, &plan);
     {
         let w = &*ctx.world;
-        let plan = &plan;
+        let order = st.by_class.order();
+        let pair = |m: usize| order.get(m).map(|&k| plan[k as usize]);
         workers.map(
             plan.len(),
-            |k| {
+            |m| {
                 // What the narrow phase reads of the pairs ahead is asked for now
                 // (`prefetch.rs`): their shapes (a table far bigger than the cache, read at
                 // random) and poses miss the cache, and asked for here they overlap this
                 // pair's work instead of stalling their own. The bodies' columns first (the
                 // shape id says where the shape is: read while it missed, it stalled the
                 // loop); then a shape's first line; then, once it is in, the rest of it.
-                if let Some(&(i, j, _)) = plan.get(k + AHEAD_IDS) {
+                if let Some((i, j, _)) = pair(m + AHEAD_IDS) {
                     w.prefetch_columns(i);
                     w.prefetch_columns(j);
                 }
-                if let Some(&(i, j, _)) = plan.get(k + AHEAD) {
+                if let Some((i, j, _)) = pair(m + AHEAD) {
                     w.prefetch_shape(i);
                     w.prefetch_shape(j);
                 }
-                if let Some(&(i, j, _)) = plan.get(k + AHEAD_REST) {
+                if let Some((i, j, _)) = pair(m + AHEAD_REST) {
                     prefetch::rest_of(w.shape(i));
                     prefetch::rest_of(w.shape(j));
                 }
-                let (i, j, response) = plan[k];
+                let (i, j, response) = plan[order[m] as usize];
                 narrow(w, (i, j), response, &w.pose(j))
             },
             &mut contacts,
@@ -408,7 +415,7 @@ pub(crate) fn run(
         let mut c = if pushed[i] || pushed[j] {
             narrow(w, (i, j), response, &pose_b)
         } else {
-            contacts[k]
+            contacts[st.by_class.rank(k)]
         };
         let before = (w.position[i], w.position[j]);
         let mut note_pushes = |w: &World| {

@@ -18,6 +18,7 @@ pub(crate) mod far_path;
 pub(crate) mod lifetimes;
 pub(crate) mod motion;
 pub(crate) mod mover_pairs;
+pub(crate) mod narrow_groups;
 pub(crate) mod obstacles;
 pub(crate) mod one_way;
 pub(crate) mod pass_order;
