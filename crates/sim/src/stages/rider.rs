@@ -16,7 +16,28 @@ use crate::world::World;
 /// kinematic carrier it rode into the frame), and it still overlaps a static or kinematic
 /// box by more than [`SLOP`] on both axes, it had no room: the [`GameEvent::Crushed`] to
 /// raise. It is left where the pushes put it; the game decides.
+///
+/// Always in line for the usual case (a box that rode nothing and that no kinematic body
+/// pushed: nothing to do), which is a call a box and axis otherwise: whether the compiler
+/// inlined it moved with how it cut the crate, by 50,000 instructions a frame at
+/// platformer-10000-1000.
+#[inline(always)]
 pub(crate) fn rider(
+    w: &mut World,
+    layers: &Layers,
+    lookup: (&TileMap, &MoverGrid),
+    found: &mut Vec<Obstacle>,
+    at: (usize, usize),
+    (old_carrier, pushed_by): (Option<Entity>, Option<usize>),
+) -> Option<GameEvent> {
+    if old_carrier.is_none() && pushed_by.is_none() {
+        return None;
+    }
+    rode(w, layers, lookup, found, at, (old_carrier, pushed_by))
+}
+
+/// [`rider`] of a box that rode something or that a kinematic body pushed.
+fn rode(
     w: &mut World,
     layers: &Layers,
     lookup: (&TileMap, &MoverGrid),
@@ -24,10 +45,6 @@ pub(crate) fn rider(
     (i, axis): (usize, usize),
     (old_carrier, pushed_by): (Option<Entity>, Option<usize>),
 ) -> Option<GameEvent> {
-    if old_carrier.is_none() && pushed_by.is_none() {
-        // Rode nothing, pushed by no kinematic body: the usual case, nothing to do.
-        return None;
-    }
     let bi = box_bounds(w, i);
     if axis == 1
         && w.carrier(i).is_none()
