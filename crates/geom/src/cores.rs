@@ -281,13 +281,21 @@ fn feature(core: &Core, dir: Vec2, tangent: Vec2) -> (f64, f64, f64) {
     let mut lo = f64::INFINITY;
     let mut hi = f64::NEG_INFINITY;
     for p in pts {
-        if p.dot(dir) >= top - eps {
-            let t = p.dot(tangent);
-            lo = lo.min(t);
-            hi = hi.max(t);
-        }
+        // Picked by bits, not branched on: whether a point is on the feature is a coin toss
+        // from pair to pair (the compiler made an `if` of a plain `if` select).
+        let on = p.dot(dir) >= top - eps;
+        let t = p.dot(tangent);
+        lo = pick(on, lo.min(t), lo);
+        hi = pick(on, hi.max(t), hi);
     }
     (lo, hi, top)
+}
+
+/// `a` when `on`, else `b`, the same bits, by a mask: no branch however the compiler sees it.
+#[inline(always)]
+fn pick(on: bool, a: f64, b: f64) -> f64 {
+    let mask = u64::from(on).wrapping_neg();
+    f64::from_bits((a.to_bits() & mask) | (b.to_bits() & !mask))
 }
 
 /// The contact point of intersecting cores along `normal` (a to b): midway between the two
@@ -457,6 +465,16 @@ mod tests {
             }
             prop_assert!(!below(f64::NAN, stop, dd));
             prop_assert!(!below(x, f64::NAN, dd));
+        }
+
+        /// `pick` is `if on { a } else { b }`, to the bit (NaN payloads and signed zeros).
+        #[test]
+        fn a_pick_is_the_choice(on: bool, a in coordinate(), b in coordinate(), bits: u64) {
+            let c = f64::from_bits(bits);
+            for (x, y) in [(a, b), (c, b), (a, c)] {
+                let want = if on { x } else { y };
+                prop_assert_eq!(pick(on, x, y).to_bits(), want.to_bits());
+            }
         }
 
         /// `project` is the first smallest and the first largest of the projections, NaN
