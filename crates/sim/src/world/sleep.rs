@@ -37,6 +37,13 @@ impl World {
         self.sleeping
     }
 
+    /// Whether every body is awake and none is frozen (outside the active region): then a
+    /// pair's bodies need not be read to know that neither is. One pass over a byte a row,
+    /// without a branch a row; `sleeping` is the count of the asleep ones.
+    pub(crate) fn all_awake_and_free(&self) -> bool {
+        self.sleeping == 0 && !self.rows.frozen.iter().fold(false, |any, &f| any | f)
+    }
+
     /// Wakes every sleeping body, now: the active list is recomputed.
     pub fn wake_all(&mut self) {
         if self.sleeping > 0 {
