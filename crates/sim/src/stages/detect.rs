@@ -465,7 +465,10 @@ pub(crate) fn run(
         let Some(c) = c.filter(|c| c.depth > threshold(response)) else {
             continue;
         };
-        woken.extend([i, j].into_iter().filter(|&k| w.asleep(k)));
+        if w.sleeping() > 0 {
+            // Else none is asleep: their columns are not read (a cache miss a body).
+            woken.extend([i, j].into_iter().filter(|&k| w.asleep(k)));
+        }
         respond(
             ctx,
             (&mut doomed, &mut st.push_statics),
