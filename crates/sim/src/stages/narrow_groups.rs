@@ -33,9 +33,12 @@ impl ByClass {
     /// Groups `plan`'s pairs (a counting sort: stable, so a group keeps the plan's order).
     pub(crate) fn sort(&mut self, w: &World, plan: &[(usize, usize, Response)]) {
         self.groups.clear();
+        // A byte a body, read by its shape id: not the shape.
+        let (table, ids) = (w.shape_table(), w.looks());
+        let class = |i: usize| usize::from(table.class(ids[i]));
         self.groups.extend(plan.iter().map(|&(i, j, _)| {
             // At most CLASSES * CLASSES - 1: a byte (checked above).
-            (usize::from(w.shape_class(i)) * CLASSES + usize::from(w.shape_class(j))) as u8
+            (class(i) * CLASSES + class(j)) as u8
         }));
         let mut start = [0u32; CLASSES * CLASSES + 1];
         for &g in &self.groups {
@@ -74,6 +77,7 @@ mod tests {
     use ricochet_geom::{Shape, Vec2};
 
     use crate::def::BodyDef;
+    use crate::interned::shape_class;
 
     fn shape(class: usize) -> Shape {
         match class % 4 {
@@ -101,7 +105,8 @@ mod tests {
                 pairs.iter().map(|&(i, j)| (i % n, j % n, Response::Report)).collect();
             let mut by = ByClass::default();
             by.sort(&w, &plan);
-            let group = |k: usize| (w.shape_class(plan[k].0), w.shape_class(plan[k].1));
+            let class = |i: usize| shape_class(w.shape(i));
+            let group = |k: usize| (class(plan[k].0), class(plan[k].1));
             let order: Vec<usize> = by.order().iter().map(|&k| k as usize).collect();
             let mut seen = order.clone();
             seen.sort_unstable();

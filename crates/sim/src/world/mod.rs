@@ -201,13 +201,6 @@ impl World {
         &self.shapes.get(self.shape_id[i]).0
     }
 
-    /// The class of body `i`'s shape: which code of the narrow phase it takes
-    /// (`interned::shape_class`), read without reading the shape.
-    #[inline]
-    pub(crate) fn shape_class(&self, i: usize) -> u8 {
-        self.shapes.class(self.shape_id[i])
-    }
-
     /// Asks for body `i`'s columns the narrow phase reads, without reading them (a hint:
     /// `prefetch.rs`): its shape id, position and angle.
     #[inline]
