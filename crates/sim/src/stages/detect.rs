@@ -97,8 +97,9 @@ pub(crate) struct DetectState {
     /// This frame's pairs for the narrow phase (dense indices, response), their contacts at
     /// the poses the pass started from, and the bodies a response has moved since.
     plan: Vec<(usize, usize, Response)>,
-    /// The order the contacts are computed in (`narrow_groups.rs`), and the contacts in it.
+    /// The order the contacts are computed in (`narrow_groups.rs`).
     by_class: ByClass,
+    /// The contacts, in `by_class`'s order (a plan place's is at its `rank`).
     contacts: Vec<Option<Contact>>,
     /// Per body, all false between passes (only the `moved` ones are set, then cleared).
     pushed: Vec<bool>,
@@ -374,7 +375,8 @@ pub(crate) fn run(
     // (`parallel.rs`): a pure function of shapes and poses, gathered in order. Computed
     // grouped by the pairs' shapes (`narrow_groups.rs`), used in the plan's order.
     let mut contacts = std::mem::take(&mut st.contacts);
-    st.by_class.sort(ctx.world, &plan);
+    st.by_class
+        .sort(ctx.world, &plan, workers.chunk(plan.len()));
     {
         let w = &*ctx.world;
         let order = st.by_class.order();
