@@ -269,14 +269,12 @@ fn point_segment(p: Vec2, s0: Vec2, s1: Vec2) -> (f64, Vec2, Vec2) {
 /// the furthest value along `dir`.
 fn feature(core: &Core, dir: Vec2, tangent: Vec2) -> (f64, f64, f64) {
     let pts = core.points();
-    let top = pts
-        .iter()
-        .map(|p| p.dot(dir))
-        .fold(f64::NEG_INFINITY, f64::max);
-    let scale = pts
-        .iter()
-        .map(|p| p.abs().max_element())
-        .fold(0.0, f64::max);
+    // The two maxima in one pass: each the same fold, in the same order.
+    let (mut top, mut scale) = (f64::NEG_INFINITY, 0.0);
+    for p in pts {
+        top = f64::max(top, p.dot(dir));
+        scale = f64::max(scale, p.abs().max_element());
+    }
     let eps = 1e-12 * scale.max(f64::MIN_POSITIVE);
     let mut lo = f64::INFINITY;
     let mut hi = f64::NEG_INFINITY;
