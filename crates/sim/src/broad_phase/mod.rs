@@ -149,6 +149,7 @@ pub(crate) mod static_tree;
 mod strip_height;
 mod strip_list;
 mod strip_reach;
+mod strip_slot;
 mod strips;
 mod tally;
 mod tile_map;

@@ -28,14 +28,11 @@
 
 use super::sorted::{self, order_key};
 use super::strip_reach::{Fate, Reach};
+use super::strip_slot::{Slot, UPPER};
 use super::{BodyEntry, Member, member};
 
 /// No index: a body gone from a list.
 const NONE: u32 = u32::MAX;
-
-/// The bit of a slot's `local` field that marks a body's upper slot (indices stay below
-/// `2^31`: the broad phase asserts fewer bodies).
-const UPPER: u32 = 1 << 31;
 
 /// One list: bodies sorted by strip, then by `min.x`.
 #[derive(Debug, Default, Clone)]
@@ -70,68 +67,6 @@ pub(super) struct StripList {
     merged: Vec<Slot>,
 }
 
-/// A body's place in a [`StripList`] (16 bytes, so the insertion sort and the merge move a
-/// quarter of what they would with the bounds): `(strip, min.x, local)` packed into one
-/// integer whose order is the list order. From the high bits: the strip (`floor(min.y / H)`,
-/// clamped, plus one for an upper slot) with its sign bit flipped, `min.x` as [`order_key`],
-/// and the body's index in the list's key order with [`UPPER`] on an upper slot, which breaks
-/// ties so the order is a function of the input.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
-struct Slot(u128);
-
-impl Slot {
-    #[inline]
-    fn new(strip: i32, x: u64, local: u32) -> Slot {
-        let strip = strip as u32 ^ (1 << 31);
-        Slot(u128::from(strip) << 96 | u128::from(x) << 32 | u128::from(local))
-    }
-
-    /// The slots of a body reaching `reach` with `min.x` at `x` (as [`order_key`]): its
-    /// lower one, then its upper one if any.
-    #[inline]
-    fn both(reach: Reach, x: u64, local: u32) -> (Slot, Option<Slot>) {
-        let lower = Slot::new(reach.lower, x, local);
-        // Two strips means `lower + 1` did not overflow.
-        let upper = reach
-            .two
-            .then(|| Slot::new(reach.lower + 1, x, local | UPPER));
-        (lower, upper)
-    }
-
-    /// The slot with `min.x` at `x` instead (its strip and body kept).
-    #[inline]
-    fn at_x(self, x: u64) -> Slot {
-        Slot(self.0 & !(u128::from(u64::MAX) << 32) | u128::from(x) << 32)
-    }
-
-    #[inline]
-    fn strip(self) -> i32 {
-        ((self.0 >> 96) as u32 ^ (1 << 31)) as i32
-    }
-
-    /// The body's index in the list's key order.
-    #[inline]
-    fn local(self) -> u32 {
-        self.0 as u32 & !UPPER
-    }
-
-    /// The slot with its role turned (a lower slot made its body's upper one, or the
-    /// reverse) when `turn`: the same strip and key.
-    #[inline]
-    fn turned(self, turn: bool) -> Slot {
-        Slot(self.0 ^ (u128::from(turn) << 31))
-    }
-
-    /// Whether this is the body's lower slot, not its upper one.
-    #[inline]
-    fn is_lower(self) -> bool {
-        self.0 as u32 & UPPER == 0
-    }
-
-    /// A slot that sorts after every other (a body gone from the list).
-    const GONE: Slot = Slot(u128::MAX);
-}
-
 /// What a sweep reads of a body, in list order: 40 bytes, where the bounds alone are 32 (the
 /// gather writes every slot each frame and the sweeps read them; 16 bytes more cost rain-10000
 /// 1% to 5%).
@@ -163,6 +98,17 @@ pub(super) struct Swept {
 const _: () = assert!(size_of::<Swept>() == 40, "a slot of the sweeps stays lean");
 
 impl Swept {
+    /// A slot that overlaps nothing: room not yet written.
+    const NONE: Swept = Swept {
+        min: 0,
+        max: 0,
+        min_y: f64::NAN,
+        max_y: f64::NAN,
+        handle: 0,
+        dynamic: false,
+        lower: false,
+    };
+
     #[inline]
     fn new(m: Member, lower: bool) -> Swept {
         let b = &m.bounds;
@@ -289,20 +235,33 @@ impl StripList {
     /// too, and the cursor stays: it is at most the old slots before it plus the fresh ones,
     /// so within the room of both lists). `merged` keeps its length from call to call, so
     /// only growth is filled.
+    ///
+    /// The next fresh slot is kept at hand ([`Slot::GONE`] once they are all in: no slot sorts
+    /// after it, as a body's index is below `2^31 - 1`), and the rare slot it goes before
+    /// sends the walk out of line to [`put_fresh`]. Never inlined either. With the fresh
+    /// slots' loop in line, and this one in line in [`StripList::update`], the compiler kept
+    /// the loop's state on the stack and loaded it again at every slot: rain-10000's merge
+    /// took 800,000 instructions a frame, where it takes 560,000.
+    #[inline(never)]
     fn merge_moved(&mut self) {
         let room = self.order.len() + self.fresh.len();
         if self.merged.len() < room {
             self.merged.resize(room, Slot::GONE);
         }
-        let (fresh, merged) = (&self.fresh, &mut self.merged[..room]);
+        let (fresh, merged) = (&self.fresh[..], &mut self.merged[..room]);
+        // The columns as local slices (read through `self`, they were loaded again at every
+        // slot), of the same length: one bounds check for both.
+        let xs = &self.x[..];
+        let fates = &self.fate[..xs.len()];
         let (mut w, mut f) = (0, 0);
+        let mut next = fresh.first().copied().unwrap_or(Slot::GONE);
         for &old in &self.order {
             let local = old.local() as usize;
-            let fate = Fate::slot_bits(self.fate[local], !old.is_lower());
-            let new = old.at_x(self.x[local]).turned(fate & Fate::TURNS != 0);
-            while f < fresh.len() && fresh[f] < new {
-                merged[w] = fresh[f];
-                (w, f) = (w + 1, f + 1);
+            let fate = Fate::slot_bits(fates[local], !old.is_lower());
+            let new = old.at_x(xs[local]).turned(fate & Fate::TURNS != 0);
+            debug_assert!(new < Slot::GONE, "no slot sorts after the last fresh one");
+            if next < new {
+                (w, f, next) = put_fresh(merged, fresh, (w, f), new);
             }
             merged[w] = new;
             w += usize::from(fate & Fate::STAYS);
@@ -329,25 +288,15 @@ impl StripList {
         self.fate.resize(n, Fate::SAME);
         self.moved.clear();
         let (keys, reach) = (&self.keys[..n], &self.reach[..n]);
-        let columns = keys
-            .iter()
-            .zip(reach)
-            .zip(self.x.iter_mut().zip(&mut self.fate));
-        for (j, (&h, ((&key, &was), (x, fate)))) in handles.iter().zip(columns).enumerate() {
-            let body = &bodies[h as usize];
-            if body.key != key {
-                return false;
-            }
-            let now = Reach::of(&body.bounds, inv_h);
-            let moved = now != was;
-            if moved {
-                self.moved.push((j as u32, now));
-            }
-            *x = order_key(body.bounds.min.x);
-            // A moved body's fate is written once the pass is through.
-            *fate = Fate::SAME;
+        let out = (&mut self.x[..], &mut self.fate[..], &mut self.moved);
+        // Every body in order when there are as many handles ([`StripList::gather`]): read
+        // without them, the loop's state fits in registers.
+        if n == bodies.len() {
+            read_into(bodies.iter(), (keys, reach), out, inv_h)
+        } else {
+            let each = handles.iter().map(|&h| &bodies[h as usize]);
+            read_into(each, (keys, reach), out, inv_h)
         }
-        true
     }
 
     /// [`StripList::update`]'s first step when the bodies are not the same as last time:
@@ -389,19 +338,20 @@ impl StripList {
 
     /// Reads the bodies' bounds in list order into `swept`, and the widest body.
     fn gather(&mut self, handles: &[u32], bodies: &[BodyEntry]) {
-        // The widest body (NaN ignored): a maximum, so any order gives it.
-        let mut width = 0.0;
-        self.swept.clear();
-        self.swept.extend(self.order.iter().map(|s| {
-            let h = handles[s.local() as usize];
-            let b = &bodies[h as usize];
-            let x = b.bounds.max.x - b.bounds.min.x;
-            if x > width {
-                width = x;
-            }
-            Swept::new(member(b, h), s.is_lower())
-        }));
-        self.width = width;
+        // Written in place (only growth is filled), the widest body in a local: through
+        // `extend`, the loop was a call that kept it in memory, and read the body's bounds
+        // again after each store to it.
+        let n = self.order.len();
+        self.swept.resize(n, Swept::NONE);
+        // Handles ascend (key order) within `bodies`: as many as the bodies, they are every
+        // body in order, and a slot's body is read without them.
+        if handles.len() == bodies.len() {
+            debug_assert!(handles.iter().enumerate().all(|(k, &h)| h as usize == k));
+            self.width = gather_into(&mut self.swept, &self.order, |local| local, bodies);
+        } else {
+            let at = |local: u32| handles[local as usize];
+            self.width = gather_into(&mut self.swept, &self.order, at, bodies);
+        }
     }
 
     /// Finds the runs of one strip in `order`. The slots sort by strip first, so each run's
@@ -467,65 +417,66 @@ impl StripList {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use proptest::prelude::*;
-
-    use super::Slot;
-    use crate::broad_phase::sorted::gallop;
-
-    proptest! {
-        /// The galloping search ends each run where a scan slot by slot does: runs of one
-        /// slot, of a power of two and one either side of it, and one run for all.
-        #[test]
-        fn a_run_ends_where_a_scan_finds_its_end(
-            mut strips in prop::collection::vec(
-                prop_oneof![-3..3i32, Just(i32::MIN), Just(i32::MAX)],
-                1..300,
-            ),
-        ) {
-            strips.sort_unstable();
-            let order: Vec<Slot> = strips
-                .iter()
-                .enumerate()
-                .map(|(k, &s)| Slot::new(s, k as u64, k as u32))
-                .collect();
-            let mut k = 0;
-            while k < order.len() {
-                let strip = order[k].strip();
-                let scanned = order[k..].iter().take_while(|s| s.strip() == strip).count();
-                prop_assert_eq!(gallop(&order[k..], |s| s.strip() == strip), scanned);
-                k += scanned;
-            }
+/// [`StripList::read_bodies`]' loop over the list's bodies in key order (`bodies`), with
+/// their keys and reach at the last update: false at the first body whose key differs.
+#[inline(always)]
+fn read_into<'a>(
+    bodies: impl Iterator<Item = &'a BodyEntry>,
+    (keys, reach): (&[u64], &[Reach]),
+    (xs, fates, moved): (&mut [u64], &mut [u8], &mut Vec<(u32, Reach)>),
+    inv_h: f64,
+) -> bool {
+    let columns = keys.iter().zip(reach).zip(xs.iter_mut().zip(fates));
+    for (j, (body, ((&key, &was), (x, fate)))) in bodies.zip(columns).enumerate() {
+        if body.key != key {
+            return false;
         }
-    }
-
-    /// The galloping search finds where a binary search does: before every slot,
-    /// between any two, after all, and on a slot equal to the one looked for.
-    #[test]
-    fn gallop_finds_where_a_binary_search_does() {
-        for len in 0..70u64 {
-            let order: Vec<Slot> = (0..len).map(|k| Slot::new(0, 2 * k, 0)).collect();
-            for x in 0..2 * len + 2 {
-                let f = Slot::new(0, x, 0);
-                let want = order.partition_point(|&s| s < f);
-                assert_eq!(gallop(&order, |&s| s < f), want, "{x} among {len}");
-            }
+        let now = Reach::of(&body.bounds, inv_h);
+        if now != was {
+            moved.push((j as u32, now));
         }
+        *x = order_key(body.bounds.min.x);
+        // A moved body's fate is written once the pass is through.
+        *fate = Fate::SAME;
     }
+    true
+}
 
-    #[test]
-    fn runs_of_every_length_around_the_doublings() {
-        for len in 1..70 {
-            for tail in 0..3 {
-                let mut order: Vec<Slot> = (0..len).map(|k| Slot::new(5, k, k as u32)).collect();
-                order.extend((0..tail).map(|k| Slot::new(6, k, (len + k) as u32)));
-                assert_eq!(
-                    gallop(&order, |s| s.strip() == 5),
-                    len as usize,
-                    "{len} then {tail}"
-                );
-            }
-        }
+/// [`StripList::gather`]'s loop: each slot's bounds (its body's handle `handle(local)`) into
+/// `swept`, as long as `order`; returns the widest body (NaN ignored: a maximum, so any order
+/// gives it).
+#[inline(always)]
+fn gather_into(
+    swept: &mut [Swept],
+    order: &[Slot],
+    handle: impl Fn(u32) -> u32,
+    bodies: &[BodyEntry],
+) -> f64 {
+    let mut width = 0.0;
+    for (out, s) in swept.iter_mut().zip(order) {
+        let h = handle(s.local());
+        let b = &bodies[h as usize];
+        let x = b.bounds.max.x - b.bounds.min.x;
+        width = if x > width { x } else { width };
+        *out = Swept::new(member(b, h), s.is_lower());
     }
+    width
+}
+
+/// [`StripList::merge_moved`]'s fresh slots that sort before `new`, from the `f`-th on,
+/// written from the cursor `w`: returns the cursor, the next fresh slot's index, and that
+/// slot ([`Slot::GONE`] when none is left).
+#[cold]
+#[inline(never)]
+fn put_fresh(
+    merged: &mut [Slot],
+    fresh: &[Slot],
+    (mut w, mut f): (usize, usize),
+    new: Slot,
+) -> (usize, usize, Slot) {
+    while f < fresh.len() && fresh[f] < new {
+        merged[w] = fresh[f];
+        (w, f) = (w + 1, f + 1);
+    }
+    (w, f, fresh.get(f).copied().unwrap_or(Slot::GONE))
 }
