@@ -87,12 +87,12 @@ pub(super) struct Swept {
     pub(super) max_y: f64,
     /// The body's handle ([`Member::handle`]).
     pub(super) handle: u32,
-    /// Whether the body is dynamic.
-    pub(super) dynamic: bool,
-    /// Whether this is the body's lower slot (its `min.y` is in this strip), not its upper
-    /// one: two overlapping bodies' pair is kept in this strip when one of them is
-    /// (`strips.rs`, `Sink::test`).
-    pub(super) lower: bool,
+    /// [`Swept::DYNAMIC`] when the body is dynamic, and [`Swept::LOWER`] when this is the
+    /// body's lower slot (its `min.y` is in this strip), not its upper one: two overlapping
+    /// bodies' pair is kept in this strip when one of them is (`strips.rs`, `Sink::verdict`).
+    /// One byte, so a pair's two tests are one `or` of two bytes: two `bool`s made the
+    /// compiler unpack them with vector instructions at every test.
+    pub(super) flags: u8,
 }
 
 const _: () = assert!(size_of::<Swept>() == 40, "a slot of the sweeps stays lean");
@@ -105,9 +105,13 @@ impl Swept {
         min_y: f64::NAN,
         max_y: f64::NAN,
         handle: 0,
-        dynamic: false,
-        lower: false,
+        flags: 0,
     };
+
+    /// [`Swept::flags`]: the body is dynamic.
+    pub(super) const DYNAMIC: u8 = 1;
+    /// [`Swept::flags`]: this is the body's lower slot.
+    pub(super) const LOWER: u8 = 2;
 
     #[inline]
     fn new(m: Member, lower: bool) -> Swept {
@@ -119,8 +123,7 @@ impl Swept {
             min_y: if numbers { b.min.y } else { f64::NAN },
             max_y: b.max.y,
             handle: m.handle,
-            dynamic: m.dynamic,
-            lower,
+            flags: (u8::from(m.dynamic) * Swept::DYNAMIC) | (u8::from(lower) * Swept::LOWER),
         }
     }
 

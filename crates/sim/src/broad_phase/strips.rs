@@ -53,11 +53,50 @@ struct Sink<'a> {
     out: &'a mut Vec<(u32, u32)>,
     /// The pairs kept: `out`'s length once the sink is dropped.
     len: usize,
-    /// The strip swept and `1 / H`, for the debug check of the rule.
+    /// The strip swept, for the debug check of the rule.
+    rule: Rule,
+}
+
+/// What the debug check of [`Sink`]'s rule needs: the strip swept and `1 / H` (nothing in a
+/// release build).
+#[derive(Clone, Copy)]
+struct Rule {
     #[cfg(debug_assertions)]
     strip: i32,
     #[cfg(debug_assertions)]
     inv_h: f64,
+}
+
+impl Rule {
+    /// Whether the pair of `p` and `q` is kept (one is dynamic, their bounds overlap and
+    /// this is their strip), and the tests it counts: 1 when one is dynamic and `q` starts
+    /// before `p`'s end along x (always so for a slot that [`Sink::scan`] reaches), else 0.
+    ///
+    /// Without a branch: whether bounds overlap is a coin toss for the sweeps' candidates,
+    /// and a mispredicted branch a test cost more than the test (see [`Sink`]).
+    #[cfg_attr(not(debug_assertions), allow(clippy::unused_self))]
+    #[inline(always)]
+    fn verdict(self, p: &Swept, q: &Swept) -> (bool, u64) {
+        let flags = p.flags | q.flags;
+        let either = flags & Swept::DYNAMIC != 0;
+        let starts = q.min <= p.max;
+        // `Bounds::overlaps`, x by the keys (`strip_list.rs`, `Swept`).
+        let overlap = (p.min <= q.max) & starts & (p.min_y <= q.max_y) & (q.min_y <= p.max_y);
+        #[cfg(debug_assertions)]
+        if overlap {
+            // Overlapping bounds hold no NaN.
+            let top = p.min_y.max(q.min_y);
+            assert_eq!(
+                super::grid::cell_coord(top, self.inv_h) == self.strip,
+                flags & Swept::LOWER != 0,
+                "the pair's strip is this one when one slot is a lower one"
+            );
+        }
+        (
+            either & overlap & (flags & Swept::LOWER != 0),
+            u64::from(either & starts),
+        )
+    }
 }
 
 impl<'a> Sink<'a> {
@@ -68,10 +107,12 @@ impl<'a> Sink<'a> {
         Sink {
             len: out.len(),
             out,
-            #[cfg(debug_assertions)]
-            strip: 0,
-            #[cfg(debug_assertions)]
-            inv_h,
+            rule: Rule {
+                #[cfg(debug_assertions)]
+                strip: 0,
+                #[cfg(debug_assertions)]
+                inv_h,
+            },
         }
     }
 
@@ -81,37 +122,15 @@ impl<'a> Sink<'a> {
     fn at(&mut self, strip: i32) -> &mut Self {
         #[cfg(debug_assertions)]
         {
-            self.strip = strip;
+            self.rule.strip = strip;
         }
         self
     }
 
-    /// Whether the pair of `p` and `q` is kept (one is dynamic, their bounds overlap and
-    /// this is their strip), and the tests it counts: 1 when one is dynamic and `q` starts
-    /// before `p`'s end along x (always so for a slot that [`Sink::scan`] reaches), else 0.
-    ///
-    /// Without a branch: whether bounds overlap is a coin toss for the sweeps' candidates,
-    /// and a mispredicted branch a test cost more than the test (see [`Sink`]).
+    /// [`Rule::verdict`] of this sink's strip.
     #[inline(always)]
     fn verdict(&self, p: &Swept, q: &Swept) -> (bool, u64) {
-        let either = p.dynamic | q.dynamic;
-        let starts = q.min <= p.max;
-        // `Bounds::overlaps`, x by the keys (`strip_list.rs`, `Swept`).
-        let overlap = (p.min <= q.max) & starts & (p.min_y <= q.max_y) & (q.min_y <= p.max_y);
-        #[cfg(debug_assertions)]
-        if overlap {
-            // Overlapping bounds hold no NaN.
-            let top = p.min_y.max(q.min_y);
-            assert_eq!(
-                super::grid::cell_coord(top, self.inv_h) == self.strip,
-                p.lower || q.lower,
-                "the pair's strip is this one when one slot is a lower one"
-            );
-        }
-        (
-            either & overlap & (p.lower | q.lower),
-            u64::from(either & starts),
-        )
+        self.rule.verdict(p, q)
     }
 
     /// Writes the pair of `p` and `q`, kept (`len` past it) when `keep`. The caller made
@@ -154,26 +173,23 @@ impl<'a> Sink<'a> {
 
     /// Every overlapping pair within one run. Each slot is tested against the next without
     /// a branch on whether that one starts before its end (a coin toss, where it was the
-    /// sweeps' costliest branch); the walk goes on only when the slot after it does too.
+    /// sweeps' costliest branch); the walk goes on, out of line, only when the slot after it
+    /// does too.
     fn within(&mut self, run: &[Swept]) -> u64 {
         let mut tested = 0;
-        // Room for every slot's test of the next: the loop grows nothing.
-        room(self.out, self.len + run.len());
-        for (k, p) in run.iter().enumerate() {
-            let rest = &run[k + 1..];
-            let Some(next) = rest.first() else {
-                break;
-            };
-            let (keep, t) = self.verdict(p, next);
-            self.put(p, next, keep);
+        let mut k = 0;
+        loop {
+            // Room for every slot's test of the next: the stretch grows nothing.
+            room(self.out, self.len + run.len());
+            let (stop, len, t) = next_pairs(&mut self.out[..], (self.len, self.rule), run, k);
+            (self.len, k) = (len, stop + 1);
             tested += t;
-            // The run is sorted by `min`: a slot after one that starts past `p`'s end does too.
-            if rest.get(1).is_some_and(|s| s.min <= p.max) {
-                tested += self.scan_on(p, &rest[1..]);
-                room(self.out, self.len + rest.len());
+            if stop + 2 >= run.len() {
+                return tested;
             }
+            // The slot at `stop` reaches past the next one: the rest of its walk.
+            tested += self.scan_on(&run[stop], &run[stop + 2..]);
         }
-        tested
     }
 
     /// Every overlapping pair with one slot from each run, walking both in `min.x` order.
@@ -228,6 +244,35 @@ impl<'a> Sink<'a> {
             self.merged(xs, ys)
         }
     }
+}
+
+/// [`Sink::within`]'s stretch from slot `k` of `run`: each slot tested against the next
+/// (written at `len` in `out`, kept past it when the pair is), up to the end of the run or
+/// to the first slot whose walk goes past the next one. Returns that slot (or the last
+/// one), `len`, and the tests. A free function over a slice, so that the stretch keeps its
+/// state in registers (through the sink, the pairs' length and vector were stored and
+/// loaded again at every slot).
+#[inline(always)]
+fn next_pairs(
+    out: &mut [(u32, u32)],
+    (mut len, rule): (usize, Rule),
+    run: &[Swept],
+    mut k: usize,
+) -> (usize, usize, u64) {
+    let mut tested = 0;
+    while k + 1 < run.len() {
+        let (p, next) = (&run[k], &run[k + 1]);
+        let (keep, t) = rule.verdict(p, next);
+        out[len] = (p.handle, next.handle);
+        len += usize::from(keep);
+        tested += t;
+        // The run is sorted by `min`: a slot after one that starts past `p`'s end does too.
+        if run.get(k + 2).is_some_and(|s| s.min <= p.max) {
+            return (k, len, tested);
+        }
+        k += 1;
+    }
+    (k, len, tested)
 }
 
 /// `out` made at least `n` long (see [`Sink`]); its growth out of line, away from the
