@@ -143,19 +143,23 @@ impl Core {
 #[inline(always)]
 fn each_axis<T>(a: &Core, b: &Core, mut f: impl FnMut(Vec2) -> Option<T>) -> Option<T> {
     let (mut sa, mut sb) = ([Vec2::ZERO; 2], [Vec2::ZERO; 2]);
-    for axes in [a.axes(&mut sa), b.axes(&mut sb)] {
+    // Two points have no axes of their own, only the direction between them. Listed with
+    // the others, so that `f` is called from one place (and inlined there: called from two,
+    // it was a call an axis).
+    let mut between = [Vec2::ZERO];
+    let between: &[Vec2] = if a.count == 1 && b.count == 1 && a.points[0] != b.points[0] {
+        between[0] = (b.points[0] - a.points[0]).normalize();
+        &between
+    } else {
+        &[]
+    };
+    for axes in [a.axes(&mut sa), b.axes(&mut sb), between] {
         for &u in axes {
             if u.is_finite()
                 && let Some(t) = f(u)
             {
                 return Some(t);
             }
-        }
-    }
-    if a.count == 1 && b.count == 1 && a.points[0] != b.points[0] {
-        let u = (b.points[0] - a.points[0]).normalize();
-        if u.is_finite() {
-            return f(u);
         }
     }
     None
