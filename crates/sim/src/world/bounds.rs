@@ -297,6 +297,20 @@ fn fill<M: Measure>(
                 }
                 return measured;
             }
+            // No layer widened (no bullet, nothing separated by time of impact): the
+            // bounds as placed, with no path that keeps them across a call (the compiler
+            // kept every body's bounds on the stack for it).
+            if columns.widen.iter().all(|&w| w == 0) {
+                for (k, out) in out.iter_mut().enumerate() {
+                    let bounds = columns.widened(k, k, 0);
+                    let near = visit(first + k, &bounds);
+                    if keep.keep(first + k, &bounds) || near {
+                        measured.add(&bounds);
+                        *out = columns.entry(k, k, bounds);
+                    }
+                }
+                return measured;
+            }
             for (k, out) in out.iter_mut().enumerate() {
                 let bounds = columns.bounds(k, k);
                 let near = visit(first + k, &bounds);
