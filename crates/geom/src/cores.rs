@@ -358,10 +358,12 @@ pub(crate) fn collide_cores_unless(a: &Core, b: &Core, threshold: f64) -> Option
 /// [`collide_cores_unless`] leaves.
 #[inline]
 fn below(x: f64, stop: f64, dd: f64) -> bool {
+    // `&` and `|`, not `&&` and `||`: whether `x` is negative is a coin toss from pair to
+    // pair, and the products cost less than its mispredicted branch.
     if stop < 0.0 {
-        x < 0.0 && x * x > stop * stop * dd
+        (x < 0.0) & (x * x > stop * stop * dd)
     } else if stop >= 0.0 {
-        x < 0.0 || x * x < stop * stop * dd
+        (x < 0.0) | (x * x < stop * stop * dd)
     } else {
         false
     }
