@@ -123,7 +123,7 @@ impl SweepList {
                 }
             }
             self.width = width;
-            return sorted::insertion_sort(&mut self.order, sweep_order, |_, _| {});
+            return sorted::insertion_sort(&mut self.order, sweep_order);
         }
         // Merge the old keys with the new ones (both ascending).
         let (remap, fresh) = (&mut scratch.remap, &mut scratch.fresh);
@@ -147,7 +147,7 @@ impl SweepList {
             }
             j != NONE
         });
-        let moved = sorted::insertion_sort(&mut self.order, sweep_order, |_, _| {});
+        let moved = sorted::insertion_sort(&mut self.order, sweep_order);
         if !fresh.is_empty() {
             fresh.sort_unstable_by(sweep_order);
             let merged = &mut scratch.merged;

@@ -196,7 +196,7 @@ impl StripList {
         }
         self.fresh.sort_unstable();
         self.merge_moved();
-        let moves = sorted::insertion_sort(&mut self.order, Slot::cmp, |_, _| {});
+        let moves = sorted::insertion_sort(&mut self.order, Slot::cmp);
         #[cfg(debug_assertions)]
         self.check_order();
         self.gather(handles, bodies);
