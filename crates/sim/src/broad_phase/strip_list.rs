@@ -292,9 +292,9 @@ impl StripList {
         self.moved.clear();
         let (keys, reach) = (&self.keys[..n], &self.reach[..n]);
         let out = (&mut self.x[..], &mut self.fate[..], &mut self.moved);
-        // Every body in order when there are as many handles ([`StripList::gather`]): read
-        // without them, the loop's state fits in registers.
-        if n == bodies.len() {
+        // Read without the handles when they are every body: the loop's state then fits in
+        // registers.
+        if every_body(handles, bodies) {
             read_into(bodies.iter(), (keys, reach), out, inv_h)
         } else {
             let each = handles.iter().map(|&h| &bodies[h as usize]);
@@ -346,10 +346,7 @@ impl StripList {
         // again after each store to it.
         let n = self.order.len();
         self.swept.resize(n, Swept::NONE);
-        // Handles ascend (key order) within `bodies`: as many as the bodies, they are every
-        // body in order, and a slot's body is read without them.
-        if handles.len() == bodies.len() {
-            debug_assert!(handles.iter().enumerate().all(|(k, &h)| h as usize == k));
+        if every_body(handles, bodies) {
             self.width = gather_into(&mut self.swept, &self.order, |local| local, bodies);
         } else {
             let at = |local: u32| handles[local as usize];
@@ -418,6 +415,15 @@ impl StripList {
             + self.x.capacity() * 8
             + self.fate.capacity()
     }
+}
+
+/// Whether the list's `handles` are every one of `bodies`, in order: they ascend (key order)
+/// within `bodies`, so as many of them are all of them. Then a body is read by its index in
+/// the list, without the handles.
+fn every_body(handles: &[u32], bodies: &[BodyEntry]) -> bool {
+    let every = handles.len() == bodies.len();
+    debug_assert!(!every || handles.iter().enumerate().all(|(k, &h)| h as usize == k));
+    every
 }
 
 /// [`StripList::read_bodies`]' loop over the list's bodies in key order (`bodies`), with

@@ -53,7 +53,7 @@ struct Sink<'a> {
     out: &'a mut Vec<(u32, u32)>,
     /// The pairs kept: `out`'s length once the sink is dropped.
     len: usize,
-    /// The strip swept, for the debug check of the rule.
+    /// What the debug check of the rule needs ([`Rule`]).
     rule: Rule,
 }
 

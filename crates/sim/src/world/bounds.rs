@@ -283,42 +283,23 @@ fn fill<M: Measure>(
             let len = out.len();
             let (i0, r0) = (run.index + first, run.row + first);
             let mut columns = columns.slice(i0, r0, len);
-            // The big pass's places are all of its layer: its flags read once.
-            if let Some(layer) = keep.layer() {
-                let widen = columns.widen[usize::from(layer)];
-                for (k, out) in out.iter_mut().enumerate() {
-                    debug_assert_eq!(columns.layers[k], layer, "the pass's one layer");
-                    let bounds = columns.widened(k, k, widen);
-                    let near = visit(first + k, &bounds);
-                    if keep.keep(first + k, &bounds) || near {
-                        measured.add(&bounds);
-                        *out = columns.entry(k, k, bounds);
-                    }
-                }
-                return measured;
-            }
-            // No layer widened (no bullet, nothing separated by time of impact): the
-            // bounds as placed, with no path that keeps them across a call (the compiler
-            // kept every body's bounds on the stack for it).
-            if columns.widen.iter().all(|&w| w == 0) {
-                for (k, out) in out.iter_mut().enumerate() {
-                    let bounds = columns.widened(k, k, 0);
-                    let near = visit(first + k, &bounds);
-                    if keep.keep(first + k, &bounds) || near {
-                        measured.add(&bounds);
-                        *out = columns.entry(k, k, bounds);
-                    }
-                }
-                return measured;
-            }
-            for (k, out) in out.iter_mut().enumerate() {
-                let bounds = columns.bounds(k, k);
-                let near = visit(first + k, &bounds);
-                if keep.keep(first + k, &bounds) || near {
-                    measured.add(&bounds);
-                    *out = columns.entry(k, k, bounds);
-                }
-            }
+            // One loop for each way of making a place's bounds (monomorphised). The big
+            // pass's places are all of its layer: its flags read once. With no layer widened
+            // (no bullet, nothing separated by time of impact), the bounds as placed, with no
+            // path that keeps them across a call (the compiler kept every body's bounds on
+            // the stack for it).
+            let c = &mut columns;
+            return if let Some(layer) = keep.layer() {
+                let widen = c.widen[usize::from(layer)];
+                fill_run(c, out, first, visit, keep, |c, k| {
+                    debug_assert_eq!(c.layers[k], layer, "the pass's one layer");
+                    c.widened(k, k, widen)
+                })
+            } else if c.widen.iter().all(|&w| w == 0) {
+                fill_run(c, out, first, visit, keep, |c, k| c.widened(k, k, 0))
+            } else {
+                fill_run(c, out, first, visit, keep, |c, k| c.bounds(k, k))
+            };
         }
         (None, Some((row, movers))) => {
             for (k, (out, &i)) in out.iter_mut().zip(movers).enumerate() {
@@ -332,6 +313,30 @@ fn fill<M: Measure>(
             }
         }
         (None, None) => {}
+    }
+    measured
+}
+
+/// [`fill`]'s loop over the places of one run (`columns` sliced to them), each place's
+/// bounds made by `bounds_of`.
+#[inline(always)]
+fn fill_run<M: Measure>(
+    columns: &mut EntryColumns,
+    out: &mut [BodyEntry],
+    first: usize,
+    visit: &mut impl FnMut(usize, &Bounds) -> bool,
+    keep: &mut impl Keep,
+    mut bounds_of: impl FnMut(&mut EntryColumns, usize) -> Bounds,
+) -> M {
+    // In a local, so that it stays in registers.
+    let mut measured = M::default();
+    for (k, out) in out.iter_mut().enumerate() {
+        let bounds = bounds_of(columns, k);
+        let near = visit(first + k, &bounds);
+        if keep.keep(first + k, &bounds) || near {
+            measured.add(&bounds);
+            *out = columns.entry(k, k, bounds);
+        }
     }
     measured
 }
