@@ -132,13 +132,19 @@ fn change(sim: &mut Simulation, field: &str, i: usize) {
         local_bounds,
         // A cache, not state: kept right below when a lifetime is given.
         no_lifetime_below,
+        // A count, not state: kept right below when the scale changes.
+        scaled,
     } = &mut w.rows;
     match field {
         "mass" => mass[r] += 1.0,
         "velocity" => velocity[r].y = -velocity[r].y,
         "angular_velocity" => angular_velocity[r] += 0.25,
         "force" => force[r].x = -0.0,
-        "gravity_scale" => gravity_scale[r] = 2.0,
+        "gravity_scale" => {
+            *scaled -= usize::from(super::rows::is_scaled(gravity_scale[r]));
+            gravity_scale[r] = 2.0;
+            *scaled += 1;
+        }
         "lifetime" => {
             lifetime[r] = Some(9);
             *no_lifetime_below = (*no_lifetime_below).min(r);

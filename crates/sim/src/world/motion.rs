@@ -4,7 +4,7 @@
 
 use ricochet_geom::Vec2;
 
-use super::{Inputs, World};
+use super::{Disturbed, Inputs, World};
 use crate::def::{BodyKind, Controller};
 use crate::entity::Entity;
 
@@ -73,25 +73,26 @@ impl World {
             && let Some(run) = self.active_run()
         {
             // The usual case without a controller, over one run (`runs.rs`): each column a
-            // slice, in place; the loop below with a zero thrust.
+            // slice, in place; the loop below with a zero thrust. Without a force or a
+            // gravity scale anywhere (counted), neither column is read: 24 bytes a body the
+            // pass would bring in for nothing.
             let rows = &mut self.rows;
-            let (kind, entity) = (&self.kind[run.indices()], &self.entity[run.indices()]);
-            let (mass, force) = (&rows.mass[run.rows()], &rows.force[run.rows()]);
-            let scale = &rows.gravity_scale[run.rows()];
-            let velocity = &mut rows.velocity[run.rows()];
-            let (disturbed, len) = (&mut self.disturbed, self.entity.len());
-            for k in 0..run.len {
-                if kind[k] != BodyKind::Dynamic {
-                    continue;
-                }
-                let v = velocity[k];
-                // `+ Vec2::ZERO` is the loop's zero thrust, added as there: it turns a force
-                // of -0.0 into +0.0, which can change the sum's sign bit, so the log's.
-                let changed = accelerated(v, force[k] + Vec2::ZERO, g, mass[k], scale[k], dt);
-                if NAME && differs(changed, v) {
-                    disturbed.name(entity[k], len);
-                }
-                velocity[k] = changed;
+            let columns = RunColumns {
+                kind: &self.kind[run.indices()],
+                entity: &self.entity[run.indices()],
+                mass: &rows.mass[run.rows()],
+                force: &rows.force[run.rows()],
+                scale: &rows.gravity_scale[run.rows()],
+                velocity: &mut rows.velocity[run.rows()],
+                disturbed: &mut self.disturbed,
+                len: self.entity.len(),
+            };
+            if self.with_force == 0 && rows.scaled == 0 {
+                debug_assert!(columns.force.iter().all(|f| *f == Vec2::ZERO));
+                debug_assert!(columns.scale.iter().all(|s| !super::rows::is_scaled(*s)));
+                columns.accelerate::<NAME, true>(dt, g);
+            } else {
+                columns.accelerate::<NAME, false>(dt, g);
             }
             return;
         }
@@ -318,6 +319,55 @@ pub(super) struct KeptOutside {
 fn accelerated(v: Vec2, pushed: Vec2, g: Vec2, m: f64, scale: f64, dt: f64) -> Vec2 {
     let a = (pushed + g * (m * scale)) / m;
     v + a * dt
+}
+
+/// What [`World::accelerate`] reads and writes over one run of rows.
+struct RunColumns<'a> {
+    kind: &'a [BodyKind],
+    entity: &'a [Entity],
+    mass: &'a [f64],
+    force: &'a [Vec2],
+    scale: &'a [f64],
+    velocity: &'a mut [Vec2],
+    disturbed: &'a mut Disturbed,
+    len: usize,
+}
+
+impl RunColumns<'_> {
+    /// The pass, naming each changed body when `NAME`; when `PLAIN` (no force, every
+    /// gravity scale 1), neither column is read: a force of ±0 plus the zero thrust is +0,
+    /// and a scale of 1 multiplies exactly, so the bits are the same.
+    #[inline(always)]
+    fn accelerate<const NAME: bool, const PLAIN: bool>(self, dt: f64, g: Vec2) {
+        let RunColumns {
+            kind,
+            entity,
+            mass,
+            force,
+            scale,
+            velocity,
+            disturbed,
+            len,
+        } = self;
+        for k in 0..velocity.len() {
+            if kind[k] != BodyKind::Dynamic {
+                continue;
+            }
+            let v = velocity[k];
+            // `+ Vec2::ZERO` is the loop's zero thrust, added as there: it turns a force
+            // of -0.0 into +0.0, which can change the sum's sign bit, so the log's.
+            let (pushed, s) = if PLAIN {
+                (Vec2::ZERO, 1.0)
+            } else {
+                (force[k] + Vec2::ZERO, scale[k])
+            };
+            let changed = accelerated(v, pushed, g, mass[k], s, dt);
+            if NAME && differs(changed, v) {
+                disturbed.name(entity[k], len);
+            }
+            velocity[k] = changed;
+        }
+    }
 }
 
 /// Whether `a` and `b` differ in any bit.

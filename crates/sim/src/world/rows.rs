@@ -36,6 +36,9 @@ pub(super) struct Rows {
     /// No row below this one has a lifetime (0 claims nothing): an asteroid field spawned
     /// before its bullets counts down only the bullets' rows.
     pub(super) no_lifetime_below: usize,
+    /// How many rows have a gravity scale other than 1 (by its bits): with none, and no
+    /// force, the `forces` stage reads neither column (`World::accelerate`).
+    pub(super) scaled: usize,
 }
 
 /// The row columns every body reads (a copy), with what scenery reads: each gets a reader
@@ -212,6 +215,11 @@ impl World {
     }
 }
 
+/// Whether a gravity scale counts in [`Rows::scaled`]: any but 1, by its bits.
+pub(super) fn is_scaled(scale: f64) -> bool {
+    scale.to_bits() != 1f64.to_bits()
+}
+
 impl Rows {
     /// Appends a row for `def`'s body `e`.
     pub(super) fn push(&mut self, e: Entity, def: &BodyDef) {
@@ -225,6 +233,7 @@ impl Rows {
             .push(if moves { def.angular_velocity } else { 0.0 });
         self.force.push(def.force);
         self.gravity_scale.push(def.gravity_scale);
+        self.scaled += usize::from(is_scaled(def.gravity_scale));
         if def.lifetime.is_none() && self.no_lifetime_below == self.lifetime.len() {
             self.no_lifetime_below += 1;
         }
@@ -252,7 +261,7 @@ impl Rows {
         self.velocity.swap_remove(r);
         self.angular_velocity.swap_remove(r);
         self.force.swap_remove(r);
-        self.gravity_scale.swap_remove(r);
+        self.scaled -= usize::from(is_scaled(self.gravity_scale.swap_remove(r)));
         self.lifetime.swap_remove(r);
         // The last row moved into `r` (if `r` was not the last).
         let below = self.no_lifetime_below.min(self.lifetime.len());

@@ -240,6 +240,14 @@ mod tests {
 
     #[test]
     fn the_passes_over_a_run_give_the_bits_of_the_passes_body_by_body() {
+        // Without a force or a gravity scale (forces of -0.0 count as none), the run's
+        // `forces` pass reads neither column; with some, it reads both.
+        for pushed in [false, true] {
+            passes_over_a_run(pushed);
+        }
+    }
+
+    fn passes_over_a_run(pushed: bool) {
         let mut run = World::new();
         // Scenery first: its body has no row, so each mover's index is its row plus one.
         run.spawn(&BodyDef {
@@ -247,8 +255,16 @@ mod tests {
             ..BodyDef::default()
         });
         for k in 0..150 {
-            run.spawn(&varied(k));
+            let mut def = varied(k);
+            if k % 5 == 1 {
+                def.force = Vec2::new(-0.0, 0.0);
+            }
+            if pushed && k % 11 == 5 {
+                (def.force, def.gravity_scale) = (Vec2::new(0.3, -0.2), 0.5);
+            }
+            run.spawn(&def);
         }
+        assert_eq!((run.with_force > 0, run.rows.scaled > 0), (pushed, pushed));
         let mut plain = run.clone();
         assert!(run.row_run(run.movers()).is_some());
         let dt = 1.0 / 60.0;
@@ -261,6 +277,7 @@ mod tests {
             let mut frames = Vec::new();
             for _ in 0..3 {
                 w.start_frame();
+                w.accelerate(dt, Vec2::new(0.0, -9.81), |_, _, _| Vec2::ZERO);
                 w.integrate(dt, true, true, true);
                 let widen = (&sweeping[..], &separate_swept[..]);
                 let mut entries = Vec::new();
@@ -302,11 +319,12 @@ mod tests {
                     (h.to_bits(), a.to_bits()),
                     (height.to_bits(), max_abs.to_bits())
                 );
-                let state: Vec<[u64; 5]> = (w.movers().iter())
+                let state: Vec<[u64; 7]> = (w.movers().iter())
                     .map(|&i| {
                         let (i, r) = (i as usize, w.row[i as usize] as usize);
                         let (p, s) = (w.position[i], w.rows.start_position[r]);
-                        [p.x, p.y, w.angle[i], s.x, s.y].map(f64::to_bits)
+                        let v = w.rows.velocity[r];
+                        [p.x, p.y, w.angle[i], s.x, s.y, v.x, v.y].map(f64::to_bits)
                     })
                     .collect();
                 frames.push((state, w.kinetic_energy().to_bits(), entries, visited));

@@ -365,6 +365,7 @@ impl World {
             local_bounds: _, // `turned`, below
             user_data: _,
             no_lifetime_below: _, // a cache: counted again by a restore
+            scaled: _,            // a count of `gravity_scale`, kept by every row's push
         } = &self.rows;
         // The `_` columns above are the motion group's ([`World::motion`] reads them all).
         s.entity(self.entity[i]);
