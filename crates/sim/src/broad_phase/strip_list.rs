@@ -28,7 +28,7 @@
 
 use super::sorted::{self, order_key};
 use super::strip_reach::{Fate, Reach};
-use super::strip_slot::{Slot, UPPER};
+use super::strip_slot::Slot;
 use super::{BodyEntry, Member, member};
 
 /// No index: a body gone from a list.
@@ -333,7 +333,7 @@ impl StripList {
             *s = if j == NONE {
                 Slot::GONE
             } else {
-                Slot((s.0 & !u128::from(!UPPER)) | u128::from(j))
+                s.with_local(j)
             };
         }
         self.order.retain(|&s| s != Slot::GONE);

@@ -5,7 +5,7 @@ use super::strip_reach::Reach;
 
 /// The bit of a slot's `local` field that marks a body's upper slot (indices stay below
 /// `2^31`: the broad phase asserts fewer bodies).
-pub(super) const UPPER: u32 = 1 << 31;
+const UPPER: u32 = 1 << 31;
 
 /// A body's place in a [`StripList`] (16 bytes, so the insertion sort and the merge move a
 /// quarter of what they would with the bounds): `(strip, min.x, local)` packed into one
@@ -17,7 +17,7 @@ pub(super) const UPPER: u32 = 1 << 31;
 /// [`StripList`]: super::strip_list::StripList
 /// [`order_key`]: super::sorted::order_key
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
-pub(super) struct Slot(pub(super) u128);
+pub(super) struct Slot(u128);
 
 impl Slot {
     #[inline]
@@ -53,6 +53,13 @@ impl Slot {
     #[inline]
     pub(super) fn local(self) -> u32 {
         self.0 as u32 & !UPPER
+    }
+
+    /// The slot of body `local` instead (its strip, key and role kept): the same place for a
+    /// body whose index in the list changed.
+    #[inline]
+    pub(super) fn with_local(self, local: u32) -> Slot {
+        Slot((self.0 & !u128::from(!UPPER)) | u128::from(local))
     }
 
     /// The slot with its role turned (a lower slot made its body's upper one, or the
