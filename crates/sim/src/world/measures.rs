@@ -83,7 +83,9 @@ impl World {
     /// [`World::kinetic_energy`] at the end of a step, kept until a velocity changes
     /// ([`World::velocity_mut`], the forces stage), a body comes or goes, or a restore:
     /// mass and kind never change, so summing the same terms again in the same order would
-    /// give the same bits. A debug build sums again and asserts them.
+    /// give the same bits. The forces stage's pass over the movers' run keeps the sum it
+    /// makes of the velocities it writes (`motion.rs`). A debug build sums again and
+    /// asserts them.
     pub(crate) fn step_kinetic_energy(&mut self) -> f64 {
         if let Some(kept) = self.kept_energy {
             debug_assert_eq!(
@@ -202,7 +204,7 @@ fn pairs_finite(xs: &[Vec2]) -> bool {
 
 /// A body's kinetic energy of translation, `m v² / 2`, as [`World::kinetic_energy`] adds it.
 #[inline]
-fn energy(mass: f64, velocity: Vec2) -> f64 {
+pub(super) fn energy(mass: f64, velocity: Vec2) -> f64 {
     0.5 * mass * velocity.length_squared()
 }
 

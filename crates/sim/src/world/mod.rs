@@ -136,9 +136,11 @@ pub struct World {
     disturbed: Disturbed,
     /// The last answer of [`World::active_not_inside`] kept for the same step's next ask.
     kept_outside: KeptOutside,
-    /// The kinetic energy summed at the end of a step, until a velocity changes or a body
-    /// comes or goes ([`World::step_kinetic_energy`]).
+    /// The kinetic energy summed at the end of a step or by the forces pass, until a
+    /// velocity changes or a body comes or goes ([`World::step_kinetic_energy`]).
     kept_energy: Option<f64>,
+    /// Whether gravity alone accelerates every row by itself (`motion.rs`).
+    gravity_exact: motion::GravityExact,
     /// Counts every change of a body's frozen bit ([`World::set_frozen`]).
     frozen_changes: u64,
     /// [`World::count_movers`]' stretches, with the `layout` and `frozen_changes` they

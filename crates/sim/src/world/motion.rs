@@ -87,12 +87,24 @@ impl World {
                 disturbed: &mut self.disturbed,
                 len: self.entity.len(),
             };
-            if self.with_force == 0 && rows.scaled == 0 {
+            let energy = if self.with_force == 0 && rows.scaled == 0 {
                 debug_assert!(columns.force.iter().all(|f| *f == Vec2::ZERO));
                 debug_assert!(columns.scale.iter().all(|s| !super::rows::is_scaled(*s)));
-                columns.accelerate::<NAME, true>(dt, g);
+                let exact = self.gravity_exact.holds(self.layout, &rows.mass, g);
+                if exact {
+                    columns.accelerate::<NAME, true, true>(dt, g)
+                } else {
+                    columns.accelerate::<NAME, true, false>(dt, g)
+                }
             } else {
-                columns.accelerate::<NAME, false>(dt, g);
+                columns.accelerate::<NAME, false, false>(dt, g)
+            };
+            // Every mover active: the run is the movers' one, and its sum is the kinetic
+            // energy's terms in its order (`measures.rs`), kept until a velocity changes
+            // again. Summed here, the pass's own reads of the velocities feed it, and its
+            // chain of additions runs beside the pass's work instead of after it.
+            if self.active.len() == self.movers.len() {
+                self.kept_energy = Some(energy);
             }
             return;
         }
@@ -317,8 +329,47 @@ pub(super) struct KeptOutside {
 /// order is part of the log).
 #[inline]
 fn accelerated(v: Vec2, pushed: Vec2, g: Vec2, m: f64, scale: f64, dt: f64) -> Vec2 {
-    let a = (pushed + g * (m * scale)) / m;
-    v + a * dt
+    v + acceleration(pushed, g, m, scale) * dt
+}
+
+/// [`accelerated`]'s acceleration.
+#[inline]
+fn acceleration(pushed: Vec2, g: Vec2, m: f64, scale: f64) -> Vec2 {
+    (pushed + g * (m * scale)) / m
+}
+
+/// Whether every row's acceleration under gravity alone, `(+0 + g * (m * 1)) / m` as
+/// [`accelerated`] computes it, is `g` itself, bit for bit, with the world's layout, the
+/// count of rows and the `g` it was found for. Usually so (a product divided by the same
+/// mass gives the number back, and each mass is checked), and then the forces pass divides
+/// by no mass: a division a body bounded that pass at 10,000 bodies. A mass is set only
+/// when its row is made (`Rows::push`), which a new layout or another count of rows tells.
+#[derive(Clone, Debug, Default)]
+pub(super) struct GravityExact(Option<(u64, usize, [u64; 2], bool)>);
+
+impl GravityExact {
+    /// Whether it holds for `mass` (every row's) under `g` in a world of `layout`: kept,
+    /// or found again (a pass over the masses) when any of them changed.
+    fn holds(&mut self, layout: u64, mass: &[f64], g: Vec2) -> bool {
+        let at = (layout, mass.len(), [g.x.to_bits(), g.y.to_bits()]);
+        match self.0 {
+            Some((l, n, bits, holds)) if (l, n, bits) == at => holds,
+            _ => {
+                let same = |a: Vec2| [a.x.to_bits(), a.y.to_bits()] == at.2;
+                let holds = mass
+                    .iter()
+                    .all(|&m| same(acceleration(Vec2::ZERO, g, m, 1.0)));
+                self.0 = Some((at.0, at.1, at.2, holds));
+                holds
+            }
+        }
+    }
+
+    /// The count of rows it was last found for, and whether it held.
+    #[cfg(test)]
+    pub(super) fn found(&self) -> Option<(usize, bool)> {
+        self.0.map(|(_, n, _, holds)| (n, holds))
+    }
 }
 
 /// What [`World::accelerate`] reads and writes over one run of rows.
@@ -336,9 +387,18 @@ struct RunColumns<'a> {
 impl RunColumns<'_> {
     /// The pass, naming each changed body when `NAME`; when `PLAIN` (no force, every
     /// gravity scale 1), neither column is read: a force of ±0 plus the zero thrust is +0,
-    /// and a scale of 1 multiplies exactly, so the bits are the same.
+    /// and a scale of 1 multiplies exactly, so the bits are the same. When `EXACT` too,
+    /// every body's acceleration is `g` itself ([`GravityExact`]), and no mass divides: the
+    /// pass is `v + g * dt`, the same bits. Returns the dynamic bodies' kinetic energy at
+    /// their new velocities: [`World::kinetic_energy`]'s terms, summed in its order from
+    /// its start.
     #[inline(always)]
-    fn accelerate<const NAME: bool, const PLAIN: bool>(self, dt: f64, g: Vec2) {
+    fn accelerate<const NAME: bool, const PLAIN: bool, const EXACT: bool>(
+        self,
+        dt: f64,
+        g: Vec2,
+    ) -> f64 {
+        debug_assert!(PLAIN || !EXACT, "exact under gravity alone");
         let RunColumns {
             kind,
             entity,
@@ -349,6 +409,8 @@ impl RunColumns<'_> {
             disturbed,
             len,
         } = self;
+        // `Iterator::sum`'s start, whatever its zero's sign.
+        let mut sum: f64 = std::iter::empty::<f64>().sum();
         for k in 0..velocity.len() {
             if kind[k] != BodyKind::Dynamic {
                 continue;
@@ -361,12 +423,18 @@ impl RunColumns<'_> {
             } else {
                 (force[k] + Vec2::ZERO, scale[k])
             };
-            let changed = accelerated(v, pushed, g, mass[k], s, dt);
+            let changed = if EXACT {
+                v + g * dt
+            } else {
+                accelerated(v, pushed, g, mass[k], s, dt)
+            };
             if NAME && differs(changed, v) {
                 disturbed.name(entity[k], len);
             }
             velocity[k] = changed;
+            sum += super::measures::energy(mass[k], changed);
         }
+        sum
     }
 }
 

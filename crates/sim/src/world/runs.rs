@@ -241,13 +241,44 @@ mod tests {
     #[test]
     fn the_passes_over_a_run_give_the_bits_of_the_passes_body_by_body() {
         // Without a force or a gravity scale (forces of -0.0 count as none), the run's
-        // `forces` pass reads neither column; with some, it reads both.
-        for pushed in [false, true] {
-            passes_over_a_run(pushed);
+        // `forces` pass reads neither column; with some, it reads both. With masses that
+        // are powers of two, gravity alone accelerates every body by `g` itself, and the
+        // run's pass divides by no mass (`motion.rs`, `GravityExact`); with the varied
+        // masses, six do not give `g` back, and it divides.
+        for (pushed, exact) in [(false, false), (true, false), (false, true)] {
+            passes_over_a_run(pushed, exact);
         }
     }
 
-    fn passes_over_a_run(pushed: bool) {
+    /// Whether gravity alone is exact is found again when a body comes (a mass that does
+    /// not give `g` back: 1 + 17 × 0.37) and when `g` changes, and kept otherwise.
+    #[test]
+    fn gravity_alone_exact_is_found_again_when_a_mass_or_g_changes() {
+        let mut w = World::new();
+        for k in 0..4 {
+            w.spawn(&BodyDef {
+                mass: f64::from(1 << k),
+                ..varied(3 * k)
+            });
+        }
+        let (g, h) = (Vec2::new(0.0, -9.81), Vec2::new(0.0, -9.80665));
+        let step = |w: &mut World, g: Vec2| w.accelerate(1.0 / 60.0, g, |_, _, _| Vec2::ZERO);
+        step(&mut w, g);
+        assert_eq!(w.gravity_exact.found(), Some((4, true)));
+        let m = 1.0 + 17.0 * 0.37;
+        assert_ne!((g * m) / m, g);
+        assert_eq!((h * m) / m, h, "another g, that mass gives it back");
+        w.spawn(&BodyDef {
+            mass: m,
+            ..varied(0)
+        });
+        step(&mut w, g);
+        assert_eq!(w.gravity_exact.found(), Some((5, false)));
+        step(&mut w, h);
+        assert_eq!(w.gravity_exact.found(), Some((5, true)));
+    }
+
+    fn passes_over_a_run(pushed: bool, exact: bool) {
         let mut run = World::new();
         // Scenery first: its body has no row, so each mover's index is its row plus one.
         run.spawn(&BodyDef {
@@ -262,8 +293,16 @@ mod tests {
             if pushed && k % 11 == 5 {
                 (def.force, def.gravity_scale) = (Vec2::new(0.3, -0.2), 0.5);
             }
+            if exact {
+                def.mass = f64::from(1 << (k % 4));
+            }
             run.spawn(&def);
         }
+        let g = Vec2::new(0.0, -9.81);
+        let inexact = (run.rows.mass.iter())
+            .filter(|&&m| (Vec2::ZERO + g * (m * 1.0)) / m != g)
+            .count();
+        assert_eq!(inexact, if exact { 0 } else { 6 });
         assert_eq!((run.with_force > 0, run.rows.scaled > 0), (pushed, pushed));
         let mut plain = run.clone();
         assert!(run.row_run(run.movers()).is_some());
@@ -277,7 +316,13 @@ mod tests {
             let mut frames = Vec::new();
             for _ in 0..3 {
                 w.start_frame();
-                w.accelerate(dt, Vec2::new(0.0, -9.81), |_, _, _| Vec2::ZERO);
+                w.accelerate(dt, g, |_, _, _| Vec2::ZERO);
+                // The run's pass keeps the energy it summed, the same bits as summed again.
+                assert_eq!(w.kept_energy.is_some(), !body_by_body);
+                assert_eq!(
+                    w.step_kinetic_energy().to_bits(),
+                    w.kinetic_energy().to_bits()
+                );
                 w.integrate(dt, true, true, true);
                 let widen = (&sweeping[..], &separate_swept[..]);
                 let mut entries = Vec::new();
@@ -333,5 +378,10 @@ mod tests {
         }
         NO_RUNS.set(false);
         assert_eq!(seen[0], seen[1]);
+        // The run's pass found whether gravity alone is exact (only without a force or a
+        // scale); the body-by-body one never asks.
+        let found = |w: &World| w.gravity_exact.found();
+        let expect = (!pushed).then_some((150, exact));
+        assert_eq!((found(&run), found(&plain)), (expect, None));
     }
 }
