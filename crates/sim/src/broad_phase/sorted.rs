@@ -65,6 +65,39 @@ pub(super) fn gallop<T>(list: &[T], pred: impl Fn(&T) -> bool) -> usize {
     below + list[below..end].partition_point(pred)
 }
 
+/// `list.partition_point(|x| key(x) < t)` for each target `t` of `targets` (`list` sorted
+/// by `key`), the `N` searches in lockstep: the same halving steps for all, each a
+/// selection, not a branch. One search's steps each wait for the read before; the `N`
+/// reads of a step are independent, so their waits overlap. The answer to each is the one
+/// place where the keys stop being below it: the same as a search on its own.
+#[inline]
+pub(super) fn lower_bounds<T, const N: usize>(
+    list: &[T],
+    key: impl Fn(&T) -> u64,
+    targets: [u64; N],
+) -> [usize; N] {
+    let mut base = [0; N];
+    if list.is_empty() {
+        return base;
+    }
+    // Every item before `base[k]` is below `targets[k]`, the answer is within
+    // `base[k]..=base[k] + size`, and `base[k] + size <= list.len()`. Whether a key is
+    // below a target is a coin toss: each step is a selection the compiler is told is
+    // unpredictable (as a plain `if`, or as a product, it made a branch of it).
+    let mut size = list.len();
+    while size > 1 {
+        let half = size / 2;
+        for (b, &t) in base.iter_mut().zip(&targets) {
+            *b = std::hint::select_unpredictable(key(&list[*b + half]) < t, *b + half, *b);
+        }
+        size -= half;
+    }
+    for (b, &t) in base.iter_mut().zip(&targets) {
+        *b += usize::from(key(&list[*b]) < t);
+    }
+    base
+}
+
 /// Insertion sort of a nearly sorted list by `cmp` (a total order). Past `8n + 64` moves it
 /// gives up and sorts. Returns the moves.
 ///
@@ -106,7 +139,22 @@ pub(super) fn insertion_sort<T: Copy>(order: &mut [T], cmp: impl Fn(&T, &T) -> O
 mod tests {
     use proptest::prelude::*;
 
-    use super::{from_order_key, order_key};
+    use super::{from_order_key, lower_bounds, order_key};
+
+    proptest! {
+        /// The searches in lockstep give each target the place `partition_point` gives it,
+        /// in lists of every length (none, one, odd, even) with repeated keys, and for
+        /// targets before, among and past the keys.
+        #[test]
+        fn searches_in_lockstep_give_partition_points(
+            mut list in proptest::collection::vec(0u64..40, 0..70),
+            targets in proptest::array::uniform4(0u64..45),
+        ) {
+            list.sort_unstable();
+            let want = targets.map(|t| list.partition_point(|&x| x < t));
+            prop_assert_eq!(lower_bounds(&list, |&x| x, targets), want);
+        }
+    }
 
     proptest! {
         /// `from_order_key` undoes `order_key` to the bit, NaNs and signed zeros included.
