@@ -5,7 +5,8 @@
 //! bounding box of any shape at any pose ([`Bounds`]), the scenario/case-file description of a
 //! shape ([`ShapeDef`]) with its validation, and the narrow phase: a cheap boolean
 //! [`overlaps`] and a full [`contact()`] (signed depth, unit normal from `a` to `b`, a contact
-//! point) for every pairing, and rays against every shape ([`cast_ray`], [`contains_point`]).
+//! point) for every pairing, how far a shape reaches at any angle ([`Shape::reach`],
+//! [`beyond_reach`]), and rays against every shape ([`cast_ray`], [`contains_point`]).
 //!
 //! **Never:** does I/O (a case file is read from a reader its caller opened, through
 //! [`CaseReader`]), keeps state between calls, reads the clock, allocates in the narrow phase
@@ -55,6 +56,7 @@ mod math;
 mod number;
 mod placed;
 mod ray;
+mod reach;
 mod shape;
 mod toi;
 
@@ -74,6 +76,7 @@ pub use placed::{
     PlacedSegment, place, place_rotated, placed_bounds,
 };
 pub use ray::{Ray, RayIntersection, cast_placed, cast_ray, contains_placed, contains_point};
+pub use reach::beyond_reach;
 pub use shape::{
     Aabb, Capsule, Circle, Compound, MAX_CHAIN_POINTS, MAX_COMPOUND_PARTS, MAX_COORDINATE,
     MAX_POLYGON_VERTICES, MIN_SIZE, Obb, Polygon, Primitive, Segment, Shape, ShapeError, ShapeKind,

@@ -118,6 +118,9 @@ pub(crate) struct ShapeTable {
     /// Each id's [`shape_class`]: the narrow phase groups its pairs by it, reading a byte
     /// a body instead of the shape.
     classes: Vec<u8>,
+    /// Each id's [`Shape::reach`]: the narrow phase rules out a pair too far apart for it
+    /// without reading either shape.
+    reaches: Vec<f64>,
     /// How many bodies use each id.
     users: Vec<u32>,
     /// Ids no body uses, to reuse.
@@ -168,7 +171,7 @@ impl ShapeTable {
             }
         }
         let entry = value();
-        let class = shape_class(&entry.0);
+        let (class, reach) = (shape_class(&entry.0), entry.0.reach());
         let entry = Some(entry);
         let serial = next_serial();
         self.last_serial = serial;
@@ -177,6 +180,7 @@ impl ShapeTable {
                 self.entries[id as usize] = entry;
                 self.names[id as usize] = name;
                 self.classes[id as usize] = class;
+                self.reaches[id as usize] = reach;
                 self.users[id as usize] = 1;
                 self.serials[id as usize] = serial;
                 id
@@ -185,6 +189,7 @@ impl ShapeTable {
                 self.entries.push(entry);
                 self.names.push(name);
                 self.classes.push(class);
+                self.reaches.push(reach);
                 self.users.push(1);
                 self.serials.push(serial);
                 u32::try_from(self.entries.len() - 1).expect("fewer than 2^32 distinct shapes")
@@ -204,6 +209,12 @@ impl ShapeTable {
     #[inline]
     pub(crate) fn class(&self, id: u32) -> u8 {
         self.classes[id as usize]
+    }
+
+    /// The [`Shape::reach`] of an id.
+    #[inline]
+    pub(crate) fn reach(&self, id: u32) -> f64 {
+        self.reaches[id as usize]
     }
 
     /// One user of `id` fewer; the shape is dropped with its last user.
@@ -261,6 +272,7 @@ impl ShapeTable {
         self.entries.capacity() * size_of::<Option<(Shape, Bounds)>>()
             + self.names.capacity() * 4
             + self.classes.capacity()
+            + self.reaches.capacity() * size_of::<f64>()
             + self.users.capacity() * 4
             + self.free.capacity() * 4
             + self.serials.capacity() * 8

@@ -40,7 +40,7 @@
 //! ended its motion half the world's size or more outside it is wrapped in first
 //! (`wrap::bring_in`), so the images reach every contact whatever the speed.
 
-use ricochet_geom::{Contact, Pose, Vec2, contact, contact_deeper_than};
+use ricochet_geom::{Contact, Pose, Vec2, beyond_reach, contact, contact_deeper_than};
 
 use crate::broad_phase::{BodyEntry, BroadPhase, BroadPhaseKind, Interactions, STATIC_BIT};
 use crate::def::{BodyKind, Doomed, Layers, Response, WorldDef};
@@ -540,17 +540,18 @@ const AHEAD_IDS: usize = 16;
 const AHEAD_REST: usize = 2;
 
 /// The contact of bodies `i` and `j` with `j` at `pose_b`: always for a `separate` pair (its
-/// time of impact starts from it), otherwise `None` when it is no deeper than the threshold
-/// (`contact_deeper_than`: a pair whose bounds overlap but whose shapes are apart skips the
-/// exact algorithm's closest-point scan). A contact that comes back is `contact`'s, bit for
-/// bit.
+/// time of impact starts from it), else `None` when no deeper than the threshold: at once for
+/// bodies too far apart for their shapes to meet (`beyond_reach`: no shape read or placed),
+/// else by `contact_deeper_than`. A contact that comes back is `contact`'s, bit for bit.
 fn narrow(w: &World, (i, j): (usize, usize), response: Response, pose_b: &Pose) -> Option<Contact> {
-    let (a, b, pose_a) = (w.shape(i), w.shape(j), w.pose(i));
+    let pose_a = w.pose(i);
     if response == Response::Separate {
-        Some(contact(a, &pose_a, b, pose_b))
-    } else {
-        contact_deeper_than(a, &pose_a, b, pose_b, threshold(response))
+        return Some(contact(w.shape(i), &pose_a, w.shape(j), pose_b));
     }
+    if beyond_reach(pose_b.position - pose_a.position, w.reach(i) + w.reach(j)) {
+        return None;
+    }
+    contact_deeper_than(w.shape(i), &pose_a, w.shape(j), pose_b, threshold(response))
 }
 
 /// Records a contact and applies its response: a `destroy` adds to `doomed`, a `separate`
