@@ -237,11 +237,13 @@ impl ShapeTable {
         self.entries[id as usize].as_ref().expect("an id in use")
     }
 
-    /// Asks for the first cache line of `id`'s entry, without reading it (`prefetch.rs`).
+    /// Asks for the first cache line of `id`'s entry, and its reach, without reading them
+    /// (`prefetch.rs`).
     #[inline]
     pub(crate) fn prefetch(&self, id: u32) {
         if let Some(entry) = self.entries.get(id as usize) {
             crate::prefetch::line_of(entry);
+            crate::prefetch::line_of(&self.reaches[id as usize]);
         }
     }
 
