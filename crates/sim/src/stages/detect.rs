@@ -59,7 +59,7 @@ use crate::stages::sweep_normal;
 use crate::stages::swept_pairs::run_swept;
 use crate::stages::wrap::{self, Seam};
 use crate::stages::{SLOP, StageCtx};
-use crate::world::World;
+use crate::world::{MoverEntries, World};
 
 /// Whether there are two bodies and a layer pair that does not `ignore`.
 pub(crate) fn has_work(w: &World, def: &WorldDef) -> bool {
@@ -88,7 +88,7 @@ pub(crate) struct DetectState {
     /// The world index of each of `statics`.
     static_index: StaticIndex,
     statics: Vec<BodyEntry>,
-    movers: Vec<BodyEntry>,
+    movers: MoverEntries,
     pairs: Vec<(u32, u32)>,
     /// The wrap seam's images (a wrapping world only).
     seam: Seam,
@@ -125,7 +125,7 @@ impl DetectState {
             statics_version: 0,
             static_index: StaticIndex::default(),
             statics: Vec::new(),
-            movers: Vec::new(),
+            movers: MoverEntries::default(),
             pairs: Vec::new(),
             seam: Seam::new(kind),
             tests: vec![0; n * n],
@@ -266,7 +266,7 @@ fn candidate_pairs(ctx: &mut StageCtx, st: &mut DetectState) -> Vec<(u32, u32)> 
     };
     if let Some(b) = wrap
         && !not_made.is_empty()
-        && st.seam.reads_every_mover(&b, &st.movers)
+        && st.seam.reads_every_mover(&b, st.movers.list())
     {
         let widen = (&st.sweeping[..], &st.separate_swept[..]);
         w.some_mover_entries(widen, &mut st.movers, not_made, |_, _| false, None);
@@ -303,7 +303,7 @@ fn candidate_pairs(ctx: &mut StageCtx, st: &mut DetectState) -> Vec<(u32, u32)> 
             &b,
             w,
             (&st.statics, generation, static_index),
-            &st.movers,
+            st.movers.list(),
             &st.interactions,
             &mut pairs,
         );

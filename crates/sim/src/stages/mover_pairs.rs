@@ -11,7 +11,7 @@ use std::ops::Range;
 use ricochet_geom::Bounds;
 
 use crate::broad_phase::{BodyEntry, BroadPhase, BroadPhaseStats, Extent, Interactions};
-use crate::world::World;
+use crate::world::{MoverEntries, World};
 
 /// What the broad phase is given of the moving bodies.
 pub(crate) struct MoverCall<'a> {
@@ -23,7 +23,7 @@ pub(crate) struct MoverCall<'a> {
     pub(crate) statics: (&'a [BodyEntry], u64),
     pub(crate) interactions: &'a Interactions,
     /// The entries, made here.
-    pub(crate) movers: &'a mut Vec<BodyEntry>,
+    pub(crate) movers: &'a mut MoverEntries,
 }
 
 /// Makes the moving bodies' entries (each shown to `visit`, which says whether its entry
@@ -48,10 +48,11 @@ pub(crate) fn mover_pairs(
     let mut tally = bp.tally();
     if !w.count_movers(&mut tally) {
         let extent = every_entry(w, widen, movers, visit, measure);
-        tally.count(movers);
+        tally.count(movers.list());
         if let Some(extent) = extent {
             bp.give_extent(extent);
         }
+        let movers = movers.list();
         let stats = bp.pairs_counted_handles(statics, generation, movers, interactions, out);
         return (stats, 0..0);
     }
@@ -61,14 +62,15 @@ pub(crate) fn mover_pairs(
         if let Some(extent) = every_entry(w, widen, movers, visit, measure) {
             bp.give_extent(extent);
         }
+        let movers = movers.list();
         let stats = bp.pairs_counted_handles(statics, generation, movers, interactions, out);
         return (stats, 0..0);
     };
     let () = w.mover_entries(widen, movers, places.clone(), &mut visit);
     #[cfg(debug_assertions)]
     check_and_poison(w, bp, widen, movers, places.clone());
-    bp.begin_counted(movers, interactions);
-    let left_out = match bp.big_pass(big, movers, interactions) {
+    bp.begin_counted(movers.list(), interactions);
+    let left_out = match bp.big_pass(big, movers.list(), interactions) {
         Some(mut pass) => {
             w.some_mover_entries(widen, movers, places.clone(), visit, Some(&mut pass));
             let enough = pass.finish();
@@ -82,7 +84,7 @@ pub(crate) fn mover_pairs(
             false
         }
     };
-    let stats = bp.finish_counted(movers, interactions, out);
+    let stats = bp.finish_counted(movers.list(), interactions, out);
     (stats, if left_out { places } else { 0..0 })
 }
 
@@ -91,7 +93,7 @@ pub(crate) fn mover_pairs(
 fn every_entry(
     w: &mut World,
     widen: (&[bool], &[bool]),
-    movers: &mut Vec<BodyEntry>,
+    movers: &mut MoverEntries,
     visit: impl FnMut(usize, &Bounds) -> bool,
     measure: bool,
 ) -> Option<Extent> {
@@ -111,19 +113,16 @@ fn check_and_poison(
     w: &mut World,
     bp: &BroadPhase,
     widen: (&[bool], &[bool]),
-    movers: &mut [BodyEntry],
+    movers: &mut MoverEntries,
     places: Range<usize>,
 ) {
-    let mut every = Vec::new();
+    let mut every = MoverEntries::default();
     let () = w.mover_entries(widen, &mut every, 0..0, |_, _| false);
-    for k in (0..movers.len()).filter(|k| !places.contains(k)) {
-        assert_eq!(movers[k], every[k], "entry {k}");
+    let (list, every) = (movers.list(), every.list());
+    for k in (0..list.len()).filter(|k| !places.contains(k)) {
+        assert_eq!(list[k], every[k], "entry {k}");
     }
-    bp.check_counted(&every);
-    for e in &mut movers[places] {
-        e.bounds = Bounds {
-            min: ricochet_geom::Vec2::splat(f64::NAN),
-            max: ricochet_geom::Vec2::splat(f64::NAN),
-        };
-    }
+    bp.check_counted(every);
+    let nan = ricochet_geom::Vec2::splat(f64::NAN);
+    movers.set_bounds(places, Bounds { min: nan, max: nan });
 }

@@ -83,25 +83,23 @@ impl World {
     /// (`out` is sized to every mover first). Returns what `M` measures of the entries made,
     /// as they are made: their [`Extent`], from which the broad phase's strips choose their
     /// height (`BroadPhase::give_extent`) instead of reading every entry again, or nothing.
+    ///
+    /// Each entry's key, layer and kind are written only when the layout or a frozen bit
+    /// changed since they were (`MoverEntries`), every place's then; the passes that make
+    /// the entries write their bounds alone.
     pub(crate) fn mover_entries<M: Measure>(
         &mut self,
         (sweeping, separate_swept): (&[bool], &[bool]),
-        out: &mut Vec<BodyEntry>,
+        out: &mut MoverEntries,
         skip: Range<usize>,
         mut visit: impl FnMut(usize, &Bounds) -> bool,
     ) -> M {
-        // Written in place, by place: the vector keeps its length from call to call (only a
-        // change in the count of movers resizes it), so no length is stored a body.
-        let placeholder = BodyEntry {
-            key: 0,
-            bounds: Bounds {
-                min: Vec2::ZERO,
-                max: Vec2::ZERO,
-            },
-            layer: 0,
-            kind: BodyKind::Dynamic,
-        };
-        out.resize(self.movers.len(), placeholder);
+        let at = (self.layout, self.frozen_changes);
+        if out.made != Some(at) || out.list.len() != self.movers.len() {
+            self.entry_keys(&mut out.list);
+            out.made = Some(at);
+        }
+        let out = &mut out.list[..];
         let (before, after) = (0..skip.start, skip.end..out.len());
         let mut measured = M::default();
         for places in [before, after] {
@@ -120,12 +118,44 @@ impl World {
     pub(crate) fn some_mover_entries(
         &mut self,
         widen: (&[bool], &[bool]),
-        out: &mut [BodyEntry],
+        out: &mut MoverEntries,
         places: Range<usize>,
         mut visit: impl FnMut(usize, &Bounds) -> bool,
         pass: Option<&mut BigPass>,
     ) {
-        let () = self.entries_where(widen, out, places, &mut visit, pass);
+        debug_assert_eq!(
+            out.made,
+            Some((self.layout, self.frozen_changes)),
+            "after `mover_entries` in the same layout: every place's key made"
+        );
+        let () = self.entries_where(widen, &mut out.list, places, &mut visit, pass);
+    }
+
+    /// Every mover's key, layer and kind into its place in `out`, sized to the movers (a
+    /// frozen body handed over as kinematic); the bounds of a place new to `out` are
+    /// empty until made.
+    fn entry_keys(&self, out: &mut Vec<BodyEntry>) {
+        let placeholder = BodyEntry {
+            key: 0,
+            bounds: Bounds {
+                min: Vec2::ZERO,
+                max: Vec2::ZERO,
+            },
+            layer: 0,
+            kind: BodyKind::Dynamic,
+        };
+        out.resize(self.movers.len(), placeholder);
+        for (out, &i) in out.iter_mut().zip(&self.movers) {
+            let i = i as usize;
+            let frozen = self.rows.frozen[self.row[i] as usize];
+            out.key = self.key(i);
+            out.layer = self.layer[i];
+            out.kind = if frozen {
+                BodyKind::Kinematic
+            } else {
+                self.kind[i]
+            };
+        }
     }
 
     /// The entries of `places` ([`World::some_mover_entries`]).
@@ -157,12 +187,9 @@ impl World {
             position: &self.position[..n],
             angle: &self.angle[..n],
             layers: &self.layer[..n],
-            kinds: &self.kind[..n],
-            entity: &self.entity[..n],
             shape_id: &self.shape_id[..n],
             local_bounds: rows.local_bounds.rows(0, m),
             start_position: &rows.start_position[..m],
-            frozen: &rows.frozen[..m],
             shapes: &self.shapes,
             widen: &widen,
         };
@@ -308,7 +335,7 @@ fn fill<M: Measure>(
                 let near = visit(first + k, &bounds);
                 if keep.keep(first + k, &bounds) || near {
                     measured.add(&bounds);
-                    *out = columns.entry(i, r, bounds);
+                    out.bounds = bounds;
                 }
             }
         }
@@ -335,7 +362,7 @@ fn fill_run<M: Measure>(
         let near = visit(first + k, &bounds);
         if keep.keep(first + k, &bounds) || near {
             measured.add(&bounds);
-            *out = columns.entry(k, k, bounds);
+            out.bounds = bounds;
         }
     }
     measured
@@ -346,12 +373,9 @@ struct EntryColumns<'a> {
     position: &'a [Vec2],
     angle: &'a [f64],
     layers: &'a [u8],
-    kinds: &'a [BodyKind],
-    entity: &'a [Entity],
     shape_id: &'a [u32],
     local_bounds: LocalBoundsRows<'a>,
     start_position: &'a [Vec2],
-    frozen: &'a [bool],
     shapes: &'a ShapeTable,
     /// Per layer, [`SWEEPS`] and [`SEPARATE_SWEPT`].
     widen: &'a [u8; 256],
@@ -371,12 +395,9 @@ impl EntryColumns<'_> {
             position: &self.position[i..][..len],
             angle: &self.angle[i..][..len],
             layers: &self.layers[i..][..len],
-            kinds: &self.kinds[i..][..len],
-            entity: &self.entity[i..][..len],
             shape_id: &self.shape_id[i..][..len],
             local_bounds: self.local_bounds.rows(r, len),
             start_position: &self.start_position[r..][..len],
-            frozen: &self.frozen[r..][..len],
             shapes: self.shapes,
             widen: self.widen,
         }
@@ -409,21 +430,32 @@ impl EntryColumns<'_> {
         }
         bounds
     }
+}
 
-    /// The entry of body `i`, of row `r`, with its [`EntryColumns::bounds`].
-    #[inline(always)]
-    fn entry(&self, i: usize, r: usize, bounds: Bounds) -> BodyEntry {
-        let e = self.entity[i];
-        BodyEntry {
-            // As [`World::key`].
-            key: (u64::from(e.index) << 32) | u64::from(e.generation),
-            bounds,
-            layer: self.layers[i],
-            kind: if self.frozen[r] {
-                BodyKind::Kinematic
-            } else {
-                self.kinds[i]
-            },
+/// The moving bodies' entries ([`World::mover_entries`]), kept by the caller from call to
+/// call, with the world's layout and count of frozen-bit changes their keys, layers and
+/// kinds were written at. While those stay, the keys, layers and kinds do (the
+/// layout changes with every body added or removed and every restore, as
+/// [`World::count_movers`]' kept answer says), so only the bounds are written: 16 bytes of a
+/// body's 48 not read from four columns, and no key made, each frame.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct MoverEntries {
+    list: Vec<BodyEntry>,
+    made: Option<(u64, u64)>,
+}
+
+impl MoverEntries {
+    /// The entries, in [`World::movers`] order.
+    pub(crate) fn list(&self) -> &[BodyEntry] {
+        &self.list
+    }
+
+    /// Sets the bounds of the entries at `places` (a debug build's poison of the places not
+    /// made: their keys stay).
+    #[cfg(debug_assertions)]
+    pub(crate) fn set_bounds(&mut self, places: Range<usize>, bounds: Bounds) {
+        for e in &mut self.list[places] {
+            e.bounds = bounds;
         }
     }
 }

@@ -46,7 +46,7 @@ mod set;
 mod sleep;
 mod state;
 
-pub(crate) use bounds::placed;
+pub(crate) use bounds::{MoverEntries, placed};
 pub use disturbed::Disturbed;
 pub use rows::Motion;
 pub(crate) use state::{Bodies, PackedWorld};

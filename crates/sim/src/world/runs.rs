@@ -109,7 +109,7 @@ mod tests {
 
     use crate::broad_phase::Extent;
     use crate::def::{BodyDef, BodyKind};
-    use crate::world::World;
+    use crate::world::{MoverEntries, World};
 
     thread_local! {
         /// Every pass of this thread goes body by body, as if no list were a run: the
@@ -278,6 +278,40 @@ mod tests {
         assert_eq!(w.gravity_exact.found(), Some((5, true)));
     }
 
+    /// Entries kept from call to call write their keys, layers and kinds again when a
+    /// body is frozen or thawed, comes or goes: each call's are those made afresh.
+    #[test]
+    fn kept_entries_follow_frozen_bits_and_bodies_that_come_and_go() {
+        let mut w = World::new();
+        for k in 0..12 {
+            w.spawn(&varied(k));
+        }
+        let widen = (&[false; 3][..], &[false; 3][..]);
+        let mut kept = MoverEntries::default();
+        let check = |w: &mut World, kept: &mut MoverEntries| {
+            let mut fresh = MoverEntries::default();
+            let () = w.mover_entries(widen, &mut fresh, 0..0, |_, _| false);
+            let () = w.mover_entries(widen, kept, 0..0, |_, _| false);
+            assert_eq!(kept.list(), fresh.list());
+        };
+        check(&mut w, &mut kept);
+        let i = w.movers()[4] as usize;
+        w.set_frozen(i, true);
+        check(&mut w, &mut kept);
+        assert_eq!(
+            kept.list()[4].kind,
+            BodyKind::Kinematic,
+            "frozen, handed over"
+        );
+        w.set_frozen(i, false);
+        check(&mut w, &mut kept);
+        w.spawn(&varied(20));
+        check(&mut w, &mut kept);
+        w.despawn(3);
+        check(&mut w, &mut kept);
+        assert_eq!(kept.list().len(), 12);
+    }
+
     fn passes_over_a_run(pushed: bool, exact: bool) {
         let mut run = World::new();
         // Scenery first: its body has no row, so each mover's index is its row plus one.
@@ -314,6 +348,7 @@ mod tests {
             NO_RUNS.set(body_by_body);
             assert_eq!(w.row_run(w.movers()).is_none(), body_by_body);
             let mut frames = Vec::new();
+            let mut some = MoverEntries::default();
             for _ in 0..3 {
                 w.start_frame();
                 w.accelerate(dt, g, |_, _, _| Vec2::ZERO);
@@ -325,14 +360,16 @@ mod tests {
                 );
                 w.integrate(dt, true, true, true);
                 let widen = (&sweeping[..], &separate_swept[..]);
-                let mut entries = Vec::new();
+                let mut entries = MoverEntries::default();
                 let mut visited: Vec<(usize, Bounds)> = Vec::new();
                 let extent: Extent = w.mover_entries(widen, &mut entries, 0..0, |k, b| {
                     visited.push((k, *b));
                     false
                 });
-                // Some places made apart: the same entries, each visited once.
-                let (mut some, skipped) = (Vec::new(), 40..90);
+                let entries = entries.list().to_vec();
+                // Some places made apart, into entries kept from the frame before (their
+                // keys then not written again): the same entries, each visited once.
+                let skipped = 40..90;
                 let () = w.mover_entries(widen, &mut some, skipped.clone(), |k, _| {
                     assert!(!skipped.contains(&k));
                     true
@@ -347,7 +384,7 @@ mod tests {
                     },
                     None,
                 );
-                assert_eq!(some, entries);
+                assert_eq!(some.list(), entries);
                 // The extent measured as the entries were made is theirs: the tallest box
                 // and the largest finite coordinate, each value tested on its own.
                 let (mut height, mut max_abs) = (0.0f64, 0.0f64);
