@@ -8,6 +8,7 @@
 
 use crate::math::Vec2;
 use crate::shape::{Primitive, Shape};
+use crate::toi::Sweep;
 
 impl Shape {
     /// The largest distance from the body origin of any point of the shape, at any angle of
@@ -44,13 +45,39 @@ pub fn beyond_reach(d: Vec2, reach: f64) -> bool {
     d.dot(d) > r * r
 }
 
+/// Whether shapes `a` and `b`, moving on their sweeps (straight lines at fixed angles), keep
+/// their discs apart by more than `tol` for the whole step: the closest approach of their
+/// positions (`b`'s minus `a`'s, a point on a line, exactly the nearest point of a segment
+/// to the origin) beyond their reaches plus `tol`, with a margin far above the rounding of
+/// that approach and of the time of impact's poses (`1e-8` of the reaches, `1e-12` of the
+/// coordinates). Then the shapes never come within `tol` of touching.
+pub(crate) fn paths_beyond_reach(
+    (a, sweep_a): (&Shape, &Sweep),
+    (b, sweep_b): (&Shape, &Sweep),
+    tol: f64,
+) -> bool {
+    let d0 = sweep_b.start - sweep_a.start;
+    let v = (sweep_b.end - sweep_b.start) - (sweep_a.end - sweep_a.start);
+    let vv = v.dot(v);
+    let t = if vv > 0.0 {
+        (-d0.dot(v) / vv).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let reach = a.reach() + b.reach();
+    let size = |p: Vec2| p.x.abs() + p.y.abs();
+    let coordinates =
+        size(sweep_a.start) + size(sweep_a.end) + size(sweep_b.start) + size(sweep_b.end);
+    beyond_reach(d0 + v * t, reach + tol + 1e-8 * reach + 1e-12 * coordinates)
+}
+
 #[cfg(test)]
 mod tests {
     use proptest::prelude::*;
 
-    use crate::{Pose, Shape, Vec2, contact};
+    use crate::{Pose, Shape, Sweep, Vec2, contact};
 
-    use super::beyond_reach;
+    use super::{beyond_reach, paths_beyond_reach};
 
     /// A shape of every kind, off the body origin or not.
     fn shape() -> impl Strategy<Value = Shape> {
@@ -113,6 +140,76 @@ mod tests {
                 prop_assert!(c.depth < 0.0, "depth {} at {} apart", c.depth, d.length());
             }
         }
+    }
+
+    proptest! {
+        /// Two shapes whose discs stay apart over their whole sweeps (passing as near as
+        /// the margin allows, or further) are never found touching by the search itself, at
+        /// any angles, near the origin and at 1e6: what lets `time_of_impact` skip it.
+        #[test]
+        fn paths_beyond_reach_never_touch(
+            a in shape(),
+            b in shape(),
+            (ta, tb, dir, along) in (-10.0..10.0f64, -10.0..10.0f64, -4.0..4.0f64, -30.0..30.0f64),
+            (t, gap) in (0.0..1.0f64, prop_oneof![Just(0.0), 0.0..1e-6f64, 0.0..1.0f64]),
+            a_moves in (-20.0..20.0f64, -20.0..20.0f64),
+            origin in prop_oneof![Just(Vec2::ZERO), Just(Vec2::new(1e6, -3e5))],
+        ) {
+            // `b`'s path relative to `a`'s passes nearest at `t`, `reach (1 + 2e-8) + gap`
+            // away along `n`, moving along `n`'s perpendicular.
+            let n = Vec2::new(libm::cos(dir), libm::sin(dir));
+            let reach = a.reach() + b.reach();
+            let near = n * (reach * (1.0 + 2e-8) + 1e-9 + gap);
+            let rel = Vec2::new(-n.y, n.x) * along;
+            let a_moves = Vec2::new(a_moves.0, a_moves.1);
+            let sa = Sweep { start: origin, end: origin + a_moves, angle: ta };
+            let start_b = origin + near - rel * t;
+            let sb = Sweep { start: start_b, end: start_b + rel + a_moves, angle: tb };
+            let tol = 1e-9 * reach;
+            if paths_beyond_reach((&a, &sa), (&b, &sb), tol) {
+                prop_assert!(crate::toi::searched(&a, &sa, &b, &sb, tol).is_none());
+            }
+        }
+    }
+
+    /// A head-on path is never beyond reach; one that passes wide always is.
+    #[test]
+    fn paths_that_meet_are_not_beyond_reach() {
+        let c = Shape::circle(1.0).unwrap();
+        let at = |x: f64, y: f64, to: f64| Sweep {
+            start: Vec2::new(x, y),
+            end: Vec2::new(to, y),
+            angle: 0.0,
+        };
+        let still = at(0.0, 0.0, 0.0);
+        assert!(!paths_beyond_reach(
+            (&c, &still),
+            (&c, &at(10.0, 0.0, -10.0)),
+            0.0
+        ));
+        assert!(!paths_beyond_reach(
+            (&c, &still),
+            (&c, &at(10.0, 1.99, -10.0)),
+            0.0
+        ));
+        assert!(paths_beyond_reach(
+            (&c, &still),
+            (&c, &at(10.0, 2.01, -10.0)),
+            0.0
+        ));
+        // Stopping short of the other: the nearest point is the path's end.
+        assert!(paths_beyond_reach(
+            (&c, &still),
+            (&c, &at(10.0, 0.0, 2.01)),
+            0.0
+        ));
+        assert!(!paths_beyond_reach(
+            (&c, &still),
+            (&c, &at(10.0, 0.0, 1.99)),
+            0.0
+        ));
+        let nan = at(f64::NAN, 0.0, 0.0);
+        assert!(!paths_beyond_reach((&c, &still), (&c, &nan), 0.0));
     }
 
     /// The margin: discs that meet, or miss by less than it, are left to the narrow phase;

@@ -53,13 +53,30 @@ pub struct Impact {
 /// first touch, and is quick when heading straight in); if that crawls, as on a grazing
 /// path, a golden-section search finds the closest approach, and bisection the first
 /// moment before it within the tolerance.
+///
+/// Two shapes whose discs (`Shape::reach`) stay apart by more than the tolerance for the
+/// whole step never come within it: `None` at once, before any part is placed.
 #[must_use]
 pub fn time_of_impact(a: &Shape, sweep_a: &Sweep, b: &Shape, sweep_b: &Sweep) -> Option<Impact> {
+    let size = |s: &Shape, w: &Sweep| s.bounds(&Pose::new(w.end, w.angle)).half_extents().length();
+    let tol = TOI_TOLERANCE * size(a, sweep_a).min(size(b, sweep_b));
+    if crate::reach::paths_beyond_reach((a, sweep_a), (b, sweep_b), tol) {
+        return None;
+    }
+    searched(a, sweep_a, b, sweep_b, tol)
+}
+
+/// [`time_of_impact`] by the search alone, at tolerance `tol`.
+pub(crate) fn searched(
+    a: &Shape,
+    sweep_a: &Sweep,
+    b: &Shape,
+    sweep_b: &Sweep,
+    tol: f64,
+) -> Option<Impact> {
     let (sa, sb) = (sweep_a.start, sweep_b.start);
     let (da, db) = (sweep_a.end - sa, sweep_b.end - sb);
     let speed = (da - db).length();
-    let size = |s: &Shape, w: &Sweep| s.bounds(&Pose::new(w.end, w.angle)).half_extents().length();
-    let tol = TOI_TOLERANCE * size(a, sweep_a).min(size(b, sweep_b));
     let poses = |t: f64| {
         (
             Pose::new(sa + da * t, sweep_a.angle),
