@@ -31,6 +31,12 @@ impl World {
         }
     }
 
+    /// How far body `i`'s shape reaches from its position at any angle
+    /// ([`ricochet_geom::Shape::reach`], kept in the shape table): the disc around it.
+    pub(crate) fn reach(&self, i: usize) -> f64 {
+        self.shapes.reach(self.shape_id[i])
+    }
+
     /// [`World::bounds`] of scenery `i`, which never turns: its bounds at its angle,
     /// translated.
     fn scenery_bounds(&self, i: usize) -> Bounds {

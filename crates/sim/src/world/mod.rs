@@ -203,11 +203,6 @@ impl World {
         &self.shapes.get(self.shape_id[i]).0
     }
 
-    /// How far body `i`'s shape reaches from its position ([`Shape::reach`]), kept.
-    pub(crate) fn reach(&self, i: usize) -> f64 {
-        self.shapes.reach(self.shape_id[i])
-    }
-
     /// Asks for body `i`'s columns the narrow phase reads, without reading them (a hint:
     /// `prefetch.rs`): its shape id, position and angle.
     #[inline]
